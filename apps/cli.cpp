@@ -1,0 +1,130 @@
+#include "apps/cli.h"
+
+#include <charconv>
+#include <chrono>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "apps/progress_bar.h"
+#include "datasets_synthetic/object_scene.h"
+#include "sfm/file_util.h"
+#include "sfm/inspect.h"
+
+namespace texlume::apps {
+
+Arguments::Arguments(const std::vector<std::string>& args, const std::set<std::string>& with_value,
+                     const std::set<std::string>& flags) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a.rfind("--", 0) != 0) throw UsageError("unexpected argument '" + a + "'");
+    std::string name = a.substr(2);
+    std::optional<std::string> inline_value;
+    if (const auto eq = name.find('='); eq != std::string::npos) {
+      inline_value = name.substr(eq + 1);
+      name = name.substr(0, eq);
+    }
+    if (flags.count(name)) {
+      if (inline_value) throw UsageError("--" + name + " takes no value");
+      values_[name] = "";
+    } else if (with_value.count(name)) {
+      if (inline_value) {
+        values_[name] = *inline_value;
+      } else {
+        if (i + 1 >= args.size()) throw UsageError("--" + name + " needs a value");
+        values_[name] = args[++i];
+      }
+    } else {
+      throw UsageError("unknown option --" + name);
+    }
+  }
+}
+
+std::optional<std::string> Arguments::Get(const std::string& name) const {
+  const auto it = values_.find(name);
+  return it == values_.end() ? std::nullopt : std::optional<std::string>(it->second);
+}
+
+std::string Arguments::Require(const std::string& name) const {
+  const auto v = Get(name);
+  if (!v || v->empty()) throw UsageError("--" + name + " is required");
+  return *v;
+}
+
+bool Arguments::Has(const std::string& name) const { return values_.count(name) > 0; }
+
+int Arguments::GetInt(const std::string& name, int fallback) const {
+  const auto v = Get(name);
+  if (!v) return fallback;
+  int value = 0;
+  const auto [ptr, ec] = std::from_chars(v->data(), v->data() + v->size(), value);
+  if (ec != std::errc() || ptr != v->data() + v->size()) {
+    throw UsageError("--" + name + " expects an integer, got '" + *v + "'");
+  }
+  return value;
+}
+
+int RunInspectCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  const Arguments a(args, {"model", "mesh", "images", "lights", "json", "max-buffer-size"}, {});
+  sfm::InspectOptions options;
+  options.model_dir = a.Require("model");
+  if (auto v = a.Get("mesh")) options.mesh = *v;
+  if (auto v = a.Get("images")) options.images_dir = *v;
+  if (auto v = a.Get("lights")) options.lights = *v;
+  options.visibility.max_buffer_dimension = a.GetInt("max-buffer-size", 0);
+  ProgressBar bar;
+  const sfm::InspectReport report = sfm::RunInspect(options, bar.Callback());
+  out << sfm::FormatInspectReport(report);
+  if (auto path = a.Get("json")) {
+    const std::string json = sfm::InspectReportToJson(report);
+    WriteFileAtomically(*path, [&](std::ostream& o) { o << json << "\n"; }, false);
+  }
+  if (report.missing_images && !report.missing_images->empty()) {
+    err << "error: " << options.images_dir->string() << ": " << report.missing_images->size()
+        << " image(s) named in the model are missing, first: '" << report.missing_images->front()
+        << "'\n";
+    return kExitInputError;
+  }
+  return kExitOk;
+}
+
+int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& /*err*/) {
+  const Arguments a(args, {"out", "images", "seed"}, {});
+  const std::filesystem::path dir = a.Get("out").value_or("texlume_demo");
+  datasets::ObjectSceneOptions scene_options;
+  scene_options.num_images = a.GetInt("images", scene_options.num_images);
+  scene_options.seed = static_cast<std::uint32_t>(a.GetInt("seed", 1));
+  scene_options.Check();
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const datasets::ObjectScene scene = datasets::MakeObjectScene(scene_options);
+  datasets::WriteObjectScene(scene, dir);
+  const auto t1 = std::chrono::steady_clock::now();
+  out << "Synthetic scene written to " << dir.string() << " (sparse/, sparse_txt/, mesh.ply, "
+      << "lights.json)\n\n";
+
+  sfm::InspectOptions options;
+  options.model_dir = dir / "sparse";
+  options.mesh = dir / "mesh.ply";
+  options.lights = dir / "lights.json";
+  ProgressBar bar;
+  const sfm::InspectReport report = sfm::RunInspect(options, bar.Callback());
+  const auto t2 = std::chrono::steady_clock::now();
+  out << "texlume inspect --model " << options.model_dir.string() << " --mesh "
+      << options.mesh->string() << " --lights " << options.lights->string() << "\n";
+  out << sfm::FormatInspectReport(report);
+
+  nlohmann::json run;
+  run["command"] = "demo";
+  run["settings"] = {{"shape", "sphere"},
+                     {"resolution", scene_options.resolution},
+                     {"num_images", scene_options.num_images},
+                     {"image_size", {scene_options.image_width, scene_options.image_height}},
+                     {"seed", scene_options.seed}};
+  run["timings_s"] = {{"scene", std::chrono::duration<double>(t1 - t0).count()},
+                      {"inspect", std::chrono::duration<double>(t2 - t1).count()}};
+  run["inspect"] = nlohmann::json::parse(sfm::InspectReportToJson(report));
+  WriteFileAtomically(dir / "run.json", [&](std::ostream& o) { o << run.dump(2) << "\n"; }, false);
+  return kExitOk;
+}
+
+}  // namespace texlume::apps

@@ -1,0 +1,48 @@
+#pragma once
+
+#include <map>
+#include <optional>
+#include <ostream>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace texlume::apps {
+
+/// A command line that does not fit the subcommand: exit code 2 and the usage text.
+class UsageError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// `--name value` and `--flag` arguments of one subcommand, checked against the
+/// names it accepts.
+class Arguments {
+ public:
+  /// @param args  arguments after the subcommand name
+  /// @param with_value  option names that take a value
+  /// @param flags  option names without a value
+  Arguments(const std::vector<std::string>& args, const std::set<std::string>& with_value,
+            const std::set<std::string>& flags);
+
+  std::optional<std::string> Get(const std::string& name) const;
+  std::string Require(const std::string& name) const;
+  bool Has(const std::string& name) const;
+  int GetInt(const std::string& name, int fallback) const;
+
+ private:
+  std::map<std::string, std::string> values_;
+};
+
+/// Exit codes of the texlume program.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitInputError = 1;  ///< bad or missing input files, problems found
+inline constexpr int kExitUsage = 2;       ///< bad command line
+
+/// `texlume inspect`: see docs/cli.md. Returns the exit code.
+int RunInspectCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// `texlume demo`: builds a synthetic scene and inspects it. Returns the exit code.
+int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+}  // namespace texlume::apps

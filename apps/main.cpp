@@ -1,0 +1,64 @@
+// texlume: one program, one subcommand per pipeline step. Each subcommand is a
+// thin wrapper over a tested Run...Command function (apps/cli.h).
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "apps/cli.h"
+#include "sfm/errors.h"
+
+namespace {
+
+constexpr const char* kUsage =
+    "texlume: relightable PTM models from photos and a material sample\n"
+    "\n"
+    "Usage: texlume <command> [options]\n"
+    "\n"
+    "Commands:\n"
+    "  inspect --model DIR [--mesh FILE] [--images DIR] [--lights FILE] [--json FILE]\n"
+    "          [--max-buffer-size N]\n"
+    "      Summarise a COLMAP model (.bin or .txt), check a mesh, lights and image\n"
+    "      files, and report which triangles the photos see fully.\n"
+    "  demo [--out DIR] [--images N] [--seed S]\n"
+    "      Generate a small synthetic scene and inspect it.\n"
+    "  help, --help\n"
+    "  version, --version\n"
+    "\n"
+    "Exit codes: 0 success, 1 bad input (the message names the file), 2 bad command line.\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace texlume::apps;
+  if (argc < 2) {
+    std::cerr << kUsage;
+    return kExitUsage;
+  }
+  const std::string command = argv[1];
+  const std::vector<std::string> args(argv + 2, argv + argc);
+  try {
+    if (command == "help" || command == "--help" || command == "-h") {
+      std::cout << kUsage;
+      return kExitOk;
+    }
+    if (command == "version" || command == "--version") {
+      std::cout << "texlume 0.1.0\n";
+      return kExitOk;
+    }
+    if (command == "inspect") return RunInspectCommand(args, std::cout, std::cerr);
+    if (command == "demo") return RunDemoCommand(args, std::cout, std::cerr);
+    throw UsageError("unknown command '" + command + "'");
+  } catch (const UsageError& e) {
+    std::cerr << "texlume " << command << ": " << e.what() << "\n\n" << kUsage;
+    return kExitUsage;
+  } catch (const texlume::OptionError& e) {
+    std::cerr << "texlume " << command << ": invalid option: " << e.what() << "\n";
+    return kExitUsage;
+  } catch (const texlume::InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitInputError;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitInputError;
+  }
+}

@@ -1,0 +1,70 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+
+#include "sfm/camera_models.h"
+#include "sfm/lights.h"
+#include "sfm/mesh.h"
+#include "sfm/reconstruction.h"
+
+namespace texlume::datasets {
+
+/// Shapes of the synthetic objects (world frame: Z up, object centred at the origin).
+enum class SceneShape {
+  kSphere,    ///< icosphere of radius 1
+  kCylinder,  ///< capped cylinder of radius 0.6 and height 1.6 (a column)
+  kPlane,     ///< 2 x 2 grid in the z = 0 plane, facing +Z
+};
+
+/// Settings of MakeObjectScene. Defaults give a small scene in well under a second.
+struct ObjectSceneOptions {
+  SceneShape shape = SceneShape::kSphere;
+  /// Mesh resolution: icosphere subdivision level (sphere), or segments / 8
+  /// around and along (cylinder, plane). Range [0, 7].
+  int resolution = 3;
+  /// Number of photos, placed on two rings around the object. Range [1, 1000].
+  int num_images = 16;
+  int image_width = 640;    ///< pixels, [16, 16384]
+  int image_height = 480;   ///< pixels, [16, 16384]
+  double focal_px = 600.0;  ///< pixels, > 0
+  /// Distance of the cameras from the origin, world units (> 1.5: outside the object).
+  double camera_distance = 3.5;
+  /// PINHOLE, or OPENCV with a mild barrel distortion.
+  sfm::CameraModelId camera_model = sfm::CameraModelId::kPinhole;
+  /// Sparse points sampled on the surface and observed in the photos that see them.
+  int num_points = 1500;
+  /// Standard deviation of the noise added to the 2D observations, pixels, >= 0.
+  double observation_noise_px = 0.3;
+  std::uint32_t seed = 1;
+
+  void Check() const;
+};
+
+/// A synthetic object: its coarse mesh, a COLMAP model of its photos (cameras,
+/// poses, sparse points with tracks) and one directional light per photo.
+struct ObjectScene {
+  sfm::TriangleMesh mesh;
+  sfm::Reconstruction reconstruction;
+  sfm::ObjectLights lights;
+};
+
+/// Builds the scene deterministically from the options (same seed, same scene).
+ObjectScene MakeObjectScene(const ObjectSceneOptions& options);
+
+/// Writes `dir/sparse` (COLMAP .bin), `dir/sparse_txt` (COLMAP .txt), `dir/mesh.ply`
+/// and `dir/lights.json`.
+void WriteObjectScene(const ObjectScene& scene, const std::filesystem::path& dir);
+
+/// Mesh generators (outward normals), also used by tests.
+sfm::TriangleMesh MakeIcosphere(int subdivisions, double radius);
+sfm::TriangleMesh MakeCylinder(int segments_around, int segments_along, double radius,
+                               double height);
+sfm::TriangleMesh MakeGridPlane(int segments, double size);
+
+/// The cam_from_world pose of a camera at `center_in_world` looking at
+/// `target_in_world` with world +Z up in the image (camera +Y down).
+sfm::Rigid3d LookAt(const Eigen::Vector3d& center_in_world, const Eigen::Vector3d& target_in_world,
+                    const Eigen::Vector3d& up_in_world = Eigen::Vector3d::UnitZ());
+
+}  // namespace texlume::datasets

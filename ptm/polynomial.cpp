@@ -1,0 +1,1 @@
+#include "ptm/polynomial.h"

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include "sfm/mesh.h"
+
+namespace texlume::synth {
+
+/// The local frame of a triangle (paper 003 §3.0.2): origin at the centroid,
+/// X along v0->v1 (or a given tangent), Z the face normal, Y = Z x X. All axes are
+/// unit vectors in the world frame.
+struct TriangleFrame {
+  Eigen::Vector3d origin_in_world = Eigen::Vector3d::Zero();
+  Eigen::Vector3d x_axis = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d y_axis = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d z_axis = Eigen::Vector3d::UnitZ();
+
+  /// A world-frame direction expressed in this frame.
+  Eigen::Vector3d DirectionInFrame(const Eigen::Vector3d& direction_in_world) const {
+    return {x_axis.dot(direction_in_world), y_axis.dot(direction_in_world),
+            z_axis.dot(direction_in_world)};
+  }
+  /// A world point expressed in this frame.
+  Eigen::Vector3d PointInFrame(const Eigen::Vector3d& point_in_world) const {
+    return DirectionInFrame(point_in_world - origin_in_world);
+  }
+};
+
+/// The frame of face `face` with X along v0->v1. Precondition: non-degenerate face.
+TriangleFrame MakeTriangleFrame(const sfm::TriangleMesh& mesh, std::size_t face);
+
+/// The frame of face `face` with X along `tangent_in_world` projected onto the
+/// face plane (for a smooth tangent field). Falls back to v0->v1 when the tangent
+/// is (nearly) parallel to the normal.
+TriangleFrame MakeTriangleFrame(const sfm::TriangleMesh& mesh, std::size_t face,
+                                const Eigen::Vector3d& tangent_in_world);
+
+}  // namespace texlume::synth
