@@ -11,6 +11,8 @@
 namespace texlume::sfm {
 
 InspectReport RunInspect(const InspectOptions& options, const ProgressCallback& progress) {
+  options.mesh_clean.Check();
+  options.visibility.Check();
   InspectReport report;
   LoadedModel model = ReadModel(options.model_dir);
   const Reconstruction& r = model.reconstruction;

@@ -18,7 +18,8 @@ Eigen::Vector3d NormalisedDirection(const Eigen::Vector3d& d, const std::string&
   if (!(n > 1e-9) || !std::isfinite(n)) {
     throw InputError(label, what + " is zero or not finite", line);
   }
-  return d / n;
+  // Unit vectors as written are kept bit-exact; others are normalised.
+  return std::abs(n - 1.0) < 1e-12 ? d : Eigen::Vector3d(d / n);
 }
 
 Eigen::Vector3d JsonVector3(const nlohmann::json& j, const std::string& label,
