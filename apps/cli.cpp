@@ -76,7 +76,8 @@ int RunInspectCommand(const std::vector<std::string>& args, std::ostream& out, s
   out << sfm::FormatInspectReport(report);
   if (auto path = a.Get("json")) {
     const std::string json = sfm::InspectReportToJson(report);
-    WriteFileAtomically(*path, [&](std::ostream& o) { o << json << "\n"; }, false);
+    WriteFileAtomically(
+        *path, [&](std::ostream& o) { o << json << "\n"; }, false);
   }
   if (report.missing_images && !report.missing_images->empty()) {
     err << "error: " << options.images_dir->string() << ": " << report.missing_images->size()
@@ -123,7 +124,8 @@ int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std:
   run["timings_s"] = {{"scene", std::chrono::duration<double>(t1 - t0).count()},
                       {"inspect", std::chrono::duration<double>(t2 - t1).count()}};
   run["inspect"] = nlohmann::json::parse(sfm::InspectReportToJson(report));
-  WriteFileAtomically(dir / "run.json", [&](std::ostream& o) { o << run.dump(2) << "\n"; }, false);
+  WriteFileAtomically(
+      dir / "run.json", [&](std::ostream& o) { o << run.dump(2) << "\n"; }, false);
   return kExitOk;
 }
 

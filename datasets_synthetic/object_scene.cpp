@@ -34,12 +34,11 @@ void ObjectSceneOptions::Check() const {
 sfm::TriangleMesh MakeIcosphere(int subdivisions, double radius) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   sfm::TriangleMesh mesh;
-  mesh.vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                   {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  mesh.faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  mesh.vertices = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                   {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  mesh.faces = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (auto& v : mesh.vertices) v.normalize();
   for (int level = 0; level < subdivisions; ++level) {
     std::map<std::pair<int, int>, int> midpoint;
@@ -138,8 +137,8 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
       scene.mesh = MakeIcosphere(options.resolution, 1.0);
       break;
     case SceneShape::kCylinder:
-      scene.mesh = MakeCylinder(8 * std::max(1, options.resolution), 4 * std::max(1, options.resolution),
-                                0.6, 1.6);
+      scene.mesh = MakeCylinder(8 * std::max(1, options.resolution),
+                                4 * std::max(1, options.resolution), 0.6, 1.6);
       break;
     case SceneShape::kPlane:
       scene.mesh = MakeGridPlane(8 * std::max(1, options.resolution), 2.0);
@@ -166,8 +165,8 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   for (int i = 0; i < options.num_images; ++i) {
     const double azimuth = 2 * kPi * i / options.num_images;
-    const double elevation = (options.shape == SceneShape::kPlane ? 55.0 : (i % 2 ? 10.0 : 35.0)) *
-                             kPi / 180.0;
+    const double elevation =
+        (options.shape == SceneShape::kPlane ? 55.0 : (i % 2 ? 10.0 : 35.0)) * kPi / 180.0;
     const Eigen::Vector3d center =
         options.camera_distance * Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
                                                   std::cos(elevation) * std::sin(azimuth),
@@ -207,7 +206,8 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
       }
       sfm::Point3D point;
       point.point3d_id = sfm::Point3DId(static_cast<std::uint64_t>(p + 1));
-      point.xyz = scene.mesh.Corner(f, 0) + a * (scene.mesh.Corner(f, 1) - scene.mesh.Corner(f, 0)) +
+      point.xyz = scene.mesh.Corner(f, 0) +
+                  a * (scene.mesh.Corner(f, 1) - scene.mesh.Corner(f, 0)) +
                   b * (scene.mesh.Corner(f, 2) - scene.mesh.Corner(f, 0));
       point.rgb = {static_cast<std::uint8_t>(100 + p % 100), 120, 140};
       double error_sum = 0.0;
@@ -222,7 +222,8 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
       }
       if (point.track.size() < 2) {
         // COLMAP keeps only points seen twice or more: drop this one again.
-        for (const auto& e : point.track) scene.reconstruction.images.at(e.image_id).points2d.back().point3d_id = sfm::Point3DId();
+        for (const auto& e : point.track)
+          scene.reconstruction.images.at(e.image_id).points2d.back().point3d_id = sfm::Point3DId();
         continue;
       }
       point.error = error_sum / static_cast<double>(point.track.size());

@@ -27,8 +27,7 @@ constexpr std::array<ModelInfo, kNumCameraModels> kModels = {{
     {"FOV", 5, "fx, fy, cx, cy, omega", false, false},
     {"SIMPLE_RADIAL_FISHEYE", 4, "f, cx, cy, k", true, true},
     {"RADIAL_FISHEYE", 5, "f, cx, cy, k1, k2", true, true},
-    {"THIN_PRISM_FISHEYE", 12, "fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, sx1, sy1", false,
-     true},
+    {"THIN_PRISM_FISHEYE", 12, "fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, sx1, sy1", false, true},
 }};
 
 const ModelInfo& Info(CameraModelId model) {
@@ -160,8 +159,8 @@ Eigen::Vector2d DistortNormalized(CameraModelId model, std::span<const double> p
     case CameraModelId::kFullOpenCV: {
       // k1 k2 p1 p2 k3 k4 k5 k6: rational radial model plus tangential.
       const double r4 = r2 * r2, r6 = r4 * r2;
-      const double radial = (1.0 + k[0] * r2 + k[1] * r4 + k[4] * r6) /
-                            (1.0 + k[5] * r2 + k[6] * r4 + k[7] * r6);
+      const double radial =
+          (1.0 + k[0] * r2 + k[1] * r4 + k[4] * r6) / (1.0 + k[5] * r2 + k[6] * r4 + k[7] * r6);
       return {x * radial + 2.0 * k[2] * x * y + k[3] * (r2 + 2.0 * x * x),
               y * radial + 2.0 * k[3] * x * y + k[2] * (r2 + 2.0 * y * y)};
     }
@@ -199,13 +198,11 @@ Eigen::Vector3d Camera::CamRayFromImage(const Eigen::Vector2d& pixel) const {
     // Invert the distortion on the angle plane, then the equidistant map.
     const double* k = params.data() + ExtraOffset(model);
     const Eigen::Vector2d a = SolveNewton(
-        [&](const Eigen::Vector2d& p) { return FisheyeDistortAnglePlane(model, k, p); },
-        distorted);
+        [&](const Eigen::Vector2d& p) { return FisheyeDistortAnglePlane(model, k, p); }, distorted);
     const double theta = a.norm();
     if (theta < 1e-15) return Eigen::Vector3d(a.x(), a.y(), 1.0).normalized();
     const Eigen::Vector2d dir = a / theta;
-    return Eigen::Vector3d(std::sin(theta) * dir.x(), std::sin(theta) * dir.y(),
-                           std::cos(theta));
+    return Eigen::Vector3d(std::sin(theta) * dir.x(), std::sin(theta) * dir.y(), std::cos(theta));
   }
   const Eigen::Vector2d u = SolveNewton(
       [&](const Eigen::Vector2d& p) { return DistortNormalized(model, params, p); }, distorted);

@@ -107,9 +107,9 @@ std::map<CameraId, Camera> ReadCamerasText(std::istream& in, const std::string& 
     if (!model) {
       throw InputError(label, "unknown camera model '" + std::string(tokens[1]) + "'", ln);
     }
-    Camera camera = MakeCamera(id, static_cast<int>(*model),
-                               ParseUnsigned(tokens[2], "WIDTH", label, ln),
-                               ParseUnsigned(tokens[3], "HEIGHT", label, ln), label, ln);
+    Camera camera =
+        MakeCamera(id, static_cast<int>(*model), ParseUnsigned(tokens[2], "WIDTH", label, ln),
+                   ParseUnsigned(tokens[3], "HEIGHT", label, ln), label, ln);
     const std::size_t expected = static_cast<std::size_t>(CameraModelNumParams(*model));
     if (tokens.size() - 4 != expected) {
       throw InputError(label,
@@ -155,8 +155,8 @@ std::map<ImageId, Image> ReadImagesText(std::istream& in, const std::string& lab
     // The name is the rest of the line (COLMAP writes it verbatim).
     const std::size_t name_start = static_cast<std::size_t>(tokens[9].data() - reader.line.data());
     image.name = reader.line.substr(name_start);
-    while (!image.name.empty() && (image.name.back() == '\r' || image.name.back() == ' ' ||
-                                   image.name.back() == '\t')) {
+    while (!image.name.empty() &&
+           (image.name.back() == '\r' || image.name.back() == ' ' || image.name.back() == '\t')) {
       image.name.pop_back();
     }
     // The next line holds the 2D points, possibly none (an empty line).
@@ -274,8 +274,8 @@ std::map<ImageId, Image> ReadImagesBinary(std::istream& in, const std::string& l
     image.image_id = ImageId(id);
     double q[4];
     for (double& v : q) v = reader.ReadF64();
-    image.cam_from_world.rotation =
-        QuaternionFromWxyz(q[0], q[1], q[2], q[3], label + " (image " + std::to_string(id) + ")", 0);
+    image.cam_from_world.rotation = QuaternionFromWxyz(
+        q[0], q[1], q[2], q[3], label + " (image " + std::to_string(id) + ")", 0);
     for (int k = 0; k < 3; ++k) image.cam_from_world.translation[k] = reader.ReadF64();
     if (!image.cam_from_world.translation.allFinite()) {
       throw InputError(label, "image " + std::to_string(id) + " has a non-finite translation");
@@ -283,8 +283,7 @@ std::map<ImageId, Image> ReadImagesBinary(std::istream& in, const std::string& l
     image.camera_id = CameraId(reader.ReadU32());
     image.name = reader.ReadNulTerminatedString("the name of image " + std::to_string(id));
     const std::uint64_t num_points2d = reader.ReadU64();
-    reader.CheckCount(num_points2d, kPoint2DBytes,
-                      "2D point (image " + std::to_string(id) + ")");
+    reader.CheckCount(num_points2d, kPoint2DBytes, "2D point (image " + std::to_string(id) + ")");
     image.points2d.resize(num_points2d);
     for (Point2D& p : image.points2d) {
       p.xy.x() = reader.ReadF64();
@@ -354,9 +353,9 @@ void WriteImagesText(const Reconstruction& reconstruction, std::ostream& out) {
   for (const auto& [id, image] : reconstruction.images) {
     const Eigen::Quaterniond& q = image.cam_from_world.rotation;
     const Eigen::Vector3d& t = image.cam_from_world.translation;
-    out << id.value << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " "
-        << t.x() << " " << t.y() << " " << t.z() << " " << image.camera_id.value << " "
-        << image.name << "\n";
+    out << id.value << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " " << t.x()
+        << " " << t.y() << " " << t.z() << " " << image.camera_id.value << " " << image.name
+        << "\n";
     bool first = true;
     for (const Point2D& p : image.points2d) {
       if (!first) out << " ";
@@ -379,10 +378,11 @@ void WritePoints3DText(const Reconstruction& reconstruction, std::ostream& out) 
       << "# Number of points: " << reconstruction.points3d.size()
       << ", mean track length: " << reconstruction.MeanTrackLength() << "\n";
   for (const auto& [id, point] : reconstruction.points3d) {
-    out << id.value << " " << point.xyz.x() << " " << point.xyz.y() << " " << point.xyz.z()
-        << " " << int(point.rgb[0]) << " " << int(point.rgb[1]) << " " << int(point.rgb[2]) << " "
+    out << id.value << " " << point.xyz.x() << " " << point.xyz.y() << " " << point.xyz.z() << " "
+        << int(point.rgb[0]) << " " << int(point.rgb[1]) << " " << int(point.rgb[2]) << " "
         << point.error;
-    for (const TrackElement& e : point.track) out << " " << e.image_id.value << " " << e.point2d_idx;
+    for (const TrackElement& e : point.track)
+      out << " " << e.image_id.value << " " << e.point2d_idx;
     out << "\n";
   }
 }
@@ -482,7 +482,8 @@ LoadedModel ReadModel(const std::filesystem::path& model_dir) {
   loaded.reconstruction = ReadModel(model_dir, loaded.format);
   std::error_code ec;
   for (const char* name : {"rigs.bin", "rigs.txt", "frames.bin", "frames.txt"}) {
-    if (std::filesystem::exists(model_dir / name, ec)) loaded.ignored_files.push_back(model_dir / name);
+    if (std::filesystem::exists(model_dir / name, ec))
+      loaded.ignored_files.push_back(model_dir / name);
   }
   return loaded;
 }
@@ -507,8 +508,7 @@ void WriteModel(const Reconstruction& reconstruction, const std::filesystem::pat
   WriteFileAtomically(
       model_dir / ("points3D" + ext),
       [&](std::ostream& out) {
-        binary ? WritePoints3DBinary(reconstruction, out)
-               : WritePoints3DText(reconstruction, out);
+        binary ? WritePoints3DBinary(reconstruction, out) : WritePoints3DText(reconstruction, out);
       },
       binary);
 }

@@ -15,16 +15,13 @@ class InputError : public std::runtime_error {
   /// @param message  what is wrong, in words a user understands
   /// @param line  1-based line number, 0 when unknown or not a text format
   InputError(std::string file, const std::string& message, std::size_t line = 0)
-      : std::runtime_error(Format(file, message, line)),
-        file_(std::move(file)),
-        line_(line) {}
+      : std::runtime_error(Format(file, message, line)), file_(std::move(file)), line_(line) {}
 
   const std::string& file() const { return file_; }
   std::size_t line() const { return line_; }
 
  private:
-  static std::string Format(const std::string& file, const std::string& message,
-                            std::size_t line) {
+  static std::string Format(const std::string& file, const std::string& message, std::size_t line) {
     std::string out;
     out.append(file);
     if (line > 0) out.append(":").append(std::to_string(line));

@@ -158,13 +158,14 @@ std::vector<std::string_view> SplitWhitespace(std::string_view line) {
   return tokens;
 }
 
-std::uint64_t ParseUnsigned(std::string_view token, std::string_view what,
-                            const std::string& file, std::size_t line) {
+std::uint64_t ParseUnsigned(std::string_view token, std::string_view what, const std::string& file,
+                            std::size_t line) {
   std::uint64_t v = 0;
   const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
   if (ec != std::errc() || ptr != token.data() + token.size()) {
-    throw InputError(file, "expected a non-negative integer for " + std::string(what) +
-                               ", got '" + std::string(token) + "'",
+    throw InputError(file,
+                     "expected a non-negative integer for " + std::string(what) + ", got '" +
+                         std::string(token) + "'",
                      line);
   }
   return v;
@@ -175,9 +176,9 @@ std::int64_t ParseSigned(std::string_view token, std::string_view what, const st
   std::int64_t v = 0;
   const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
   if (ec != std::errc() || ptr != token.data() + token.size()) {
-    throw InputError(file, "expected an integer for " + std::string(what) + ", got '" +
-                               std::string(token) + "'",
-                     line);
+    throw InputError(
+        file, "expected an integer for " + std::string(what) + ", got '" + std::string(token) + "'",
+        line);
   }
   return v;
 }
@@ -187,9 +188,10 @@ double ParseDouble(std::string_view token, std::string_view what, const std::str
   double v = 0;
   const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
   if (ec != std::errc() || ptr != token.data() + token.size() || !std::isfinite(v)) {
-    throw InputError(file, "expected a finite number for " + std::string(what) + ", got '" +
-                               std::string(token) + "'",
-                     line);
+    throw InputError(
+        file,
+        "expected a finite number for " + std::string(what) + ", got '" + std::string(token) + "'",
+        line);
   }
   return v;
 }

@@ -69,8 +69,8 @@ void WriteF64(std::ostream& out, double v);
 std::vector<std::string_view> SplitWhitespace(std::string_view line);
 
 /// Strict number parsing of a whole token; throws InputError(file, message, line).
-std::uint64_t ParseUnsigned(std::string_view token, std::string_view what,
-                            const std::string& file, std::size_t line);
+std::uint64_t ParseUnsigned(std::string_view token, std::string_view what, const std::string& file,
+                            std::size_t line);
 std::int64_t ParseSigned(std::string_view token, std::string_view what, const std::string& file,
                          std::size_t line);
 double ParseDouble(std::string_view token, std::string_view what, const std::string& file,

@@ -26,12 +26,14 @@ InspectReport RunInspect(const InspectOptions& options, const ProgressCallback& 
   report.mean_track_length = r.MeanTrackLength();
   report.mean_observations_per_image = r.MeanObservationsPerImage();
   report.mean_reprojection_error_px = r.MeanReprojectionError();
-  for (const auto& [id, camera] : r.cameras) ++report.camera_models[std::string(CameraModelName(camera.model))];
+  for (const auto& [id, camera] : r.cameras)
+    ++report.camera_models[std::string(CameraModelName(camera.model))];
 
   if (options.lights) {
     const std::filesystem::path& path = *options.lights;
     std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
     if (ext == ".lp") {
       report.lights_kind = ".lp";
       const auto entries = ReadLpFile(path);
@@ -107,9 +109,8 @@ std::string FormatInspectReport(const InspectReport& rep) {
   if (rep.mesh_stats) {
     const MeshStats& s = *rep.mesh_stats;
     out << std::setprecision(4);
-    out << "Mesh: " << s.vertices << " vertices, " << s.faces << " faces, " << s.edges
-        << " edges, " << s.boundary_edges << " boundary edges, " << s.components
-        << " components\n";
+    out << "Mesh: " << s.vertices << " vertices, " << s.faces << " faces, " << s.edges << " edges, "
+        << s.boundary_edges << " boundary edges, " << s.components << " components\n";
     out << "Mesh surface area: " << s.surface_area << ", mean edge length: " << s.mean_edge_length
         << "\n";
     out << "Mesh bounding box: [" << s.bbox_min.transpose() << "] - [" << s.bbox_max.transpose()
@@ -128,9 +129,9 @@ std::string FormatInspectReport(const InspectReport& rep) {
     out << std::setprecision(1);
     out << "Triangles fully seen by >= 1 photo: " << *rep.triangles_fully_seen << " ("
         << pct(*rep.triangles_fully_seen) << "%)\n";
-    out << "Triangles fully seen by none: "
-        << *rep.triangles_partially_seen + *rep.triangles_unseen << " (partly seen "
-        << *rep.triangles_partially_seen << ", unseen " << *rep.triangles_unseen << ")\n";
+    out << "Triangles fully seen by none: " << *rep.triangles_partially_seen + *rep.triangles_unseen
+        << " (partly seen " << *rep.triangles_partially_seen << ", unseen " << *rep.triangles_unseen
+        << ")\n";
     out << std::setprecision(3) << "Visibility time: " << rep.visibility_seconds << " s\n";
   }
   if (rep.lights_kind) {

@@ -15,10 +15,10 @@ namespace texlume::sfm {
 
 /// Inputs of `texlume inspect`.
 struct InspectOptions {
-  std::filesystem::path model_dir;                 ///< COLMAP model folder (.bin or .txt)
-  std::optional<std::filesystem::path> mesh;       ///< coarse mesh in the model's frame
-  std::optional<std::filesystem::path> images_dir; ///< folder the image names are relative to
-  std::optional<std::filesystem::path> lights;     ///< object-lights .json or an .lp file
+  std::filesystem::path model_dir;                  ///< COLMAP model folder (.bin or .txt)
+  std::optional<std::filesystem::path> mesh;        ///< coarse mesh in the model's frame
+  std::optional<std::filesystem::path> images_dir;  ///< folder the image names are relative to
+  std::optional<std::filesystem::path> lights;      ///< object-lights .json or an .lp file
   MeshCleanOptions mesh_clean;
   VisibilityOptions visibility;
 };

@@ -79,7 +79,8 @@ std::vector<LpEntry> ReadLp(std::istream& in, const std::string& label) {
     ++line_number;
     const auto tokens = SplitWhitespace(line);
     if (tokens.empty()) continue;
-    if (tokens.size() != 1) throw InputError(label, "first line must hold the light count", line_number);
+    if (tokens.size() != 1)
+      throw InputError(label, "first line must hold the light count", line_number);
     count = ParseUnsigned(tokens[0], "the light count", label, line_number);
     have_count = true;
   }
@@ -99,7 +100,8 @@ std::vector<LpEntry> ReadLp(std::istream& in, const std::string& label) {
                       ParseDouble(tokens[n - 1], "lz", label, line_number));
     LpEntry entry;
     const auto start = static_cast<std::size_t>(tokens[0].data() - line.data());
-    const auto end = static_cast<std::size_t>(tokens[n - 4].data() - line.data()) + tokens[n - 4].size();
+    const auto end =
+        static_cast<std::size_t>(tokens[n - 4].data() - line.data()) + tokens[n - 4].size();
     entry.filename = line.substr(start, end - start);
     entry.direction_in_image = NormalisedDirection(d, label, line_number, "light direction");
     entries.push_back(std::move(entry));
@@ -111,8 +113,9 @@ std::vector<LpEntry> ReadLp(std::istream& in, const std::string& label) {
   while (std::getline(in, line)) {
     ++line_number;
     if (!SplitWhitespace(line).empty()) {
-      throw InputError(label, "more light lines than the count " + std::to_string(count) +
-                                  " announced", line_number);
+      throw InputError(label,
+                       "more light lines than the count " + std::to_string(count) + " announced",
+                       line_number);
     }
   }
   std::set<std::string> names;
@@ -139,7 +142,8 @@ void WriteLp(const std::vector<LpEntry>& entries, std::ostream& out) {
 }
 
 void WriteLpFile(const std::vector<LpEntry>& entries, const std::filesystem::path& path) {
-  WriteFileAtomically(path, [&](std::ostream& out) { WriteLp(entries, out); }, false);
+  WriteFileAtomically(
+      path, [&](std::ostream& out) { WriteLp(entries, out); }, false);
 }
 
 std::string BaseName(const std::string& path) {
@@ -168,7 +172,8 @@ ObjectLights ReadObjectLights(std::istream& in, const std::string& label) {
   } catch (const nlohmann::json::parse_error& e) {
     const std::size_t byte = std::min<std::size_t>(e.byte, text.size());
     const std::size_t line =
-        1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(byte), '\n'));
+        1 + static_cast<std::size_t>(
+                std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(byte), '\n'));
     throw InputError(label, std::string("invalid JSON: ") + e.what(), line);
   }
   if (!root.is_object() || !root.contains("images") || !root["images"].is_object()) {
@@ -212,8 +217,7 @@ void WriteObjectLights(const ObjectLights& lights, std::ostream& out) {
                           l.direction_in_world.z()};
       } else {
         j["type"] = "point";
-        j["position"] = {l.position_in_world.x(), l.position_in_world.y(),
-                         l.position_in_world.z()};
+        j["position"] = {l.position_in_world.x(), l.position_in_world.y(), l.position_in_world.z()};
       }
       j["intensity"] = l.intensity;
       arr.push_back(j);
@@ -225,7 +229,8 @@ void WriteObjectLights(const ObjectLights& lights, std::ostream& out) {
 }
 
 void WriteObjectLightsFile(const ObjectLights& lights, const std::filesystem::path& path) {
-  WriteFileAtomically(path, [&](std::ostream& out) { WriteObjectLights(lights, out); }, false);
+  WriteFileAtomically(
+      path, [&](std::ostream& out) { WriteObjectLights(lights, out); }, false);
 }
 
 std::vector<std::string> CheckLightsAgainstModel(const ObjectLights& lights,
@@ -235,8 +240,8 @@ std::vector<std::string> CheckLightsAgainstModel(const ObjectLights& lights,
   for (const auto& [id, image] : reconstruction.images) model_names.insert(image.name);
   for (const auto& [name, list] : lights) {
     if (!model_names.count(name)) {
-      throw InputError(label, "lights are given for image '" + name +
-                                  "', which is not in the COLMAP model");
+      throw InputError(
+          label, "lights are given for image '" + name + "', which is not in the COLMAP model");
     }
   }
   std::vector<std::string> without;

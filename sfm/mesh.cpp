@@ -1,10 +1,10 @@
 #include "sfm/mesh.h"
 
+#include <unistd.h>
+
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <mutex>
@@ -149,8 +149,8 @@ std::vector<std::string> MeshReport::Problems() const {
 }
 
 LoadedMesh CleanMesh(const std::vector<Eigen::Vector3d>& vertices,
-                     const std::vector<std::vector<int>>& polygons,
-                     const MeshCleanOptions& options, const std::string& label) {
+                     const std::vector<std::vector<int>>& polygons, const MeshCleanOptions& options,
+                     const std::string& label) {
   options.Check();
   LoadedMesh result;
   MeshReport& report = result.report;
@@ -190,7 +190,8 @@ LoadedMesh CleanMesh(const std::vector<Eigen::Vector3d>& vertices,
       int found = -1;
       if (tol > 0.0) {
         std::array<std::int64_t, 3> key;
-        for (int c = 0; c < 3; ++c) key[c] = static_cast<std::int64_t>(std::floor((p[c] - lo[c]) / cell));
+        for (int c = 0; c < 3; ++c)
+          key[c] = static_cast<std::int64_t>(std::floor((p[c] - lo[c]) / cell));
         for (int dx = -1; dx <= 1 && found < 0; ++dx)
           for (int dy = -1; dy <= 1 && found < 0; ++dy)
             for (int dz = -1; dz <= 1 && found < 0; ++dz) {
@@ -205,8 +206,8 @@ LoadedMesh CleanMesh(const std::vector<Eigen::Vector3d>& vertices,
             }
         if (found < 0) grid[key].push_back(static_cast<int>(i));
       } else {
-        const auto [it, inserted] = exact.emplace(std::array<double, 3>{p.x(), p.y(), p.z()},
-                                                  static_cast<int>(i));
+        const auto [it, inserted] =
+            exact.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<int>(i));
         if (!inserted) found = it->second;
       }
       representative[i] = found < 0 ? static_cast<int>(i) : found;
@@ -365,7 +366,8 @@ LoadedMesh LoadMesh(const std::filesystem::path& path, const MeshCleanOptions& o
     throw InputError(path.string(), "mesh file not found");
   }
   std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   if (ext != ".ply" && ext != ".obj" && ext != ".off" && ext != ".stl") {
     throw InputError(path.string(), "unsupported mesh format '" + ext +
                                         "' (texlume reads .ply, .obj, .off, .stl)");
@@ -409,9 +411,9 @@ void SaveMesh(const TriangleMesh& mesh, const std::filesystem::path& path) {
       om.add_face(fh);
     }
   }
-  std::filesystem::path tmp = path.parent_path() /
-                              (path.stem().string() + ".tmp-" + std::to_string(::getpid()) +
-                               path.extension().string());
+  std::filesystem::path tmp =
+      path.parent_path() /
+      (path.stem().string() + ".tmp-" + std::to_string(::getpid()) + path.extension().string());
   OpenMesh::IO::Options write_options = OpenMesh::IO::Options::Binary;
   if (path.extension() == ".obj" || path.extension() == ".off") write_options = {};
   if (!OpenMesh::IO::write_mesh(om, tmp.string(), write_options, 17)) {
@@ -436,9 +438,9 @@ std::vector<Eigen::Vector3d> FaceNormals(const TriangleMesh& mesh) {
 std::vector<double> FaceAreas(const TriangleMesh& mesh) {
   std::vector<double> areas(mesh.faces.size());
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-    areas[f] = 0.5 * (mesh.Corner(f, 1) - mesh.Corner(f, 0))
-                         .cross(mesh.Corner(f, 2) - mesh.Corner(f, 0))
-                         .norm();
+    areas[f] =
+        0.5 *
+        (mesh.Corner(f, 1) - mesh.Corner(f, 0)).cross(mesh.Corner(f, 2) - mesh.Corner(f, 0)).norm();
   }
   return areas;
 }
@@ -497,9 +499,11 @@ MeshStats ComputeMeshStats(const TriangleMesh& mesh) {
   for (const auto& [key, list] : uses) {
     if (list.size() == 1) ++s.boundary_edges;
     const auto& f = mesh.faces[static_cast<std::size_t>(list[0].face)];
-    edge_length_sum += (mesh.vertices[static_cast<std::size_t>(f[static_cast<std::size_t>(list[0].corner)])] -
-                        mesh.vertices[static_cast<std::size_t>(f[static_cast<std::size_t>((list[0].corner + 1) % 3)])])
-                           .norm();
+    edge_length_sum +=
+        (mesh.vertices[static_cast<std::size_t>(f[static_cast<std::size_t>(list[0].corner)])] -
+         mesh.vertices[static_cast<std::size_t>(
+             f[static_cast<std::size_t>((list[0].corner + 1) % 3)])])
+            .norm();
   }
   s.mean_edge_length = s.edges ? edge_length_sum / static_cast<double>(s.edges) : 0.0;
   for (double a : FaceAreas(mesh)) s.surface_area += a;

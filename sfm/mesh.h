@@ -45,8 +45,8 @@ struct MeshCleanOptions {
 /// What was wrong with a mesh and what was done about it.
 struct MeshReport {
   std::size_t input_vertices = 0;
-  std::size_t input_faces = 0;               ///< polygons as read
-  std::size_t polygons_triangulated = 0;     ///< faces with more than 3 corners, fanned
+  std::size_t input_faces = 0;            ///< polygons as read
+  std::size_t polygons_triangulated = 0;  ///< faces with more than 3 corners, fanned
   std::size_t duplicate_vertices_merged = 0;
   std::size_t degenerate_faces_removed = 0;  ///< repeated corner or (near) zero area
   std::size_t duplicate_faces_removed = 0;   ///< same three vertices as an earlier face
@@ -56,8 +56,8 @@ struct MeshReport {
   std::size_t non_manifold_edges = 0;
   /// Manifold edges whose two faces traverse them in the same direction, as read.
   std::size_t inconsistently_oriented_edges = 0;
-  std::size_t faces_flipped = 0;             ///< by the orientation repair
-  std::size_t non_orientable_components = 0; ///< components no flipping can make consistent
+  std::size_t faces_flipped = 0;              ///< by the orientation repair
+  std::size_t non_orientable_components = 0;  ///< components no flipping can make consistent
 
   /// One line per problem found, empty for a clean mesh.
   std::vector<std::string> Problems() const;
@@ -80,8 +80,8 @@ LoadedMesh LoadMesh(const std::filesystem::path& path, const MeshCleanOptions& o
 /// TriangleMesh; see MeshCleanOptions. `label` names the source in errors.
 /// Throws InputError for out-of-range indices, non-finite positions or no faces.
 LoadedMesh CleanMesh(const std::vector<Eigen::Vector3d>& vertices,
-                     const std::vector<std::vector<int>>& polygons,
-                     const MeshCleanOptions& options, const std::string& label);
+                     const std::vector<std::vector<int>>& polygons, const MeshCleanOptions& options,
+                     const std::string& label);
 
 /// Writes the mesh (PLY, OBJ, OFF or STL by extension) through OpenMesh, atomically.
 void SaveMesh(const TriangleMesh& mesh, const std::filesystem::path& path);
@@ -110,8 +110,8 @@ struct MeshStats {
   std::size_t edges = 0;
   std::size_t boundary_edges = 0;
   std::size_t components = 0;
-  double surface_area = 0.0;     ///< squared world units
-  double mean_edge_length = 0.0; ///< world units
+  double surface_area = 0.0;      ///< squared world units
+  double mean_edge_length = 0.0;  ///< world units
   Eigen::Vector3d bbox_min = Eigen::Vector3d::Zero();
   Eigen::Vector3d bbox_max = Eigen::Vector3d::Zero();
 };

@@ -15,15 +15,15 @@ std::size_t Reconstruction::NumObservations() const {
 }
 
 double Reconstruction::MeanTrackLength() const {
-  return points3d.empty() ? 0.0
-                          : static_cast<double>(NumObservations()) /
-                                static_cast<double>(points3d.size());
+  return points3d.empty()
+             ? 0.0
+             : static_cast<double>(NumObservations()) / static_cast<double>(points3d.size());
 }
 
 double Reconstruction::MeanObservationsPerImage() const {
-  return images.empty() ? 0.0
-                        : static_cast<double>(NumObservations()) /
-                              static_cast<double>(images.size());
+  return images.empty()
+             ? 0.0
+             : static_cast<double>(NumObservations()) / static_cast<double>(images.size());
 }
 
 double Reconstruction::MeanReprojectionError() const {

@@ -157,8 +157,7 @@ ImageViews ComputeImageViews(const TriangleMesh& mesh, const std::vector<Eigen::
       ++total;
       seen += shows(x, y, z, f) ? 1 : 0;
     });
-    const double area_buffer_px =
-        0.5 * std::abs(Edge(t.p[0], t.p[1], t.p[2].x(), t.p[2].y()));
+    const double area_buffer_px = 0.5 * std::abs(Edge(t.p[0], t.p[1], t.p[2].x(), t.p[2].y()));
     double fraction;
     if (total == 0) {
       // Smaller than a buffer pixel: test the centroid and corners instead.
@@ -173,8 +172,8 @@ ImageViews ComputeImageViews(const TriangleMesh& mesh, const std::vector<Eigen::
       }
       fraction = static_cast<double>(seen) / static_cast<double>(total);
     } else {
-      fraction = std::min(1.0, static_cast<double>(seen) /
-                                   std::max(static_cast<double>(total), area_buffer_px));
+      fraction = std::min(
+          1.0, static_cast<double>(seen) / std::max(static_cast<double>(total), area_buffer_px));
       if (inside && seen == total) fraction = 1.0;
     }
     if (seen == 0) continue;
@@ -242,7 +241,8 @@ VisibilityResult ComputeVisibility(const TriangleMesh& mesh, const Reconstructio
           mesh, normals, centroids, image, reconstruction.cameras.at(image.camera_id), options);
     }
     for (auto& v : views) {
-      for (auto& [f, view] : v.records) result.triangles[static_cast<std::size_t>(f)].views.push_back(view);
+      for (auto& [f, view] : v.records)
+        result.triangles[static_cast<std::size_t>(f)].views.push_back(view);
       v.records.clear();
       v.records.shrink_to_fit();
     }
@@ -275,8 +275,7 @@ VisibilityResult ComputeVisibility(const TriangleMesh& mesh, const Reconstructio
       ++result.num_unseen;
     }
   }
-  result.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

@@ -66,10 +66,10 @@ struct TriangleVisibility {
 /// Visibility of every triangle in every image.
 struct VisibilityResult {
   std::vector<TriangleVisibility> triangles;  ///< indexed by face
-  std::size_t num_fully_seen = 0;       ///< triangles fully visible in >= 1 photo
-  std::size_t num_partially_seen = 0;   ///< only partly visible in every photo that sees them
-  std::size_t num_unseen = 0;           ///< visible in no photo at all
-  double seconds = 0.0;                 ///< wall time of the computation
+  std::size_t num_fully_seen = 0;             ///< triangles fully visible in >= 1 photo
+  std::size_t num_partially_seen = 0;         ///< only partly visible in every photo that sees them
+  std::size_t num_unseen = 0;                 ///< visible in no photo at all
+  double seconds = 0.0;                       ///< wall time of the computation
 };
 
 /// Computes, for every (triangle, image), full visibility, visible fraction,

@@ -62,7 +62,8 @@ TEST_F(CliTest, TruncatedBinaryModelIsACleanErrorNamingTheFile) {
   std::string out;
   EXPECT_EQ(Texlume("inspect --model " + Path("sparse"), &out), 1);
   EXPECT_NE(out.find("points3D.bin"), std::string::npos) << out;
-  EXPECT_TRUE(out.find("truncated") != std::string::npos || out.find("corrupt") != std::string::npos)
+  EXPECT_TRUE(out.find("truncated") != std::string::npos ||
+              out.find("corrupt") != std::string::npos)
       << out;
 }
 
@@ -86,11 +87,14 @@ TEST_F(CliTest, MalformedTextLineNamesFileAndLine) {
 TEST_F(CliTest, BadMeshLightsAndMissingImagesAreCleanErrors) {
   std::string out;
   WriteText(tmp_ / "broken.obj", "v 0 0 0\nf 1 2 3\n");
-  EXPECT_EQ(Texlume("inspect --model " + Path("sparse") + " --mesh " + Path("broken.obj"), &out), 1);
+  EXPECT_EQ(Texlume("inspect --model " + Path("sparse") + " --mesh " + Path("broken.obj"), &out),
+            1);
   EXPECT_NE(out.find("broken.obj"), std::string::npos) << out;
 
   WriteText(tmp_ / "bad_lights.json", R"({"images": {"nope.png": {"direction": [0, 0, 1]}}})");
-  EXPECT_EQ(Texlume("inspect --model " + Path("sparse") + " --lights " + Path("bad_lights.json"), &out), 1);
+  EXPECT_EQ(
+      Texlume("inspect --model " + Path("sparse") + " --lights " + Path("bad_lights.json"), &out),
+      1);
   EXPECT_NE(out.find("nope.png"), std::string::npos) << out;
 
   std::filesystem::create_directories(tmp_ / "photos");
@@ -104,8 +108,8 @@ TEST(Cli, DemoWritesTheSceneAndItsRunRecord) {
   std::string out;
   EXPECT_EQ(Texlume("demo --out " + (tmp / "demo").string() + " --images 5", &out), 0) << out;
   EXPECT_NE(out.find("Images: 5"), std::string::npos) << out;
-  for (const std::string f : {"sparse/cameras.bin", "sparse_txt/images.txt", "mesh.ply",
-                              "lights.json", "run.json"}) {
+  for (const std::string f :
+       {"sparse/cameras.bin", "sparse_txt/images.txt", "mesh.ply", "lights.json", "run.json"}) {
     EXPECT_TRUE(std::filesystem::exists(tmp / "demo" / f)) << f;
   }
 }

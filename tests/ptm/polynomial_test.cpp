@@ -11,7 +11,8 @@ TEST(PtmPolynomial, EvaluationIsTheBasisDotTheCoefficients) {
     for (double lv : {-0.2, 0.1, 0.9}) {
       const auto basis = PtmBasis(lu, lv);
       double dot = 0;
-      for (int i = 0; i < 6; ++i) dot += a[static_cast<std::size_t>(i)] * basis[static_cast<std::size_t>(i)];
+      for (int i = 0; i < 6; ++i)
+        dot += a[static_cast<std::size_t>(i)] * basis[static_cast<std::size_t>(i)];
       EXPECT_DOUBLE_EQ(EvaluatePtm(a, lu, lv), dot);
     }
   }

@@ -13,10 +13,18 @@ Camera MakeCamera(CameraModelId model) {
   c.width = 1600;
   c.height = 1200;
   switch (model) {
-    case CameraModelId::kSimplePinhole: c.params = {1000, 800, 600}; break;
-    case CameraModelId::kPinhole: c.params = {1000, 1020, 805, 598}; break;
-    case CameraModelId::kSimpleRadial: c.params = {1000, 800, 600, -0.08}; break;
-    case CameraModelId::kRadial: c.params = {1000, 800, 600, -0.08, 0.02}; break;
+    case CameraModelId::kSimplePinhole:
+      c.params = {1000, 800, 600};
+      break;
+    case CameraModelId::kPinhole:
+      c.params = {1000, 1020, 805, 598};
+      break;
+    case CameraModelId::kSimpleRadial:
+      c.params = {1000, 800, 600, -0.08};
+      break;
+    case CameraModelId::kRadial:
+      c.params = {1000, 800, 600, -0.08, 0.02};
+      break;
     case CameraModelId::kOpenCV:
       c.params = {1000, 1010, 800, 600, -0.1, 0.03, 0.001, -0.0015};
       break;
@@ -26,12 +34,18 @@ Camera MakeCamera(CameraModelId model) {
     case CameraModelId::kFullOpenCV:
       c.params = {1000, 1010, 800, 600, -0.1, 0.03, 0.001, -0.0015, 0.002, 0.01, -0.003, 0.001};
       break;
-    case CameraModelId::kFov: c.params = {1000, 1010, 800, 600, 0.6}; break;
-    case CameraModelId::kSimpleRadialFisheye: c.params = {600, 800, 600, 0.04}; break;
-    case CameraModelId::kRadialFisheye: c.params = {600, 800, 600, 0.04, -0.005}; break;
+    case CameraModelId::kFov:
+      c.params = {1000, 1010, 800, 600, 0.6};
+      break;
+    case CameraModelId::kSimpleRadialFisheye:
+      c.params = {600, 800, 600, 0.04};
+      break;
+    case CameraModelId::kRadialFisheye:
+      c.params = {600, 800, 600, 0.04, -0.005};
+      break;
     case CameraModelId::kThinPrismFisheye:
-      c.params = {600, 605, 800, 600, 0.04, -0.005, 0.001, -0.0008, 0.002, -0.0003, 0.0007,
-                  -0.0004};
+      c.params = {600,   605,     800,   600,     0.04,   -0.005,
+                  0.001, -0.0008, 0.002, -0.0003, 0.0007, -0.0004};
       break;
   }
   return c;
@@ -81,14 +95,21 @@ INSTANTIATE_TEST_SUITE_P(AllColmapModels, CameraModelTest, ::testing::Range(0, k
                          });
 
 TEST(CameraModels, NamesIdsAndParameterCountsMatchColmap) {
-  const std::vector<std::pair<std::string, int>> expected = {
-      {"SIMPLE_PINHOLE", 3}, {"PINHOLE", 4},        {"SIMPLE_RADIAL", 4},
-      {"RADIAL", 5},         {"OPENCV", 8},         {"OPENCV_FISHEYE", 8},
-      {"FULL_OPENCV", 12},   {"FOV", 5},            {"SIMPLE_RADIAL_FISHEYE", 4},
-      {"RADIAL_FISHEYE", 5}, {"THIN_PRISM_FISHEYE", 12}};
+  const std::vector<std::pair<std::string, int>> expected = {{"SIMPLE_PINHOLE", 3},
+                                                             {"PINHOLE", 4},
+                                                             {"SIMPLE_RADIAL", 4},
+                                                             {"RADIAL", 5},
+                                                             {"OPENCV", 8},
+                                                             {"OPENCV_FISHEYE", 8},
+                                                             {"FULL_OPENCV", 12},
+                                                             {"FOV", 5},
+                                                             {"SIMPLE_RADIAL_FISHEYE", 4},
+                                                             {"RADIAL_FISHEYE", 5},
+                                                             {"THIN_PRISM_FISHEYE", 12}};
   for (int id = 0; id < kNumCameraModels; ++id) {
     EXPECT_EQ(CameraModelName(CameraModelId(id)), expected[static_cast<std::size_t>(id)].first);
-    EXPECT_EQ(CameraModelNumParams(CameraModelId(id)), expected[static_cast<std::size_t>(id)].second);
+    EXPECT_EQ(CameraModelNumParams(CameraModelId(id)),
+              expected[static_cast<std::size_t>(id)].second);
     EXPECT_EQ(CameraModelFromName(expected[static_cast<std::size_t>(id)].first), CameraModelId(id));
   }
   EXPECT_FALSE(IsValidCameraModelId(11));

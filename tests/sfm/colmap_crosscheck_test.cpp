@@ -65,7 +65,8 @@ TEST(ColmapCrossCheck, ModelAnalyzerReportsTheCountsTexlumeInspectReports) {
   options.model_dir = tmp / "model";
   const std::string ours = FormatInspectReport(RunInspect(options));
   // Every statistic line COLMAP prints appears verbatim in texlume's summary.
-  const std::regex stat(R"((Cameras|Images|Registered images|Points|Observations|Mean track length|Mean observations per image|Mean reprojection error): ([0-9.]+)(px)?)");
+  const std::regex stat(
+      R"((Cameras|Images|Registered images|Points|Observations|Mean track length|Mean observations per image|Mean reprojection error): ([0-9.]+)(px)?)");
   int compared = 0;
   for (std::sregex_iterator it(analyzer.begin(), analyzer.end(), stat), end; it != end; ++it) {
     const std::string name = (*it)[1];

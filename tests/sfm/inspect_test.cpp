@@ -31,9 +31,9 @@ TEST(Inspect, ReportsModelMeshVisibilityLightsAndMissingImages) {
   EXPECT_EQ(report.num_points3d, scene.reconstruction.points3d.size());
   EXPECT_EQ(report.num_observations, scene.reconstruction.NumObservations());
   EXPECT_EQ(report.mesh_stats->faces, scene.mesh.NumFaces());
-  EXPECT_EQ(*report.triangles_fully_seen + *report.triangles_partially_seen +
-                *report.triangles_unseen,
-            scene.mesh.NumFaces());
+  EXPECT_EQ(
+      *report.triangles_fully_seen + *report.triangles_partially_seen + *report.triangles_unseen,
+      scene.mesh.NumFaces());
   EXPECT_GT(*report.triangles_fully_seen, scene.mesh.NumFaces() * 8 / 10);
   EXPECT_EQ(report.missing_images->size(), 7u);
   EXPECT_EQ(report.num_lit_images, 8u);

@@ -50,14 +50,14 @@ TEST(Mesh, EveryFormatRoundTripsThroughOpenMesh) {
 
 TEST(Mesh, DuplicateVerticesDegenerateAndDuplicateFacesAreRepaired) {
   auto vertices = TetraVertices();
-  vertices.push_back({1, 0, 0});      // 4: duplicate of 1
-  vertices.push_back({0.5, 0, 0});    // 5: on edge 0-1 (collinear face)
-  vertices.push_back({9, 9, 9});      // 6: unused
+  vertices.push_back({1, 0, 0});    // 4: duplicate of 1
+  vertices.push_back({0.5, 0, 0});  // 5: on edge 0-1 (collinear face)
+  vertices.push_back({9, 9, 9});    // 6: unused
   auto faces = TetraFaces();
-  faces[3] = {4, 2, 3};               // uses the duplicate vertex
-  faces.push_back({0, 0, 3});         // repeated corner
-  faces.push_back({0, 5, 1});         // zero area
-  faces.push_back({2, 3, 1});         // same vertices as face 3 once welded
+  faces[3] = {4, 2, 3};        // uses the duplicate vertex
+  faces.push_back({0, 0, 3});  // repeated corner
+  faces.push_back({0, 5, 1});  // zero area
+  faces.push_back({2, 3, 1});  // same vertices as face 3 once welded
   const LoadedMesh m = CleanMesh(vertices, faces, {}, "soup");
   EXPECT_EQ(m.report.duplicate_vertices_merged, 1u);
   EXPECT_EQ(m.report.degenerate_faces_removed, 2u);
@@ -137,7 +137,8 @@ TEST(Mesh, BreadthFirstOrderGivesEveryFaceAProcessedNeighbour) {
   const int offset = static_cast<int>(mesh.NumVertices());
   const TriangleMesh copy = datasets::MakeIcosphere(1, 0.5);
   for (const auto& v : copy.vertices) mesh.vertices.push_back(v + Eigen::Vector3d(5, 0, 0));
-  for (const auto& f : copy.faces) mesh.faces.push_back({f[0] + offset, f[1] + offset, f[2] + offset});
+  for (const auto& f : copy.faces)
+    mesh.faces.push_back({f[0] + offset, f[1] + offset, f[2] + offset});
   const auto neighbours = FaceNeighbours(mesh);
   const auto order = BreadthFirstFaceOrder(mesh, neighbours, 17);
   ASSERT_EQ(order.size(), mesh.NumFaces());
@@ -168,8 +169,9 @@ TEST(MeshBadInput, UnparsableMissingAndOutOfRangeFilesAreNamed) {
     }
     return "";
   };
-  WriteText(tmp / "garbage.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
-                                 "end_header\nthis is not a number\n");
+  WriteText(tmp / "garbage.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+            "end_header\nthis is not a number\n");
   WriteText(tmp / "out_of_range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n");
   WriteText(tmp / "no_faces.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n");
   WriteText(tmp / "mesh.xyz", "1 2 3\n");

@@ -38,7 +38,8 @@ bool OverlapsSquare(const TriangleMesh& m, std::size_t f, double h) {
   std::vector<Eigen::Vector2d> square = {{-h, -h}, {h, -h}, {h, h}, {-h, h}};
   std::vector<Eigen::Vector2d> axes = {{1, 0}, {0, 1}};
   for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector2d e = p[static_cast<std::size_t>((k + 1) % 3)] - p[static_cast<std::size_t>(k)];
+    const Eigen::Vector2d e =
+        p[static_cast<std::size_t>((k + 1) % 3)] - p[static_cast<std::size_t>(k)];
     axes.emplace_back(-e.y(), e.x());
   }
   for (const auto& a : axes) {
@@ -56,7 +57,8 @@ TEST(Visibility, KnownOccluderHidesExactlyTheTrianglesBehindItPartlyOrWholly) {
   TriangleMesh mesh = datasets::MakeGridPlane(16, 2.0);
   const std::size_t plane_faces = mesh.NumFaces();
   const int base = static_cast<int>(mesh.NumVertices());
-  for (const auto& v : std::vector<Eigen::Vector3d>{{-0.2, -0.2, 1}, {0.2, -0.2, 1}, {0.2, 0.2, 1}, {-0.2, 0.2, 1}}) {
+  for (const auto& v : std::vector<Eigen::Vector3d>{
+           {-0.2, -0.2, 1}, {0.2, -0.2, 1}, {0.2, 0.2, 1}, {-0.2, 0.2, 1}}) {
     mesh.vertices.push_back(v);
   }
   mesh.faces.push_back({base, base + 1, base + 2});
@@ -69,9 +71,9 @@ TEST(Visibility, KnownOccluderHidesExactlyTheTrianglesBehindItPartlyOrWholly) {
     ASSERT_EQ(vis.triangles[f].FullyVisibleViews().empty(), behind) << "face " << f;
     occluded += behind ? 1 : 0;
     if (behind) {
-      EXPECT_EQ(vis.triangles[f].best_view_source,
-                vis.triangles[f].views.empty() ? BestViewSource::kNone
-                                               : BestViewSource::kPartiallyVisible);
+      EXPECT_EQ(vis.triangles[f].best_view_source, vis.triangles[f].views.empty()
+                                                       ? BestViewSource::kNone
+                                                       : BestViewSource::kPartiallyVisible);
     } else {
       EXPECT_EQ(vis.triangles[f].best_view_source, BestViewSource::kFullyVisible);
       EXPECT_NEAR(vis.triangles[f].views[0].visible_fraction, 1.0, 1e-6);
@@ -85,7 +87,7 @@ TEST(Visibility, KnownOccluderHidesExactlyTheTrianglesBehindItPartlyOrWholly) {
 TEST(Visibility, OccluderInsideATriangleWithAllCornersVisibleIsDetected) {
   // One big triangle; a tiny occluder in front of its middle hides no corner.
   TriangleMesh mesh;
-  mesh.vertices = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0},
+  mesh.vertices = {{-1, -1, 0},         {1, -1, 0},         {0, 1, 0},
                    {-0.05, -0.05, 0.5}, {0.05, -0.05, 0.5}, {0, 0.05, 0.5}};
   mesh.faces = {{0, 1, 2}, {3, 4, 5}};
   const VisibilityResult vis = ComputeVisibility(mesh, CamerasLookingAtOrigin({{0, 0, 4}}));
@@ -98,8 +100,7 @@ TEST(Visibility, OccluderInsideATriangleWithAllCornersVisibleIsDetected) {
 
 TEST(Visibility, BestViewIsTheSmallestAngleAmongFullyVisibleViews) {
   const TriangleMesh mesh = datasets::MakeGridPlane(4, 0.5);
-  const Reconstruction r =
-      CamerasLookingAtOrigin({{3, 0, 2}, {0.3, 0, 4}, {-2, 0, 2}, {0, 0, -3}});
+  const Reconstruction r = CamerasLookingAtOrigin({{3, 0, 2}, {0.3, 0, 4}, {-2, 0, 2}, {0, 0, -3}});
   const VisibilityResult vis = ComputeVisibility(mesh, r);
   for (const TriangleVisibility& t : vis.triangles) {
     EXPECT_EQ(t.best_view, ImageId(2));

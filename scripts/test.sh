@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# Installs the dependencies, builds texlume with warnings as errors, checks the
+# formatting and runs the whole test suite (unit tests, COLMAP cross-checks,
+# end-to-end CLI tests).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./scripts/install_deps.sh
+TEXLUME_CMAKE_ARGS="-DTEXLUME_WERROR=ON" ./scripts/build.sh
+cmake --build build --target check-format
+ctest --test-dir build -j"$(nproc)" --output-on-failure
