@@ -87,15 +87,6 @@ TEST(ColmapIo, NonUnitQuaternionIsNormalisedLikeColmap) {
 
 // ----------------------------------------------------------------- bad input
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(ColmapIoBadInput, EveryTruncationOfEveryBinaryFileIsACleanError) {
   Reconstruction r = MakeTestReconstruction();
   // Keep the files small so every prefix can be tried.
@@ -114,7 +105,7 @@ TEST(ColmapIoBadInput, EveryTruncationOfEveryBinaryFileIsACleanError) {
   for (const auto& [name, bytes] : files) {
     for (std::size_t len = 0; len < bytes.size(); ++len) {
       std::istringstream in(bytes.substr(0, len));
-      const std::string error = ErrorOf([&] {
+      const std::string error = testing::InputErrorMessage([&] {
         if (name == "cameras.bin") ReadCamerasBinary(in, name);
         if (name == "images.bin") ReadImagesBinary(in, name);
         if (name == "points3D.bin") ReadPoints3DBinary(in, name);
@@ -129,7 +120,7 @@ TEST(ColmapIoBadInput, HugeCountsAreRefusedBeforeAllocating) {
   std::stringstream s;
   WriteU64(s, 1ull << 60);  // cameras claimed
   WriteU32(s, 1);
-  std::string error = ErrorOf([&] { ReadCamerasBinary(s, "cameras.bin"); });
+  std::string error = testing::InputErrorMessage([&] { ReadCamerasBinary(s, "cameras.bin"); });
   EXPECT_NE(error.find("count"), std::string::npos) << error;
 
   // An image whose 2D point count is far larger than the bytes left.
@@ -140,7 +131,7 @@ TEST(ColmapIoBadInput, HugeCountsAreRefusedBeforeAllocating) {
   WriteU32(img, 1);
   img.write("a.png", 6);
   WriteU64(img, 0xFFFFFFFFFFFFull);
-  error = ErrorOf([&] { ReadImagesBinary(img, "images.bin"); });
+  error = testing::InputErrorMessage([&] { ReadImagesBinary(img, "images.bin"); });
   EXPECT_NE(error.find("2D point (image 1) count"), std::string::npos) << error;
 
   // A point whose track length is too large.
@@ -151,7 +142,7 @@ TEST(ColmapIoBadInput, HugeCountsAreRefusedBeforeAllocating) {
   for (int i = 0; i < 3; ++i) WriteU8(pts, 0);
   WriteF64(pts, 0.5);
   WriteU64(pts, 1ull << 40);
-  error = ErrorOf([&] { ReadPoints3DBinary(pts, "points3D.bin"); });
+  error = testing::InputErrorMessage([&] { ReadPoints3DBinary(pts, "points3D.bin"); });
   EXPECT_NE(error.find("track element (point 7) count"), std::string::npos) << error;
 }
 
@@ -163,7 +154,8 @@ TEST(ColmapIoBadInput, UnknownModelIdIsNamed) {
   WriteU64(s, 640);
   WriteU64(s, 480);
   for (int i = 0; i < 4; ++i) WriteF64(s, 1.0);
-  const std::string error = ErrorOf([&] { ReadCamerasBinary(s, "cameras.bin"); });
+  const std::string error =
+      testing::InputErrorMessage([&] { ReadCamerasBinary(s, "cameras.bin"); });
   EXPECT_NE(error.find("unknown camera model id 11"), std::string::npos) << error;
 }
 
@@ -174,7 +166,8 @@ TEST(ColmapIoBadInput, MissingNulInImageNameIsNamed) {
   for (double v : {1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0}) WriteF64(img, v);
   WriteU32(img, 1);
   img.write("name_without_nul_and_more_bytes_after_it", 40);
-  const std::string error = ErrorOf([&] { ReadImagesBinary(img, "images.bin"); });
+  const std::string error =
+      testing::InputErrorMessage([&] { ReadImagesBinary(img, "images.bin"); });
   EXPECT_NE(error.find("no terminating NUL"), std::string::npos) << error;
 }
 
@@ -183,7 +176,9 @@ TEST(ColmapIoBadInput, TrailingBytesAreRefused) {
   std::stringstream s;
   WriteCamerasBinary(r, s);
   s << "xx";
-  EXPECT_NE(ErrorOf([&] { ReadCamerasBinary(s, "cameras.bin"); }).find("unexpected bytes"),
+  EXPECT_NE(testing::InputErrorMessage([&] {
+              ReadCamerasBinary(s, "cameras.bin");
+            }).find("unexpected bytes"),
             std::string::npos);
 }
 
@@ -212,7 +207,7 @@ TEST(ColmapIoBadInput, MalformedTextLinesNameFileAndLine) {
   };
   for (const auto& c : cases) {
     std::istringstream in(c.text);
-    const std::string error = ErrorOf([&] {
+    const std::string error = testing::InputErrorMessage([&] {
       if (c.file == "cameras.txt") ReadCamerasText(in, c.file);
       if (c.file == "images.txt") ReadImagesText(in, c.file);
       if (c.file == "points3D.txt") ReadPoints3DText(in, c.file);
@@ -228,22 +223,26 @@ TEST(ColmapIoBadInput, DanglingReferencesAreRefused) {
   Reconstruction r = MakeTestReconstruction();
   r.images.begin()->second.camera_id = CameraId(999);
   WriteModel(r, tmp.path(), ModelFormat::kBinary);
-  EXPECT_NE(ErrorOf([&] { ReadModel(tmp.path()); }).find("camera 999"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { ReadModel(tmp.path()); }).find("camera 999"),
+            std::string::npos);
 
   r = MakeTestReconstruction();
   r.points3d.begin()->second.track.push_back({ImageId(1), 100000});
   WriteModel(r, tmp.path(), ModelFormat::kText);
   std::filesystem::remove(tmp / "cameras.bin");
-  EXPECT_NE(ErrorOf([&] { ReadModel(tmp.path()); }).find("feature 100000"), std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] { ReadModel(tmp.path()); }).find("feature 100000"),
+            std::string::npos);
 }
 
 TEST(ColmapIoBadInput, MissingFolderOrFilesAreNamed) {
   TempDir tmp;
-  EXPECT_NE(ErrorOf([&] { ReadModel(tmp / "nope"); }).find("model folder not found"),
-            std::string::npos);
+  EXPECT_NE(
+      testing::InputErrorMessage([&] { ReadModel(tmp / "nope"); }).find("model folder not found"),
+      std::string::npos);
   WriteText(tmp / "cameras.txt", "");
-  EXPECT_NE(ErrorOf([&] { ReadModel(tmp.path()); }).find("not a COLMAP model folder"),
-            std::string::npos);
+  EXPECT_NE(
+      testing::InputErrorMessage([&] { ReadModel(tmp.path()); }).find("not a COLMAP model folder"),
+      std::string::npos);
 }
 
 }  // namespace

@@ -10,15 +10,6 @@
 namespace texlume::sfm {
 namespace {
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(Lp, RoundTripIsExactAndMatchesByName) {
   std::vector<LpEntry> entries = {
       {"C:\\capture\\img_01.jpg", Eigen::Vector3d(0.3, -0.2, 0.5).normalized()},
@@ -57,7 +48,7 @@ TEST(LpBadInput, ErrorsNameFileAndLine) {
       {"2\na.jpg 0 0 1\ndir/a.jpg 0 0 1\n", "listed twice"}};
   for (const auto& [text, expected] : cases) {
     std::istringstream in(text);
-    const std::string error = ErrorOf([&] { ReadLp(in, "x.lp"); });
+    const std::string error = testing::InputErrorMessage([&] { ReadLp(in, "x.lp"); });
     EXPECT_NE(error.find(expected), std::string::npos) << "'" << text << "' gave '" << error << "'";
   }
 }
@@ -104,7 +95,7 @@ TEST(ObjectLightsBadInput, ErrorsNameTheFileAndTheImage) {
       {R"({"frame": "camera", "images": {}})", "frame"}};
   for (const auto& [text, expected] : cases) {
     std::istringstream in(text);
-    const std::string error = ErrorOf([&] { ReadObjectLights(in, "l.json"); });
+    const std::string error = testing::InputErrorMessage([&] { ReadObjectLights(in, "l.json"); });
     EXPECT_EQ(error.rfind("l.json", 0), 0u) << error;
     EXPECT_NE(error.find(expected), std::string::npos) << "'" << text << "' gave '" << error << "'";
   }
@@ -123,7 +114,8 @@ TEST(ObjectLightsBadInput, LightsForUnknownImagesAreRefused) {
   lights["a.png"] = {ObjectLight{}};
   EXPECT_EQ(CheckLightsAgainstModel(lights, r, "l.json"), std::vector<std::string>{"b.png"});
   lights["zzz.png"] = {ObjectLight{}};
-  const std::string error = ErrorOf([&] { CheckLightsAgainstModel(lights, r, "l.json"); });
+  const std::string error =
+      testing::InputErrorMessage([&] { CheckLightsAgainstModel(lights, r, "l.json"); });
   EXPECT_NE(error.find("zzz.png"), std::string::npos) << error;
 }
 
