@@ -30,6 +30,7 @@ class Arguments {
   std::string Require(const std::string& name) const;
   bool Has(const std::string& name) const;
   int GetInt(const std::string& name, int fallback) const;
+  double GetDouble(const std::string& name, double fallback) const;
 
  private:
   std::map<std::string, std::string> values_;
@@ -42,6 +43,8 @@ inline constexpr int kExitUsage = 2;       ///< bad command line
 
 /// `texlume inspect`: see docs/cli.md. Returns the exit code.
 int RunInspectCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// `texlume scene`: writes a synthetic heritage scene. Returns the exit code.
+int RunSceneCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 /// `texlume demo`: builds a synthetic scene and inspects it. Returns the exit code.
 int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 

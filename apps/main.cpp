@@ -19,6 +19,12 @@ constexpr const char* kUsage =
     "          [--max-buffer-size N]\n"
     "      Summarise a COLMAP model (.bin or .txt), check a mesh, lights and image\n"
     "      files, and report which triangles the photos see fully.\n"
+    "  scene --out DIR [--kind sphere|cylinder|plane|torus] [--material stone|brick|grooves]\n"
+    "        [--seed S] [--images N] [--camera-model pinhole|opencv] [--width W] [--height H]\n"
+    "        [--capture-size N] [--capture-lights N] [--held-out-lights N] [--held-out-views N]\n"
+    "        [--texel-size T] [--relief R] [--specular KS] [--samples N] [--no-btf]\n"
+    "        [--fixed-exposure]\n"
+    "      Write a synthetic heritage scene with ground truth (docs/synthetic_scenes.md).\n"
     "  demo [--out DIR] [--images N] [--seed S]\n"
     "      Generate a small synthetic scene and inspect it.\n"
     "  help, --help\n"
@@ -46,6 +52,7 @@ int main(int argc, char** argv) {
       return kExitOk;
     }
     if (command == "inspect") return RunInspectCommand(args, std::cout, std::cerr);
+    if (command == "scene") return RunSceneCommand(args, std::cout, std::cerr);
     if (command == "demo") return RunDemoCommand(args, std::cout, std::cerr);
     throw UsageError("unknown command '" + command + "'");
   } catch (const UsageError& e) {

@@ -26,90 +26,12 @@ void ObjectSceneOptions::Check() const {
   if (!(camera_distance > 1.5)) throw OptionError("camera_distance must be > 1.5");
   if (num_points < 0) throw OptionError("num_points must be >= 0");
   if (!(observation_noise_px >= 0.0)) throw OptionError("observation_noise_px must be >= 0");
+  if (max_lights_per_image < 1 || max_lights_per_image > 3) {
+    throw OptionError("max_lights_per_image must be in [1, 3]");
+  }
   if (camera_model != sfm::CameraModelId::kPinhole && camera_model != sfm::CameraModelId::kOpenCV) {
     throw OptionError("camera_model must be PINHOLE or OPENCV");
   }
-}
-
-sfm::TriangleMesh MakeIcosphere(int subdivisions, double radius) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  sfm::TriangleMesh mesh;
-  mesh.vertices = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
-                   {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
-  mesh.faces = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-  for (auto& v : mesh.vertices) v.normalize();
-  for (int level = 0; level < subdivisions; ++level) {
-    std::map<std::pair<int, int>, int> midpoint;
-    auto mid = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      const auto it = midpoint.find(key);
-      if (it != midpoint.end()) return it->second;
-      mesh.vertices.push_back(
-          (mesh.vertices[static_cast<std::size_t>(a)] + mesh.vertices[static_cast<std::size_t>(b)])
-              .normalized());
-      const int index = static_cast<int>(mesh.vertices.size()) - 1;
-      midpoint[key] = index;
-      return index;
-    };
-    std::vector<std::array<int, 3>> faces;
-    for (const auto& f : mesh.faces) {
-      const int a = mid(f[0], f[1]), b = mid(f[1], f[2]), c = mid(f[2], f[0]);
-      faces.push_back({f[0], a, c});
-      faces.push_back({f[1], b, a});
-      faces.push_back({f[2], c, b});
-      faces.push_back({a, b, c});
-    }
-    mesh.faces = std::move(faces);
-  }
-  for (auto& v : mesh.vertices) v *= radius;
-  return mesh;
-}
-
-sfm::TriangleMesh MakeCylinder(int around, int along, double radius, double height) {
-  sfm::TriangleMesh mesh;
-  for (int j = 0; j <= along; ++j) {
-    const double z = -height / 2 + height * j / along;
-    for (int i = 0; i < around; ++i) {
-      const double a = 2 * kPi * i / around;
-      mesh.vertices.emplace_back(radius * std::cos(a), radius * std::sin(a), z);
-    }
-  }
-  auto ring = [&](int i, int j) { return j * around + (i % around); };
-  for (int j = 0; j < along; ++j) {
-    for (int i = 0; i < around; ++i) {
-      mesh.faces.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
-      mesh.faces.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
-    }
-  }
-  const int bottom = static_cast<int>(mesh.vertices.size());
-  mesh.vertices.emplace_back(0, 0, -height / 2);
-  const int top = bottom + 1;
-  mesh.vertices.emplace_back(0, 0, height / 2);
-  for (int i = 0; i < around; ++i) {
-    mesh.faces.push_back({bottom, ring(i + 1, 0), ring(i, 0)});
-    mesh.faces.push_back({top, ring(i, along), ring(i + 1, along)});
-  }
-  return mesh;
-}
-
-sfm::TriangleMesh MakeGridPlane(int segments, double size) {
-  sfm::TriangleMesh mesh;
-  for (int j = 0; j <= segments; ++j) {
-    for (int i = 0; i <= segments; ++i) {
-      mesh.vertices.emplace_back(-size / 2 + size * i / segments, -size / 2 + size * j / segments,
-                                 0.0);
-    }
-  }
-  auto at = [&](int i, int j) { return j * (segments + 1) + i; };
-  for (int j = 0; j < segments; ++j) {
-    for (int i = 0; i < segments; ++i) {
-      mesh.faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
-      mesh.faces.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
-    }
-  }
-  return mesh;
 }
 
 sfm::Rigid3d LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target,
@@ -132,17 +54,24 @@ sfm::Rigid3d LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target
 ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
   options.Check();
   ObjectScene scene;
-  switch (options.shape) {
-    case SceneShape::kSphere:
-      scene.mesh = MakeIcosphere(options.resolution, 1.0);
-      break;
-    case SceneShape::kCylinder:
-      scene.mesh = MakeCylinder(8 * std::max(1, options.resolution),
-                                4 * std::max(1, options.resolution), 0.6, 1.6);
-      break;
-    case SceneShape::kPlane:
-      scene.mesh = MakeGridPlane(8 * std::max(1, options.resolution), 2.0);
-      break;
+  const int res = options.resolution;
+  if (res == 0) {
+    scene.mesh = CoarseMesh(options.shape);
+  } else {
+    switch (options.shape) {
+      case SceneShape::kSphere:
+        scene.mesh = MakeIcosphere(res, 1.0);
+        break;
+      case SceneShape::kCylinder:
+        scene.mesh = MakeCylinder(8 * res, 4 * res, 0.6, 1.6);
+        break;
+      case SceneShape::kPlane:
+        scene.mesh = MakeGridPlane(8 * res, 2.0);
+        break;
+      case SceneShape::kTorus:
+        scene.mesh = MakeTorus(16 * res, 8 * res, 0.8, 0.35);
+        break;
+    }
   }
   std::mt19937_64 rng(options.seed);
 
@@ -159,14 +88,19 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
   }
   scene.reconstruction.cameras[camera.camera_id] = camera;
 
-  // Two rings of cameras (elevations +35 and +10 degrees; the plane is seen from
-  // above only), each camera with a directional light from a random direction in
-  // the camera's hemisphere, raised above the horizon.
+  // A ring of cameras looking at the origin (the plane is seen from above only,
+  // the torus from higher up so its hole shows). Each photo gets 1 to
+  // max_lights_per_image directional lights from the camera's side of the object,
+  // 20 to 70 degrees above the horizon, with intensities summing to about 1.
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  // Elevation waves gently around the ring (neighbours stay close, as in a real
+  // photo set, while the set covers a band of elevations).
+  double mid = 22.0, amplitude = 12.0;
+  if (options.shape == SceneShape::kPlane) mid = 55.0, amplitude = 10.0;
+  if (options.shape == SceneShape::kTorus) mid = 38.0, amplitude = 12.0;
   for (int i = 0; i < options.num_images; ++i) {
     const double azimuth = 2 * kPi * i / options.num_images;
-    const double elevation =
-        (options.shape == SceneShape::kPlane ? 55.0 : (i % 2 ? 10.0 : 35.0)) * kPi / 180.0;
+    const double elevation = (mid + amplitude * std::sin(3.0 * azimuth)) * kPi / 180.0;
     const Eigen::Vector3d center =
         options.camera_distance * Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
                                                   std::cos(elevation) * std::sin(azimuth),
@@ -180,13 +114,19 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
     image.cam_from_world = LookAt(center, Eigen::Vector3d::Zero());
     scene.reconstruction.images[image.image_id] = image;
 
-    const double light_azimuth = azimuth + (uniform(rng) - 0.5) * kPi / 1.5;
-    const double light_elevation = (20.0 + 50.0 * uniform(rng)) * kPi / 180.0;
-    sfm::ObjectLight light;
-    light.direction_in_world = Eigen::Vector3d(std::cos(light_elevation) * std::cos(light_azimuth),
-                                               std::cos(light_elevation) * std::sin(light_azimuth),
-                                               std::sin(light_elevation));
-    scene.lights[image.name] = {light};
+    const int num_lights = 1 + static_cast<int>(uniform(rng) * options.max_lights_per_image);
+    std::vector<sfm::ObjectLight> lights;
+    for (int k = 0; k < num_lights; ++k) {
+      const double light_azimuth = azimuth + (uniform(rng) - 0.5) * kPi / 2.5;
+      const double light_elevation = (25.0 + 40.0 * uniform(rng)) * kPi / 180.0;
+      sfm::ObjectLight light;
+      light.direction_in_world = Eigen::Vector3d(
+          std::cos(light_elevation) * std::cos(light_azimuth),
+          std::cos(light_elevation) * std::sin(light_azimuth), std::sin(light_elevation));
+      light.intensity = (0.85 + 0.3 * uniform(rng)) / num_lights;
+      lights.push_back(light);
+    }
+    scene.lights[image.name] = lights;
   }
 
   // Sparse points on the surface, observed where their face is fully visible.

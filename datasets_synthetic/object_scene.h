@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "datasets_synthetic/shapes.h"
 #include "sfm/camera_models.h"
 #include "sfm/lights.h"
 #include "sfm/mesh.h"
@@ -10,18 +11,12 @@
 
 namespace texlume::datasets {
 
-/// Shapes of the synthetic objects (world frame: Z up, object centred at the origin).
-enum class SceneShape {
-  kSphere,    ///< icosphere of radius 1
-  kCylinder,  ///< capped cylinder of radius 0.6 and height 1.6 (a column)
-  kPlane,     ///< 2 x 2 grid in the z = 0 plane, facing +Z
-};
-
 /// Settings of MakeObjectScene. Defaults give a small scene in well under a second.
 struct ObjectSceneOptions {
   SceneShape shape = SceneShape::kSphere;
-  /// Mesh resolution: icosphere subdivision level (sphere), or segments / 8
-  /// around and along (cylinder, plane). Range [0, 7].
+  /// Mesh resolution: 0 takes the shape's standard coarse mesh (CoarseMesh);
+  /// 1..7 an icosphere subdivision level (sphere) or segments / 8 around and
+  /// along (cylinder, plane, torus).
   int resolution = 3;
   /// Number of photos, placed on two rings around the object. Range [1, 1000].
   int num_images = 16;
@@ -36,6 +31,8 @@ struct ObjectSceneOptions {
   int num_points = 1500;
   /// Standard deviation of the noise added to the 2D observations, pixels, >= 0.
   double observation_noise_px = 0.3;
+  /// Each photo is lit by 1 to this many directional lights (drawn per photo). [1, 3].
+  int max_lights_per_image = 1;
   std::uint32_t seed = 1;
 
   void Check() const;
@@ -55,12 +52,6 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options);
 /// Writes `dir/sparse` (COLMAP .bin), `dir/sparse_txt` (COLMAP .txt), `dir/mesh.ply`
 /// and `dir/lights.json`.
 void WriteObjectScene(const ObjectScene& scene, const std::filesystem::path& dir);
-
-/// Mesh generators (outward normals), also used by tests.
-sfm::TriangleMesh MakeIcosphere(int subdivisions, double radius);
-sfm::TriangleMesh MakeCylinder(int segments_around, int segments_along, double radius,
-                               double height);
-sfm::TriangleMesh MakeGridPlane(int segments, double size);
 
 /// The cam_from_world pose of a camera at `center_in_world` looking at
 /// `target_in_world` with world +Z up in the image (camera +Y down).

@@ -9,6 +9,7 @@ PACKAGES=(
   # libraries (see DESIGN.md, "Modules")
   libeigen3-dev libopenmesh-dev libopencv-dev libceres-dev libopenimageio-dev
   nlohmann-json3-dev libembree-dev
+  openimageio-tools  # its CMake package config refers to the OIIO tools
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # the real COLMAP program, used by the cross-check tests

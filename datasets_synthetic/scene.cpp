@@ -1,0 +1,445 @@
+#include "datasets_synthetic/scene.h"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <sstream>
+
+#include "datasets_synthetic/object_scene.h"
+#include "ptm/exr_io.h"
+#include "sfm/colmap_io.h"
+#include "sfm/errors.h"
+#include "sfm/file_util.h"
+
+namespace texlume::datasets {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr int kSampleMarginTexels = 24;  // geometry around the captured area casts shadows in
+
+Eigen::Vector3d FromAngles(double azimuth_rad, double elevation_rad) {
+  return {std::cos(elevation_rad) * std::cos(azimuth_rad),
+          std::cos(elevation_rad) * std::sin(azimuth_rad), std::sin(elevation_rad)};
+}
+
+// BTF view directions: straight down first, then rings at 60 and 35 degrees elevation.
+std::vector<Eigen::Vector3d> BtfViewDirections(int count) {
+  std::vector<Eigen::Vector3d> views = {Eigen::Vector3d::UnitZ()};
+  const int rest = count - 1;
+  const int high = (rest + 1) / 2, low = rest - high;
+  for (int i = 0; i < high; ++i) {
+    views.push_back(FromAngles(2 * kPi * i / high, 60.0 * kPi / 180.0));
+  }
+  for (int i = 0; i < low; ++i) {
+    views.push_back(FromAngles(2 * kPi * (i + 0.5) / low, 35.0 * kPi / 180.0));
+  }
+  return views;
+}
+
+class StageTimer {
+ public:
+  explicit StageTimer(SceneSummary& summary) : summary_(summary) {}
+  void Done(const std::string& stage) {
+    const auto now = std::chrono::steady_clock::now();
+    summary_.stage_seconds.emplace_back(stage, std::chrono::duration<double>(now - last_).count());
+    last_ = now;
+  }
+
+ private:
+  SceneSummary& summary_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+std::string Numbered(const char* pattern, int a, int b = 0) {
+  char name[64];
+  std::snprintf(name, sizeof(name), pattern, a, b);
+  return name;
+}
+
+nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+}  // namespace
+
+void SceneOptions::Check() const {
+  material.Check();
+  auto in = [](double v, double lo, double hi, const char* what) {
+    if (!(v >= lo && v <= hi)) {
+      throw OptionError(std::string(what) + " must be in [" + std::to_string(lo) + ", " +
+                        std::to_string(hi) + "]");
+    }
+  };
+  in(num_images, 3, 500, "num_images");
+  in(image_width, 64, 8192, "image_width");
+  in(image_height, 64, 8192, "image_height");
+  in(focal_px, 1, 1e6, "focal_px");
+  in(camera_distance, 1.6, 1000, "camera_distance");
+  in(max_lights_per_image, 1, 3, "max_lights_per_image");
+  in(num_held_out_views, 0, 100, "num_held_out_views");
+  in(held_out_lights_per_view, 1, 20, "held_out_lights_per_view");
+  in(capture_size, 16, 4096, "capture_size");
+  in(num_capture_lights, 6, 500, "num_capture_lights");
+  in(num_held_out_capture_lights, 0, 500, "num_held_out_capture_lights");
+  in(btf_size, 16, 1024, "btf_size");
+  in(btf_view_count, 1, 64, "btf_view_count");
+  in(btf_light_count, 1, 128, "btf_light_count");
+  in(tessellation_step, 0, 1, "tessellation_step");
+  in(shading.ambient, 0, 1, "ambient");
+  in(shading.samples_per_axis, 1, 8, "samples_per_axis");
+  if (camera_model != sfm::CameraModelId::kPinhole && camera_model != sfm::CameraModelId::kOpenCV) {
+    throw OptionError("camera_model must be PINHOLE or OPENCV");
+  }
+}
+
+std::vector<Eigen::Vector3d> DomeLights(int count, double min_elevation_deg,
+                                        double max_elevation_deg, double offset) {
+  std::vector<Eigen::Vector3d> lights;
+  if (count <= 0) return lights;
+  const int rings = std::max(1, static_cast<int>(std::round(std::sqrt(count / 1.6))));
+  std::vector<double> elevations, weights;
+  double total = 0;
+  for (int r = 0; r < rings; ++r) {
+    const double t = rings == 1 ? 0.5 : (r + 0.5 * offset) / (rings - 1 + 0.5 * offset);
+    const double e = min_elevation_deg + (max_elevation_deg - min_elevation_deg) * std::min(1.0, t);
+    elevations.push_back(e * kPi / 180.0);
+    weights.push_back(std::cos(e * kPi / 180.0));
+    total += weights.back();
+  }
+  // Ring sizes proportional to cos(elevation), at least one each, summing to count.
+  std::vector<int> sizes(static_cast<std::size_t>(rings), 1);
+  int assigned = rings;
+  while (assigned < count) {
+    std::size_t best = 0;
+    double best_deficit = -1e9;
+    for (std::size_t r = 0; r < sizes.size(); ++r) {
+      const double deficit = weights[r] / total * count - sizes[r];
+      if (deficit > best_deficit) best_deficit = deficit, best = r;
+    }
+    ++sizes[best];
+    ++assigned;
+  }
+  for (std::size_t r = 0; r < sizes.size() && static_cast<int>(lights.size()) < count; ++r) {
+    for (int i = 0; i < sizes[r] && static_cast<int>(lights.size()) < count; ++i) {
+      const double azimuth = 2 * kPi * (i + offset + 0.37 * static_cast<double>(r)) / sizes[r];
+      lights.push_back(FromAngles(azimuth, elevations[r]));
+    }
+  }
+  return lights;
+}
+
+void WritePngAtomically(const std::filesystem::path& path, const cv::Mat& image) {
+  std::vector<unsigned char> bytes;
+  if (!cv::imencode(".png", image, bytes)) {
+    throw std::runtime_error(path.string() + ": cannot encode PNG");
+  }
+  WriteFileAtomically(
+      path,
+      [&](std::ostream& out) {
+        out.write(reinterpret_cast<const char*>(bytes.data()),
+                  static_cast<std::streamsize>(bytes.size()));
+      },
+      true);
+}
+
+cv::Mat CoverageMask(const Rendering& rendering) {
+  cv::Mat mask;
+  cv::compare(rendering.coverage, 0.5, mask, cv::CMP_GE);
+  return mask;
+}
+
+SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::path& dir,
+                           const ProgressCallback& progress) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  SceneSummary summary;
+  summary.dir = dir;
+  StageTimer timer(summary);
+  auto report = [&](std::string_view stage, std::size_t done, std::size_t total) {
+    if (progress) progress(stage, done, total);
+  };
+  namespace fs = std::filesystem;
+  for (const char* sub :
+       {"material/capture", "material/held_out", "material/btf", "material/ground_truth",
+        "object/images", "object/masks", "object/held_out/images", "object/held_out/masks"}) {
+    fs::create_directories(dir / sub);
+  }
+  std::size_t files = 0;
+  const double texel = options.material.texel_size;
+
+  // ------------------------------------------------------------ material sample
+  const Material sample_material(options.material);
+  const double extent = options.capture_size * texel;
+  const double margin = kSampleMarginTexels * texel;
+  SurfacePatch sample_patch = ShapePatches(SceneShape::kPlane)[0];
+  sample_patch.u0 = sample_patch.v0 = -margin;
+  sample_patch.u1 = sample_patch.v1 = extent + margin;
+  const BakedMaterial sample_baked(sample_material, sample_patch.u0, sample_patch.u1,
+                                   sample_patch.v0, sample_patch.v1, false, false, texel);
+  const Renderer sample_renderer(DisplacePatches({sample_patch}, {&sample_baked}, texel),
+                                 {&sample_baked});
+  ShadingOptions capture_shading = options.shading;
+  capture_shading.exposure = 1.0;
+  auto capture_set = [&](const std::vector<Eigen::Vector3d>& lights, const fs::path& folder,
+                         const char* pattern, const std::string& stage) {
+    std::vector<sfm::LpEntry> entries;
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+      const Rendering r = sample_renderer.RenderOrthographic(
+          options.capture_size, options.capture_size, 0.0, extent, texel, Eigen::Vector3d::UnitZ(),
+          {{lights[i], 1.0}}, capture_shading);
+      const std::string name = Numbered(pattern, static_cast<int>(i));
+      WritePngAtomically(folder / name, LinearToSrgb8(r.linear_rgb));
+      entries.push_back({name, lights[i]});
+      ++files;
+      report(stage, i + 1, lights.size());
+    }
+    sfm::WriteLpFile(entries, folder / "lights.lp");
+    ++files;
+  };
+  capture_set(DomeLights(options.num_capture_lights, 15, 80, 0.0), dir / "material/capture",
+              "rti_%03d.png", "rti capture");
+  if (options.num_held_out_capture_lights > 0) {
+    capture_set(DomeLights(options.num_held_out_capture_lights, 20, 75, 0.5),
+                dir / "material/held_out", "rti_held_%03d.png", "rti held-out");
+  }
+  timer.Done("material_capture");
+
+  // Ground truth in the material frame, at the capture's texels (pixel centres).
+  {
+    const int n = options.capture_size;
+    cv::Mat albedo(n, n, CV_32FC3), height(n, n, CV_32FC1), normals(n, n, CV_32FC3);
+#pragma omp parallel for schedule(dynamic, 8)
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const double u = (x + 0.5) * texel, v = extent - (y + 0.5) * texel;
+        const Eigen::Vector3d a = sample_baked.Albedo(u, v);
+        const Eigen::Vector2d g = sample_baked.HeightGradient(u, v);
+        const Eigen::Vector3d nrm = Eigen::Vector3d(-g.x(), -g.y(), 1.0).normalized();
+        albedo.at<cv::Vec3f>(y, x) = cv::Vec3f(static_cast<float>(a.x()), static_cast<float>(a.y()),
+                                               static_cast<float>(a.z()));
+        height.at<float>(y, x) = static_cast<float>(sample_baked.Height(u, v));
+        normals.at<cv::Vec3f>(y, x) = cv::Vec3f(
+            static_cast<float>(nrm.x()), static_cast<float>(nrm.y()), static_cast<float>(nrm.z()));
+      }
+    }
+    std::vector<cv::Mat> a, nm;
+    cv::split(albedo, a);
+    cv::split(normals, nm);
+    const fs::path gt = dir / "material/ground_truth";
+    ptm::WriteExr(gt / "albedo.exr", a, {"R", "G", "B"});
+    ptm::WriteExr(gt / "height.exr", {height}, {"Y"});
+    ptm::WriteExr(gt / "normals.exr", nm, {"X", "Y", "Z"});
+    WritePngAtomically(gt / "albedo.png", LinearToSrgb8(albedo));
+    cv::Mat normals_png;
+    normals.convertTo(normals_png, CV_8UC3, 127.5, 127.5);
+    cv::cvtColor(normals_png, normals_png, cv::COLOR_RGB2BGR);
+    WritePngAtomically(gt / "normals.png", normals_png);
+    files += 5;
+  }
+  timer.Done("ground_truth");
+
+  // BTF: views x lights, rectified to the material frame.
+  nlohmann::json btf;
+  if (options.write_btf) {
+    const auto views = BtfViewDirections(options.btf_view_count);
+    const auto lights = DomeLights(options.btf_light_count, 20, 75, 0.25);
+    btf["texel_size"] = texel;
+    btf["size"] = options.btf_size;
+    btf["frame"] =
+        "material: x right (u), y up (v), z out of the sample; directions towards viewer/light";
+    btf["file_pattern"] = "view_%02d_light_%02d.png";
+    for (const auto& v : views) btf["views"].push_back(Vec(v));
+    for (const auto& l : lights) btf["lights"].push_back(Vec(l));
+    std::size_t done = 0;
+    for (std::size_t vi = 0; vi < views.size(); ++vi) {
+      for (std::size_t li = 0; li < lights.size(); ++li) {
+        const Rendering r = sample_renderer.RenderOrthographic(
+            options.btf_size, options.btf_size, 0.0, options.btf_size * texel, texel, views[vi],
+            {{lights[li], 1.0}}, capture_shading);
+        WritePngAtomically(
+            dir / "material/btf" /
+                Numbered("view_%02d_light_%02d.png", static_cast<int>(vi), static_cast<int>(li)),
+            LinearToSrgb8(r.linear_rgb));
+        ++files;
+        report("btf capture", ++done, views.size() * lights.size());
+      }
+    }
+    WriteFileAtomically(
+        dir / "material/btf/btf.json", [&](std::ostream& o) { o << btf.dump(2) << "\n"; }, false);
+    ++files;
+  }
+  timer.Done("btf_capture");
+
+  // --------------------------------------------------------------------- object
+  ObjectSceneOptions object_options;
+  object_options.shape = options.shape;
+  object_options.resolution = 0;
+  object_options.num_images = options.num_images;
+  object_options.image_width = options.image_width;
+  object_options.image_height = options.image_height;
+  object_options.focal_px = options.focal_px;
+  object_options.camera_distance = options.camera_distance;
+  object_options.camera_model = options.camera_model;
+  object_options.max_lights_per_image = options.max_lights_per_image;
+  object_options.seed = options.seed;
+  const ObjectScene object = MakeObjectScene(object_options);
+
+  const std::vector<SurfacePatch> patches = ShapePatches(options.shape);
+  std::vector<std::unique_ptr<BakedMaterial>> materials;
+  std::vector<const BakedMaterial*> material_ptrs;
+  for (const SurfacePatch& p : patches) {
+    const Material material(options.material, p.periodic_u ? p.u1 - p.u0 : 0.0,
+                            p.periodic_v ? p.v1 - p.v0 : 0.0);
+    materials.push_back(std::make_unique<BakedMaterial>(material, p.u0, p.u1, p.v0, p.v1,
+                                                        p.periodic_u, p.periodic_v, texel));
+    material_ptrs.push_back(materials.back().get());
+  }
+  const double step = options.tessellation_step > 0 ? options.tessellation_step : 2 * texel;
+  const Renderer renderer(DisplacePatches(patches, material_ptrs, step), material_ptrs);
+  summary.displaced_triangles = renderer.NumTriangles();
+  timer.Done("object_geometry");
+
+  std::mt19937_64 rng(options.seed * 31u + 7u);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  nlohmann::json photos = nlohmann::json::object();
+  const sfm::Camera& camera = object.reconstruction.cameras.begin()->second;
+  std::size_t done = 0;
+  for (const auto& [id, image] : object.reconstruction.images) {
+    ShadingOptions shading = options.shading;
+    shading.exposure = options.vary_exposure ? 0.8 + 0.4 * uniform(rng) : 1.0;
+    std::vector<RenderLight> lights;
+    for (const auto& l : object.lights.at(image.name)) {
+      lights.push_back({l.direction_in_world, l.intensity});
+    }
+    const Rendering r = renderer.RenderPerspective(camera, image.cam_from_world, lights, shading);
+    WritePngAtomically(dir / "object/images" / image.name, LinearToSrgb8(r.linear_rgb));
+    WritePngAtomically(dir / "object/masks" / image.name, CoverageMask(r));
+    photos[image.name] = {{"exposure", shading.exposure}, {"lights", lights.size()}};
+    files += 2;
+    report("object photos", ++done, object.reconstruction.images.size());
+  }
+  WriteObjectScene(object, dir / "object");
+  files += 9;
+  timer.Done("object_photos");
+
+  // Held-out views x held-out lights: ground truth for relighting from new views.
+  if (options.num_held_out_views > 0) {
+    sfm::Reconstruction held;
+    held.cameras = object.reconstruction.cameras;
+    sfm::ObjectLights held_lights;
+    std::uint32_t next_id = 1;
+    done = 0;
+    const std::size_t total =
+        static_cast<std::size_t>(options.num_held_out_views * options.held_out_lights_per_view);
+    const bool plane = options.shape == SceneShape::kPlane;
+    for (int v = 0; v < options.num_held_out_views; ++v) {
+      const double azimuth = 2 * kPi * (v + 0.5) / options.num_held_out_views + 0.2;
+      const double elevation = (plane ? 50.0 : 22.0) * kPi / 180.0;
+      const sfm::Rigid3d pose =
+          LookAt(options.camera_distance * FromAngles(azimuth, elevation), Eigen::Vector3d::Zero());
+      const auto dome = DomeLights(options.held_out_lights_per_view, 25, 65, 0.3);
+      for (int k = 0; k < options.held_out_lights_per_view; ++k) {
+        // The dome is turned towards the view so the visible side is lit.
+        const Eigen::Vector3d d = dome[static_cast<std::size_t>(k)];
+        const Eigen::Vector3d light = Eigen::AngleAxisd(azimuth, Eigen::Vector3d::UnitZ()) *
+                                      Eigen::Vector3d(std::abs(d.x()), d.y(), d.z());
+        sfm::Image image;
+        image.image_id = sfm::ImageId(next_id++);
+        image.camera_id = camera.camera_id;
+        image.name = Numbered("view_%02d_light_%02d.png", v, k);
+        image.cam_from_world = pose;
+        held.images[image.image_id] = image;
+        sfm::ObjectLight object_light;
+        object_light.direction_in_world = light.normalized();
+        held_lights[image.name] = {object_light};
+        ShadingOptions shading = options.shading;
+        shading.exposure = 1.0;
+        const Rendering r =
+            renderer.RenderPerspective(camera, pose, {{light.normalized(), 1.0}}, shading);
+        WritePngAtomically(dir / "object/held_out/images" / image.name,
+                           LinearToSrgb8(r.linear_rgb));
+        WritePngAtomically(dir / "object/held_out/masks" / image.name, CoverageMask(r));
+        files += 2;
+        report("held-out views", ++done, total);
+      }
+    }
+    sfm::WriteModel(held, dir / "object/held_out/sparse", sfm::ModelFormat::kBinary);
+    sfm::WriteModel(held, dir / "object/held_out/sparse_txt", sfm::ModelFormat::kText);
+    sfm::WriteObjectLightsFile(held_lights, dir / "object/held_out/lights.json");
+    files += 7;
+  }
+  timer.Done("held_out_views");
+
+  // ------------------------------------------------------------ records
+  summary.seconds_total =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  nlohmann::json record;
+  record["generator"] = "texlume scene";
+  record["shape"] = SceneShapeName(options.shape);
+  record["material"] = {{"kind", MaterialKindName(options.material.kind)},
+                        {"texel_size", texel},
+                        {"relief_height", options.material.relief_height},
+                        {"feature_scale", options.material.feature_scale},
+                        {"specular", options.material.specular},
+                        {"shininess", options.material.shininess}};
+  record["seed"] = options.seed;
+  record["units"] = "world units of the COLMAP model (the shapes are about 2 units across)";
+  record["camera"] = {{"model", sfm::CameraModelName(options.camera_model)},
+                      {"width", options.image_width},
+                      {"height", options.image_height},
+                      {"focal_px", options.focal_px},
+                      {"distance", options.camera_distance}};
+  record["shading"] = {
+      {"ambient", options.shading.ambient},
+      {"samples_per_pixel", options.shading.samples_per_axis * options.shading.samples_per_axis},
+      {"shadows", options.shading.shadows}};
+  record["capture"] = {{"size", options.capture_size},
+                       {"lights", options.num_capture_lights},
+                       {"held_out_lights", options.num_held_out_capture_lights}};
+  record["photos"] = photos;
+  record["displaced_triangles"] = summary.displaced_triangles;
+  record["tessellation_step"] = step;
+  for (const auto& [stage, s] : summary.stage_seconds) record["timings_s"][stage] = s;
+  record["timings_s"]["total"] = summary.seconds_total;
+  WriteFileAtomically(
+      dir / "scene.json", [&](std::ostream& o) { o << record.dump(2) << "\n"; }, false);
+  ++files;
+
+  std::ostringstream manifest;
+  manifest << "# Synthetic texlume scene: " << MaterialKindName(options.material.kind) << " "
+           << SceneShapeName(options.shape) << " (seed " << options.seed << ")\n\n"
+           << "Generated by `texlume scene`; layout and conventions in texlume's "
+              "docs/synthetic_scenes.md. Settings and timings: `scene.json`.\n\n"
+           << "| path | what |\n| --- | --- |\n"
+           << "| `material/capture/rti_NNN.png`, `lights.lp` | RTI capture of the flat sample: "
+           << options.capture_size << "x" << options.capture_size << " texels of " << texel
+           << " world units, orthographic from above, " << options.num_capture_lights
+           << " directional lights (8-bit sRGB) |\n"
+           << "| `material/held_out/` | the same sample under "
+           << options.num_held_out_capture_lights << " other lights, for leave-out tests |\n"
+           << "| `material/btf/view_VV_light_LL.png`, `btf.json` | BTF capture, views x lights, "
+              "rectified to the material frame |\n"
+           << "| `material/ground_truth/` | albedo (linear EXR, sRGB PNG), height (EXR, world "
+              "units), normals (EXR, material frame; PNG as 0.5 + 0.5 n) |\n"
+           << "| `object/images/`, `object/masks/` | " << options.num_images
+           << " photos of the displaced " << SceneShapeName(options.shape)
+           << " and their object masks |\n"
+           << "| `object/sparse/`, `object/sparse_txt/` | the COLMAP model (binary, text) |\n"
+           << "| `object/lights.json` | object lights per photo (world frame) |\n"
+           << "| `object/mesh.ply` | the coarse undisplaced mesh, in the model's frame |\n"
+           << "| `object/held_out/` | held-out views x held-out lights: images, masks, COLMAP "
+              "model, lights |\n\n"
+           << "Light directions point from the surface to the light. In `.lp` files: x right, y "
+              "up, z out of the sample. In JSON: world frame (Z up).\n";
+  WriteFileAtomically(
+      dir / "MANIFEST.md", [&](std::ostream& o) { o << manifest.str(); }, false);
+  ++files;
+  summary.num_files = files;
+  return summary;
+}
+
+}  // namespace texlume::datasets

@@ -1,0 +1,82 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "datasets_synthetic/material.h"
+#include "datasets_synthetic/renderer.h"
+#include "datasets_synthetic/shapes.h"
+#include "sfm/camera_models.h"
+#include "sfm/lights.h"
+#include "sfm/progress.h"
+
+namespace texlume::datasets {
+
+/// Settings of a complete synthetic heritage scene (docs/synthetic_scenes.md):
+/// a material sample with its RTI and BTF captures and ground-truth maps, and an
+/// object of that material photographed under known lights, with its COLMAP model.
+struct SceneOptions {
+  SceneShape shape = SceneShape::kSphere;
+  MaterialOptions material;
+
+  // Object photos.
+  int num_images = 36;           ///< [3, 500]; 10-degree steps let COLMAP register them all
+  int image_width = 640;         ///< pixels, [64, 8192]
+  int image_height = 480;        ///< pixels, [64, 8192]
+  double focal_px = 600.0;       ///< pixels
+  double camera_distance = 3.5;  ///< world units from the origin
+  sfm::CameraModelId camera_model = sfm::CameraModelId::kPinhole;  ///< PINHOLE or OPENCV
+  int max_lights_per_image = 3;  ///< each photo has 1..this many directional lights, [1, 3]
+  /// Per-photo exposure drawn in [0.8, 1.2] (recorded in scene.json); off: 1 for all.
+  bool vary_exposure = true;
+  int num_held_out_views = 4;        ///< [0, 100]
+  int held_out_lights_per_view = 3;  ///< [1, 20]
+
+  // Material sample captures (orthographic, rectified to the material frame).
+  int capture_size = 256;                ///< texels per side, [16, 4096]
+  int num_capture_lights = 40;           ///< RTI dome, [6, 500]
+  int num_held_out_capture_lights = 10;  ///< [0, 500]
+  bool write_btf = true;
+  int btf_size = 128;        ///< texels per side, [16, 1024]
+  int btf_view_count = 6;    ///< [1, 64]
+  int btf_light_count = 12;  ///< [1, 128]
+
+  /// Edge length of the displaced geometry's triangles, world units; 0 = 2 texels.
+  double tessellation_step = 0.0;
+  ShadingOptions shading;
+  std::uint32_t seed = 1;
+
+  void Check() const;
+};
+
+/// What GenerateScene wrote.
+struct SceneSummary {
+  std::filesystem::path dir;
+  std::size_t num_files = 0;
+  std::size_t displaced_triangles = 0;  ///< of the object geometry
+  double seconds_total = 0.0;
+  std::vector<std::pair<std::string, double>> stage_seconds;
+};
+
+/// Directional lights on a dome: `count` directions in rings between the given
+/// elevations (degrees), ring sizes proportional to cos(elevation); `offset`
+/// in [0, 1) shifts azimuths and elevations by that share of a step, so a second
+/// dome with offset 0.5 interleaves with the first (held-out lights).
+/// Directions are in the material frame (x right, y up, z out of the surface).
+std::vector<Eigen::Vector3d> DomeLights(int count, double min_elevation_deg,
+                                        double max_elevation_deg, double offset);
+
+/// Writes the complete scene folder (layout in docs/synthetic_scenes.md) into
+/// `dir`. Deterministic: the same options give the same bytes.
+SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::path& dir,
+                           const ProgressCallback& progress = {});
+
+/// Writes an image as PNG atomically (temporary name, then rename).
+void WritePngAtomically(const std::filesystem::path& path, const cv::Mat& image);
+
+/// The mask of a rendering: 255 where at least half of a pixel's samples hit.
+cv::Mat CoverageMask(const Rendering& rendering);
+
+}  // namespace texlume::datasets

@@ -1,0 +1,263 @@
+#include "datasets_synthetic/shapes.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+namespace texlume::datasets {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Shape dimensions (world units).
+constexpr double kSphereRadius = 1.0;
+constexpr double kCylinderRadius = 0.6;
+constexpr double kCylinderHeight = 1.6;
+constexpr double kPlaneSize = 2.0;
+constexpr double kTorusMajor = 0.8;
+constexpr double kTorusMinor = 0.35;
+
+SurfacePoint Complete(SurfacePoint p) {
+  const Eigen::Vector3d n = p.d_du.cross(p.d_dv);
+  if (n.norm() > 1e-12) p.normal = n.normalized();
+  return p;
+}
+
+}  // namespace
+
+std::string_view SceneShapeName(SceneShape shape) {
+  switch (shape) {
+    case SceneShape::kSphere:
+      return "sphere";
+    case SceneShape::kCylinder:
+      return "cylinder";
+    case SceneShape::kPlane:
+      return "plane";
+    case SceneShape::kTorus:
+      return "torus";
+  }
+  return "?";
+}
+
+std::optional<SceneShape> SceneShapeFromName(std::string_view name) {
+  for (auto s :
+       {SceneShape::kSphere, SceneShape::kCylinder, SceneShape::kPlane, SceneShape::kTorus}) {
+    if (SceneShapeName(s) == name) return s;
+  }
+  return std::nullopt;
+}
+
+std::vector<SurfacePatch> ShapePatches(SceneShape shape) {
+  std::vector<SurfacePatch> patches;
+  switch (shape) {
+    case SceneShape::kPlane: {
+      SurfacePatch p;
+      p.u0 = p.v0 = -kPlaneSize / 2;
+      p.u1 = p.v1 = kPlaneSize / 2;
+      p.eval = [](double u, double v) {
+        SurfacePoint s;
+        s.position = {u, v, 0};
+        return s;
+      };
+      patches.push_back(p);
+      break;
+    }
+    case SceneShape::kSphere: {
+      // u = R * longitude (wraps), v = R * latitude: isometric along meridians and
+      // the equator, stretched towards the poles.
+      SurfacePatch p;
+      p.u0 = 0;
+      p.u1 = 2 * kPi * kSphereRadius;
+      p.v0 = -kPi / 2 * kSphereRadius;
+      p.v1 = kPi / 2 * kSphereRadius;
+      p.periodic_u = true;
+      p.eval = [](double u, double v) {
+        const double phi = u / kSphereRadius, lat = v / kSphereRadius;
+        SurfacePoint s;
+        s.position = kSphereRadius * Eigen::Vector3d(std::cos(lat) * std::cos(phi),
+                                                     std::cos(lat) * std::sin(phi), std::sin(lat));
+        s.d_du = Eigen::Vector3d(-std::cos(lat) * std::sin(phi), std::cos(lat) * std::cos(phi), 0);
+        s.d_dv = Eigen::Vector3d(-std::sin(lat) * std::cos(phi), -std::sin(lat) * std::sin(phi),
+                                 std::cos(lat));
+        s = Complete(s);
+        s.normal = s.position.normalized();
+        return s;
+      };
+      patches.push_back(p);
+      break;
+    }
+    case SceneShape::kCylinder: {
+      SurfacePatch side;
+      side.u0 = 0;
+      side.u1 = 2 * kPi * kCylinderRadius;
+      side.v0 = -kCylinderHeight / 2;
+      side.v1 = kCylinderHeight / 2;
+      side.periodic_u = true;
+      side.eval = [](double u, double v) {
+        const double phi = u / kCylinderRadius;
+        SurfacePoint s;
+        s.position = {kCylinderRadius * std::cos(phi), kCylinderRadius * std::sin(phi), v};
+        s.d_du = {-std::sin(phi), std::cos(phi), 0};
+        s.d_dv = {0, 0, 1};
+        return Complete(s);
+      };
+      patches.push_back(side);
+      for (int top = 0; top < 2; ++top) {
+        SurfacePatch cap;
+        cap.domain = SurfacePatch::Domain::kDisk;
+        cap.u0 = cap.v0 = -kCylinderRadius;
+        cap.u1 = cap.v1 = kCylinderRadius;
+        cap.eval = [top](double u, double v) {
+          SurfacePoint s;
+          // Top: (u, v) = (x, y); bottom: (u, v) = (x, -y) so that d_du x d_dv = -Z.
+          s.position = {u, top ? v : -v, top ? kCylinderHeight / 2 : -kCylinderHeight / 2};
+          s.d_du = {1, 0, 0};
+          s.d_dv = {0, top ? 1.0 : -1.0, 0};
+          return Complete(s);
+        };
+        patches.push_back(cap);
+      }
+      break;
+    }
+    case SceneShape::kTorus: {
+      SurfacePatch p;
+      p.u0 = 0;
+      p.u1 = 2 * kPi * kTorusMajor;
+      p.v0 = 0;
+      p.v1 = 2 * kPi * kTorusMinor;
+      p.periodic_u = p.periodic_v = true;
+      p.eval = [](double u, double v) {
+        const double phi = u / kTorusMajor, theta = v / kTorusMinor;
+        const double ring = kTorusMajor + kTorusMinor * std::cos(theta);
+        SurfacePoint s;
+        s.position = {ring * std::cos(phi), ring * std::sin(phi), kTorusMinor * std::sin(theta)};
+        s.d_du = (ring / kTorusMajor) * Eigen::Vector3d(-std::sin(phi), std::cos(phi), 0);
+        s.d_dv = {-std::sin(theta) * std::cos(phi), -std::sin(theta) * std::sin(phi),
+                  std::cos(theta)};
+        return Complete(s);
+      };
+      patches.push_back(p);
+      break;
+    }
+  }
+  return patches;
+}
+
+sfm::TriangleMesh CoarseMesh(SceneShape shape) {
+  switch (shape) {
+    case SceneShape::kSphere:
+      return MakeIcosphere(3, kSphereRadius);
+    case SceneShape::kCylinder:
+      return MakeCylinder(48, 12, kCylinderRadius, kCylinderHeight);
+    case SceneShape::kPlane:
+      return MakeGridPlane(16, kPlaneSize);
+    case SceneShape::kTorus:
+      return MakeTorus(48, 20, kTorusMajor, kTorusMinor);
+  }
+  return {};
+}
+
+sfm::TriangleMesh MakeTorus(int around, int tube, double major, double minor) {
+  sfm::TriangleMesh mesh;
+  for (int j = 0; j < tube; ++j) {
+    const double theta = 2 * kPi * j / tube;
+    for (int i = 0; i < around; ++i) {
+      const double phi = 2 * kPi * i / around;
+      const double ring = major + minor * std::cos(theta);
+      mesh.vertices.emplace_back(ring * std::cos(phi), ring * std::sin(phi),
+                                 minor * std::sin(theta));
+    }
+  }
+  auto at = [&](int i, int j) { return (j % tube) * around + (i % around); };
+  for (int j = 0; j < tube; ++j) {
+    for (int i = 0; i < around; ++i) {
+      mesh.faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      mesh.faces.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  }
+  return mesh;
+}
+
+sfm::TriangleMesh MakeIcosphere(int subdivisions, double radius) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  sfm::TriangleMesh mesh;
+  mesh.vertices = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                   {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  mesh.faces = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  for (auto& v : mesh.vertices) v.normalize();
+  for (int level = 0; level < subdivisions; ++level) {
+    std::map<std::pair<int, int>, int> midpoint;
+    auto mid = [&](int a, int b) {
+      const auto key = std::minmax(a, b);
+      const auto it = midpoint.find(key);
+      if (it != midpoint.end()) return it->second;
+      mesh.vertices.push_back(
+          (mesh.vertices[static_cast<std::size_t>(a)] + mesh.vertices[static_cast<std::size_t>(b)])
+              .normalized());
+      const int index = static_cast<int>(mesh.vertices.size()) - 1;
+      midpoint[key] = index;
+      return index;
+    };
+    std::vector<std::array<int, 3>> faces;
+    for (const auto& f : mesh.faces) {
+      const int a = mid(f[0], f[1]), b = mid(f[1], f[2]), c = mid(f[2], f[0]);
+      faces.push_back({f[0], a, c});
+      faces.push_back({f[1], b, a});
+      faces.push_back({f[2], c, b});
+      faces.push_back({a, b, c});
+    }
+    mesh.faces = std::move(faces);
+  }
+  for (auto& v : mesh.vertices) v *= radius;
+  return mesh;
+}
+
+sfm::TriangleMesh MakeCylinder(int around, int along, double radius, double height) {
+  sfm::TriangleMesh mesh;
+  for (int j = 0; j <= along; ++j) {
+    const double z = -height / 2 + height * j / along;
+    for (int i = 0; i < around; ++i) {
+      const double a = 2 * kPi * i / around;
+      mesh.vertices.emplace_back(radius * std::cos(a), radius * std::sin(a), z);
+    }
+  }
+  auto ring = [&](int i, int j) { return j * around + (i % around); };
+  for (int j = 0; j < along; ++j) {
+    for (int i = 0; i < around; ++i) {
+      mesh.faces.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
+      mesh.faces.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
+    }
+  }
+  const int bottom = static_cast<int>(mesh.vertices.size());
+  mesh.vertices.emplace_back(0, 0, -height / 2);
+  const int top = bottom + 1;
+  mesh.vertices.emplace_back(0, 0, height / 2);
+  for (int i = 0; i < around; ++i) {
+    mesh.faces.push_back({bottom, ring(i + 1, 0), ring(i, 0)});
+    mesh.faces.push_back({top, ring(i, along), ring(i + 1, along)});
+  }
+  return mesh;
+}
+
+sfm::TriangleMesh MakeGridPlane(int segments, double size) {
+  sfm::TriangleMesh mesh;
+  for (int j = 0; j <= segments; ++j) {
+    for (int i = 0; i <= segments; ++i) {
+      mesh.vertices.emplace_back(-size / 2 + size * i / segments, -size / 2 + size * j / segments,
+                                 0.0);
+    }
+  }
+  auto at = [&](int i, int j) { return j * (segments + 1) + i; };
+  for (int j = 0; j < segments; ++j) {
+    for (int i = 0; i < segments; ++i) {
+      mesh.faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      mesh.faces.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  }
+  return mesh;
+}
+
+}  // namespace texlume::datasets

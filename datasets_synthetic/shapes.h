@@ -1,0 +1,57 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "sfm/mesh.h"
+
+namespace texlume::datasets {
+
+/// Shapes of the synthetic objects (world frame: Z up, object centred at the origin).
+enum class SceneShape {
+  kSphere,    ///< sphere of radius 1
+  kCylinder,  ///< capped column of radius 0.6 and height 1.6
+  kPlane,     ///< 2 x 2 square in the z = 0 plane, facing +Z
+  kTorus,     ///< torus of radii 0.8 and 0.35 around Z (the less regular shape)
+};
+std::string_view SceneShapeName(SceneShape shape);  ///< "sphere", "cylinder", "plane", "torus"
+std::optional<SceneShape> SceneShapeFromName(std::string_view name);
+
+/// A point of the undisplaced (base) surface with its derivatives with respect to
+/// the material coordinates (u, v), which are world units along the surface.
+struct SurfacePoint {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit, outwards; = d_du x d_dv normalised
+  Eigen::Vector3d d_du = Eigen::Vector3d::UnitX();    ///< dS/du
+  Eigen::Vector3d d_dv = Eigen::Vector3d::UnitY();    ///< dS/dv
+};
+
+/// One parametric piece of a shape's base surface and its material domain.
+struct SurfacePatch {
+  enum class Domain { kRectangle, kDisk };
+  Domain domain = Domain::kRectangle;
+  double u0 = 0, u1 = 1, v0 = 0, v1 = 1;  ///< material-coordinate bounds (world units)
+  bool periodic_u = false;                ///< u wraps: period u1 - u0
+  bool periodic_v = false;                ///< v wraps: period v1 - v0
+  /// kDisk: the patch is the disk inscribed in the rectangle.
+  std::function<SurfacePoint(double u, double v)> eval;
+};
+
+/// The base surface of a shape as patches (a cylinder: side and two caps).
+std::vector<SurfacePatch> ShapePatches(SceneShape shape);
+
+/// The coarse, undisplaced, low-poly mesh of a shape (what a mesher would give).
+sfm::TriangleMesh CoarseMesh(SceneShape shape);
+
+/// Mesh generators (outward normals), also used by tests.
+sfm::TriangleMesh MakeIcosphere(int subdivisions, double radius);
+sfm::TriangleMesh MakeCylinder(int segments_around, int segments_along, double radius,
+                               double height);
+sfm::TriangleMesh MakeGridPlane(int segments, double size);
+sfm::TriangleMesh MakeTorus(int segments_around, int segments_tube, double major_radius,
+                            double minor_radius);
+
+}  // namespace texlume::datasets

@@ -1,0 +1,78 @@
+#include "ptm/exr_io.h"
+
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include <stdexcept>
+
+#include "sfm/errors.h"
+
+namespace texlume::ptm {
+
+void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& planes,
+              const std::vector<std::string>& channel_names) {
+  if (planes.empty() || planes.size() != channel_names.size()) {
+    throw std::invalid_argument("WriteExr: one name per plane");
+  }
+  const int width = planes[0].cols, height = planes[0].rows;
+  for (const cv::Mat& p : planes) {
+    if (p.type() != CV_32FC1 || p.cols != width || p.rows != height) {
+      throw std::invalid_argument("WriteExr: planes must be CV_32FC1 of one size");
+    }
+  }
+  const int channels = static_cast<int>(planes.size());
+  std::vector<float> interleaved(static_cast<std::size_t>(width) * height * channels);
+  for (int y = 0; y < height; ++y) {
+    for (int c = 0; c < channels; ++c) {
+      const float* row = planes[static_cast<std::size_t>(c)].ptr<float>(y);
+      for (int x = 0; x < width; ++x) {
+        interleaved[(static_cast<std::size_t>(y) * width + x) * channels + c] = row[x];
+      }
+    }
+  }
+  const std::filesystem::path tmp =
+      path.parent_path() / (path.stem().string() + ".tmp-" + std::to_string(::getpid()) + ".exr");
+  auto out = OIIO::ImageOutput::create(tmp.string());
+  if (!out) throw std::runtime_error(path.string() + ": OpenImageIO cannot write EXR");
+  OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
+  spec.channelnames = channel_names;
+  spec.attribute("compression", "zip");
+  const bool ok = out->open(tmp.string(), spec) &&
+                  out->write_image(OIIO::TypeDesc::FLOAT, interleaved.data()) && out->close();
+  if (!ok) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(path.string() + ": cannot write EXR: " + out->geterror());
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
+                             std::vector<std::string>* channel_names) {
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) throw InputError(path.string(), "cannot open image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.width > (1 << 16) ||
+      spec.height > (1 << 16) || spec.nchannels > 64) {
+    throw InputError(path.string(), "implausible image size or channel count");
+  }
+  std::vector<float> data(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data())) {
+    throw InputError(path.string(), "cannot read pixels: " + in->geterror());
+  }
+  std::vector<cv::Mat> planes;
+  for (int c = 0; c < spec.nchannels; ++c) {
+    cv::Mat p(spec.height, spec.width, CV_32FC1);
+    for (int y = 0; y < spec.height; ++y) {
+      float* row = p.ptr<float>(y);
+      for (int x = 0; x < spec.width; ++x) {
+        row[x] = data[(static_cast<std::size_t>(y) * spec.width + x) * spec.nchannels + c];
+      }
+    }
+    planes.push_back(p);
+  }
+  if (channel_names) *channel_names = spec.channelnames;
+  return planes;
+}
+
+}  // namespace texlume::ptm

@@ -1,0 +1,21 @@
+#pragma once
+
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace texlume::ptm {
+
+/// Writes a float image (CV_32FC1..CV_32FC4, or a vector of CV_32FC1 planes) as a
+/// lossless (ZIP-compressed) OpenEXR file with the given channel names, through
+/// OpenImageIO, atomically. Throws std::runtime_error naming the file on failure.
+void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& planes,
+              const std::vector<std::string>& channel_names);
+
+/// Reads every channel of an EXR (or any OpenImageIO-readable) file as float
+/// planes, and their names. Throws InputError naming the file.
+std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
+                             std::vector<std::string>* channel_names = nullptr);
+
+}  // namespace texlume::ptm

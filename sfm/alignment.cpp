@@ -1,0 +1,55 @@
+#include "sfm/alignment.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace texlume::sfm {
+
+SimilarityAlignment AlignByCameraCenters(const Reconstruction& reference,
+                                         const Reconstruction& estimate) {
+  std::map<std::string, const Image*> by_name;
+  for (const auto& [id, image] : reference.images) by_name[image.name] = &image;
+  std::vector<std::pair<const Image*, const Image*>> pairs;  // (reference, estimate)
+  for (const auto& [id, image] : estimate.images) {
+    const auto it = by_name.find(image.name);
+    if (it != by_name.end()) pairs.emplace_back(it->second, &image);
+  }
+  if (pairs.size() < 3) {
+    throw std::invalid_argument("alignment needs at least 3 images common to both models, found " +
+                                std::to_string(pairs.size()));
+  }
+  Eigen::Matrix3Xd src(3, static_cast<Eigen::Index>(pairs.size()));
+  Eigen::Matrix3Xd dst(3, static_cast<Eigen::Index>(pairs.size()));
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    dst.col(static_cast<Eigen::Index>(i)) = pairs[i].first->ProjectionCenter();
+    src.col(static_cast<Eigen::Index>(i)) = pairs[i].second->ProjectionCenter();
+  }
+  const Eigen::Matrix4d t = Eigen::umeyama(src, dst, true);
+  SimilarityAlignment a;
+  a.num_matched = pairs.size();
+  a.scale = t.block<3, 1>(0, 0).norm();
+  a.rotation = t.block<3, 3>(0, 0) / a.scale;
+  a.translation = t.block<3, 1>(0, 3);
+  double sum_sq = 0.0;
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const Eigen::Vector3d aligned =
+        a.scale * a.rotation * src.col(static_cast<Eigen::Index>(i)) + a.translation;
+    const double e = (aligned - dst.col(static_cast<Eigen::Index>(i))).norm();
+    sum_sq += e * e;
+    a.max_center_error = std::max(a.max_center_error, e);
+    // R_ref_cam_from_world should equal R_est_cam_from_world * rotation^T.
+    const Eigen::Matrix3d r_ref = pairs[i].first->cam_from_world.rotation.toRotationMatrix();
+    const Eigen::Matrix3d r_est =
+        pairs[i].second->cam_from_world.rotation.toRotationMatrix() * a.rotation.transpose();
+    const double angle = Eigen::AngleAxisd(r_ref * r_est.transpose()).angle();
+    a.max_rotation_error_deg = std::max(a.max_rotation_error_deg, angle * 180.0 / M_PI);
+  }
+  a.rms_center_error = std::sqrt(sum_sq / static_cast<double>(pairs.size()));
+  return a;
+}
+
+}  // namespace texlume::sfm
