@@ -37,6 +37,8 @@ void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& pla
   OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
   spec.channelnames = channel_names;
   spec.attribute("compression", "zip");
+  // No capture date: the same data must give the same bytes.
+  spec.attribute("DateTime", "");
   const bool ok = out->open(tmp.string(), spec) &&
                   out->write_image(OIIO::TypeDesc::FLOAT, interleaved.data()) && out->close();
   if (!ok) {
