@@ -152,38 +152,50 @@ int RunSceneCommand(const std::vector<std::string>& args, std::ostream& out,
 }
 
 int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& /*err*/) {
-  const Arguments a(args, {"out", "images", "seed"}, {});
+  const Arguments a(args, {"out", "seed", "kind", "material"}, {});
   const std::filesystem::path dir = a.Get("out").value_or("texlume_demo");
-  datasets::ObjectSceneOptions scene_options;
-  scene_options.num_images = a.GetInt("images", scene_options.num_images);
-  scene_options.seed = static_cast<std::uint32_t>(a.GetInt("seed", 1));
-  scene_options.Check();
+  datasets::SceneOptions options;
+  options.seed = static_cast<std::uint32_t>(a.GetInt("seed", 1));
+  options.material.seed = options.seed;
+  const std::string kind = a.Get("kind").value_or("sphere");
+  const std::string material = a.Get("material").value_or("stone");
+  if (!datasets::SceneShapeFromName(kind)) throw UsageError("--kind: unknown shape '" + kind + "'");
+  if (!datasets::MaterialKindFromName(material)) {
+    throw UsageError("--material: unknown material '" + material + "'");
+  }
+  options.shape = *datasets::SceneShapeFromName(kind);
+  options.material.kind = *datasets::MaterialKindFromName(material);
+  options.Check();
 
-  const auto t0 = std::chrono::steady_clock::now();
-  const datasets::ObjectScene scene = datasets::MakeObjectScene(scene_options);
-  datasets::WriteObjectScene(scene, dir);
-  const auto t1 = std::chrono::steady_clock::now();
-  out << "Synthetic scene written to " << dir.string() << " (sparse/, sparse_txt/, mesh.ply, "
-      << "lights.json)\n\n";
-
-  sfm::InspectOptions options;
-  options.model_dir = dir / "sparse";
-  options.mesh = dir / "mesh.ply";
-  options.lights = dir / "lights.json";
   ProgressBar bar;
-  const sfm::InspectReport report = sfm::RunInspect(options, bar.Callback());
+  const auto t0 = std::chrono::steady_clock::now();
+  out << "1. A synthetic heritage scene: a " << material << " " << kind
+      << " photographed under known lights, and an RTI capture of the " << material
+      << " sample (texlume scene)\n";
+  const datasets::SceneSummary scene =
+      datasets::GenerateScene(options, dir / "scene", bar.Callback());
+  out << "   " << scene.num_files << " files in " << (dir / "scene").string() << " ("
+      << scene.seconds_total << " s); see MANIFEST.md there\n\n";
+  const auto t1 = std::chrono::steady_clock::now();
+
+  sfm::InspectOptions inspect;
+  inspect.model_dir = dir / "scene/object/sparse";
+  inspect.mesh = dir / "scene/object/mesh.ply";
+  inspect.lights = dir / "scene/object/lights.json";
+  inspect.images_dir = dir / "scene/object/images";
+  out << "2. texlume inspect --model " << inspect.model_dir.string() << " --mesh "
+      << inspect.mesh->string() << " --lights " << inspect.lights->string() << " --images "
+      << inspect.images_dir->string() << "\n";
+  const sfm::InspectReport report = sfm::RunInspect(inspect, bar.Callback());
   const auto t2 = std::chrono::steady_clock::now();
-  out << "texlume inspect --model " << options.model_dir.string() << " --mesh "
-      << options.mesh->string() << " --lights " << options.lights->string() << "\n";
   out << sfm::FormatInspectReport(report);
 
   nlohmann::json run;
   run["command"] = "demo";
-  run["settings"] = {{"shape", "sphere"},
-                     {"resolution", scene_options.resolution},
-                     {"num_images", scene_options.num_images},
-                     {"image_size", {scene_options.image_width, scene_options.image_height}},
-                     {"seed", scene_options.seed}};
+  run["settings"] = {{"shape", kind},
+                     {"material", material},
+                     {"seed", options.seed},
+                     {"num_images", options.num_images}};
   run["timings_s"] = {{"scene", std::chrono::duration<double>(t1 - t0).count()},
                       {"inspect", std::chrono::duration<double>(t2 - t1).count()}};
   run["inspect"] = nlohmann::json::parse(sfm::InspectReportToJson(report));

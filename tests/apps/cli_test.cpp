@@ -103,15 +103,30 @@ TEST_F(CliTest, BadMeshLightsAndMissingImagesAreCleanErrors) {
   EXPECT_NE(out.find("image_000.png"), std::string::npos) << out;
 }
 
-TEST(Cli, DemoWritesTheSceneAndItsRunRecord) {
+TEST(Cli, DemoWritesTheSceneInspectsItAndRecordsTheRun) {
   TempDir tmp;
   std::string out;
-  EXPECT_EQ(Texlume("demo --out " + (tmp / "demo").string() + " --images 5", &out), 0) << out;
-  EXPECT_NE(out.find("Images: 5"), std::string::npos) << out;
+  EXPECT_EQ(
+      Texlume("demo --out " + (tmp / "demo").string() + " --kind plane --material brick", &out), 0)
+      << out;
+  EXPECT_NE(out.find("Images: 36"), std::string::npos) << out;
+  EXPECT_NE(out.find("Images missing on disk: 0"), std::string::npos) << out;
   for (const std::string f :
-       {"sparse/cameras.bin", "sparse_txt/images.txt", "mesh.ply", "lights.json", "run.json"}) {
+       {"scene/object/sparse/cameras.bin", "scene/object/sparse_txt/images.txt",
+        "scene/object/mesh.ply", "scene/object/lights.json", "scene/material/capture/lights.lp",
+        "scene/MANIFEST.md", "run.json"}) {
     EXPECT_TRUE(std::filesystem::exists(tmp / "demo" / f)) << f;
   }
+}
+
+TEST(Cli, SceneRefusesUnknownKindsAndMaterials) {
+  TempDir tmp;
+  std::string out;
+  EXPECT_EQ(Texlume("scene --out " + tmp.path().string() + " --kind cube", &out), 2);
+  EXPECT_NE(out.find("--kind"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("scene --out " + tmp.path().string() + " --material marble", &out), 2);
+  EXPECT_EQ(Texlume("scene --out " + tmp.path().string() + " --images 1", &out), 2);
+  EXPECT_NE(out.find("num_images"), std::string::npos) << out;
 }
 
 }  // namespace
