@@ -1,15 +1,23 @@
 #include "apps/cli.h"
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "apps/progress_bar.h"
 #include "datasets_synthetic/object_scene.h"
 #include "datasets_synthetic/scene.h"
+#include "ptm/fit.h"
+#include "ptm/ptm_io.h"
+#include "ptm/sphere_lights.h"
+#include "sfm/errors.h"
 #include "sfm/file_util.h"
 #include "sfm/inspect.h"
+#include "sfm/lights.h"
 
 namespace texlume::apps {
 
@@ -97,6 +105,199 @@ int RunInspectCommand(const std::vector<std::string>& args, std::ostream& out, s
         << "'\n";
     return kExitInputError;
   }
+  return kExitOk;
+}
+
+namespace {
+
+// "a,b,c" -> numbers; throws UsageError naming the option.
+std::vector<double> ParseList(const std::string& text, std::size_t count, const std::string& name) {
+  std::vector<double> values;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string token = text.substr(start, comma - start);
+    double v = 0;
+    const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
+    if (token.empty() || ec != std::errc() || ptr != token.data() + token.size() ||
+        !std::isfinite(v)) {
+      throw UsageError("--" + name + " expects " + std::to_string(count) +
+                       " comma-separated numbers, got '" + text + "'");
+    }
+    values.push_back(v);
+    start = comma + 1;
+  }
+  if (values.size() != count) {
+    throw UsageError("--" + name + " expects " + std::to_string(count) + " numbers, got '" + text +
+                     "'");
+  }
+  return values;
+}
+
+ptm::Ptm LoadAnyPtm(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext == ".exr" ? ptm::ReadPtmExr(path) : ptm::ReadPtmFile(path);
+}
+
+void WriteRgbPng(const std::filesystem::path& path, const std::vector<float>& rgb, int width,
+                 int height, bool signed_unit) {
+  cv::Mat image(height, width, CV_8UC3);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        float v = rgb[(static_cast<std::size_t>(y) * width + x) * 3 + static_cast<std::size_t>(c)];
+        if (signed_unit) v = 0.5f * v + 0.5f;
+        image.at<cv::Vec3b>(y, x)[2 - c] =
+            static_cast<std::uint8_t>(std::clamp(std::lround(255.0f * v), 0L, 255L));
+      }
+    }
+  }
+  std::vector<unsigned char> bytes;
+  if (!cv::imencode(path.extension().string().empty() ? ".png" : path.extension().string(), image,
+                    bytes)) {
+    throw std::runtime_error(path.string() + ": cannot encode the image (use .png, .jpg or .tif)");
+  }
+  WriteFileAtomically(
+      path,
+      [&](std::ostream& o) {
+        o.write(reinterpret_cast<const char*>(bytes.data()),
+                static_cast<std::streamsize>(bytes.size()));
+      },
+      true);
+}
+
+}  // namespace
+
+int RunFitCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& /*err*/) {
+  const Arguments a(args, {"images", "lights", "out", "format", "exr", "web", "band-rows"},
+                    {"robust"});
+  const std::filesystem::path images_dir = a.Require("images");
+  const std::filesystem::path lp_path = a.Require("lights");
+  const std::filesystem::path out_path = a.Require("out");
+  ptm::FitOptions options;
+  const std::string format = a.Get("format").value_or("lrgb");
+  if (format == "rgb") {
+    options.format = ptm::PtmFormat::kRgb;
+  } else if (format != "lrgb") {
+    throw UsageError("--format must be lrgb or rgb");
+  }
+  options.robust = a.Has("robust");
+  options.band_rows = a.GetInt("band-rows", options.band_rows);
+  options.Check();
+  std::error_code ec;
+  if (!std::filesystem::is_directory(images_dir, ec)) {
+    throw InputError(images_dir.string(), "image folder not found");
+  }
+  const auto entries = sfm::ReadLpFile(lp_path);
+  std::vector<std::filesystem::path> files;
+  std::vector<Eigen::Vector3d> lights;
+  for (const auto& e : entries) {
+    const std::filesystem::path file = images_dir / sfm::BaseName(e.filename);
+    if (!std::filesystem::is_regular_file(file, ec)) {
+      throw InputError(lp_path.string(),
+                       "names '" + e.filename + "', but " + file.string() + " does not exist");
+    }
+    files.push_back(file);
+    lights.push_back(e.direction_in_image);
+  }
+  ProgressBar bar;
+  ptm::CheckLightSet(lights, options, lp_path.string());
+  const ptm::FitResult result = ptm::FitPtmFromFiles(files, lights, options, bar.Callback());
+  const auto t0 = std::chrono::steady_clock::now();
+  ptm::WritePtmFile(result.ptm, out_path);
+  if (auto exr = a.Get("exr")) ptm::WritePtmExr(result.ptm, *exr);
+  if (auto web = a.Get("web")) ptm::WriteRelightWeb(result.ptm, *web);
+  const double write_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out << "Fitted a " << result.ptm.width << "x" << result.ptm.height << " "
+      << (options.format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB") << " PTM to "
+      << result.num_images << " images in " << result.seconds << " s"
+      << (options.robust ? " (robust)" : "") << "; mean RMS residual "
+      << result.mean_residual_rms * 255.0 << " / 255. Wrote " << out_path.string() << "\n";
+  nlohmann::json record;
+  record["command"] = "fit";
+  record["settings"] = {{"images", images_dir.string()},
+                        {"lights", lp_path.string()},
+                        {"format", format},
+                        {"robust", options.robust},
+                        {"band_rows", options.band_rows},
+                        {"robust_scale", options.robust_scale}};
+  record["result"] = {{"width", result.ptm.width},
+                      {"height", result.ptm.height},
+                      {"images", result.num_images},
+                      {"mean_residual_rms", result.mean_residual_rms},
+                      {"intensity_space", "display (sRGB-encoded) values in [0, 1]"}};
+  record["timings_s"] = {{"fit", result.seconds}, {"write", write_seconds}};
+  std::filesystem::path record_path = out_path;
+  record_path += ".json";
+  WriteFileAtomically(
+      record_path, [&](std::ostream& o) { o << record.dump(2) << "\n"; }, false);
+  return kExitOk;
+}
+
+int RunRelightCommand(const std::vector<std::string>& args, std::ostream& out,
+                      std::ostream& /*err*/) {
+  const Arguments a(args, {"ptm", "light", "out", "normals", "gain", "specular"}, {});
+  const ptm::Ptm ptm = LoadAnyPtm(a.Require("ptm"));
+  const auto l = ParseList(a.Require("light"), 3, "light");
+  Eigen::Vector3d light(l[0], l[1], l[2]);
+  if (!(light.norm() > 1e-9)) throw UsageError("--light must not be zero");
+  light.normalize();
+  if (!(light.z() > 0)) throw UsageError("--light must be above the horizon (z > 0)");
+  ptm::EnhancementOptions enhancement;
+  enhancement.diffuse_gain = a.GetDouble("gain", 1.0);
+  enhancement.specular = a.GetDouble("specular", 0.0);
+  if (!(enhancement.diffuse_gain >= 1.0 && enhancement.diffuse_gain <= 100.0)) {
+    throw UsageError("--gain must be in [1, 100]");
+  }
+  if (!(enhancement.specular >= 0.0 && enhancement.specular <= 10.0)) {
+    throw UsageError("--specular must be in [0, 10]");
+  }
+  const std::filesystem::path out_path = a.Require("out");
+  WriteRgbPng(out_path, ptm::Relight(ptm, light, enhancement), ptm.width, ptm.height, false);
+  if (auto normals = a.Get("normals")) {
+    WriteRgbPng(*normals, ptm::NormalMap(ptm), ptm.width, ptm.height, true);
+  }
+  out << "Relit " << ptm.width << "x" << ptm.height << " PTM under (" << light.transpose()
+      << ") into " << out_path.string() << "\n";
+  return kExitOk;
+}
+
+int RunLightsFromSphereCommand(const std::vector<std::string>& args, std::ostream& out,
+                               std::ostream& err) {
+  const Arguments a(args, {"images", "out", "circle", "threshold"}, {});
+  const std::filesystem::path dir = a.Require("images");
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec))
+    throw InputError(dir.string(), "image folder not found");
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    std::string ext = entry.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff") {
+      files.push_back(entry.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw InputError(dir.string(), "no images (.png, .jpg, .tif) in the folder");
+  std::optional<ptm::SphereCircle> circle;
+  if (auto c = a.Get("circle")) {
+    const auto v = ParseList(*c, 3, "circle");
+    circle = ptm::SphereCircle{v[0], v[1], v[2]};
+  }
+  ptm::HighlightOptions options;
+  options.threshold_fraction = a.GetDouble("threshold", options.threshold_fraction);
+  std::vector<std::string> skipped;
+  ptm::SphereCircle used;
+  const auto entries = ptm::LightsFromSphere(files, circle, options, &skipped, &used);
+  const std::filesystem::path out_path = a.Require("out");
+  sfm::WriteLpFile(entries, out_path);
+  out << "Sphere at (" << used.center_x << ", " << used.center_y << "), radius " << used.radius
+      << " px; wrote " << entries.size() << " light directions to " << out_path.string() << "\n";
+  for (const auto& name : skipped) err << "warning: no highlight found in " << name << "\n";
   return kExitOk;
 }
 

@@ -45,6 +45,13 @@ inline constexpr int kExitUsage = 2;       ///< bad command line
 int RunInspectCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 /// `texlume scene`: writes a synthetic heritage scene. Returns the exit code.
 int RunSceneCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// `texlume fit`: fits a PTM to an RTI capture. Returns the exit code.
+int RunFitCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// `texlume relight`: renders a PTM under a light. Returns the exit code.
+int RunRelightCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// `texlume lights-from-sphere`: light directions from a reflective sphere.
+int RunLightsFromSphereCommand(const std::vector<std::string>& args, std::ostream& out,
+                               std::ostream& err);
 /// `texlume demo`: builds a synthetic scene and inspects it. Returns the exit code.
 int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 

@@ -19,6 +19,14 @@ constexpr const char* kUsage =
     "          [--max-buffer-size N]\n"
     "      Summarise a COLMAP model (.bin or .txt), check a mesh, lights and image\n"
     "      files, and report which triangles the photos see fully.\n"
+    "  fit --images DIR --lights FILE.lp --out sample.ptm [--format lrgb|rgb] [--robust]\n"
+    "      [--exr FILE] [--web DIR] [--band-rows N]\n"
+    "      Fit a PTM to an RTI capture (writes sample.ptm.json with settings and timings).\n"
+    "  relight --ptm FILE(.ptm|.exr) --light lx,ly,lz --out image.png [--normals FILE]\n"
+    "      [--gain G] [--specular KS]\n"
+    "      Render a PTM under a light (texture frame: x right, y up, z out).\n"
+    "  lights-from-sphere --images DIR --out lights.lp [--circle cx,cy,r] [--threshold F]\n"
+    "      Light directions from the highlight on a glossy sphere in every photo.\n"
     "  scene --out DIR [--kind sphere|cylinder|plane|torus] [--material stone|brick|grooves]\n"
     "        [--seed S] [--images N] [--camera-model pinhole|opencv] [--width W] [--height H]\n"
     "        [--capture-size N] [--capture-lights N] [--held-out-lights N] [--held-out-views N]\n"
@@ -52,6 +60,10 @@ int main(int argc, char** argv) {
       return kExitOk;
     }
     if (command == "inspect") return RunInspectCommand(args, std::cout, std::cerr);
+    if (command == "fit") return RunFitCommand(args, std::cout, std::cerr);
+    if (command == "relight") return RunRelightCommand(args, std::cout, std::cerr);
+    if (command == "lights-from-sphere")
+      return RunLightsFromSphereCommand(args, std::cout, std::cerr);
     if (command == "scene") return RunSceneCommand(args, std::cout, std::cerr);
     if (command == "demo") return RunDemoCommand(args, std::cout, std::cerr);
     throw UsageError("unknown command '" + command + "'");

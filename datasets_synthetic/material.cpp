@@ -58,6 +58,9 @@ void MaterialOptions::Check() const {
     throw OptionError("feature_scale must be in (0, 100]");
   }
   if (!(specular >= 0.0 && specular <= 1.0)) throw OptionError("specular must be in [0, 1]");
+  if (!(albedo_scale >= 0.0 && albedo_scale <= 1.0)) {
+    throw OptionError("albedo_scale must be in [0, 1]");
+  }
   if (!(shininess >= 1.0 && shininess <= 10000.0)) {
     throw OptionError("shininess must be in [1, 10000]");
   }
@@ -172,7 +175,9 @@ Eigen::Vector2d Material::HeightGradient(double u, double v) const {
 Eigen::Vector3d Material::Albedo(double u, double v) const {
   const double stain = FractalNoise(MakeLattice(7, weather_u_, weather_v_), u / weather_u_.cell,
                                     v / weather_v_.cell, 3);
-  return (BaseAlbedo(u, v) * (0.8 + 0.25 * stain)).cwiseMax(0.0).cwiseMin(1.0);
+  return (BaseAlbedo(u, v) * (options_.albedo_scale * (0.8 + 0.25 * stain)))
+      .cwiseMax(0.0)
+      .cwiseMin(1.0);
 }
 
 Eigen::Vector3d Material::BaseAlbedo(double u, double v) const {

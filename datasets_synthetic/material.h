@@ -33,6 +33,8 @@ struct MaterialOptions {
   double feature_scale = 1.0;
   /// Blinn-Phong specular coefficient added to the Lambertian albedo; 0 = matte. [0, 1].
   double specular = 0.0;
+  /// Multiplies the albedo (0.05 makes a near-black glossy material). [0, 1].
+  double albedo_scale = 1.0;
   /// Blinn-Phong exponent. [1, 10000].
   double shininess = 40.0;
   std::uint32_t seed = 1;

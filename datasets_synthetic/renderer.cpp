@@ -298,7 +298,7 @@ Rendering Renderer::RenderOrthographic(int width, int height, double u0, double 
       width, height,
       [&](double px, double py, Eigen::Vector3d& origin, Eigen::Vector3d& direction) {
         const Eigen::Vector3d on_plane(u0 + px * texel_size, v_top - py * texel_size, 0.0);
-        origin = on_plane + w * (1.0 / w.z());  // one world unit above the plane
+        origin = on_plane + w * (10.0 / w.z());  // ten world units above the plane
         direction = -w;
         return true;
       },

@@ -1,0 +1,419 @@
+#include "ptm/fit.h"
+
+#include <OpenImageIO/imageio.h>
+#include <ceres/ceres.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <memory>
+#include <thread>
+
+#include "sfm/errors.h"
+
+namespace texlume::ptm {
+namespace {
+
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+using MatrixX6 = Eigen::Matrix<double, Eigen::Dynamic, 6>;
+
+MatrixX6 LightMatrix(const std::vector<Eigen::Vector3d>& lights) {
+  MatrixX6 a(static_cast<Eigen::Index>(lights.size()), 6);
+  for (std::size_t k = 0; k < lights.size(); ++k) {
+    const auto b = PtmBasis(lights[k].x(), lights[k].y());
+    for (int i = 0; i < 6; ++i) a(static_cast<Eigen::Index>(k), i) = b[static_cast<std::size_t>(i)];
+  }
+  return a;
+}
+
+// Robust refinement of one polynomial from its samples (Cauchy loss), starting
+// from the least-squares coefficients in `a`.
+void RobustRefine(const MatrixX6& basis, const std::vector<double>& values,
+                  const std::vector<char>& usable, double scale, double* a) {
+  std::size_t count = 0;
+  for (char u : usable) count += u ? 1 : 0;
+  if (count < 6) return;
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  ceres::CauchyLoss loss(scale);
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (!usable[k]) continue;
+    std::array<double, 6> b;
+    for (int i = 0; i < 6; ++i)
+      b[static_cast<std::size_t>(i)] = basis(static_cast<Eigen::Index>(k), i);
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PtmSampleResidual, 1, 6>(
+                                 new PtmSampleResidual(b, values[k])),
+                             &loss, a);
+  }
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = 25;
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.num_threads = 1;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+}
+
+// Fits every texel of a band. pixels[k] holds the band of image k (rows x width x 3).
+class BandFitter {
+ public:
+  BandFitter(const std::vector<Eigen::Vector3d>& lights, const FitOptions& options)
+      : options_(options), basis_(LightMatrix(lights)) {
+    pseudo_inverse_ = basis_.completeOrthogonalDecomposition().pseudoInverse();
+    gram_ = basis_.transpose() * basis_;
+  }
+
+  void Fit(const std::vector<const float*>& pixels, int rows, int width, int first_row, Ptm& ptm,
+           std::vector<float>& residual) const {
+    const std::size_t k_count = pixels.size();
+    const long texels = static_cast<long>(rows) * width;
+#pragma omp parallel
+    {
+      // Per-thread buffers, reused for every texel (no allocation in the loop).
+      std::vector<Eigen::Vector3d> rgb(k_count);
+      std::vector<char> usable(k_count, 1);
+      std::vector<double> values(k_count);
+#pragma omp for schedule(dynamic, 256)
+      for (long t = 0; t < texels; ++t) {
+        const std::size_t local = static_cast<std::size_t>(t);
+        const std::size_t texel =
+            static_cast<std::size_t>(first_row) * static_cast<std::size_t>(width) + local;
+        for (std::size_t k = 0; k < k_count; ++k) {
+          const float* p = pixels[k] + local * 3;
+          rgb[k] = Eigen::Vector3d(p[0], p[1], p[2]);
+          usable[k] = !options_.robust || (rgb[k].maxCoeff() < options_.saturation_threshold &&
+                                           rgb[k].maxCoeff() > options_.shadow_threshold);
+        }
+        double sum_sq = 0.0;
+        if (ptm.format == PtmFormat::kLrgb) {
+          // Chromaticity: luminance-weighted mean colour, largest channel 1.
+          Eigen::Vector3d c = Eigen::Vector3d::Zero();
+          for (std::size_t k = 0; k < k_count; ++k) {
+            if (usable[k]) c += rgb[k].mean() * rgb[k];
+          }
+          c = c.maxCoeff() > 1e-9 ? Eigen::Vector3d(c / c.maxCoeff()) : Eigen::Vector3d::Ones();
+          const Eigen::Vector3d c_scaled = c / c.squaredNorm();
+          for (std::size_t k = 0; k < k_count; ++k) values[k] = rgb[k].dot(c_scaled);
+          double a[6];
+          Solve(values, a);
+          if (options_.robust) RobustRefine(basis_, values, usable, options_.robust_scale, a);
+          float* out = ptm.Coefficients(texel);
+          for (int i = 0; i < 6; ++i) out[i] = static_cast<float>(a[i]);
+          for (int ch = 0; ch < 3; ++ch) {
+            ptm.colour[texel * 3 + static_cast<std::size_t>(ch)] = static_cast<float>(c[ch]);
+          }
+          if (options_.robust) {
+            for (std::size_t k = 0; k < k_count; ++k) {
+              sum_sq += (Predict(k, a) * c - rgb[k]).squaredNorm();
+            }
+          } else {
+            // At the least-squares solution, sum |L_k c - rgb_k|^2 =
+            // sum |rgb_k|^2 - |c|^2 a^T (A^T A) a: no second pass over the samples.
+            double energy = 0.0;
+            for (std::size_t k = 0; k < k_count; ++k) energy += rgb[k].squaredNorm();
+            sum_sq = std::max(0.0, energy - c.squaredNorm() * Quadratic(a));
+          }
+        } else {
+          for (int ch = 0; ch < 3; ++ch) {
+            for (std::size_t k = 0; k < k_count; ++k) values[k] = rgb[k][ch];
+            double a[6];
+            Solve(values, a);
+            if (options_.robust) RobustRefine(basis_, values, usable, options_.robust_scale, a);
+            float* out = ptm.Coefficients(texel, ch);
+            for (int i = 0; i < 6; ++i) out[i] = static_cast<float>(a[i]);
+            if (options_.robust) {
+              for (std::size_t k = 0; k < k_count; ++k) {
+                const double d = Predict(k, a) - values[k];
+                sum_sq += d * d;
+              }
+            } else {
+              double energy = 0.0;
+              for (double v : values) energy += v * v;
+              sum_sq += std::max(0.0, energy - Quadratic(a));
+            }
+          }
+        }
+        residual[texel] =
+            static_cast<float>(std::sqrt(sum_sq / (3.0 * static_cast<double>(k_count))));
+      }
+    }
+  }
+
+ private:
+  // Least squares: a = A^+ values (one 6 x N product).
+  void Solve(const std::vector<double>& values, double* a) const {
+    for (int i = 0; i < 6; ++i) {
+      double sum = 0.0;
+      for (std::size_t k = 0; k < values.size(); ++k) {
+        sum += pseudo_inverse_(i, static_cast<Eigen::Index>(k)) * values[k];
+      }
+      a[i] = sum;
+    }
+  }
+  // a^T (A^T A) a
+  double Quadratic(const double* a) const {
+    double q = 0.0;
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j) q += a[i] * gram_(i, j) * a[j];
+    return q;
+  }
+  double Predict(std::size_t k, const double* a) const {
+    double v = 0.0;
+    for (int i = 0; i < 6; ++i) v += basis_(static_cast<Eigen::Index>(k), i) * a[i];
+    return v;
+  }
+
+  const FitOptions& options_;
+  MatrixX6 basis_;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> pseudo_inverse_;
+  Matrix6 gram_;
+};
+
+void Finish(FitResult& result, std::chrono::steady_clock::time_point start) {
+  double sum = 0.0;
+  for (float r : result.residual_rms) sum += r;
+  result.mean_residual_rms =
+      result.residual_rms.empty() ? 0.0 : sum / static_cast<double>(result.residual_rms.size());
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+void FitOptions::Check() const {
+  if (!(robust_scale > 0.0 && robust_scale <= 1.0))
+    throw OptionError("robust_scale must be in (0, 1]");
+  if (!(saturation_threshold > 0.0 && saturation_threshold <= 1.0)) {
+    throw OptionError("saturation_threshold must be in (0, 1]");
+  }
+  if (!(shadow_threshold >= 0.0 && shadow_threshold < 1.0)) {
+    throw OptionError("shadow_threshold must be in [0, 1)");
+  }
+  if (band_rows < 1) throw OptionError("band_rows must be >= 1");
+  if (min_lights < 6) throw OptionError("min_lights must be >= 6");
+  if (!(max_condition_number > 1.0)) throw OptionError("max_condition_number must be > 1");
+}
+
+void CheckLightSet(const std::vector<Eigen::Vector3d>& lights, const FitOptions& options,
+                   const std::string& label) {
+  if (static_cast<int>(lights.size()) < options.min_lights) {
+    throw InputError(label, std::to_string(lights.size()) +
+                                " usable lights; a PTM needs at least " +
+                                std::to_string(options.min_lights));
+  }
+  for (std::size_t k = 0; k < lights.size(); ++k) {
+    if (!lights[k].allFinite() || std::abs(lights[k].norm() - 1.0) > 1e-6) {
+      throw InputError(label, "light " + std::to_string(k) + " is not a unit vector");
+    }
+    if (!(lights[k].z() > 0.0)) {
+      throw InputError(label,
+                       "light " + std::to_string(k) + " is at or below the horizon (z <= 0)");
+    }
+  }
+  const MatrixX6 a = LightMatrix(lights);
+  const Eigen::JacobiSVD<MatrixX6> svd(a);
+  const auto s = svd.singularValues();
+  const double condition = s(5) > 0 ? (s(0) / s(5)) * (s(0) / s(5)) : INFINITY;
+  if (!(condition <= options.max_condition_number)) {
+    throw InputError(label, "degenerate light set: the normal equations are singular (condition " +
+                                std::to_string(condition) +
+                                "); spread the lights over the dome in azimuth and elevation");
+  }
+}
+
+FitResult FitPtm(const std::vector<ImageRgb>& images, const std::vector<Eigen::Vector3d>& lights,
+                 const FitOptions& options, const std::string& label) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  if (images.size() != lights.size()) {
+    throw InputError(label, std::to_string(images.size()) + " images but " +
+                                std::to_string(lights.size()) + " lights");
+  }
+  CheckLightSet(lights, options, label);
+  const int width = images[0].width, height = images[0].height;
+  for (std::size_t k = 0; k < images.size(); ++k) {
+    if (images[k].width != width || images[k].height != height ||
+        images[k].pixels.size() != static_cast<std::size_t>(width) * height * 3) {
+      throw InputError(label, "image " + std::to_string(k) + " differs in size from image 0");
+    }
+  }
+  FitResult result;
+  result.ptm.Resize(options.format, width, height);
+  result.residual_rms.assign(result.ptm.NumTexels(), 0.0f);
+  result.num_images = images.size();
+  const BandFitter fitter(lights, options);
+  std::vector<const float*> pixels;
+  for (const auto& image : images) pixels.push_back(image.pixels.data());
+  fitter.Fit(pixels, height, width, 0, result.ptm, result.residual_rms);
+  Finish(result, start);
+  return result;
+}
+
+FitResult FitPtmFromFiles(const std::vector<std::filesystem::path>& files,
+                          const std::vector<Eigen::Vector3d>& lights, const FitOptions& options,
+                          const ProgressCallback& progress) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  if (files.size() != lights.size()) throw std::invalid_argument("one light per file");
+  const std::string label = files.empty() ? "images" : files[0].parent_path().string();
+  CheckLightSet(lights, options, label);
+  std::vector<std::unique_ptr<OIIO::ImageInput>> inputs;
+  int width = 0, height = 0;
+  for (const auto& file : files) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec))
+      throw InputError(file.string(), "image file not found");
+    auto in = OIIO::ImageInput::open(file.string());
+    if (!in) throw InputError(file.string(), "cannot read image: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    if (inputs.empty()) {
+      width = spec.width;
+      height = spec.height;
+      if (width <= 0 || height <= 0 || width > 65536 || height > 65536) {
+        throw InputError(file.string(), "implausible image size");
+      }
+    } else if (spec.width != width || spec.height != height) {
+      throw InputError(file.string(), "is " + std::to_string(spec.width) + "x" +
+                                          std::to_string(spec.height) + " but " +
+                                          files[0].string() + " is " + std::to_string(width) + "x" +
+                                          std::to_string(height));
+    }
+    inputs.push_back(std::move(in));
+  }
+  FitResult result;
+  result.ptm.Resize(options.format, width, height);
+  result.residual_rms.assign(result.ptm.NumTexels(), 0.0f);
+  result.num_images = files.size();
+  const BandFitter fitter(lights, options);
+  const std::size_t band_floats = static_cast<std::size_t>(options.band_rows) * width * 3;
+  // Two bands: the next one is decoded while the current one is fitted.
+  std::vector<std::vector<float>> bands[2];
+  for (auto& set : bands) set.assign(files.size(), std::vector<float>(band_floats));
+  auto read_band = [&](int y0, std::vector<std::vector<float>>& band) {
+    const int rows = std::min(options.band_rows, height - y0);
+    std::vector<float> raw;
+    for (std::size_t k = 0; k < inputs.size(); ++k) {
+      const int read = std::min(inputs[k]->spec().nchannels, 3);
+      float* out = band[k].data();
+      if (read == 3) {
+        if (!inputs[k]->read_scanlines(0, 0, y0, y0 + rows, 0, 0, 3, OIIO::TypeDesc::FLOAT, out)) {
+          throw InputError(files[k].string(), "cannot read rows " + std::to_string(y0) + ".." +
+                                                  std::to_string(y0 + rows) + ": " +
+                                                  inputs[k]->geterror());
+        }
+        continue;
+      }
+      raw.resize(static_cast<std::size_t>(rows) * width * static_cast<std::size_t>(read));
+      if (!inputs[k]->read_scanlines(0, 0, y0, y0 + rows, 0, 0, read, OIIO::TypeDesc::FLOAT,
+                                     raw.data())) {
+        throw InputError(files[k].string(), "cannot read rows " + std::to_string(y0) + ".." +
+                                                std::to_string(y0 + rows) + ": " +
+                                                inputs[k]->geterror());
+      }
+      const std::size_t n = static_cast<std::size_t>(rows) * width;
+      for (std::size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < 3; ++c) {
+          out[i * 3 + static_cast<std::size_t>(c)] =
+              raw[i * static_cast<std::size_t>(read) +
+                  static_cast<std::size_t>(std::min(c, read - 1))];
+        }
+      }
+    }
+  };
+  read_band(0, bands[0]);
+  for (int b = 0, y0 = 0; y0 < height; ++b, y0 += options.band_rows) {
+    const int rows = std::min(options.band_rows, height - y0);
+    const int next = y0 + options.band_rows;
+    std::exception_ptr read_error;
+    std::thread reader;
+    if (next < height) {
+      reader = std::thread([&, next, b] {
+        try {
+          read_band(next, bands[(b + 1) % 2]);
+        } catch (...) {
+          read_error = std::current_exception();
+        }
+      });
+    }
+    std::vector<const float*> pixels;
+    for (const auto& image_band : bands[b % 2]) pixels.push_back(image_band.data());
+    fitter.Fit(pixels, rows, width, y0, result.ptm, result.residual_rms);
+    if (reader.joinable()) reader.join();
+    if (read_error) std::rethrow_exception(read_error);
+    if (progress) {
+      progress("fit", static_cast<std::size_t>(y0 + rows), static_cast<std::size_t>(height));
+    }
+  }
+  Finish(result, start);
+  return result;
+}
+
+FitResult FitPtmPerTexelLights(
+    const std::vector<ImageRgb>& images,
+    const std::function<Eigen::Vector3d(int image, int x, int y)>& light_at,
+    const FitOptions& options) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  if (images.empty()) throw std::invalid_argument("no images");
+  const int width = images[0].width, height = images[0].height;
+  FitResult result;
+  result.ptm.Resize(options.format, width, height);
+  result.residual_rms.assign(result.ptm.NumTexels(), 0.0f);
+  result.num_images = images.size();
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::size_t texel = static_cast<std::size_t>(y) * width + static_cast<std::size_t>(x);
+      std::vector<Eigen::Vector3d> lights, rgb;
+      for (std::size_t k = 0; k < images.size(); ++k) {
+        const Eigen::Vector3d l = light_at(static_cast<int>(k), x, y);
+        if (!(l.z() > 0.0)) continue;
+        lights.push_back(l.normalized());
+        const float* p = images[k].pixels.data() + texel * 3;
+        rgb.emplace_back(p[0], p[1], p[2]);
+      }
+      Matrix6 normal = Matrix6::Zero();
+      const MatrixX6 a = LightMatrix(lights);
+      normal = a.transpose() * a;
+      const Eigen::JacobiSVD<Matrix6> svd(normal);
+      const bool solvable =
+          lights.size() >= 6 &&
+          svd.singularValues()(5) * options.max_condition_number > svd.singularValues()(0);
+      Eigen::Vector3d c = Eigen::Vector3d::Ones();
+      if (options.format == PtmFormat::kLrgb) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (const auto& v : rgb) sum += v.mean() * v;
+        c = sum.maxCoeff() > 1e-9 ? Eigen::Vector3d(sum / sum.maxCoeff()) : Eigen::Vector3d::Ones();
+        for (int ch = 0; ch < 3; ++ch)
+          result.ptm.colour[texel * 3 + static_cast<std::size_t>(ch)] = static_cast<float>(c[ch]);
+      }
+      double sum_sq = 0.0;
+      for (int poly = 0; poly < result.ptm.NumPolynomials(); ++poly) {
+        Eigen::VectorXd v(static_cast<Eigen::Index>(rgb.size()));
+        for (std::size_t k = 0; k < rgb.size(); ++k) {
+          v(static_cast<Eigen::Index>(k)) =
+              options.format == PtmFormat::kLrgb ? rgb[k].dot(c) / c.squaredNorm() : rgb[k][poly];
+        }
+        Eigen::Matrix<double, 6, 1> coef = Eigen::Matrix<double, 6, 1>::Zero();
+        if (solvable) {
+          coef = normal.ldlt().solve(a.transpose() * v);  // normal equations
+        } else if (v.size() > 0) {
+          coef[5] = v.mean();
+        }
+        float* out = result.ptm.Coefficients(texel, poly);
+        for (int i = 0; i < 6; ++i) out[i] = static_cast<float>(coef[i]);
+        if (v.size() > 0) sum_sq += (a * coef - v).squaredNorm();
+      }
+      result.residual_rms[texel] =
+          rgb.empty() ? 0.0f
+                      : static_cast<float>(std::sqrt(sum_sq / (static_cast<double>(rgb.size()) *
+                                                               result.ptm.NumPolynomials())));
+    }
+  }
+  Finish(result, start);
+  return result;
+}
+
+}  // namespace texlume::ptm

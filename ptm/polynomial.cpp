@@ -1,1 +1,0 @@
-#include "ptm/polynomial.h"

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <filesystem>
+#include <istream>
+#include <ostream>
+#include <string>
+
+#include "ptm/ptm.h"
+
+namespace texlume::ptm {
+
+/// Writes an HP PTM 1.2 file (docs/ptm_format.md): `PTM_1.2`, the format name,
+/// width, height, 6 scales, 6 biases (ASCII, LF), then bytes, rows bottom to top.
+/// Coefficients are quantised per coefficient index over the whole image, on a
+/// range from the 0.1 % and 99.9 % quantiles (always including 0), in the 0-255
+/// display domain: coefficient = (byte - bias) * scale.
+void WritePtm(const Ptm& ptm, std::ostream& out);
+void WritePtmFile(const Ptm& ptm, const std::filesystem::path& path);
+
+/// Reads PTM_1.2 (and PTM_1.1) files in PTM_FORMAT_RGB or PTM_FORMAT_LRGB.
+/// Throws InputError naming the file (and header line) for anything else, a
+/// corrupt header or a truncated payload; sizes are checked against the bytes
+/// left before anything is allocated.
+Ptm ReadPtm(std::istream& in, const std::string& label);
+Ptm ReadPtmFile(const std::filesystem::path& path);
+
+/// Lossless PTM as OpenEXR: float channels named `L.a0`..`L.a5`, `R`, `G`, `B`
+/// (LRGB) or `R.a0`..`R.a5`, `G.a0`.., `B.a0`.. (RGB).
+void WritePtmExr(const Ptm& ptm, const std::filesystem::path& path);
+Ptm ReadPtmExr(const std::filesystem::path& path);
+
+/// Writes the relight / OpenLIME web format into `dir`: `info.json` (type "ptm",
+/// colorspace "rgb" or "lrgb", nplanes, per-plane scale and bias) and the
+/// coefficient planes as `plane_N.jpg`, three coefficients per JPEG
+/// (docs/ptm_format.md). Returns the number of files written.
+int WriteRelightWeb(const Ptm& ptm, const std::filesystem::path& dir, int jpeg_quality = 95);
+
+}  // namespace texlume::ptm

@@ -1,0 +1,153 @@
+#include "ptm/ptm_io.h"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+
+#include "sfm/errors.h"
+#include "tests/test_util.h"
+
+namespace texlume::ptm {
+namespace {
+
+Ptm RandomPtm(PtmFormat format, int width, int height, std::uint32_t seed) {
+  Ptm ptm;
+  ptm.Resize(format, width, height);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-0.3f, 0.3f);
+  for (float& a : ptm.coefficients) a = u(rng);
+  for (std::size_t t = 0; t < ptm.NumTexels(); ++t) {
+    for (int p = 0; p < ptm.NumPolynomials(); ++p) ptm.Coefficients(t, p)[5] += 0.5f;
+  }
+  std::uniform_real_distribution<float> c(0.2f, 1.0f);
+  for (float& v : ptm.colour) v = c(rng);
+  return ptm;
+}
+
+class PtmFileTest : public ::testing::TestWithParam<PtmFormat> {};
+
+TEST_P(PtmFileTest, RoundTripErrorIsBoundedByTheQuantisationStep) {
+  const Ptm ptm = RandomPtm(GetParam(), 37, 23, 1);
+  std::stringstream s;
+  WritePtm(ptm, s);
+  const Ptm back = ReadPtm(s, "mem.ptm");
+  ASSERT_EQ(back.width, 37);
+  ASSERT_EQ(back.height, 23);
+  ASSERT_EQ(back.format, ptm.format);
+  // 8 bits over each coefficient's range (at most 0.8 wide here, 0 included):
+  // within half a step, but for the 0.1 % tails clamped to the robust range.
+  std::size_t within = 0;
+  for (std::size_t i = 0; i < ptm.coefficients.size(); ++i) {
+    const double error = std::abs(back.coefficients[i] - ptm.coefficients[i]);
+    within += error <= 0.8 / 255.0 / 2 + 1e-6 ? 1 : 0;
+    ASSERT_LT(error, 0.02) << i;
+  }
+  EXPECT_GE(within, ptm.coefficients.size() * 995 / 1000);
+  for (std::size_t i = 0; i < ptm.colour.size(); ++i) {
+    ASSERT_NEAR(back.colour[i], ptm.colour[i], 0.5 / 255 + 1e-6);
+  }
+}
+
+TEST_P(PtmFileTest, ByteLayoutMatchesTheHpSpecification) {
+  // An independent reading of the layout (DESIGN.md): header lines, then per
+  // block rows bottom to top, 6 bytes per texel; LRGB then RGB bytes.
+  Ptm ptm = RandomPtm(GetParam(), 3, 2, 2);
+  std::stringstream s;
+  WritePtm(ptm, s);
+  const std::string bytes = s.str();
+  std::istringstream header(bytes);
+  std::string version, format, w, h, scales_line, biases_line;
+  std::getline(header, version);
+  std::getline(header, format);
+  std::getline(header, w);
+  std::getline(header, h);
+  std::getline(header, scales_line);
+  std::getline(header, biases_line);
+  EXPECT_EQ(version, "PTM_1.2");
+  EXPECT_EQ(format, GetParam() == PtmFormat::kLrgb ? "PTM_FORMAT_LRGB" : "PTM_FORMAT_RGB");
+  EXPECT_EQ(w, "3");
+  EXPECT_EQ(h, "2");
+  std::istringstream sl(scales_line), bl(biases_line);
+  double scale[6];
+  int bias[6];
+  for (int i = 0; i < 6; ++i) sl >> scale[i], bl >> bias[i];
+  const std::size_t payload = static_cast<std::size_t>(header.tellg());
+  const int polys = ptm.NumPolynomials();
+  ASSERT_EQ(bytes.size() - payload,
+            static_cast<std::size_t>(3 * 2 * (polys * 6 + (polys == 1 ? 3 : 0))));
+  for (int p = 0; p < polys; ++p) {
+    for (int file_row = 0; file_row < 2; ++file_row) {
+      const int y = 1 - file_row;  // bottom row first
+      for (int x = 0; x < 3; ++x) {
+        for (int i = 0; i < 6; ++i) {
+          const auto byte = static_cast<unsigned char>(
+              bytes[payload + static_cast<std::size_t>(((p * 2 + file_row) * 3 + x) * 6 + i)]);
+          const double value = (byte - bias[i]) * scale[i] / 255.0;
+          EXPECT_NEAR(value, ptm.Coefficients(static_cast<std::size_t>(y * 3 + x), p)[i],
+                      scale[i] / 255.0);
+        }
+      }
+    }
+  }
+  if (GetParam() == PtmFormat::kLrgb) {
+    const std::size_t rgb = payload + 3 * 2 * 6;
+    EXPECT_EQ(static_cast<unsigned char>(bytes[rgb]),
+              std::lround(255 * ptm.colour[3 * 3]));  // (0, 1)
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, PtmFileTest,
+                         ::testing::Values(PtmFormat::kLrgb, PtmFormat::kRgb));
+
+TEST(PtmFile, CorruptHeadersAndTruncatedPayloadsAreCleanErrors) {
+  std::stringstream good;
+  WritePtm(RandomPtm(PtmFormat::kLrgb, 4, 4, 3), good);
+  const std::string bytes = good.str();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"", "truncated header"},
+      {"PTM_9.9\n", "not a PTM file"},
+      {"PTM_1.2\nPTM_FORMAT_JPEG_LRGB\n", "unsupported PTM format"},
+      {"PTM_1.2\nPTM_FORMAT_RGB\n0\n4\n", "implausible size"},
+      {"PTM_1.2\nPTM_FORMAT_RGB\n4\n4\n1 2 3\n", "expected 6 scales"},
+      {"PTM_1.2\nPTM_FORMAT_RGB\n4\n4\n1 1 1 1 1 1\n0 0 0 x 0 0\n", "integer"},
+      {"PTM_1.2\nPTM_FORMAT_RGB\n60000\n60000\n1 1 1 1 1 1\n0 0 0 0 0 0\n", "truncated payload"},
+      {bytes.substr(0, bytes.size() - 1), "truncated payload"}};
+  for (const auto& [text, expected] : cases) {
+    std::istringstream in(text);
+    const std::string error = testing::InputErrorMessage([&] { ReadPtm(in, "x.ptm"); });
+    EXPECT_EQ(error.rfind("x.ptm", 0), 0u) << error;
+    EXPECT_NE(error.find(expected), std::string::npos)
+        << "'" << text.substr(0, 30) << "' gave " << error;
+  }
+}
+
+TEST(PtmFile, ExrRoundTripIsLossless) {
+  testing::TempDir tmp;
+  for (auto format : {PtmFormat::kLrgb, PtmFormat::kRgb}) {
+    const Ptm ptm = RandomPtm(format, 9, 7, 4);
+    WritePtmExr(ptm, tmp / "p.exr");
+    const Ptm back = ReadPtmExr(tmp / "p.exr");
+    EXPECT_EQ(back.format, format);
+    EXPECT_EQ(back.coefficients, ptm.coefficients);
+    EXPECT_EQ(back.colour, ptm.colour);
+  }
+}
+
+TEST(PtmFile, RelightWebExportWritesInfoAndPlanes) {
+  testing::TempDir tmp;
+  const Ptm ptm = RandomPtm(PtmFormat::kRgb, 16, 8, 5);
+  EXPECT_EQ(WriteRelightWeb(ptm, tmp / "web"), 7);
+  const auto info = nlohmann::json::parse(testing::ReadText(tmp / "web/info.json"));
+  EXPECT_EQ(info["type"], "ptm");
+  EXPECT_EQ(info["colorspace"], "rgb");
+  EXPECT_EQ(info["nplanes"], 18);
+  EXPECT_EQ(info["materials"][0]["scale"].size(), 18u);
+  EXPECT_TRUE(std::filesystem::exists(tmp / "web/plane_5.jpg"));
+  const Ptm lrgb = RandomPtm(PtmFormat::kLrgb, 16, 8, 6);
+  EXPECT_EQ(WriteRelightWeb(lrgb, tmp / "web2"), 4);
+}
+
+}  // namespace
+}  // namespace texlume::ptm
