@@ -240,7 +240,6 @@ int RunFitCommand(const std::vector<std::string>& args, std::ostream& out, std::
 int RunRelightCommand(const std::vector<std::string>& args, std::ostream& out,
                       std::ostream& /*err*/) {
   const Arguments a(args, {"ptm", "light", "out", "normals", "gain", "specular"}, {});
-  const ptm::Ptm ptm = LoadAnyPtm(a.Require("ptm"));
   const auto l = ParseList(a.Require("light"), 3, "light");
   Eigen::Vector3d light(l[0], l[1], l[2]);
   if (!(light.norm() > 1e-9)) throw UsageError("--light must not be zero");
@@ -256,6 +255,7 @@ int RunRelightCommand(const std::vector<std::string>& args, std::ostream& out,
     throw UsageError("--specular must be in [0, 10]");
   }
   const std::filesystem::path out_path = a.Require("out");
+  const ptm::Ptm ptm = LoadAnyPtm(a.Require("ptm"));
   WriteRgbPng(out_path, ptm::Relight(ptm, light, enhancement), ptm.width, ptm.height, false);
   if (auto normals = a.Get("normals")) {
     WriteRgbPng(*normals, ptm::NormalMap(ptm), ptm.width, ptm.height, true);

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "datasets_synthetic/object_scene.h"
+#include "datasets_synthetic/scene.h"
 #include "tests/test_util.h"
 
 namespace texlume {
@@ -127,6 +128,109 @@ TEST(Cli, SceneRefusesUnknownKindsAndMaterials) {
   EXPECT_EQ(Texlume("scene --out " + tmp.path().string() + " --material marble", &out), 2);
   EXPECT_EQ(Texlume("scene --out " + tmp.path().string() + " --images 1", &out), 2);
   EXPECT_NE(out.find("num_images"), std::string::npos) << out;
+}
+
+class FitCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    datasets::SceneOptions o;
+    o.capture_size = 24;
+    o.num_capture_lights = 12;
+    o.num_held_out_capture_lights = 2;
+    o.write_btf = false;
+    o.num_images = 3;
+    o.num_held_out_views = 0;
+    o.image_width = o.image_height = 64;
+    o.focal_px = 60;
+    o.material.texel_size = 0.01;
+    datasets::GenerateScene(o, tmp_.path());
+    capture_ = (tmp_ / "material/capture").string();
+  }
+  TempDir tmp_;
+  std::string capture_;
+};
+
+TEST_F(FitCliTest, FitWritesPtmExrWebAndRecordThenRelights) {
+  std::string out;
+  const std::string ptm = (tmp_ / "sample.ptm").string();
+  ASSERT_EQ(Texlume("fit --images " + capture_ + " --lights " + capture_ + "/lights.lp --out " +
+                        ptm + " --format rgb --exr " + (tmp_ / "sample.exr").string() + " --web " +
+                        (tmp_ / "web").string(),
+                    &out),
+            0)
+      << out;
+  EXPECT_TRUE(std::filesystem::exists(ptm + ".json"));
+  EXPECT_TRUE(std::filesystem::exists(tmp_ / "web/info.json"));
+  EXPECT_EQ(Texlume("relight --ptm " + ptm + " --light 0.3,0.2,0.9 --out " +
+                        (tmp_ / "relit.png").string() + " --normals " +
+                        (tmp_ / "normals.png").string() + " --gain 2 --specular 0.5",
+                    &out),
+            0)
+      << out;
+  EXPECT_EQ(Texlume("relight --ptm " + (tmp_ / "sample.exr").string() + " --light 0,0,1 --out " +
+                        (tmp_ / "relit2.png").string(),
+                    &out),
+            0)
+      << out;
+  EXPECT_TRUE(std::filesystem::exists(tmp_ / "normals.png"));
+}
+
+TEST_F(FitCliTest, BadCapturesAreCleanErrorsWithNothingWritten) {
+  std::string out;
+  const std::string ptm = (tmp_ / "bad.ptm").string();
+  const std::string lp = capture_ + "/lights.lp";
+  auto fit = [&](const std::string& lights) {
+    return Texlume("fit --images " + capture_ + " --lights " + lights + " --out " + ptm, &out);
+  };
+  // A file named in the .lp but missing.
+  std::filesystem::remove(tmp_ / "material/capture/rti_003.png");
+  EXPECT_EQ(fit(lp), 1);
+  EXPECT_NE(out.find("rti_003.png"), std::string::npos) << out;
+  // Fewer than 6 lights.
+  WriteText(tmp_ / "few.lp",
+            "3\nrti_000.png 0 0 1\nrti_001.png 0.5 0 0.8\nrti_002.png 0 0.5 0.8\n");
+  EXPECT_EQ(fit((tmp_ / "few.lp").string()), 1);
+  EXPECT_NE(out.find("at least 6"), std::string::npos) << out;
+  // A light below the horizon.
+  std::string text = "6\n";
+  for (int i = 4; i < 10; ++i) {
+    text += "rti_00" + std::to_string(i) + ".png " + (i == 6 ? "0.6 0 -0.8" : "0.1 0.2 0.9") + "\n";
+  }
+  WriteText(tmp_ / "low.lp", text);
+  EXPECT_EQ(fit((tmp_ / "low.lp").string()), 1);
+  EXPECT_NE(out.find("horizon"), std::string::npos) << out;
+  // Degenerate: every light the same.
+  text = "6\n";
+  for (int i = 4; i < 10; ++i) text += "rti_00" + std::to_string(i) + ".png 0.1 0.2 0.9\n";
+  WriteText(tmp_ / "same.lp", text);
+  EXPECT_EQ(fit((tmp_ / "same.lp").string()), 1);
+  EXPECT_NE(out.find("degenerate"), std::string::npos) << out;
+  // Images of different sizes.
+  std::filesystem::copy_file(tmp_ / "object/images/image_000.png",
+                             tmp_ / "material/capture/rti_005.png",
+                             std::filesystem::copy_options::overwrite_existing);
+  text = "6\n";
+  for (int i = 4; i < 10; ++i) {
+    const double a = i * 1.1, r = i % 2 ? 0.3 : 0.7;
+    text += "rti_00" + std::to_string(i) + ".png " + std::to_string(r * std::cos(a)) + " " +
+            std::to_string(r * std::sin(a)) + " " + std::to_string(std::sqrt(1 - r * r)) + "\n";
+  }
+  WriteText(tmp_ / "sizes.lp", text);
+  EXPECT_EQ(fit((tmp_ / "sizes.lp").string()), 1);
+  EXPECT_NE(out.find("rti_005.png"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(ptm));
+  // Corrupt and truncated .ptm files for relight.
+  WriteText(tmp_ / "corrupt.ptm", "PTM_1.2\nPTM_FORMAT_RGB\n10\n10\n1 1 1 1 1 1\n0 0 0 0 0 0\nabc");
+  EXPECT_EQ(Texlume("relight --ptm " + (tmp_ / "corrupt.ptm").string() + " --light 0,0,1 --out " +
+                        (tmp_ / "x.png").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("truncated payload"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp_ / "x.png"));
+  EXPECT_EQ(Texlume("relight --ptm " + (tmp_ / "corrupt.ptm").string() + " --light 0,0,-1 --out " +
+                        (tmp_ / "x.png").string(),
+                    &out),
+            2);
 }
 
 }  // namespace
