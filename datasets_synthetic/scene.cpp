@@ -146,6 +146,39 @@ void WritePngAtomically(const std::filesystem::path& path, const cv::Mat& image)
       true);
 }
 
+PlanarSurfaceRenders RenderPlanarSurface(const PlanarSurfaceOptions& options,
+                                         const std::vector<Eigen::Vector3d>& photo_lights,
+                                         const std::vector<Eigen::Vector3d>& truth_lights) {
+  options.material.Check();
+  if (options.scale < 1 || options.size % options.scale != 0) {
+    throw OptionError("scale must be >= 1 and divide size");
+  }
+  const double t = options.material.texel_size;
+  const Material material(options.material);
+  SurfacePatch patch = ShapePatches(SceneShape::kPlane)[0];
+  const double u0 = options.offset * t, extent = options.size * t;
+  const double margin = kSampleMarginTexels * t;
+  patch.u0 = patch.v0 = u0 - margin;
+  patch.u1 = patch.v1 = u0 + extent + margin;
+  const BakedMaterial baked(material, patch.u0, patch.u1, patch.v0, patch.v1, false, false, t);
+  const Renderer renderer(DisplacePatches({patch}, {&baked}, t), {&baked});
+  PlanarSurfaceRenders out;
+  const int small = options.size / options.scale;
+  for (const auto& l : photo_lights) {
+    const Rendering r =
+        renderer.RenderOrthographic(small, small, u0, u0 + extent, t * options.scale,
+                                    Eigen::Vector3d::UnitZ(), {{l, 1.0}}, options.shading);
+    out.photos.push_back(LinearToSrgb8(r.linear_rgb));
+  }
+  for (const auto& l : truth_lights) {
+    const Rendering r =
+        renderer.RenderOrthographic(options.size, options.size, u0, u0 + extent, t,
+                                    Eigen::Vector3d::UnitZ(), {{l, 1.0}}, options.shading);
+    out.truth.push_back(LinearToSrgb8(r.linear_rgb));
+  }
+  return out;
+}
+
 cv::Mat CoverageMask(const Rendering& rendering) {
   cv::Mat mask;
   cv::compare(rendering.coverage, 0.5, mask, cv::CMP_GE);

@@ -73,6 +73,29 @@ std::vector<Eigen::Vector3d> DomeLights(int count, double min_elevation_deg,
 SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::path& dir,
                            const ProgressCallback& progress = {});
 
+/// Photos of a planar surface made of the material (issue 5, paper 003 Fig. 3):
+/// a region of the material away from the captured sample, seen orthographically
+/// from above at 1/scale of the sample's resolution under some lights, and the
+/// same region at full resolution as ground truth.
+struct PlanarSurfaceOptions {
+  MaterialOptions material;
+  int size = 256;  ///< texels of the surface per side (the PTM_out size)
+  int scale = 2;   ///< texels per photo pixel, >= 1, divides size
+  /// Where the region starts, in texels from the sample's origin (away from the
+  /// RTI-captured area so the photos are of unseen surface).
+  int offset = 512;
+  ShadingOptions shading;
+};
+struct PlanarSurfaceRenders {
+  /// 8-bit sRGB (OpenCV BGR order) photos, size/scale pixels per side, one per light.
+  std::vector<cv::Mat> photos;
+  /// 8-bit sRGB ground truth at full resolution, one per light given for it.
+  std::vector<cv::Mat> truth;
+};
+PlanarSurfaceRenders RenderPlanarSurface(const PlanarSurfaceOptions& options,
+                                         const std::vector<Eigen::Vector3d>& photo_lights,
+                                         const std::vector<Eigen::Vector3d>& truth_lights);
+
 /// Writes an image as PNG atomically (temporary name, then rename).
 void WritePngAtomically(const std::filesystem::path& path, const cv::Mat& image);
 

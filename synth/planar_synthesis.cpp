@@ -1,0 +1,414 @@
+#include "synth/planar_synthesis.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "ptm/coefficient_space.h"
+#include "sfm/errors.h"
+#include "synth/template_match.h"
+
+namespace texlume::synth {
+namespace {
+
+// Number of planes that carry polynomial coefficients (compared by the overlap
+// constraint); LRGB's colour planes follow them and are only carried along.
+int CoefficientPlanes(ptm::PtmFormat format) { return format == ptm::PtmFormat::kLrgb ? 6 : 18; }
+
+std::vector<cv::Mat> Roi(const std::vector<cv::Mat>& planes, const cv::Rect& r, int count) {
+  std::vector<cv::Mat> out;
+  for (int c = 0; c < count; ++c) out.push_back(planes[static_cast<std::size_t>(c)](r));
+  return out;
+}
+
+// Block start positions along an axis of `length` texels: every `step`, the
+// last one flush with the end.
+std::vector<int> Positions(int length, int block, int step) {
+  std::vector<int> p;
+  for (int x = 0; x + block < length; x += step) p.push_back(x);
+  p.push_back(length - block);
+  return p;
+}
+
+// Minimum-cost vertical path through an error strip (rows x cols): returns, per
+// row, the column where the new block starts (texels left of it keep the old).
+std::vector<int> VerticalSeam(const cv::Mat& error) {
+  const int rows = error.rows, cols = error.cols;
+  cv::Mat cost = error.clone();
+  for (int y = 1; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      float best = cost.at<float>(y - 1, x);
+      if (x > 0) best = std::min(best, cost.at<float>(y - 1, x - 1));
+      if (x + 1 < cols) best = std::min(best, cost.at<float>(y - 1, x + 1));
+      cost.at<float>(y, x) += best;
+    }
+  }
+  std::vector<int> path(static_cast<std::size_t>(rows));
+  int x = 0;
+  for (int i = 1; i < cols; ++i) {
+    if (cost.at<float>(rows - 1, i) < cost.at<float>(rows - 1, x)) x = i;
+  }
+  for (int y = rows - 1; y >= 0; --y) {
+    path[static_cast<std::size_t>(y)] = x;
+    if (y == 0) break;
+    int best = x;
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int c = x + dx;
+      if (c >= 0 && c < cols && cost.at<float>(y - 1, c) < cost.at<float>(y - 1, best)) best = c;
+    }
+    x = best;
+  }
+  return path;
+}
+
+}  // namespace
+
+void PlanarSynthesisOptions::Check() const {
+  if (width < 0 || height < 0) throw OptionError("width and height must be >= 0");
+  if (block_size < 4) throw OptionError("block_size must be >= 4");
+  if (overlap < 1 || overlap >= block_size) throw OptionError("overlap must be in [1, block_size)");
+  if (top_k < 1) throw OptionError("top_k must be >= 1");
+  if (scale < 1) throw OptionError("scale must be >= 1");
+  if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
+}
+
+std::vector<cv::Mat> ToOrthonormalPlanes(const ptm::Ptm& ptm) {
+  const auto& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
+  std::vector<cv::Mat> planes;
+  const int polys = ptm.NumPolynomials();
+  for (int c = 0; c < polys * 6 + (ptm.format == ptm::PtmFormat::kLrgb ? 3 : 0); ++c) {
+    planes.emplace_back(ptm.height, ptm.width, CV_32FC1);
+  }
+  for (int y = 0; y < ptm.height; ++y) {
+    for (int x = 0; x < ptm.width; ++x) {
+      const std::size_t t = static_cast<std::size_t>(y) * ptm.width + x;
+      for (int p = 0; p < polys; ++p) {
+        Eigen::Matrix<double, 6, 1> a;
+        for (int i = 0; i < 6; ++i) a[i] = ptm.Coefficients(t, p)[i];
+        const Eigen::Matrix<double, 6, 1> o = to * a;
+        for (int i = 0; i < 6; ++i)
+          planes[static_cast<std::size_t>(p * 6 + i)].at<float>(y, x) = static_cast<float>(o[i]);
+      }
+      if (ptm.format == ptm::PtmFormat::kLrgb) {
+        for (int c = 0; c < 3; ++c)
+          planes[static_cast<std::size_t>(6 + c)].at<float>(y, x) =
+              ptm.colour[t * 3 + static_cast<std::size_t>(c)];
+      }
+    }
+  }
+  return planes;
+}
+
+ptm::Ptm FromOrthonormalPlanes(const std::vector<cv::Mat>& planes, ptm::PtmFormat format) {
+  const auto& from = ptm::OrthonormalBasis::Hemisphere().FromOrthonormal();
+  ptm::Ptm out;
+  out.Resize(format, planes[0].cols, planes[0].rows);
+  for (int y = 0; y < out.height; ++y) {
+    for (int x = 0; x < out.width; ++x) {
+      const std::size_t t = static_cast<std::size_t>(y) * out.width + x;
+      for (int p = 0; p < out.NumPolynomials(); ++p) {
+        Eigen::Matrix<double, 6, 1> o;
+        for (int i = 0; i < 6; ++i)
+          o[i] = planes[static_cast<std::size_t>(p * 6 + i)].at<float>(y, x);
+        const Eigen::Matrix<double, 6, 1> a = from * o;
+        for (int i = 0; i < 6; ++i) out.Coefficients(t, p)[i] = static_cast<float>(a[i]);
+      }
+      if (format == ptm::PtmFormat::kLrgb) {
+        for (int c = 0; c < 3; ++c)
+          out.colour[t * 3 + static_cast<std::size_t>(c)] =
+              planes[static_cast<std::size_t>(6 + c)].at<float>(y, x);
+      }
+    }
+  }
+  return out;
+}
+
+PlanarSynthesisResult SynthesizePlanarPtm(const ptm::Ptm& sample,
+                                          const std::vector<PlanarPhoto>& photos,
+                                          const PlanarSynthesisOptions& options_in) {
+  options_in.Check();
+  const auto start = std::chrono::steady_clock::now();
+  PlanarSynthesisOptions options = options_in;
+  PlanarSynthesisResult result;
+  const bool constrained = options.use_photos && !photos.empty();
+  if (options.use_photos && photos.empty()) {
+    throw InputError("photos", "constrained synthesis needs at least one photo");
+  }
+
+  // Output extent and photo scale (texels per photo pixel, an integer).
+  int scale = 1;
+  if (!photos.empty()) {
+    const int pw = photos[0].image.width, ph = photos[0].image.height;
+    for (const PlanarPhoto& p : photos) {
+      if (p.image.width != pw || p.image.height != ph) {
+        throw InputError(p.name, "is " + std::to_string(p.image.width) + "x" +
+                                     std::to_string(p.image.height) + ", but " + photos[0].name +
+                                     " is " + std::to_string(pw) + "x" + std::to_string(ph));
+      }
+      if (!(p.light.z() > 0.0) || std::abs(p.light.norm() - 1.0) > 1e-6) {
+        throw InputError(p.name, "its light must be a unit vector above the horizon");
+      }
+    }
+    if (options.width == 0) options.width = pw * options.scale;
+    if (options.height == 0) options.height = options.width * ph / pw;
+    if (options.width % pw != 0 || options.width / pw * ph != options.height) {
+      throw InputError(photos[0].name, "photos of " + std::to_string(pw) + "x" +
+                                           std::to_string(ph) + " do not cover a " +
+                                           std::to_string(options.width) + "x" +
+                                           std::to_string(options.height) +
+                                           " output at a whole number of texels per pixel");
+    }
+    scale = options.width / pw;
+  }
+  if (options.width == 0 || options.height == 0) {
+    throw OptionError("give the output size (width, height) for unconstrained synthesis");
+  }
+  result.scale = scale;
+  const int block = options.block_size, step = block - options.overlap;
+  if (block > sample.width || block > sample.height) {
+    throw OptionError("block_size " + std::to_string(block) + " does not fit the " +
+                      std::to_string(sample.width) + "x" + std::to_string(sample.height) +
+                      " sample");
+  }
+  if (block > options.width || block > options.height) {
+    throw OptionError("block_size is larger than the output");
+  }
+  if (block % scale != 0 || step % scale != 0) {
+    throw OptionError("block_size and block_size - overlap must be multiples of the photo scale " +
+                      std::to_string(scale));
+  }
+
+  const ptm::PtmFormat format = sample.format;
+  const int coefficient_planes = CoefficientPlanes(format);
+  const std::vector<cv::Mat> sample_planes = ToOrthonormalPlanes(sample);
+  const std::vector<cv::Mat> sample_coefficients(sample_planes.begin(),
+                                                 sample_planes.begin() + coefficient_planes);
+  const cv::Mat sample_energy = PlaneEnergy(sample_coefficients);
+
+  // The sample relit at each photo's light, at the photo's resolution, times the
+  // photo's gain (exposure x light intensity), as 3 planes per photo.
+  std::vector<std::vector<cv::Mat>> relit_small;  // [photo][channel]
+  std::vector<cv::Mat> relit_energy;
+  std::vector<std::vector<cv::Mat>> photo_planes;
+  for (const PlanarPhoto& photo : photos) {
+    const std::vector<float> relit = ptm::Relight(sample, photo.light);
+    cv::Mat full(sample.height, sample.width, CV_32FC3, const_cast<float*>(relit.data()));
+    cv::Mat small;
+    cv::resize(full, small, cv::Size(sample.width / scale, sample.height / scale), 0, 0,
+               cv::INTER_AREA);
+    cv::Mat photo_mat(photo.image.height, photo.image.width, CV_32FC3,
+                      const_cast<float*>(photo.image.pixels.data()));
+    double gain = 1.0;
+    if (options.estimate_gain) {
+      const double sample_mean = cv::mean(small)[0] + cv::mean(small)[1] + cv::mean(small)[2];
+      const double photo_mean =
+          cv::mean(photo_mat)[0] + cv::mean(photo_mat)[1] + cv::mean(photo_mat)[2];
+      if (sample_mean > 1e-6) gain = photo_mean / sample_mean;
+    }
+    result.photo_gains.push_back(gain);
+    std::vector<cv::Mat> channels, photo_channels;
+    cv::split(small * gain, channels);
+    cv::split(photo_mat, photo_channels);
+    relit_energy.push_back(PlaneEnergy(channels));
+    relit_small.push_back(channels);
+    for (cv::Mat& c : photo_channels) c = c.clone();
+    photo_planes.push_back(photo_channels);
+  }
+
+  // Output planes (orthonormal coefficients, colour) and which texels are filled.
+  std::vector<cv::Mat> out(sample_planes.size());
+  for (cv::Mat& p : out) p = cv::Mat::zeros(options.height, options.width, CV_32FC1);
+  cv::Mat filled = cv::Mat::zeros(options.height, options.width, CV_32FC1);
+  std::mt19937_64 rng(options.seed);
+  double seam_sum = 0.0;
+  std::size_t seam_texels = 0;
+
+  const std::vector<int> xs = Positions(options.width, block, step);
+  std::vector<int> ys = Positions(options.height, block, step);
+  std::reverse(ys.begin(), ys.end());  // raster from the lower-left corner upwards
+  for (std::size_t iy = 0; iy < ys.size(); ++iy) {
+    for (std::size_t ix = 0; ix < xs.size(); ++ix) {
+      const int x = xs[ix], y = ys[iy];
+      const cv::Rect out_rect(x, y, block, block);
+      const cv::Mat mask = filled(out_rect).clone();
+      const bool has_overlap = cv::countNonZero(mask) > 0;
+      const std::vector<cv::Mat> out_block = Roi(out, out_rect, coefficient_planes);
+
+      // Candidates: positions in the sample (top-left corners).
+      std::vector<std::pair<double, cv::Point>> candidates;  // (image score, position)
+      if (constrained) {
+        // S(B) = sum_n || g_n f(B, l_n) - b(I_n, x, y) || (eq. 3), at photo resolution.
+        cv::Mat score;
+        const cv::Rect photo_rect(x / scale, y / scale, block / scale, block / scale);
+        const cv::Mat ones = cv::Mat::ones(photo_rect.size(), CV_32FC1);
+        for (std::size_t n = 0; n < photos.size(); ++n) {
+          cv::Mat ssd =
+              MaskedSsd(relit_small[n], relit_energy[n], Roi(photo_planes[n], photo_rect, 3), ones);
+          cv::sqrt(ssd, ssd);
+          if (score.empty()) {
+            score = ssd;
+          } else {
+            score += ssd;
+          }
+        }
+        std::vector<std::pair<double, cv::Point>> all;
+        all.reserve(score.total());
+        for (int py = 0; py < score.rows; ++py)
+          for (int px = 0; px < score.cols; ++px)
+            all.emplace_back(score.at<float>(py, px), cv::Point(px * scale, py * scale));
+        const std::size_t k =
+            std::min<std::size_t>(static_cast<std::size_t>(options.top_k), all.size());
+        std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k), all.end(),
+                          [](const auto& a, const auto& b) { return a.first < b.first; });
+        candidates.assign(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k));
+      }
+
+      BlockPlacement placement;
+      placement.out_x = x;
+      placement.out_y = y;
+      const double overlap_texels = std::max(1.0, cv::sum(mask)[0]);
+      if (constrained) {
+        // Overlap constraint among the image-ranked candidates.
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& [s, p] : candidates) {
+          double e = 0.0;
+          if (has_overlap) {
+            const std::vector<cv::Mat> cand =
+                Roi(sample_planes, cv::Rect(p.x, p.y, block, block), coefficient_planes);
+            for (int c = 0; c < coefficient_planes; ++c) {
+              cv::Mat d =
+                  cand[static_cast<std::size_t>(c)] - out_block[static_cast<std::size_t>(c)];
+              e += d.mul(d).dot(mask);
+            }
+            e /= overlap_texels;
+          }
+          if (e < best || (e == best && s < placement.image_score)) {
+            best = e;
+            placement.sample_x = p.x;
+            placement.sample_y = p.y;
+            placement.image_score = s;
+            placement.overlap_error = e;
+          }
+        }
+      } else if (!has_overlap) {
+        std::uniform_int_distribution<int> ux(0, sample.width - block),
+            uy(0, sample.height - block);
+        placement.sample_x = ux(rng);
+        placement.sample_y = uy(rng);
+      } else {
+        // Unconstrained quilting: overlap error at every sample position (FFT).
+        const cv::Mat errors = MaskedSsd(sample_coefficients, sample_energy, out_block, mask);
+        double min_error;
+        cv::minMaxLoc(errors, &min_error);
+        std::vector<cv::Point> near;
+        for (int py = 0; py < errors.rows; ++py)
+          for (int px = 0; px < errors.cols; ++px)
+            if (errors.at<float>(py, px) <= min_error * (1.0 + options.tolerance) + 1e-12)
+              near.emplace_back(px, py);
+        std::uniform_int_distribution<std::size_t> pick(0, near.size() - 1);
+        const cv::Point p = near[pick(rng)];
+        placement.sample_x = p.x;
+        placement.sample_y = p.y;
+        placement.overlap_error = errors.at<float>(p.y, p.x) / overlap_texels;
+      }
+      result.blocks.push_back(placement);
+
+      // Paste and stitch in the orthonormal space.
+      const cv::Rect sample_rect(placement.sample_x, placement.sample_y, block, block);
+      cv::Mat alpha = cv::Mat::ones(block, block, CV_32FC1);  // weight of the new block
+      if (has_overlap) {
+        const int left = ix > 0 ? xs[ix - 1] + block - x : 0;
+        const int bottom = iy > 0 ? y + block - ys[iy - 1] : 0;
+        cv::Mat error = cv::Mat::zeros(block, block, CV_32FC1);
+        for (int c = 0; c < coefficient_planes; ++c) {
+          cv::Mat d = sample_planes[static_cast<std::size_t>(c)](sample_rect) -
+                      out_block[static_cast<std::size_t>(c)];
+          error += d.mul(d);
+        }
+        if (options.stitch == Stitch::kBlend) {
+          for (int j = 0; j < block; ++j) {
+            for (int i = 0; i < block; ++i) {
+              float a = 1.0f;
+              if (i < left) a = std::min(a, (i + 0.5f) / left);
+              if (j >= block - bottom) a = std::min(a, (block - j - 0.5f) / bottom);
+              alpha.at<float>(j, i) = a;
+            }
+          }
+          // Seam texels: the 50 % line of each blend ramp.
+          if (left > 0) {
+            for (int j = 0; j < block; ++j) seam_sum += error.at<float>(j, left / 2), ++seam_texels;
+          }
+          if (bottom > 0) {
+            for (int i = 0; i < block; ++i)
+              seam_sum += error.at<float>(block - 1 - bottom / 2, i), ++seam_texels;
+          }
+        } else {
+          if (left > 0) {
+            const std::vector<int> cut = VerticalSeam(error(cv::Rect(0, 0, left, block)));
+            for (int j = 0; j < block; ++j) {
+              const int c = cut[static_cast<std::size_t>(j)];
+              for (int i = 0; i < c; ++i) alpha.at<float>(j, i) = 0.0f;
+              seam_sum += error.at<float>(j, c);
+              ++seam_texels;
+            }
+          }
+          if (bottom > 0) {
+            // Horizontal seam: the vertical seam of the transposed strip.
+            cv::Mat strip = error(cv::Rect(0, block - bottom, block, bottom)).t();
+            const std::vector<int> cut = VerticalSeam(strip);
+            for (int i = 0; i < block; ++i) {
+              const int r = block - bottom + cut[static_cast<std::size_t>(i)];  // new block above r
+              for (int j = r + 1; j < block; ++j) alpha.at<float>(j, i) = 0.0f;
+              seam_sum += error.at<float>(r, i);
+              ++seam_texels;
+            }
+          }
+        }
+        // Texels not yet filled always take the new block.
+        for (int j = 0; j < block; ++j)
+          for (int i = 0; i < block; ++i)
+            if (mask.at<float>(j, i) == 0.0f) alpha.at<float>(j, i) = 1.0f;
+      }
+      for (std::size_t c = 0; c < out.size(); ++c) {
+        cv::Mat dst = out[c](out_rect);
+        cv::Mat blended = sample_planes[c](sample_rect).mul(alpha) + dst.mul(1.0 - alpha);
+        blended.copyTo(dst);
+      }
+      filled(out_rect).setTo(1.0f);
+    }
+  }
+  result.ptm = FromOrthonormalPlanes(out, format);
+  result.seam_cost_per_texel = seam_texels ? seam_sum / static_cast<double>(seam_texels) : 0.0;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+double NearestPatchEnergy(const ptm::Ptm& output, const ptm::Ptm& sample, int patch) {
+  const int coefficient_planes = CoefficientPlanes(sample.format);
+  const auto sample_all = ToOrthonormalPlanes(sample);
+  const std::vector<cv::Mat> sample_planes(sample_all.begin(),
+                                           sample_all.begin() + coefficient_planes);
+  const cv::Mat energy = PlaneEnergy(sample_planes);
+  const auto out_all = ToOrthonormalPlanes(output);
+  const cv::Mat ones = cv::Mat::ones(patch, patch, CV_32FC1);
+  double sum = 0.0;
+  int count = 0;
+  for (int y = 0; y + patch <= output.height; y += patch) {
+    for (int x = 0; x + patch <= output.width; x += patch) {
+      const cv::Mat ssd =
+          MaskedSsd(sample_planes, energy,
+                    Roi(out_all, cv::Rect(x, y, patch, patch), coefficient_planes), ones);
+      double min_ssd;
+      cv::minMaxLoc(ssd, &min_ssd);
+      sum += min_ssd / (patch * patch);
+      ++count;
+    }
+  }
+  return count ? sum / count : 0.0;
+}
+
+}  // namespace texlume::synth

@@ -1,0 +1,188 @@
+#include "synth/planar_synthesis.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "datasets_synthetic/scene.h"
+#include "ptm/fit.h"
+#include "sfm/errors.h"
+#include "synth/template_match.h"
+#include "tests/test_util.h"
+
+namespace texlume::synth {
+namespace {
+
+TEST(TemplateMatch, FftPathEqualsTheBruteForceReferenceAndRanksAlike) {
+  std::mt19937 rng(3);
+  std::vector<cv::Mat> image(6), templ(6);
+  for (int c = 0; c < 6; ++c) {
+    image[static_cast<std::size_t>(c)] = cv::Mat(48, 40, CV_32FC1);
+    cv::randu(image[static_cast<std::size_t>(c)], -1.0, 1.0);
+    templ[static_cast<std::size_t>(c)] =
+        image[static_cast<std::size_t>(c)](cv::Rect(11, 17, 12, 12)).clone();
+    cv::Mat noise(12, 12, CV_32FC1);
+    cv::randn(noise, 0.0, 0.05);
+    templ[static_cast<std::size_t>(c)] += noise;
+  }
+  cv::Mat mask = cv::Mat::zeros(12, 12, CV_32FC1);
+  mask(cv::Rect(0, 0, 4, 12)).setTo(1.0f);  // an L-shaped overlap
+  mask(cv::Rect(0, 8, 12, 4)).setTo(1.0f);
+  const cv::Mat fast = MaskedSsd(image, PlaneEnergy(image), templ, mask);
+  const cv::Mat reference = MaskedSsdBruteForce(image, templ, mask);
+  ASSERT_EQ(fast.size(), reference.size());
+  double max_diff;
+  cv::minMaxLoc(cv::abs(fast - reference), nullptr, &max_diff);
+  EXPECT_LT(max_diff, 1e-3);
+  cv::Point best_fast, best_reference;
+  cv::minMaxLoc(fast, nullptr, nullptr, &best_fast);
+  cv::minMaxLoc(reference, nullptr, nullptr, &best_reference);
+  EXPECT_EQ(best_fast, best_reference);
+  EXPECT_EQ(best_fast, cv::Point(11, 17));
+  // The ten best positions are the same in the same order.
+  auto top = [](const cv::Mat& m) {
+    std::vector<std::pair<float, int>> v;
+    for (int i = 0; i < static_cast<int>(m.total()); ++i) v.emplace_back(m.at<float>(i), i);
+    std::partial_sort(v.begin(), v.begin() + 10, v.end());
+    std::vector<int> ids;
+    for (int i = 0; i < 10; ++i) ids.push_back(v[static_cast<std::size_t>(i)].second);
+    return ids;
+  };
+  EXPECT_EQ(top(fast), top(reference));
+}
+
+class PlanarSynthesisTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    // A stone sample PTM fitted to a small synthetic capture, and photos of an
+    // unseen region of the same stone at half resolution.
+    testing::TempDir* tmp = new testing::TempDir;
+    datasets::SceneOptions scene;
+    scene.shape = datasets::SceneShape::kPlane;
+    scene.capture_size = 96;
+    scene.num_capture_lights = 24;
+    scene.num_held_out_capture_lights = 0;
+    scene.write_btf = false;
+    scene.num_images = 3;
+    scene.num_held_out_views = 0;
+    scene.image_width = scene.image_height = 64;
+    scene.focal_px = 60;
+    scene.material.texel_size = 0.004;
+    datasets::GenerateScene(scene, tmp->path());
+    std::vector<std::filesystem::path> files;
+    std::vector<Eigen::Vector3d> lights;
+    for (const auto& e : sfm::ReadLpFile(tmp->path() / "material/capture/lights.lp")) {
+      files.push_back(tmp->path() / "material/capture" / e.filename);
+      lights.push_back(e.direction_in_image);
+    }
+    sample_ = new ptm::Ptm(ptm::FitPtmFromFiles(files, lights, {}).ptm);
+    datasets::PlanarSurfaceOptions surface;
+    surface.material = scene.material;
+    surface.size = 64;
+    surface.scale = 2;
+    surface.offset = 200;
+    photo_lights_ = {Eigen::Vector3d(0.6, 0.2, 0.77).normalized(),
+                     Eigen::Vector3d(-0.4, 0.5, 0.77).normalized()};
+    const auto renders = datasets::RenderPlanarSurface(surface, photo_lights_, photo_lights_);
+    photos_ = new std::vector<PlanarPhoto>;
+    truth_ = new std::vector<cv::Mat>;
+    for (std::size_t n = 0; n < photo_lights_.size(); ++n) {
+      cv::Mat f;
+      renders.photos[n].convertTo(f, CV_32FC3, 1 / 255.0);
+      cv::cvtColor(f, f, cv::COLOR_BGR2RGB);
+      PlanarPhoto p;
+      p.image = {f.cols, f.rows,
+                 std::vector<float>(reinterpret_cast<float*>(f.data),
+                                    reinterpret_cast<float*>(f.data) + f.total() * 3)};
+      p.light = photo_lights_[n];
+      p.name = "photo_" + std::to_string(n) + ".png";
+      photos_->push_back(p);
+    }
+    delete tmp;
+  }
+  static double PhotoError(const PlanarSynthesisResult& r) {
+    double sum = 0;
+    for (std::size_t n = 0; n < photos_->size(); ++n) {
+      const std::vector<float> relit = ptm::Relight(r.ptm, (*photos_)[n].light);
+      cv::Mat full(r.ptm.height, r.ptm.width, CV_32FC3, const_cast<float*>(relit.data())), small;
+      cv::resize(full, small, cv::Size(32, 32), 0, 0, cv::INTER_AREA);
+      const cv::Mat photo(32, 32, CV_32FC3, const_cast<float*>((*photos_)[n].image.pixels.data()));
+      cv::Mat d = small * r.photo_gains[n] - photo;
+      sum += cv::norm(d) / std::sqrt(d.total() * 3.0);
+    }
+    return sum / static_cast<double>(photos_->size());
+  }
+  static ptm::Ptm* sample_;
+  static std::vector<PlanarPhoto>* photos_;
+  static std::vector<cv::Mat>* truth_;
+  static std::vector<Eigen::Vector3d> photo_lights_;
+};
+ptm::Ptm* PlanarSynthesisTest::sample_ = nullptr;
+std::vector<PlanarPhoto>* PlanarSynthesisTest::photos_ = nullptr;
+std::vector<cv::Mat>* PlanarSynthesisTest::truth_ = nullptr;
+std::vector<Eigen::Vector3d> PlanarSynthesisTest::photo_lights_;
+
+TEST_F(PlanarSynthesisTest, PhotoConstraintsMakeTheRelitOutputAgreeWithThePhotos) {
+  PlanarSynthesisOptions o;
+  o.block_size = 16;
+  o.overlap = 4;
+  o.scale = 2;
+  const PlanarSynthesisResult constrained = SynthesizePlanarPtm(*sample_, *photos_, o);
+  EXPECT_EQ(constrained.ptm.width, 64);
+  EXPECT_EQ(constrained.scale, 2);
+  o.use_photos = false;
+  o.width = o.height = 64;
+  PlanarSynthesisResult unconstrained = SynthesizePlanarPtm(*sample_, {}, o);
+  unconstrained.photo_gains = constrained.photo_gains;
+  EXPECT_LT(PhotoError(constrained), 0.8 * PhotoError(unconstrained));
+  // Every block comes from inside the sample and covers the output.
+  for (const BlockPlacement& b : constrained.blocks) {
+    EXPECT_GE(b.sample_x, 0);
+    EXPECT_LE(b.sample_x + 16, sample_->width);
+  }
+  EXPECT_EQ(constrained.blocks.size(), 25u);  // 5 x 5 positions over 64 with step 12
+}
+
+TEST_F(PlanarSynthesisTest, SeamCuttingLowersTheSeamCostOfBlending) {
+  PlanarSynthesisOptions o;
+  o.block_size = 16;
+  o.overlap = 6;
+  o.scale = 2;
+  const double blend = SynthesizePlanarPtm(*sample_, *photos_, o).seam_cost_per_texel;
+  o.stitch = Stitch::kSeamCut;
+  const double cut = SynthesizePlanarPtm(*sample_, *photos_, o).seam_cost_per_texel;
+  EXPECT_LT(cut, blend);
+}
+
+TEST_F(PlanarSynthesisTest, OrthonormalPlanesRoundTrip) {
+  const ptm::Ptm back = FromOrthonormalPlanes(ToOrthonormalPlanes(*sample_), sample_->format);
+  for (std::size_t i = 0; i < back.coefficients.size(); ++i) {
+    ASSERT_NEAR(back.coefficients[i], sample_->coefficients[i], 1e-5);
+  }
+  EXPECT_LT(NearestPatchEnergy(*sample_, *sample_, 16), 1e-6);  // every patch is in the sample
+}
+
+TEST_F(PlanarSynthesisTest, BadPhotosAndOptionsAreCleanErrors) {
+  PlanarSynthesisOptions o;
+  o.block_size = 16;
+  o.overlap = 4;
+  o.width = 50;  // not a whole number of texels per photo pixel (photos are 32 wide)
+  EXPECT_THROW(SynthesizePlanarPtm(*sample_, *photos_, o), InputError);
+  o.width = 0;
+  o.scale = 2;
+  auto photos = *photos_;
+  photos[1].image.width = 31;
+  EXPECT_THROW(SynthesizePlanarPtm(*sample_, photos, o), InputError);
+  o.block_size = 15;  // odd block with a photo scale of 2
+  EXPECT_THROW(SynthesizePlanarPtm(*sample_, *photos_, o), OptionError);
+  o.block_size = 128;  // larger than the sample
+  EXPECT_THROW(SynthesizePlanarPtm(*sample_, *photos_, o), OptionError);
+  o = {};
+  o.overlap = 40;
+  EXPECT_THROW(o.Check(), OptionError);
+  EXPECT_THROW(SynthesizePlanarPtm(*sample_, {}, PlanarSynthesisOptions{}), InputError);
+}
+
+}  // namespace
+}  // namespace texlume::synth
