@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "apps/progress_bar.h"
 #include "datasets_synthetic/object_scene.h"
@@ -18,6 +19,7 @@
 #include "sfm/file_util.h"
 #include "sfm/inspect.h"
 #include "sfm/lights.h"
+#include "synth/planar_synthesis.h"
 
 namespace texlume::apps {
 
@@ -298,6 +300,107 @@ int RunLightsFromSphereCommand(const std::vector<std::string>& args, std::ostrea
   out << "Sphere at (" << used.center_x << ", " << used.center_y << "), radius " << used.radius
       << " px; wrote " << entries.size() << " light directions to " << out_path.string() << "\n";
   for (const auto& name : skipped) err << "warning: no highlight found in " << name << "\n";
+  return kExitOk;
+}
+
+int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
+                      std::ostream& /*err*/) {
+  const Arguments a(args,
+                    {"sample", "photos", "lights", "out", "scale", "width", "height", "block",
+                     "overlap", "top-k", "seed"},
+                    {"seam", "unconstrained"});
+  const ptm::Ptm sample = LoadAnyPtm(a.Require("sample"));
+  const std::filesystem::path out_dir = a.Require("out");
+  synth::PlanarSynthesisOptions options;
+  options.scale = a.GetInt("scale", 1);
+  options.width = a.GetInt("width", 0);
+  options.height = a.GetInt("height", 0);
+  options.block_size = a.GetInt("block", options.block_size);
+  options.overlap = a.GetInt("overlap", options.overlap);
+  options.top_k = a.GetInt("top-k", options.top_k);
+  options.seed = static_cast<std::uint32_t>(a.GetInt("seed", 1));
+  options.stitch = a.Has("seam") ? synth::Stitch::kSeamCut : synth::Stitch::kBlend;
+  options.use_photos = !a.Has("unconstrained");
+  options.Check();
+  std::vector<synth::PlanarPhoto> photos;
+  if (options.use_photos) {
+    const std::filesystem::path dir = a.Require("photos");
+    const std::filesystem::path lp = a.Require("lights");
+    for (const auto& e : sfm::ReadLpFile(lp)) {
+      const std::filesystem::path file = dir / sfm::BaseName(e.filename);
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(file, ec)) {
+        throw InputError(lp.string(),
+                         "names '" + e.filename + "', but " + file.string() + " does not exist");
+      }
+      const cv::Mat bgr = cv::imread(file.string(), cv::IMREAD_COLOR | cv::IMREAD_ANYDEPTH);
+      if (bgr.empty()) throw InputError(file.string(), "cannot read image");
+      cv::Mat f;
+      bgr.convertTo(f, CV_32FC3, bgr.depth() == CV_16U ? 1.0 / 65535 : 1.0 / 255);
+      cv::cvtColor(f, f, cv::COLOR_BGR2RGB);
+      synth::PlanarPhoto photo;
+      photo.image = {f.cols, f.rows,
+                     std::vector<float>(reinterpret_cast<float*>(f.data),
+                                        reinterpret_cast<float*>(f.data) + f.total() * 3)};
+      photo.light = e.direction_in_image;
+      photo.name = file.string();
+      photos.push_back(std::move(photo));
+    }
+  } else if (options.width == 0 || options.height == 0) {
+    throw UsageError("--unconstrained needs --width and --height");
+  }
+  const synth::PlanarSynthesisResult result = synth::SynthesizePlanarPtm(sample, photos, options);
+  std::filesystem::create_directories(out_dir);
+  ptm::WritePtmFile(result.ptm, out_dir / "ptm_out.ptm");
+  ptm::WritePtmExr(result.ptm, out_dir / "ptm_out.exr");
+  const int w = result.ptm.width, h = result.ptm.height;
+  for (std::size_t n = 0; n < photos.size(); ++n) {
+    const std::string stem = std::filesystem::path(photos[n].name).stem().string();
+    std::vector<float> relit = ptm::Relight(result.ptm, photos[n].light);
+    for (float& v : relit) v = std::min(1.0f, static_cast<float>(v * result.photo_gains[n]));
+    WriteRgbPng(out_dir / ("relit_" + stem + ".png"), relit, w, h, false);
+    // Side by side: the photo (nearest upscale), relit PTM_out, bicubic upscale.
+    const cv::Mat photo(photos[n].image.height, photos[n].image.width, CV_32FC3,
+                        const_cast<float*>(photos[n].image.pixels.data()));
+    cv::Mat nearest, bicubic;
+    cv::resize(photo, nearest, cv::Size(w, h), 0, 0, cv::INTER_NEAREST);
+    cv::resize(photo, bicubic, cv::Size(w, h), 0, 0, cv::INTER_CUBIC);
+    cv::Mat row;
+    cv::hconcat(std::vector<cv::Mat>{nearest, cv::Mat(h, w, CV_32FC3, relit.data()), bicubic}, row);
+    WriteRgbPng(out_dir / ("comparison_" + stem + ".png"),
+                std::vector<float>(reinterpret_cast<float*>(row.data),
+                                   reinterpret_cast<float*>(row.data) + row.total() * 3),
+                row.cols, row.rows, false);
+  }
+  const std::vector<Eigen::Vector3d> new_lights = {Eigen::Vector3d(0.7, 0.0, 0.71).normalized(),
+                                                   Eigen::Vector3d(-0.35, 0.6, 0.71).normalized(),
+                                                   Eigen::Vector3d(0.0, 0.0, 1.0)};
+  for (std::size_t k = 0; k < new_lights.size(); ++k) {
+    WriteRgbPng(out_dir / ("relit_new_" + std::to_string(k) + ".png"),
+                ptm::Relight(result.ptm, new_lights[k]), w, h, false);
+  }
+  nlohmann::json record;
+  record["command"] = "synth2d";
+  record["settings"] = {{"block_size", options.block_size},
+                        {"overlap", options.overlap},
+                        {"top_k", options.top_k},
+                        {"stitch", a.Has("seam") ? "seam_cut" : "blend"},
+                        {"constrained", options.use_photos},
+                        {"seed", options.seed},
+                        {"width", w},
+                        {"height", h},
+                        {"scale", result.scale}};
+  record["photo_gains"] = result.photo_gains;
+  record["seam_cost_per_texel"] = result.seam_cost_per_texel;
+  record["blocks"] = result.blocks.size();
+  record["new_lights"] = nlohmann::json::array();
+  for (const auto& l : new_lights) record["new_lights"].push_back({l.x(), l.y(), l.z()});
+  record["timings_s"] = {{"synthesis", result.seconds}};
+  WriteFileAtomically(
+      out_dir / "synth2d.json", [&](std::ostream& o) { o << record.dump(2) << "\n"; }, false);
+  out << "Synthesised a " << w << "x" << h << " PTM from " << result.blocks.size() << " blocks of "
+      << options.block_size << " texels (" << photos.size() << " photos, scale " << result.scale
+      << ") in " << result.seconds << " s into " << out_dir.string() << "\n";
   return kExitOk;
 }
 

@@ -52,6 +52,8 @@ int RunRelightCommand(const std::vector<std::string>& args, std::ostream& out, s
 /// `texlume lights-from-sphere`: light directions from a reflective sphere.
 int RunLightsFromSphereCommand(const std::vector<std::string>& args, std::ostream& out,
                                std::ostream& err);
+/// `texlume synth2d`: image-constrained planar PTM synthesis. Returns the exit code.
+int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 /// `texlume demo`: builds a synthetic scene and inspects it. Returns the exit code.
 int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 

@@ -27,6 +27,10 @@ constexpr const char* kUsage =
     "      Render a PTM under a light (texture frame: x right, y up, z out).\n"
     "  lights-from-sphere --images DIR --out lights.lp [--circle cx,cy,r] [--threshold F]\n"
     "      Light directions from the highlight on a glossy sphere in every photo.\n"
+    "  synth2d --sample FILE.ptm --photos DIR --lights FILE.lp --out DIR [--scale R]\n"
+    "          [--width W --height H] [--block N] [--overlap N] [--top-k K] [--seam]\n"
+    "          [--unconstrained] [--seed S]\n"
+    "      Image-constrained planar PTM synthesis (paper 003 Algorithm 1).\n"
     "  scene --out DIR [--kind sphere|cylinder|plane|torus] [--material stone|brick|grooves]\n"
     "        [--seed S] [--images N] [--camera-model pinhole|opencv] [--width W] [--height H]\n"
     "        [--capture-size N] [--capture-lights N] [--held-out-lights N] [--held-out-views N]\n"
@@ -64,6 +68,7 @@ int main(int argc, char** argv) {
     if (command == "relight") return RunRelightCommand(args, std::cout, std::cerr);
     if (command == "lights-from-sphere")
       return RunLightsFromSphereCommand(args, std::cout, std::cerr);
+    if (command == "synth2d") return RunSynth2dCommand(args, std::cout, std::cerr);
     if (command == "scene") return RunSceneCommand(args, std::cout, std::cerr);
     if (command == "demo") return RunDemoCommand(args, std::cout, std::cerr);
     throw UsageError("unknown command '" + command + "'");

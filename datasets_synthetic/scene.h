@@ -39,6 +39,9 @@ struct SceneOptions {
   int num_capture_lights = 40;           ///< RTI dome, [6, 500]
   int num_held_out_capture_lights = 10;  ///< [0, 500]
   bool write_btf = true;
+  /// Photos of an unseen planar surface of the material at half resolution under
+  /// 3 lights, with full-resolution ground truth (for planar synthesis).
+  bool write_surface = true;
   int btf_size = 128;        ///< texels per side, [16, 1024]
   int btf_view_count = 6;    ///< [1, 64]
   int btf_light_count = 12;  ///< [1, 128]

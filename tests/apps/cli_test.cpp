@@ -233,5 +233,34 @@ TEST_F(FitCliTest, BadCapturesAreCleanErrorsWithNothingWritten) {
             2);
 }
 
+TEST_F(FitCliTest, Synth2dBuildsAPtmFromPhotosAndRefusesBadPhotos) {
+  std::string out;
+  const std::string sample = (tmp_ / "sample.ptm").string();
+  ASSERT_EQ(
+      Texlume("fit --images " + capture_ + " --lights " + capture_ + "/lights.lp --out " + sample,
+              &out),
+      0)
+      << out;
+  const std::string photos = (tmp_ / "material/surface/photos").string();
+  const std::string base = "synth2d --sample " + sample + " --photos " + photos + " --lights " +
+                           photos + "/lights.lp --scale 2 --block 8 --overlap 2 --out ";
+  ASSERT_EQ(Texlume(base + (tmp_ / "out").string(), &out), 0) << out;
+  for (const std::string f : {"ptm_out.ptm", "ptm_out.exr", "relit_photo_00.png",
+                              "comparison_photo_01.png", "relit_new_0.png", "synth2d.json"}) {
+    EXPECT_TRUE(std::filesystem::exists(tmp_ / "out" / f)) << f;
+  }
+  // Blocks that do not fit the photo scale, or the sample.
+  EXPECT_EQ(Texlume(base + (tmp_ / "bad").string() + " --block 7", &out), 2);
+  EXPECT_EQ(Texlume(base + (tmp_ / "bad").string() + " --block 64", &out), 2);
+  EXPECT_NE(out.find("does not fit"), std::string::npos) << out;
+  // Output size that the photos do not cover at a whole scale.
+  EXPECT_EQ(Texlume(base + (tmp_ / "bad").string() + " --width 25 --height 25", &out), 1);
+  // A photo named in the .lp but missing.
+  std::filesystem::remove(tmp_ / "material/surface/photos/photo_01.png");
+  EXPECT_EQ(Texlume(base + (tmp_ / "bad").string(), &out), 1);
+  EXPECT_NE(out.find("photo_01.png"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp_ / "bad"));
+}
+
 }  // namespace
 }  // namespace texlume
