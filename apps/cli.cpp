@@ -188,22 +188,9 @@ int RunFitCommand(const std::vector<std::string>& args, std::ostream& out, std::
   options.robust = a.Has("robust");
   options.band_rows = a.GetInt("band-rows", options.band_rows);
   options.Check();
-  std::error_code ec;
-  if (!std::filesystem::is_directory(images_dir, ec)) {
-    throw InputError(images_dir.string(), "image folder not found");
-  }
-  const auto entries = sfm::ReadLpFile(lp_path);
-  std::vector<std::filesystem::path> files;
-  std::vector<Eigen::Vector3d> lights;
-  for (const auto& e : entries) {
-    const std::filesystem::path file = images_dir / sfm::BaseName(e.filename);
-    if (!std::filesystem::is_regular_file(file, ec)) {
-      throw InputError(lp_path.string(),
-                       "names '" + e.filename + "', but " + file.string() + " does not exist");
-    }
-    files.push_back(file);
-    lights.push_back(e.direction_in_image);
-  }
+  const ptm::RtiCapture capture = ptm::ReadRtiCapture(lp_path, images_dir);
+  const std::vector<std::filesystem::path>& files = capture.files;
+  const std::vector<Eigen::Vector3d>& lights = capture.lights;
   ProgressBar bar;
   ptm::CheckLightSet(lights, options, lp_path.string());
   const ptm::FitResult result = ptm::FitPtmFromFiles(files, lights, options, bar.Callback());
@@ -326,13 +313,9 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
   if (options.use_photos) {
     const std::filesystem::path dir = a.Require("photos");
     const std::filesystem::path lp = a.Require("lights");
-    for (const auto& e : sfm::ReadLpFile(lp)) {
-      const std::filesystem::path file = dir / sfm::BaseName(e.filename);
-      std::error_code ec;
-      if (!std::filesystem::is_regular_file(file, ec)) {
-        throw InputError(lp.string(),
-                         "names '" + e.filename + "', but " + file.string() + " does not exist");
-      }
+    const ptm::RtiCapture capture = ptm::ReadRtiCapture(lp, dir);
+    for (std::size_t k = 0; k < capture.files.size(); ++k) {
+      const std::filesystem::path& file = capture.files[k];
       const cv::Mat bgr = cv::imread(file.string(), cv::IMREAD_COLOR | cv::IMREAD_ANYDEPTH);
       if (bgr.empty()) throw InputError(file.string(), "cannot read image");
       cv::Mat f;
@@ -342,7 +325,7 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
       photo.image = {f.cols, f.rows,
                      std::vector<float>(reinterpret_cast<float*>(f.data),
                                         reinterpret_cast<float*>(f.data) + f.total() * 3)};
-      photo.light = e.direction_in_image;
+      photo.light = capture.lights[k];
       photo.name = file.string();
       photos.push_back(std::move(photo));
     }

@@ -136,26 +136,18 @@ int main(int argc, char** argv) {
       fit.ptm.coefficients.size() * 4.0 / (1 << 20) + fit.ptm.colour.size() * 4.0 / (1 << 20));
 
   // Leave-out quality on a synthetic capture.
-  datasets::SceneOptions scene;
-  scene.write_btf = false;
-  scene.num_images = 3;
-  scene.num_held_out_views = 0;
-  scene.image_width = scene.image_height = 64;
+  const datasets::SceneOptions scene =
+      datasets::MaterialOnlySceneOptions(datasets::MaterialKind::kStone, 256, 40);
   const fs::path scene_dir = work / "scene";
   if (!fs::exists(scene_dir / "material/held_out/lights.lp"))
     datasets::GenerateScene(scene, scene_dir);
-  const auto train = sfm::ReadLpFile(scene_dir / "material/capture/lights.lp");
+  const ptm::RtiCapture train =
+      ptm::ReadRtiCapture(scene_dir / "material/capture/lights.lp", scene_dir / "material/capture");
   const auto held = sfm::ReadLpFile(scene_dir / "material/held_out/lights.lp");
-  std::vector<fs::path> train_files;
-  std::vector<Eigen::Vector3d> train_lights;
-  for (const auto& e : train) {
-    train_files.push_back(scene_dir / "material/capture" / e.filename);
-    train_lights.push_back(e.direction_in_image);
-  }
   for (bool robust : {false, true}) {
     ptm::FitOptions o;
     o.robust = robust;
-    const ptm::FitResult r = ptm::FitPtmFromFiles(train_files, train_lights, o);
+    const ptm::FitResult r = ptm::FitPtmFromFiles(train.files, train.lights, o);
     double psnr = 0;
     for (const auto& e : held) {
       const cv::Mat image = cv::imread((scene_dir / "material/held_out" / e.filename).string());

@@ -60,23 +60,12 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--top-k")) top_k = std::atoi(argv[i + 1]);
   }
   const fs::path work = fs::temp_directory_path() / ("texlume_synth2d_" + material);
-  datasets::SceneOptions scene;
-  scene.material.kind = *datasets::MaterialKindFromName(material);
-  scene.shape = datasets::SceneShape::kPlane;
-  scene.write_btf = false;
-  scene.num_images = 3;
-  scene.num_held_out_views = 0;
-  scene.image_width = scene.image_height = 64;
-  scene.focal_px = 60;
+  const datasets::SceneOptions scene =
+      datasets::MaterialOnlySceneOptions(*datasets::MaterialKindFromName(material), 256, 40);
   if (!fs::exists(work / "material/capture/lights.lp")) datasets::GenerateScene(scene, work);
-  const auto lp = sfm::ReadLpFile(work / "material/capture/lights.lp");
-  std::vector<fs::path> files;
-  std::vector<Eigen::Vector3d> lights;
-  for (const auto& e : lp) {
-    files.push_back(work / "material/capture" / e.filename);
-    lights.push_back(e.direction_in_image);
-  }
-  const ptm::Ptm sample = ptm::FitPtmFromFiles(files, lights, {}).ptm;
+  const ptm::RtiCapture capture =
+      ptm::ReadRtiCapture(work / "material/capture/lights.lp", work / "material/capture");
+  const ptm::Ptm sample = ptm::FitPtmFromFiles(capture.files, capture.lights, {}).ptm;
 
   const std::vector<Eigen::Vector3d> photo_lights = {
       Eigen::Vector3d(0.6, 0.2, 0.77).normalized(), Eigen::Vector3d(-0.4, 0.5, 0.77).normalized(),

@@ -96,6 +96,20 @@ void SceneOptions::Check() const {
   }
 }
 
+SceneOptions MaterialOnlySceneOptions(MaterialKind kind, int capture_size, int capture_lights) {
+  SceneOptions o;
+  o.material.kind = kind;
+  o.shape = SceneShape::kPlane;
+  o.capture_size = capture_size;
+  o.num_capture_lights = capture_lights;
+  o.write_btf = false;
+  o.num_images = 3;
+  o.num_held_out_views = 0;
+  o.image_width = o.image_height = 64;
+  o.focal_px = 60;
+  return o;
+}
+
 std::vector<Eigen::Vector3d> DomeLights(int count, double min_elevation_deg,
                                         double max_elevation_deg, double offset) {
   std::vector<Eigen::Vector3d> lights;

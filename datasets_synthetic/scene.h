@@ -54,6 +54,10 @@ struct SceneOptions {
   void Check() const;
 };
 
+/// Settings for a scene used only for its material outputs (captures, planar
+/// surface): a plane object with 3 tiny photos, no BTF, no held-out views.
+SceneOptions MaterialOnlySceneOptions(MaterialKind kind, int capture_size, int capture_lights);
+
 /// What GenerateScene wrote.
 struct SceneSummary {
   std::filesystem::path dir;

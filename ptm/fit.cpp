@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "sfm/errors.h"
+#include "sfm/lights.h"
 
 namespace texlume::ptm {
 namespace {
@@ -221,6 +222,25 @@ void CheckLightSet(const std::vector<Eigen::Vector3d>& lights, const FitOptions&
                                 std::to_string(condition) +
                                 "); spread the lights over the dome in azimuth and elevation");
   }
+}
+
+RtiCapture ReadRtiCapture(const std::filesystem::path& lp_path,
+                          const std::filesystem::path& images_dir) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(images_dir, ec)) {
+    throw InputError(images_dir.string(), "image folder not found");
+  }
+  RtiCapture capture;
+  for (const auto& e : sfm::ReadLpFile(lp_path)) {
+    const std::filesystem::path file = images_dir / sfm::BaseName(e.filename);
+    if (!std::filesystem::is_regular_file(file, ec)) {
+      throw InputError(lp_path.string(),
+                       "names '" + e.filename + "', but " + file.string() + " does not exist");
+    }
+    capture.files.push_back(file);
+    capture.lights.push_back(e.direction_in_image);
+  }
+  return capture;
 }
 
 FitResult FitPtm(const std::vector<ImageRgb>& images, const std::vector<Eigen::Vector3d>& lights,

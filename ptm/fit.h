@@ -78,6 +78,17 @@ FitResult FitPtmPerTexelLights(
     const std::function<Eigen::Vector3d(int image, int x, int y)>& light_at,
     const FitOptions& options);
 
+/// An RTI capture on disk: image files and their light directions, in .lp order.
+struct RtiCapture {
+  std::vector<std::filesystem::path> files;
+  std::vector<Eigen::Vector3d> lights;
+};
+
+/// Reads an .lp file and finds each image it names in `images_dir` (by file name).
+/// Throws InputError naming the .lp and the image when one is missing.
+RtiCapture ReadRtiCapture(const std::filesystem::path& lp_path,
+                          const std::filesystem::path& images_dir);
+
 /// Checks a light set: at least options.min_lights, every light unit, above the
 /// horizon, and the light matrix well conditioned. Throws InputError(label, ...).
 void CheckLightSet(const std::vector<Eigen::Vector3d>& lights, const FitOptions& options,

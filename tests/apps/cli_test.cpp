@@ -133,15 +133,9 @@ TEST(Cli, SceneRefusesUnknownKindsAndMaterials) {
 class FitCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    datasets::SceneOptions o;
-    o.capture_size = 24;
-    o.num_capture_lights = 12;
+    datasets::SceneOptions o =
+        datasets::MaterialOnlySceneOptions(datasets::MaterialKind::kStone, 24, 12);
     o.num_held_out_capture_lights = 2;
-    o.write_btf = false;
-    o.num_images = 3;
-    o.num_held_out_views = 0;
-    o.image_width = o.image_height = 64;
-    o.focal_px = 60;
     o.material.texel_size = 0.01;
     datasets::GenerateScene(o, tmp_.path());
     capture_ = (tmp_ / "material/capture").string();

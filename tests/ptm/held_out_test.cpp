@@ -33,26 +33,15 @@ double Psnr(const std::vector<float>& a, const std::vector<float>& b) {
 
 TEST(HeldOut, TexlumeFitRelightsHeldOutLightsAtLeastAsWellAsAReferenceFit) {
   testing::TempDir tmp;
-  datasets::SceneOptions o;
-  o.material.kind = datasets::MaterialKind::kBrick;
-  o.capture_size = 64;
-  o.write_btf = false;
-  o.num_images = 3;
-  o.num_held_out_views = 0;
-  o.image_width = o.image_height = 64;
-  o.focal_px = 60;
-  o.shape = datasets::SceneShape::kPlane;
-  datasets::GenerateScene(o, tmp.path());
-  const auto train = sfm::ReadLpFile(tmp / "material/capture/lights.lp");
+  datasets::GenerateScene(
+      datasets::MaterialOnlySceneOptions(datasets::MaterialKind::kBrick, 64, 40), tmp.path());
   const auto held = sfm::ReadLpFile(tmp / "material/held_out/lights.lp");
-  std::vector<std::filesystem::path> files;
-  std::vector<Eigen::Vector3d> lights;
+  const RtiCapture capture =
+      ReadRtiCapture(tmp / "material/capture/lights.lp", tmp / "material/capture");
+  const std::vector<std::filesystem::path>& files = capture.files;
+  const std::vector<Eigen::Vector3d>& lights = capture.lights;
   std::vector<ImageRgb> images;
-  for (const auto& e : train) {
-    files.push_back(tmp / "material/capture" / e.filename);
-    lights.push_back(e.direction_in_image);
-    images.push_back(LoadDisplay(files.back()));
-  }
+  for (const auto& f : files) images.push_back(LoadDisplay(f));
   // Reference: per texel and channel, normal equations solved by Eigen.
   Eigen::MatrixXd a(static_cast<Eigen::Index>(lights.size()), 6);
   for (std::size_t k = 0; k < lights.size(); ++k) {

@@ -58,25 +58,14 @@ class PlanarSynthesisTest : public ::testing::Test {
     // A stone sample PTM fitted to a small synthetic capture, and photos of an
     // unseen region of the same stone at half resolution.
     testing::TempDir* tmp = new testing::TempDir;
-    datasets::SceneOptions scene;
-    scene.shape = datasets::SceneShape::kPlane;
-    scene.capture_size = 96;
-    scene.num_capture_lights = 24;
+    datasets::SceneOptions scene =
+        datasets::MaterialOnlySceneOptions(datasets::MaterialKind::kStone, 96, 24);
     scene.num_held_out_capture_lights = 0;
-    scene.write_btf = false;
-    scene.num_images = 3;
-    scene.num_held_out_views = 0;
-    scene.image_width = scene.image_height = 64;
-    scene.focal_px = 60;
     scene.material.texel_size = 0.004;
     datasets::GenerateScene(scene, tmp->path());
-    std::vector<std::filesystem::path> files;
-    std::vector<Eigen::Vector3d> lights;
-    for (const auto& e : sfm::ReadLpFile(tmp->path() / "material/capture/lights.lp")) {
-      files.push_back(tmp->path() / "material/capture" / e.filename);
-      lights.push_back(e.direction_in_image);
-    }
-    sample_ = new ptm::Ptm(ptm::FitPtmFromFiles(files, lights, {}).ptm);
+    const ptm::RtiCapture capture = ptm::ReadRtiCapture(tmp->path() / "material/capture/lights.lp",
+                                                        tmp->path() / "material/capture");
+    sample_ = new ptm::Ptm(ptm::FitPtmFromFiles(capture.files, capture.lights, {}).ptm);
     datasets::PlanarSurfaceOptions surface;
     surface.material = scene.material;
     surface.size = 64;
