@@ -63,26 +63,27 @@ std::string Arguments::Require(const std::string& name) const {
 
 bool Arguments::Has(const std::string& name) const { return values_.count(name) > 0; }
 
+namespace {
+// Parses the whole value of --name as a number of type T, or throws UsageError.
+template <typename T>
+T ParseOption(const std::string& name, const std::string& value, const char* what) {
+  T parsed{};
+  const auto [ptr, ec] = std::from_chars(value.data(), value.data() + value.size(), parsed);
+  if (ec != std::errc() || ptr != value.data() + value.size()) {
+    throw UsageError("--" + name + " expects " + what + ", got '" + value + "'");
+  }
+  return parsed;
+}
+}  // namespace
+
 int Arguments::GetInt(const std::string& name, int fallback) const {
   const auto v = Get(name);
-  if (!v) return fallback;
-  int value = 0;
-  const auto [ptr, ec] = std::from_chars(v->data(), v->data() + v->size(), value);
-  if (ec != std::errc() || ptr != v->data() + v->size()) {
-    throw UsageError("--" + name + " expects an integer, got '" + *v + "'");
-  }
-  return value;
+  return v ? ParseOption<int>(name, *v, "an integer") : fallback;
 }
 
 double Arguments::GetDouble(const std::string& name, double fallback) const {
   const auto v = Get(name);
-  if (!v) return fallback;
-  double value = 0;
-  const auto [ptr, ec] = std::from_chars(v->data(), v->data() + v->size(), value);
-  if (ec != std::errc() || ptr != v->data() + v->size()) {
-    throw UsageError("--" + name + " expects a number, got '" + *v + "'");
-  }
-  return value;
+  return v ? ParseOption<double>(name, *v, "a number") : fallback;
 }
 
 int RunInspectCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {

@@ -62,6 +62,18 @@ Eigen::Vector3d PtmNormal(const float* a) {
 
 namespace {
 
+// The luminance polynomial of a texel: its own for LRGB, the mean of the three
+// channel polynomials for RGB (`scratch` holds that mean).
+const float* LuminanceCoefficients(const Ptm& ptm, std::size_t texel, float* scratch) {
+  if (ptm.format == PtmFormat::kLrgb) return ptm.Coefficients(texel);
+  for (int k = 0; k < 6; ++k) {
+    scratch[k] = (ptm.Coefficients(texel, 0)[k] + ptm.Coefficients(texel, 1)[k] +
+                  ptm.Coefficients(texel, 2)[k]) /
+                 3.0f;
+  }
+  return scratch;
+}
+
 // Diffuse gain (Malzbender et al. 2001, §5.1): keeps the value and slope at the
 // normal direction, scales the curvature by g.
 void DiffuseGain(const float* a, double g, float* out) {
@@ -88,16 +100,8 @@ std::vector<float> Relight(const Ptm& ptm, const Eigen::Vector3d& light,
   for (long t = 0; t < static_cast<long>(ptm.NumTexels()); ++t) {
     const auto texel = static_cast<std::size_t>(t);
     Eigen::Vector3f rgb;
-    float luminance_coefficients[6];
-    const float* a = ptm.Coefficients(texel);
-    if (ptm.format == PtmFormat::kRgb) {
-      for (int k = 0; k < 6; ++k) {
-        luminance_coefficients[k] = (ptm.Coefficients(texel, 0)[k] + ptm.Coefficients(texel, 1)[k] +
-                                     ptm.Coefficients(texel, 2)[k]) /
-                                    3.0f;
-      }
-      a = luminance_coefficients;
-    }
+    float scratch[6];
+    const float* a = LuminanceCoefficients(ptm, texel, scratch);
     if (gain) {
       for (int c = 0; c < ptm.NumPolynomials(); ++c) {
         float g[6];
@@ -129,16 +133,8 @@ std::vector<float> Relight(const Ptm& ptm, const Eigen::Vector3d& light,
 std::vector<float> NormalMap(const Ptm& ptm) {
   std::vector<float> out(ptm.NumTexels() * 3);
   for (std::size_t t = 0; t < ptm.NumTexels(); ++t) {
-    float mean[6];
-    const float* a = ptm.Coefficients(t);
-    if (ptm.format == PtmFormat::kRgb) {
-      for (int k = 0; k < 6; ++k) {
-        mean[k] =
-            (ptm.Coefficients(t, 0)[k] + ptm.Coefficients(t, 1)[k] + ptm.Coefficients(t, 2)[k]) /
-            3.0f;
-      }
-      a = mean;
-    }
+    float scratch[6];
+    const float* a = LuminanceCoefficients(ptm, t, scratch);
     const Eigen::Vector3d n = PtmNormal(a);
     for (int c = 0; c < 3; ++c) out[t * 3 + static_cast<std::size_t>(c)] = static_cast<float>(n[c]);
   }
