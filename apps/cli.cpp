@@ -295,7 +295,7 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
                       std::ostream& /*err*/) {
   const Arguments a(args,
                     {"sample", "photos", "lights", "out", "scale", "width", "height", "block",
-                     "overlap", "top-k", "seed"},
+                     "overlap", "top-k", "seed", "correction-iterations"},
                     {"seam", "unconstrained"});
   const ptm::Ptm sample = LoadAnyPtm(a.Require("sample"));
   const std::filesystem::path out_dir = a.Require("out");
@@ -307,6 +307,7 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
   options.overlap = a.GetInt("overlap", options.overlap);
   options.top_k = a.GetInt("top-k", options.top_k);
   options.seed = static_cast<std::uint32_t>(a.GetInt("seed", 1));
+  options.correction_iterations = a.GetInt("correction-iterations", options.correction_iterations);
   options.stitch = a.Has("seam") ? synth::Stitch::kSeamCut : synth::Stitch::kBlend;
   options.use_photos = !a.Has("unconstrained");
   options.Check();
@@ -373,8 +374,11 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
                         {"seed", options.seed},
                         {"width", w},
                         {"height", h},
-                        {"scale", result.scale}};
+                        {"scale", result.scale},
+                        {"correction_iterations", options.correction_iterations}};
   record["photo_gains"] = result.photo_gains;
+  record["photo_rms"] = {{"quilted", result.photo_rms_quilted},
+                         {"corrected", result.photo_rms_corrected}};
   record["seam_cost_per_texel"] = result.seam_cost_per_texel;
   record["blocks"] = result.blocks.size();
   record["new_lights"] = nlohmann::json::array();

@@ -1,6 +1,8 @@
 #include "synth/planar_synthesis.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -74,6 +76,8 @@ void PlanarSynthesisOptions::Check() const {
   if (top_k < 1) throw OptionError("top_k must be >= 1");
   if (scale < 1) throw OptionError("scale must be >= 1");
   if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
+  if (correction_iterations < 0 || correction_iterations > 20)
+    throw OptionError("correction_iterations must be in [0, 20]");
 }
 
 std::vector<cv::Mat> ToOrthonormalPlanes(const ptm::Ptm& ptm) {
@@ -382,9 +386,111 @@ PlanarSynthesisResult SynthesizePlanarPtm(const ptm::Ptm& sample,
     }
   }
   result.ptm = FromOrthonormalPlanes(out, format);
+  if (constrained) {
+    result.photo_rms_quilted = result.photo_rms_corrected =
+        PhotoConsistencyCorrection(result.ptm, photos, result.photo_gains, 0);
+    if (options.correction_iterations > 0) {
+      result.photo_rms_corrected = PhotoConsistencyCorrection(
+          result.ptm, photos, result.photo_gains, options.correction_iterations);
+    }
+  }
   result.seam_cost_per_texel = seam_texels ? seam_sum / static_cast<double>(seam_texels) : 0.0;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+double PhotoConsistencyCorrection(ptm::Ptm& ptm, const std::vector<PlanarPhoto>& photos,
+                                  const std::vector<double>& gains, int iterations) {
+  if (photos.empty()) return 0.0;
+  const int pw = photos[0].image.width, ph = photos[0].image.height;
+  const int n_photos = static_cast<int>(photos.size());
+  // Rows psi(l_n)^T = phi(l_n)^T L^-T of the orthonormal basis functions at each
+  // light, and the minimum-norm solve da = L^-T A^T (A A^T + lambda I)^-1 t,
+  // the same 6 x N matrix at every photo pixel (one light per photo).
+  const Eigen::Matrix<double, 6, 6>& from = ptm::OrthonormalBasis::Hemisphere().FromOrthonormal();
+  Eigen::MatrixXd a(n_photos, 6);
+  for (int n = 0; n < n_photos; ++n) {
+    const Eigen::Vector3d& l = photos[static_cast<std::size_t>(n)].light;
+    const std::array<double, 6> phi = ptm::PtmBasis(l.x(), l.y());
+    a.row(n) = Eigen::Map<const Eigen::Matrix<double, 1, 6>>(phi.data()) * from;
+  }
+  Eigen::MatrixXd aat = a * a.transpose();
+  aat.diagonal().array() += 1e-4 * aat.trace() / n_photos;
+  const Eigen::MatrixXd solve = from * a.transpose() * aat.inverse();  // 6 x N
+
+  const int polys = ptm.NumPolynomials();
+  const bool lrgb = ptm.format == ptm::PtmFormat::kLrgb;
+  auto photo_mat = [&](int n) {
+    const PlanarPhoto& p = photos[static_cast<std::size_t>(n)];
+    return cv::Mat(ph, pw, CV_32FC3, const_cast<float*>(p.image.pixels.data()));
+  };
+  auto residuals = [&](std::vector<cv::Mat>& targets) {  // per photo, polys channels
+    double sum = 0.0;
+    cv::Mat colour_small;
+    if (lrgb) {
+      cv::Mat colour(ptm.height, ptm.width, CV_32FC3, ptm.colour.data());
+      cv::resize(colour, colour_small, cv::Size(pw, ph), 0, 0, cv::INTER_AREA);
+    }
+    targets.assign(static_cast<std::size_t>(n_photos), cv::Mat());
+    for (int n = 0; n < n_photos; ++n) {
+      const double g = gains[static_cast<std::size_t>(n)];
+      const std::vector<float> relit = ptm::Relight(ptm, photos[static_cast<std::size_t>(n)].light);
+      cv::Mat full(ptm.height, ptm.width, CV_32FC3, const_cast<float*>(relit.data())), small;
+      cv::resize(full, small, cv::Size(pw, ph), 0, 0, cv::INTER_AREA);
+      const cv::Mat r = photo_mat(n) - small * g;  // RGB residual
+      cv::Mat t(ph, pw, CV_32FC(polys));
+      for (int y = 0; y < ph; ++y) {
+        for (int x = 0; x < pw; ++x) {
+          const cv::Vec3f rv = r.at<cv::Vec3f>(y, x);
+          const float y_res = (rv[0] + rv[1] + rv[2]) / 3.0f;  // Y = mean of R, G, B
+          sum += static_cast<double>(y_res) * y_res;
+          float* tp = t.ptr<float>(y) + x * polys;
+          if (lrgb) {
+            const cv::Vec3f c = colour_small.at<cv::Vec3f>(y, x);
+            const float y_colour = (c[0] + c[1] + c[2]) / 3.0f;
+            tp[0] = y_colour > 1e-3f ? static_cast<float>(y_res / (g * y_colour)) : 0.0f;
+          } else {
+            for (int p = 0; p < 3; ++p) tp[p] = static_cast<float>(rv[p] / g);
+          }
+        }
+      }
+      targets[static_cast<std::size_t>(n)] = t;
+    }
+    return std::sqrt(sum / (static_cast<double>(pw) * ph * n_photos));
+  };
+
+  std::vector<cv::Mat> targets;
+  double rms = residuals(targets);
+  for (int it = 0; it < iterations; ++it) {
+    for (int p = 0; p < polys; ++p) {
+      // da per photo pixel for polynomial p, then bicubic to the texels.
+      std::vector<cv::Mat> delta_small(6);
+      for (cv::Mat& d : delta_small) d = cv::Mat::zeros(ph, pw, CV_32FC1);
+      for (int y = 0; y < ph; ++y) {
+        for (int x = 0; x < pw; ++x) {
+          Eigen::VectorXd t(n_photos);
+          for (int n = 0; n < n_photos; ++n)
+            t[n] = targets[static_cast<std::size_t>(n)].ptr<float>(y)[x * polys + p];
+          const Eigen::Matrix<double, 6, 1> da = solve * t;
+          for (int i = 0; i < 6; ++i)
+            delta_small[static_cast<std::size_t>(i)].at<float>(y, x) = static_cast<float>(da[i]);
+        }
+      }
+      for (int i = 0; i < 6; ++i) {
+        cv::Mat delta;
+        cv::resize(delta_small[static_cast<std::size_t>(i)], delta, cv::Size(ptm.width, ptm.height),
+                   0, 0, cv::INTER_CUBIC);
+        for (int y = 0; y < ptm.height; ++y) {
+          for (int x = 0; x < ptm.width; ++x) {
+            const std::size_t texel = static_cast<std::size_t>(y) * ptm.width + x;
+            ptm.Coefficients(texel, p)[i] += delta.at<float>(y, x);
+          }
+        }
+      }
+    }
+    rms = residuals(targets);
+  }
+  return rms;
 }
 
 double NearestPatchEnergy(const ptm::Ptm& output, const ptm::Ptm& sample, int patch) {

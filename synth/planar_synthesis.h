@@ -48,6 +48,9 @@ struct PlanarSynthesisOptions {
   /// within (1 + tolerance) of the best. >= 0.
   double tolerance = 0.1;
   std::uint32_t seed = 1;
+  /// After quilting, the photo-consistency pass (PhotoConsistencyCorrection):
+  /// 0 = off (the paper's output).
+  int correction_iterations = 2;
 
   void Check() const;
 };
@@ -70,6 +73,9 @@ struct PlanarSynthesisResult {
   /// Mean squared orthonormal-coefficient difference of the two joined blocks on
   /// the seam texels (the cut path, or the overlap's centre line when blending).
   double seam_cost_per_texel = 0.0;
+  /// RMS luminance residual against the photos at their resolution, after
+  /// quilting and after the photo-consistency pass (equal when it is off).
+  double photo_rms_quilted = 0.0, photo_rms_corrected = 0.0;
   double seconds = 0.0;
 };
 
@@ -85,6 +91,22 @@ struct PlanarSynthesisResult {
 PlanarSynthesisResult SynthesizePlanarPtm(const ptm::Ptm& sample,
                                           const std::vector<PlanarPhoto>& photos,
                                           const PlanarSynthesisOptions& options);
+
+/// Photo-consistency pass (beyond paper 003, which stops at quilting): quilted
+/// blocks agree with the photos only as well as the best block of the sample
+/// does. This adds to PTM_out the smallest coefficient change (in the orthonormal
+/// space, i.e. the smallest change of the function over the hemisphere) that
+/// makes PTM_out, relit at each photo's light, reduced to the photo's resolution
+/// and times its gain, equal the photo in luminance:
+///   psi(l_n)^T dq = (Y_n - g_n Y(f(l_n))) / (g_n Y(c)),   da = L^-T dq,
+/// solved per photo pixel (Tikhonov-regularised minimum norm: with fewer than
+/// six photos the coefficients the photos do not see keep the sample's), and
+/// upsampled bicubically to the texels. The fine detail of the quilted blocks is
+/// kept; their low frequencies come from the photos. `iterations` rounds (the
+/// clamp of relighting makes one round approximate). Returns the RMS luminance
+/// residual at photo resolution after the last round.
+double PhotoConsistencyCorrection(ptm::Ptm& ptm, const std::vector<PlanarPhoto>& photos,
+                                  const std::vector<double>& gains, int iterations);
 
 /// Nearest-patch energy (DESIGN.md, synthesis quality): for patches of `patch`
 /// texels on a grid over `output`, the mean squared orthonormal-coefficient

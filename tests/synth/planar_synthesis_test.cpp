@@ -72,8 +72,10 @@ class PlanarSynthesisTest : public ::testing::Test {
     surface.scale = 2;
     surface.offset = 200;
     photo_lights_ = {Eigen::Vector3d(0.6, 0.2, 0.77).normalized(),
-                     Eigen::Vector3d(-0.4, 0.5, 0.77).normalized()};
-    const auto renders = datasets::RenderPlanarSurface(surface, photo_lights_, photo_lights_);
+                     Eigen::Vector3d(-0.4, 0.5, 0.77).normalized(),
+                     Eigen::Vector3d(-0.1, -0.65, 0.75).normalized()};
+    held_out_lights_ = datasets::DomeLights(6, 25, 70, 0.3);  // as bench/synth2d_bench
+    const auto renders = datasets::RenderPlanarSurface(surface, photo_lights_, held_out_lights_);
     photos_ = new std::vector<PlanarPhoto>;
     truth_ = new std::vector<cv::Mat>;
     for (std::size_t n = 0; n < photo_lights_.size(); ++n) {
@@ -87,6 +89,12 @@ class PlanarSynthesisTest : public ::testing::Test {
       p.light = photo_lights_[n];
       p.name = "photo_" + std::to_string(n) + ".png";
       photos_->push_back(p);
+    }
+    for (const cv::Mat& t : renders.truth) {
+      cv::Mat f;
+      t.convertTo(f, CV_32FC3, 1 / 255.0);
+      cv::cvtColor(f, f, cv::COLOR_BGR2RGB);
+      truth_->push_back(f);
     }
     delete tmp;
   }
@@ -102,15 +110,26 @@ class PlanarSynthesisTest : public ::testing::Test {
     }
     return sum / static_cast<double>(photos_->size());
   }
+  // Mean PSNR under the held-out lights against ground truth at full resolution.
+  static double HeldOutPsnr(const ptm::Ptm& p) {
+    double sum = 0;
+    for (std::size_t h = 0; h < held_out_lights_.size(); ++h) {
+      const std::vector<float> relit = ptm::Relight(p, held_out_lights_[h]);
+      sum += cv::PSNR(cv::Mat(p.height, p.width, CV_32FC3, const_cast<float*>(relit.data())),
+                      (*truth_)[h], 1.0);
+    }
+    return sum / static_cast<double>(held_out_lights_.size());
+  }
   static ptm::Ptm* sample_;
   static std::vector<PlanarPhoto>* photos_;
   static std::vector<cv::Mat>* truth_;
-  static std::vector<Eigen::Vector3d> photo_lights_;
+  static std::vector<Eigen::Vector3d> photo_lights_, held_out_lights_;
 };
 ptm::Ptm* PlanarSynthesisTest::sample_ = nullptr;
 std::vector<PlanarPhoto>* PlanarSynthesisTest::photos_ = nullptr;
 std::vector<cv::Mat>* PlanarSynthesisTest::truth_ = nullptr;
 std::vector<Eigen::Vector3d> PlanarSynthesisTest::photo_lights_;
+std::vector<Eigen::Vector3d> PlanarSynthesisTest::held_out_lights_;
 
 TEST_F(PlanarSynthesisTest, PhotoConstraintsMakeTheRelitOutputAgreeWithThePhotos) {
   PlanarSynthesisOptions o;
@@ -131,6 +150,42 @@ TEST_F(PlanarSynthesisTest, PhotoConstraintsMakeTheRelitOutputAgreeWithThePhotos
     EXPECT_LE(b.sample_x + 16, sample_->width);
   }
   EXPECT_EQ(constrained.blocks.size(), 25u);  // 5 x 5 positions over 64 with step 12
+}
+
+TEST_F(PlanarSynthesisTest, UnderHeldOutLightsConstrainedBeatsUnconstrainedAndBicubic) {
+  PlanarSynthesisOptions o;
+  o.block_size = 16;
+  o.overlap = 4;
+  o.scale = 2;
+  o.correction_iterations = 0;
+  const PlanarSynthesisResult quilted = SynthesizePlanarPtm(*sample_, *photos_, o);
+  o.correction_iterations = 2;
+  const PlanarSynthesisResult corrected = SynthesizePlanarPtm(*sample_, *photos_, o);
+  // The photo-consistency pass brings the photo residual down by more than half.
+  EXPECT_LT(corrected.photo_rms_corrected, 0.5 * quilted.photo_rms_corrected);
+  EXPECT_DOUBLE_EQ(corrected.photo_rms_quilted, quilted.photo_rms_corrected);
+  o.use_photos = false;
+  o.width = o.height = 64;
+  const PlanarSynthesisResult unconstrained = SynthesizePlanarPtm(*sample_, {}, o);
+  // Bicubic upscale of the photo whose light is nearest each held-out light.
+  double bicubic = 0;
+  for (std::size_t h = 0; h < held_out_lights_.size(); ++h) {
+    std::size_t nearest = 0;
+    for (std::size_t n = 1; n < photo_lights_.size(); ++n)
+      if (photo_lights_[n].dot(held_out_lights_[h]) >
+          photo_lights_[nearest].dot(held_out_lights_[h]))
+        nearest = n;
+    cv::Mat up;
+    cv::resize(cv::Mat(32, 32, CV_32FC3, (*photos_)[nearest].image.pixels.data()), up,
+               cv::Size(64, 64), 0, 0, cv::INTER_CUBIC);
+    bicubic += cv::PSNR(up, (*truth_)[h], 1.0) / static_cast<double>(held_out_lights_.size());
+  }
+  const double psnr_corrected = HeldOutPsnr(corrected.ptm);
+  EXPECT_GT(HeldOutPsnr(quilted.ptm), HeldOutPsnr(unconstrained.ptm));
+  EXPECT_GT(psnr_corrected, HeldOutPsnr(quilted.ptm) + 1.0);
+  EXPECT_GT(psnr_corrected, bicubic + 1.0);
+  std::printf("held-out PSNR: corrected %.2f, quilted %.2f, unconstrained %.2f, bicubic %.2f dB\n",
+              psnr_corrected, HeldOutPsnr(quilted.ptm), HeldOutPsnr(unconstrained.ptm), bicubic);
 }
 
 TEST_F(PlanarSynthesisTest, SeamCuttingLowersTheSeamCostOfBlending) {
