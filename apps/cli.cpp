@@ -19,6 +19,7 @@
 #include "sfm/file_util.h"
 #include "sfm/inspect.h"
 #include "sfm/lights.h"
+#include "synth/pipeline.h"
 #include "synth/planar_synthesis.h"
 
 namespace texlume::apps {
@@ -137,13 +138,6 @@ std::vector<double> ParseList(const std::string& text, std::size_t count, const 
   return values;
 }
 
-ptm::Ptm LoadAnyPtm(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  return ext == ".exr" ? ptm::ReadPtmExr(path) : ptm::ReadPtmFile(path);
-}
-
 void WriteRgbPng(const std::filesystem::path& path, const std::vector<float>& rgb, int width,
                  int height, bool signed_unit) {
   cv::Mat image(height, width, CV_8UC3);
@@ -245,7 +239,7 @@ int RunRelightCommand(const std::vector<std::string>& args, std::ostream& out,
     throw UsageError("--specular must be in [0, 10]");
   }
   const std::filesystem::path out_path = a.Require("out");
-  const ptm::Ptm ptm = LoadAnyPtm(a.Require("ptm"));
+  const ptm::Ptm ptm = ptm::ReadPtmAnyFormat(a.Require("ptm"));
   WriteRgbPng(out_path, ptm::Relight(ptm, light, enhancement), ptm.width, ptm.height, false);
   if (auto normals = a.Get("normals")) {
     WriteRgbPng(*normals, ptm::NormalMap(ptm), ptm.width, ptm.height, true);
@@ -297,7 +291,7 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
                     {"sample", "photos", "lights", "out", "scale", "width", "height", "block",
                      "overlap", "top-k", "seed", "correction-iterations"},
                     {"seam", "unconstrained"});
-  const ptm::Ptm sample = LoadAnyPtm(a.Require("sample"));
+  const ptm::Ptm sample = ptm::ReadPtmAnyFormat(a.Require("sample"));
   const std::filesystem::path out_dir = a.Require("out");
   synth::PlanarSynthesisOptions options;
   options.scale = a.GetInt("scale", 1);
@@ -389,6 +383,93 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
   out << "Synthesised a " << w << "x" << h << " PTM from " << result.blocks.size() << " blocks of "
       << options.block_size << " texels (" << photos.size() << " photos, scale " << result.scale
       << ") in " << result.seconds << " s into " << out_dir.string() << "\n";
+  return kExitOk;
+}
+
+int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  const Arguments a(args,
+                    {"model", "images", "lights", "mesh", "sample", "sample-texel-size", "out",
+                     "strip", "top-k", "max-views", "atlas", "atlas-size", "gutter", "seed",
+                     "tangent-field", "max-subdivisions", "max-buffer-size"},
+                    {"all-views"});
+  synth::SynthJobOptions o;
+  o.model_dir = a.Require("model");
+  o.images_dir = a.Require("images");
+  o.lights_file = a.Require("lights");
+  o.mesh_file = a.Require("mesh");
+  o.sample_file = a.Require("sample");
+  o.out_dir = a.Require("out");
+  o.synthesis.sample_texel_size = a.GetDouble("sample-texel-size", 0.0);
+  if (!(o.synthesis.sample_texel_size > 0.0)) {
+    throw UsageError(
+        "--sample-texel-size: give the sample's texel size in world units of the model");
+  }
+  o.synthesis.strip = a.GetInt("strip", o.synthesis.strip);
+  o.synthesis.top_k = a.GetInt("top-k", o.synthesis.top_k);
+  o.synthesis.all_views = a.Has("all-views");
+  o.synthesis.max_views = a.GetInt("max-views", o.synthesis.max_views);
+  o.synthesis.seed = static_cast<std::uint32_t>(a.GetInt("seed", 1));
+  if (const auto field = a.Get("tangent-field")) {
+    const std::vector<double> d = ParseList(*field, 3, "--tangent-field");
+    o.synthesis.tangent_frame = synth::TangentFrame::kSmoothField;
+    o.synthesis.field_direction_in_world = Eigen::Vector3d(d[0], d[1], d[2]);
+  }
+  const std::string atlas = a.Get("atlas").value_or("charts");
+  if (atlas != "charts" && atlas != "per-triangle") {
+    throw UsageError("--atlas: charts or per-triangle, not '" + atlas + "'");
+  }
+  o.atlas.mode = atlas == "charts" ? synth::AtlasMode::kCharts : synth::AtlasMode::kPerTriangle;
+  o.atlas.atlas_size = a.GetInt("atlas-size", o.atlas.atlas_size);
+  o.atlas.gutter = a.GetInt("gutter", o.atlas.gutter);
+  o.atlas.blend_strip = o.synthesis.strip;
+  o.max_subdivisions = a.GetInt("max-subdivisions", o.max_subdivisions);
+  o.visibility.max_buffer_dimension = a.GetInt("max-buffer-size", 0);
+  ProgressBar bar;
+  const synth::SynthJobSummary s = synth::RunSynthJob(o, bar.Callback());
+  for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
+  out << "Synthesised " << s.faces << " triangles (" << s.from_photos << " from photos, "
+      << s.from_neighbours << " from neighbours only, " << s.random << " seeds) from "
+      << s.photos_used << " photos into " << s.atlases << " atlas(es), " << s.charts
+      << " charts, occupancy " << s.occupancy << ", in " << s.seconds_total
+      << " s: " << o.out_dir.string() << " (see manifest.json)\n";
+  return kExitOk;
+}
+
+int RunRenderCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  const Arguments a(args,
+                    {"model", "cameras", "lights", "out", "baseline", "samples", "truth",
+                     "truth-masks", "reduced-factor"},
+                    {});
+  synth::RenderJobOptions o;
+  o.model_folder = a.Require("model");
+  o.cameras_dir = a.Require("cameras");
+  o.lights_file = a.Require("lights");
+  o.out_dir = a.Require("out");
+  if (const auto b = a.Get("baseline")) {
+    if (*b == "flat") {
+      o.mode = synth::RenderMode::kFlat;
+    } else if (*b == "baked") {
+      o.mode = synth::RenderMode::kBaked;
+    } else {
+      throw UsageError("--baseline: flat or baked, not '" + *b + "'");
+    }
+  }
+  o.samples_per_axis = a.GetInt("samples", o.samples_per_axis);
+  if (const auto t = a.Get("truth")) o.truth_images_dir = *t;
+  if (const auto m = a.Get("truth-masks")) o.truth_masks_dir = *m;
+  o.reduced_factor = a.GetInt("reduced-factor", 1);
+  ProgressBar bar;
+  const synth::RenderJobSummary s = synth::RunRenderJob(o, bar.Callback());
+  for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
+  out << "Rendered " << s.rendered << " views into " << o.out_dir.string() << " in " << s.seconds
+      << " s";
+  if (!s.metrics.empty()) {
+    out << "; inside the masks: PSNR " << s.mean_psnr << " dB, SSIM " << s.mean_ssim;
+    if (o.reduced_factor > 1)
+      out << " (reduced by " << o.reduced_factor << ": " << s.mean_psnr_reduced << " dB, "
+          << s.mean_ssim_reduced << ")";
+  }
+  out << "\n";
   return kExitOk;
 }
 

@@ -54,6 +54,10 @@ int RunLightsFromSphereCommand(const std::vector<std::string>& args, std::ostrea
                                std::ostream& err);
 /// `texlume synth2d`: image-constrained planar PTM synthesis. Returns the exit code.
 int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// `texlume synth`: the relightable model from photos (paper 003 Algorithm 2).
+int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// `texlume render`: a model folder drawn through COLMAP cameras under given lights.
+int RunRenderCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 /// `texlume demo`: builds a synthetic scene and inspects it. Returns the exit code.
 int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 

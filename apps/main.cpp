@@ -31,6 +31,16 @@ constexpr const char* kUsage =
     "          [--width W --height H] [--block N] [--overlap N] [--top-k K] [--seam]\n"
     "          [--unconstrained] [--seed S]\n"
     "      Image-constrained planar PTM synthesis (paper 003 Algorithm 1).\n"
+    "  synth --model DIR --images DIR --lights FILE.json --mesh FILE --sample FILE.ptm\n"
+    "        --sample-texel-size T --out DIR [--atlas charts|per-triangle] [--atlas-size N]\n"
+    "        [--strip N] [--top-k K] [--all-views] [--max-views N] [--tangent-field x,y,z]\n"
+    "        [--gutter N] [--max-subdivisions N] [--seed S]\n"
+    "      The relightable model: per-triangle image-constrained PTM synthesis on the mesh\n"
+    "      (paper 003 Algorithm 2), blended, packed into atlases, exported (docs/synth.md).\n"
+    "  render --model DIR --cameras COLMAP_DIR --lights FILE.json --out DIR\n"
+    "         [--baseline flat|baked] [--samples N] [--truth DIR [--truth-masks DIR]]\n"
+    "         [--reduced-factor R]\n"
+    "      Render a model folder for every image of a COLMAP model under its light(s).\n"
     "  scene --out DIR [--kind sphere|cylinder|plane|torus] [--material stone|brick|grooves]\n"
     "        [--seed S] [--images N] [--camera-model pinhole|opencv] [--width W] [--height H]\n"
     "        [--capture-size N] [--capture-lights N] [--held-out-lights N] [--held-out-views N]\n"
@@ -69,6 +79,8 @@ int main(int argc, char** argv) {
     if (command == "lights-from-sphere")
       return RunLightsFromSphereCommand(args, std::cout, std::cerr);
     if (command == "synth2d") return RunSynth2dCommand(args, std::cout, std::cerr);
+    if (command == "synth") return RunSynthCommand(args, std::cout, std::cerr);
+    if (command == "render") return RunRenderCommand(args, std::cout, std::cerr);
     if (command == "scene") return RunSceneCommand(args, std::cout, std::cerr);
     if (command == "demo") return RunDemoCommand(args, std::cout, std::cerr);
     throw UsageError("unknown command '" + command + "'");

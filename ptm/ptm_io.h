@@ -29,6 +29,9 @@ Ptm ReadPtmFile(const std::filesystem::path& path);
 void WritePtmExr(const Ptm& ptm, const std::filesystem::path& path);
 Ptm ReadPtmExr(const std::filesystem::path& path);
 
+/// Reads a PTM by extension: .exr (lossless) or .ptm.
+Ptm ReadPtmAnyFormat(const std::filesystem::path& path);
+
 /// Writes the relight / OpenLIME web format into `dir`: `info.json` (type "ptm",
 /// colorspace "rgb" or "lrgb", nplanes, per-plane scale and bias) and the
 /// coefficient planes as `plane_N.jpg`, three coefficients per JPEG

@@ -1,0 +1,379 @@
+#include "synth/atlas.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <unordered_map>
+
+#include "ptm/coefficient_space.h"
+#include "sfm/errors.h"
+#include "synth/planar_synthesis.h"
+
+namespace texlume::synth {
+namespace {
+
+// Signed distance from p to the triangle: negative inside (minus the distance to
+// the nearest edge), positive outside.
+double SignedDistance(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
+  const double orientation =
+      (c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x();
+  bool inside = true;
+  double nearest = std::numeric_limits<double>::max();
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector2d& a = c[static_cast<std::size_t>(k)];
+    const Eigen::Vector2d& b = c[static_cast<std::size_t>((k + 1) % 3)];
+    const Eigen::Vector2d ab = b - a;
+    const double cross = ab.x() * (p - a).y() - ab.y() * (p - a).x();
+    if (cross * orientation < 0) inside = false;
+    const double s = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+    nearest = std::min(nearest, (a + s * ab - p).norm());
+  }
+  return inside ? -nearest : nearest;
+}
+
+double RotationAngle(const Eigen::Matrix2d& r) { return std::atan2(r(1, 0), r(0, 0)); }
+
+struct ChartFace {
+  int face;
+  Eigen::Matrix2d rotation;  // chart = rotation * frame + translation (world units)
+  Eigen::Vector2d translation;
+};
+
+std::int64_t Key(int x, int y) {
+  return (static_cast<std::int64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
+}
+
+}  // namespace
+
+void AtlasOptions::Check() const {
+  if (atlas_size < 64 || atlas_size > 16384) throw OptionError("atlas size must be in [64, 16384]");
+  if (gutter < 1 || gutter > 16) throw OptionError("gutter must be in [1, 16] texels");
+  if (blend_strip < 2 || blend_strip > 32) throw OptionError("blend strip must be in [2, 32]");
+}
+
+Eigen::Matrix<double, 6, 6> OrthonormalFrameRotation(double angle_rad) {
+  const auto& basis = ptm::OrthonormalBasis::Hemisphere();
+  return basis.ToOrthonormal() * ptm::FrameRotation(angle_rad) * basis.FromOrthonormal();
+}
+
+std::vector<std::array<int, 3>> PackSkyline(const std::vector<std::pair<int, int>>& sizes,
+                                            int bin_width, int bin_height) {
+  std::vector<std::size_t> order(sizes.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return sizes[a].second != sizes[b].second ? sizes[a].second > sizes[b].second
+                                              : sizes[a].first > sizes[b].first;
+  });
+  std::vector<std::array<int, 3>> out(sizes.size());
+  std::vector<std::vector<std::pair<int, int>>> skylines;  // per bin: (x start, height) segments
+  auto new_bin = [&]() { skylines.push_back({{0, 0}}); };
+  new_bin();
+  for (const std::size_t i : order) {
+    const auto [w, h] = sizes[i];
+    if (w > bin_width || h > bin_height) {
+      throw OptionError("a chart of " + std::to_string(w) + " x " + std::to_string(h) +
+                        " texels does not fit an atlas of " + std::to_string(bin_width) + " x " +
+                        std::to_string(bin_height));
+    }
+    bool placed = false;
+    for (std::size_t bin = 0; bin < skylines.size() && !placed; ++bin) {
+      auto& sky = skylines[bin];
+      int best_y = std::numeric_limits<int>::max(), best_x = -1;
+      for (std::size_t s = 0; s < sky.size(); ++s) {
+        const int x = sky[s].first;
+        if (x + w > bin_width) break;
+        int y = 0;
+        for (std::size_t r = s; r < sky.size() && sky[r].first < x + w; ++r)
+          y = std::max(y, sky[r].second);
+        if (y + h <= bin_height && y < best_y) best_y = y, best_x = x;
+      }
+      if (best_x < 0) continue;
+      out[i] = {static_cast<int>(bin), best_x, best_y};
+      // Raise the skyline over [best_x, best_x + w) to best_y + h.
+      std::vector<std::pair<int, int>> next;
+      int height_after = 0;
+      for (std::size_t s = 0; s < sky.size(); ++s) {
+        const int x0 = sky[s].first;
+        const int x1 = s + 1 < sky.size() ? sky[s + 1].first : bin_width;
+        if (x1 <= best_x || x0 >= best_x + w) {
+          next.push_back(sky[s]);
+          continue;
+        }
+        if (x0 < best_x) next.emplace_back(x0, sky[s].second);
+        if (x1 > best_x + w) height_after = sky[s].second;
+        if (next.empty() || next.back().first != best_x) next.emplace_back(best_x, best_y + h);
+        if (x1 > best_x + w) next.emplace_back(best_x + w, height_after);
+      }
+      // Merge equal neighbours.
+      sky.clear();
+      for (const auto& seg : next)
+        if (sky.empty() || sky.back().second != seg.second) sky.push_back(seg);
+      placed = true;
+    }
+    if (!placed) {
+      new_bin();
+      skylines.back() = {{0, h}, {w, 0}};
+      if (w == bin_width) skylines.back() = {{0, h}};
+      out[i] = {static_cast<int>(skylines.size() - 1), 0, 0};
+    }
+  }
+  return out;
+}
+
+Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthesis,
+                     const AtlasOptions& options, const ProgressCallback& progress) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t num_faces = mesh.faces.size();
+  const double t = synthesis.texel_size;
+  const int gutter = options.gutter;
+
+  // 1. Charts: faces with their rigid placement in the chart plane.
+  std::vector<std::vector<ChartFace>> charts;
+  if (options.mode == AtlasMode::kPerTriangle) {
+    for (std::size_t f = 0; f < num_faces; ++f) {
+      // The minimal bounding box of a triangle has a side along one of its edges.
+      const auto& c = synthesis.patches[f].corners_in_frame;
+      double best_area = std::numeric_limits<double>::max();
+      Eigen::Matrix2d best = Eigen::Matrix2d::Identity();
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2d e = c[static_cast<std::size_t>((k + 1) % 3)] - c[static_cast<std::size_t>(k)];
+        const Eigen::Matrix2d r = Eigen::Rotation2Dd(-std::atan2(e.y(), e.x())).toRotationMatrix();
+        Eigen::Vector2d lo = r * c[0], hi = lo;
+        for (const auto& p : c) lo = lo.cwiseMin(r * p), hi = hi.cwiseMax(r * p);
+        const double area = (std::ceil((hi.x() - lo.x()) / t) + 2 * gutter) *
+                            (std::ceil((hi.y() - lo.y()) / t) + 2 * gutter);
+        if (area < best_area) best_area = area, best = r;
+      }
+      charts.push_back({{static_cast<int>(f), best, Eigen::Vector2d::Zero()}});
+    }
+  } else {
+    std::vector<std::vector<int>> faces_of_vertex(mesh.vertices.size());
+    for (std::size_t f = 0; f < num_faces; ++f)
+      for (int v : mesh.faces[f]) faces_of_vertex[static_cast<std::size_t>(v)].push_back(static_cast<int>(f));
+    auto shares_vertex = [&](int a, int b) {
+      for (int v : mesh.faces[static_cast<std::size_t>(a)])
+        for (int g : faces_of_vertex[static_cast<std::size_t>(v)])
+          if (g == b) return true;
+      return false;
+    };
+    std::vector<int> chart_of(num_faces, -1);
+    const double max_extent = (options.atlas_size - 2 * gutter - 2) * t;
+    for (std::size_t seed = 0; seed < num_faces; ++seed) {
+      if (chart_of[seed] >= 0) continue;
+      const int chart_id = static_cast<int>(charts.size());
+      std::vector<ChartFace> chart;
+      std::unordered_map<std::int64_t, int> texels;  // chart texel -> face
+      Eigen::Vector2d lo(0, 0), hi(0, 0);
+      bool first = true;
+      auto corners_of = [&](const ChartFace& cf) {
+        std::array<Eigen::Vector2d, 3> c;
+        for (int k = 0; k < 3; ++k)
+          c[static_cast<std::size_t>(k)] =
+              cf.rotation * synthesis.patches[static_cast<std::size_t>(cf.face)].corners_in_frame[static_cast<std::size_t>(k)] +
+              cf.translation;
+        return c;
+      };
+      // Accepts a placement when it overlaps nothing, keeps clear of faces it does
+      // not touch on the mesh, and the chart still fits an atlas.
+      auto try_add = [&](const ChartFace& cf) {
+        const auto c = corners_of(cf);
+        Eigen::Vector2d clo = c[0], chi = c[0];
+        for (const auto& p : c) clo = clo.cwiseMin(p), chi = chi.cwiseMax(p);
+        if (!first) {
+          const Eigen::Vector2d nlo = lo.cwiseMin(clo), nhi = hi.cwiseMax(chi);
+          if ((nhi - nlo).maxCoeff() > max_extent) return false;
+        }
+        const double clearance = (2 * gutter + 1) * t;
+        const int x0 = static_cast<int>(std::floor((clo.x() - clearance) / t));
+        const int x1 = static_cast<int>(std::ceil((chi.x() + clearance) / t));
+        const int y0 = static_cast<int>(std::floor((clo.y() - clearance) / t));
+        const int y1 = static_cast<int>(std::ceil((chi.y() + clearance) / t));
+        std::vector<std::int64_t> mine;
+        for (int y = y0; y <= y1; ++y) {
+          for (int x = x0; x <= x1; ++x) {
+            const Eigen::Vector2d p((x + 0.5) * t, (y + 0.5) * t);
+            const double d = SignedDistance(c, p);
+            if (d > clearance) continue;
+            const auto it = texels.find(Key(x, y));
+            if (it != texels.end()) {
+              if (d < -0.5 * t) return false;                        // overlap
+              if (!shares_vertex(cf.face, it->second)) return false;  // too close
+            }
+            if (d <= 0.0) mine.push_back(Key(x, y));
+          }
+        }
+        for (const std::int64_t k : mine) texels.emplace(k, cf.face);
+        lo = first ? clo : lo.cwiseMin(clo);
+        hi = first ? chi : hi.cwiseMax(chi);
+        first = false;
+        chart.push_back(cf);
+        chart_of[static_cast<std::size_t>(cf.face)] = chart_id;
+        return true;
+      };
+      try_add({static_cast<int>(seed), Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero()});
+      std::deque<std::size_t> queue = {0};
+      while (!queue.empty()) {
+        const ChartFace from = chart[queue.front()];
+        queue.pop_front();
+        for (int k = 0; k < 3; ++k) {
+          const Unfolding& u = synthesis.unfoldings[static_cast<std::size_t>(from.face)][static_cast<std::size_t>(k)];
+          if (u.face < 0 || chart_of[static_cast<std::size_t>(u.face)] >= 0) continue;
+          // p_from = R_u^T (p_nb - t_u), so chart = R_from R_u^T p_nb + ...
+          ChartFace cf;
+          cf.face = u.face;
+          cf.rotation = from.rotation * u.rotation.transpose();
+          cf.translation = from.translation - cf.rotation * u.translation;
+          if (try_add(cf)) queue.push_back(chart.size() - 1);
+        }
+      }
+      charts.push_back(std::move(chart));
+    }
+  }
+
+  // 2. Chart boxes in texels (with gutters), packed.
+  std::vector<std::pair<int, int>> sizes;
+  std::vector<Eigen::Vector2i> chart_lo, chart_hi;
+  for (const auto& chart : charts) {
+    Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
+    Eigen::Vector2d hi = -lo;
+    for (const ChartFace& cf : chart)
+      for (const auto& p : synthesis.patches[static_cast<std::size_t>(cf.face)].corners_in_frame) {
+        const Eigen::Vector2d q = (cf.rotation * p + cf.translation) / t;
+        lo = lo.cwiseMin(q);
+        hi = hi.cwiseMax(q);
+      }
+    const Eigen::Vector2i ilo(static_cast<int>(std::floor(lo.x())) - gutter,
+                              static_cast<int>(std::floor(lo.y())) - gutter);
+    const Eigen::Vector2i ihi(static_cast<int>(std::ceil(hi.x())) + gutter,
+                              static_cast<int>(std::ceil(hi.y())) + gutter);
+    chart_lo.push_back(ilo);
+    chart_hi.push_back(ihi);
+    sizes.emplace_back(ihi.x() - ilo.x(), ihi.y() - ilo.y());
+  }
+  const std::vector<std::array<int, 3>> packed =
+      PackSkyline(sizes, options.atlas_size, options.atlas_size);
+
+  Atlases atlases;
+  atlases.num_charts = static_cast<int>(charts.size());
+  atlases.faces.resize(num_faces);
+  int num_atlases = 0;
+  std::vector<int> used_height;
+  for (std::size_t c = 0; c < charts.size(); ++c) {
+    const auto [bin, x0, y0] = packed[c];
+    num_atlases = std::max(num_atlases, bin + 1);
+    used_height.resize(static_cast<std::size_t>(num_atlases), 0);
+    used_height[static_cast<std::size_t>(bin)] =
+        std::max(used_height[static_cast<std::size_t>(bin)], y0 + sizes[c].second);
+    for (const ChartFace& cf : charts[c]) {
+      FacePlacement& fp = atlases.faces[static_cast<std::size_t>(cf.face)];
+      fp.atlas = bin;
+      fp.chart = static_cast<int>(c);
+      fp.rotation = cf.rotation;
+      fp.offset = Eigen::Vector2d(x0 + cf.translation.x() / t - chart_lo[c].x(),
+                                  y0 + chart_hi[c].y() - cf.translation.y() / t);
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2d q = cf.rotation * synthesis.patches[static_cast<std::size_t>(cf.face)].corners_in_frame[static_cast<std::size_t>(k)];
+        fp.corners_px[static_cast<std::size_t>(k)] =
+            Eigen::Vector2d(fp.offset.x() + q.x() / t, fp.offset.y() - q.y() / t);
+      }
+    }
+  }
+
+  // 3. Bake: every texel inside a face (and its gutter ring) from the blended
+  // synthesis, coefficients rotated into the atlas frame.
+  const std::size_t num_planes = synthesis.sample_planes.size();
+  const int coefficient_planes = synthesis.CoefficientPlanes();
+  std::vector<std::vector<cv::Mat>> planes(static_cast<std::size_t>(num_atlases));
+  std::vector<cv::Mat> claim(static_cast<std::size_t>(num_atlases));  // distance of the claim
+  for (int a = 0; a < num_atlases; ++a) {
+    const int h = std::max(1, used_height[static_cast<std::size_t>(a)]);
+    const int w = options.atlas_size;
+    for (std::size_t c = 0; c < num_planes; ++c) planes[static_cast<std::size_t>(a)].push_back(cv::Mat::zeros(h, w, CV_32FC1));
+    claim[static_cast<std::size_t>(a)] = cv::Mat(h, w, CV_32FC1, cv::Scalar(std::numeric_limits<float>::max()));
+    atlases.coverage.push_back(cv::Mat::zeros(h, w, CV_8UC1));
+  }
+  std::size_t inside_texels = 0;
+  std::vector<float> value(num_planes);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const FacePlacement& fp = atlases.faces[f];
+    auto& atlas_planes = planes[static_cast<std::size_t>(fp.atlas)];
+    cv::Mat& claims = claim[static_cast<std::size_t>(fp.atlas)];
+    cv::Mat& coverage = atlases.coverage[static_cast<std::size_t>(fp.atlas)];
+    const Eigen::Matrix<double, 6, 6> to_atlas = OrthonormalFrameRotation(-RotationAngle(fp.rotation));
+    Eigen::Vector2d lo = fp.corners_px[0], hi = lo;
+    for (const auto& p : fp.corners_px) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const int x0 = std::max(0, static_cast<int>(std::floor(lo.x())) - gutter);
+    const int x1 = std::min(coverage.cols - 1, static_cast<int>(std::ceil(hi.x())) + gutter);
+    const int y0 = std::max(0, static_cast<int>(std::floor(lo.y())) - gutter);
+    const int y1 = std::min(coverage.rows - 1, static_cast<int>(std::ceil(hi.y())) + gutter);
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        const Eigen::Vector2d q(x + 0.5, y + 0.5);
+        const double d = SignedDistance(fp.corners_px, q);
+        if (d > gutter + 0.5) continue;
+        const float key = static_cast<float>(std::max(d, 0.0));
+        if (d <= 0.0) {
+          if (coverage.at<std::uint8_t>(y, x) == 255) continue;  // shared edge: first face wins
+        } else if (coverage.at<std::uint8_t>(y, x) == 255 || key >= claims.at<float>(y, x)) {
+          continue;
+        }
+        const Eigen::Vector2d r((q.x() - fp.offset.x()) * t, (fp.offset.y() - q.y()) * t);
+        const Eigen::Vector2d p_frame = fp.rotation.transpose() * r;
+        synthesis.SampleBlended(static_cast<int>(f), p_frame, options.blend_strip, value.data());
+        for (int poly = 0; poly < coefficient_planes / 6; ++poly) {
+          Eigen::Matrix<double, 6, 1> v;
+          for (int i = 0; i < 6; ++i) v[i] = value[static_cast<std::size_t>(poly * 6 + i)];
+          v = to_atlas * v;
+          for (int i = 0; i < 6; ++i) value[static_cast<std::size_t>(poly * 6 + i)] = static_cast<float>(v[i]);
+        }
+        for (std::size_t c = 0; c < num_planes; ++c) atlas_planes[c].at<float>(y, x) = value[c];
+        claims.at<float>(y, x) = key;
+        if (d <= 0.0) {
+          coverage.at<std::uint8_t>(y, x) = 255;
+          ++inside_texels;
+        } else {
+          coverage.at<std::uint8_t>(y, x) = 128;
+        }
+      }
+    }
+    if (progress && ((f + 1) % 256 == 0 || f + 1 == num_faces)) progress("atlas", f + 1, num_faces);
+  }
+  // Dilate into the few gutter texels no face reached (one ring per gutter texel).
+  std::size_t total_texels = 0;
+  for (int a = 0; a < num_atlases; ++a) {
+    cv::Mat& coverage = atlases.coverage[static_cast<std::size_t>(a)];
+    auto& atlas_planes = planes[static_cast<std::size_t>(a)];
+    std::vector<double> sum(num_planes);
+    for (int ring = 0; ring < gutter; ++ring) {
+      const cv::Mat before = coverage.clone();
+      for (int y = 0; y < coverage.rows; ++y) {
+        for (int x = 0; x < coverage.cols; ++x) {
+          if (before.at<std::uint8_t>(y, x)) continue;
+          int n = 0;
+          std::fill(sum.begin(), sum.end(), 0.0);
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int yy = y + dy, xx = x + dx;
+              if (yy < 0 || xx < 0 || yy >= coverage.rows || xx >= coverage.cols || !before.at<std::uint8_t>(yy, xx)) continue;
+              for (std::size_t c = 0; c < num_planes; ++c) sum[c] += atlas_planes[c].at<float>(yy, xx);
+              ++n;
+            }
+          if (n == 0) continue;
+          for (std::size_t c = 0; c < num_planes; ++c) atlas_planes[c].at<float>(y, x) = static_cast<float>(sum[c] / n);
+          coverage.at<std::uint8_t>(y, x) = 64;
+        }
+      }
+    }
+    total_texels += coverage.total();
+    atlases.ptms.push_back(FromOrthonormalPlanes(atlas_planes, synthesis.format));
+  }
+  atlases.occupancy = total_texels ? static_cast<double>(inside_texels) / static_cast<double>(total_texels) : 0.0;
+  atlases.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return atlases;
+}
+
+}  // namespace texlume::synth

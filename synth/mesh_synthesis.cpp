@@ -1,0 +1,568 @@
+#include "synth/mesh_synthesis.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "ptm/coefficient_space.h"
+#include "sfm/errors.h"
+#include "synth/planar_synthesis.h"
+#include "synth/template_match.h"
+
+namespace texlume::synth {
+namespace {
+
+using LightList = std::vector<std::pair<Eigen::Vector3d, double>>;  // (tangent-frame dir, I)
+
+// The sample's raw coefficient planes (a0..a5 per polynomial, then LRGB colour),
+// for relighting at reduced resolutions (evaluation is linear in the coefficients,
+// so reducing the planes equals reducing the relit image, up to the clamp).
+std::vector<cv::Mat> RawPlanes(const ptm::Ptm& p) {
+  const int polys = p.NumPolynomials();
+  const int count = polys * 6 + (p.format == ptm::PtmFormat::kLrgb ? 3 : 0);
+  std::vector<cv::Mat> planes(static_cast<std::size_t>(count));
+  for (cv::Mat& m : planes) m = cv::Mat(p.height, p.width, CV_32FC1);
+  for (int y = 0; y < p.height; ++y) {
+    for (int x = 0; x < p.width; ++x) {
+      const std::size_t t = static_cast<std::size_t>(y) * p.width + x;
+      for (int q = 0; q < polys; ++q)
+        for (int i = 0; i < 6; ++i)
+          planes[static_cast<std::size_t>(q * 6 + i)].at<float>(y, x) = p.Coefficients(t, q)[i];
+      if (p.format == ptm::PtmFormat::kLrgb)
+        for (int c = 0; c < 3; ++c)
+          planes[static_cast<std::size_t>(6 + c)].at<float>(y, x) = p.colour[t * 3 + c];
+    }
+  }
+  return planes;
+}
+
+// The sample reduced to a photo density r = 2^(-level/4) photo pixels per texel.
+struct ReducedSample {
+  std::vector<cv::Mat> raw;  // raw coefficient (+ colour) planes
+  double rx = 1.0, ry = 1.0;  // effective density along x and y
+};
+
+Eigen::Matrix<double, 6, 6> OrthonormalRotation(double angle_rad) {
+  const auto& basis = ptm::OrthonormalBasis::Hemisphere();
+  return basis.ToOrthonormal() * ptm::FrameRotation(angle_rad) * basis.FromOrthonormal();
+}
+
+bool InsideTriangle(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
+  auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() * b.y() - a.y() * b.x();
+  };
+  const double d0 = cross(c[1] - c[0], p - c[0]);
+  const double d1 = cross(c[2] - c[1], p - c[1]);
+  const double d2 = cross(c[0] - c[2], p - c[2]);
+  return (d0 >= 0 && d1 >= 0 && d2 >= 0) || (d0 <= 0 && d1 <= 0 && d2 <= 0);
+}
+
+double SegmentDistance(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                       const Eigen::Vector2d& p) {
+  const Eigen::Vector2d ab = b - a;
+  const double s = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+  return (a + s * ab - p).norm();
+}
+
+}  // namespace
+
+float SrgbToLinear(float v) {
+  v = std::clamp(v, 0.0f, 1.0f);
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+float LinearToSrgb(float v) {
+  v = std::clamp(v, 0.0f, 1.0f);
+  return v <= 0.0031308f ? v * 12.92f : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+Eigen::Vector3f RelightMixture(const float* coefficients, const float* colour,
+                               ptm::PtmFormat format, const LightList& lights, double gain) {
+  Eigen::Vector3f linear = Eigen::Vector3f::Zero();
+  for (const auto& [l, intensity] : lights) {
+    if (l.z() <= 0.0) continue;
+    for (int c = 0; c < 3; ++c) {
+      double v;
+      if (format == ptm::PtmFormat::kLrgb) {
+        v = ptm::EvaluatePolynomial(coefficients, l.x(), l.y()) * colour[c];
+      } else {
+        v = ptm::EvaluatePolynomial(coefficients + 6 * c, l.x(), l.y());
+      }
+      linear[c] += static_cast<float>(intensity) * SrgbToLinear(static_cast<float>(v));
+    }
+  }
+  Eigen::Vector3f out;
+  for (int c = 0; c < 3; ++c) out[c] = LinearToSrgb(static_cast<float>(gain) * linear[c]);
+  return out;
+}
+
+void MeshSynthesisOptions::Check() const {
+  if (!(sample_texel_size > 0.0) || !std::isfinite(sample_texel_size))
+    throw OptionError("sample texel size must be a positive number of world units");
+  if (strip < 2 || strip > 32) throw OptionError("strip (W_e) must be in [2, 32] texels");
+  if (top_k < 1) throw OptionError("top_k must be >= 1");
+  if (max_views < 1) throw OptionError("max_views must be >= 1");
+  if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
+  if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
+  if (max_texels < 1) throw OptionError("max_texels must be >= 1");
+  if (!(field_direction_in_world.norm() > 0.0)) throw OptionError("field direction must be nonzero");
+}
+
+bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) const {
+  const TrianglePatch& patch = patches[static_cast<std::size_t>(face)];
+  const double u = (p.x() - patch.x_min) / texel_size - 0.5;
+  const double v = (patch.y_max - p.y()) / texel_size - 0.5;
+  if (u < -0.5 || v < -0.5 || u > patch.width - 0.5 || v > patch.height - 0.5) return false;
+  const double uc = std::clamp(u, 0.0, patch.width - 1.0), vc = std::clamp(v, 0.0, patch.height - 1.0);
+  const int x0 = std::min(static_cast<int>(uc), patch.width - 2 < 0 ? 0 : patch.width - 2);
+  const int y0 = std::min(static_cast<int>(vc), patch.height - 2 < 0 ? 0 : patch.height - 2);
+  const int x1 = std::min(x0 + 1, patch.width - 1), y1 = std::min(y0 + 1, patch.height - 1);
+  const float fx = static_cast<float>(uc - x0), fy = static_cast<float>(vc - y0);
+  for (std::size_t c = 0; c < sample_planes.size(); ++c) {
+    const cv::Mat& m = sample_planes[c];
+    const float a = m.at<float>(patch.sample_y + y0, patch.sample_x + x0);
+    const float b = m.at<float>(patch.sample_y + y0, patch.sample_x + x1);
+    const float d = m.at<float>(patch.sample_y + y1, patch.sample_x + x0);
+    const float e = m.at<float>(patch.sample_y + y1, patch.sample_x + x1);
+    out[c] = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * d + fx * e);
+  }
+  return true;
+}
+
+void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip,
+                                  float* out) const {
+  const std::size_t n = sample_planes.size();
+  std::vector<float> own(n), other(n);
+  if (!SamplePatch(face, p, own.data())) std::fill(own.begin(), own.end(), 0.0f);
+  std::vector<double> sum(n, 0.0);
+  double own_weight = 1.0;
+  const TrianglePatch& patch = patches[static_cast<std::size_t>(face)];
+  const double half_width = 0.5 * strip * texel_size;
+  const int coefficient_planes = CoefficientPlanes();
+  for (int k = 0; k < 3; ++k) {
+    const Unfolding& u = unfoldings[static_cast<std::size_t>(face)][static_cast<std::size_t>(k)];
+    if (u.face < 0) continue;
+    const Eigen::Vector2d& a = patch.corners_in_frame[static_cast<std::size_t>(k)];
+    const Eigen::Vector2d& b = patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)];
+    const double d = SegmentDistance(a, b, p);
+    if (d >= half_width) continue;
+    if (!SamplePatch(u.face, u.rotation * p + u.translation, other.data())) continue;
+    const double w = 0.5 * (1.0 - d / half_width);  // 1/2 at the edge, 0 at W_e / 2
+    for (int q = 0; q < coefficient_planes / 6; ++q) {
+      Eigen::Matrix<double, 6, 1> c;
+      for (int i = 0; i < 6; ++i) c[i] = other[static_cast<std::size_t>(q * 6 + i)];
+      c = u.coefficients_to_this * c;
+      for (int i = 0; i < 6; ++i) sum[static_cast<std::size_t>(q * 6 + i)] += w * c[i];
+    }
+    for (std::size_t c = static_cast<std::size_t>(coefficient_planes); c < n; ++c)
+      sum[c] += w * other[c];
+    own_weight -= w;
+  }
+  for (std::size_t c = 0; c < n; ++c) out[c] = static_cast<float>(own_weight * own[c] + sum[c]);
+}
+
+MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
+                                const sfm::Reconstruction& reconstruction,
+                                const sfm::VisibilityResult& visibility,
+                                const std::vector<MeshPhoto>& photos, const ptm::Ptm& sample,
+                                const MeshSynthesisOptions& options,
+                                const ProgressCallback& progress) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t num_faces = mesh.faces.size();
+  if (visibility.triangles.size() != num_faces)
+    throw InputError("visibility", "does not match the mesh's face count");
+  const double t = options.sample_texel_size;
+  MeshSynthesis result;
+  result.format = sample.format;
+  result.texel_size = t;
+  result.sample_planes = ToOrthonormalPlanes(sample);
+  const int coefficient_planes = result.CoefficientPlanes();
+  const std::vector<cv::Mat> sample_coefficients(
+      result.sample_planes.begin(), result.sample_planes.begin() + coefficient_planes);
+  const cv::Mat sample_energy = PlaneEnergy(sample_coefficients);
+  const std::vector<cv::Mat> sample_raw = RawPlanes(sample);
+
+  // 1. Frames, patch rectangles, and the memory they need (refused up front).
+  result.patches.resize(num_faces);
+  std::int64_t total_texels = 0;
+  int widest = 0, tallest = 0;
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    TrianglePatch& patch = result.patches[f];
+    if (options.tangent_frame == TangentFrame::kSmoothField) {
+      const Eigen::Vector3d n =
+          (mesh.Corner(f, 1) - mesh.Corner(f, 0)).cross(mesh.Corner(f, 2) - mesh.Corner(f, 0)).normalized();
+      Eigen::Vector3d d = options.field_direction_in_world.normalized();
+      if ((d - n * n.dot(d)).norm() < 0.3) {
+        // Near the field's poles: the world axis least aligned with the normal.
+        Eigen::Index axis;
+        n.cwiseAbs().minCoeff(&axis);
+        d = Eigen::Vector3d::Unit(axis);
+      }
+      patch.frame = MakeTriangleFrame(mesh, f, d);
+    } else {
+      patch.frame = MakeTriangleFrame(mesh, f);
+    }
+    Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
+    Eigen::Vector2d hi = -lo;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = patch.frame.PointInFrame(mesh.Corner(f, k));
+      patch.corners_in_frame[static_cast<std::size_t>(k)] = p.head<2>();
+      lo = lo.cwiseMin(p.head<2>());
+      hi = hi.cwiseMax(p.head<2>());
+    }
+    patch.x_min = lo.x() - options.strip * t;
+    patch.y_max = hi.y() + options.strip * t;
+    const double w = std::ceil((hi.x() - lo.x()) / t) + 2.0 * options.strip;
+    const double h = std::ceil((hi.y() - lo.y()) / t) + 2.0 * options.strip;
+    if (!(w < 1e7 && h < 1e7)) {
+      throw InputError("mesh", "face " + std::to_string(f) + " needs a patch of " +
+                                   std::to_string(w) + " x " + std::to_string(h) +
+                                   " texels; is the sample texel size in the model's units?");
+    }
+    patch.width = static_cast<int>(w);
+    patch.height = static_cast<int>(h);
+    widest = std::max(widest, patch.width);
+    tallest = std::max(tallest, patch.height);
+    total_texels += static_cast<std::int64_t>(patch.width) * patch.height;
+  }
+  if (total_texels > options.max_texels) {
+    throw InputError("mesh", "at a texel size of " + std::to_string(t) + " world units the " +
+                                 std::to_string(num_faces) + " patches need " +
+                                 std::to_string(total_texels) + " texels (about " +
+                                 std::to_string(total_texels * 4 * static_cast<std::int64_t>(result.sample_planes.size()) >> 20) +
+                                 " MiB per copy), more than the limit of " +
+                                 std::to_string(options.max_texels) +
+                                 "; use a larger texel size or a finer mesh");
+  }
+  if (widest > sample.width || tallest > sample.height) {
+    throw InputError("mesh", "the largest triangle needs a patch of " + std::to_string(widest) +
+                                 " x " + std::to_string(tallest) + " texels (strip included) but the sample is " +
+                                 std::to_string(sample.width) + " x " + std::to_string(sample.height) +
+                                 "; subdivide the mesh (texlume synth --subdivide) or capture a larger sample");
+  }
+
+  // Unfoldings across every shared edge.
+  const std::vector<std::array<int, 3>> neighbours = sfm::FaceNeighbours(mesh);
+  result.unfoldings.resize(num_faces);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int nb = neighbours[f][static_cast<std::size_t>(k)];
+      Unfolding& u = result.unfoldings[f][static_cast<std::size_t>(k)];
+      if (nb < 0) continue;
+      const int va = mesh.faces[f][static_cast<std::size_t>(k)];
+      const int vb = mesh.faces[f][static_cast<std::size_t>((k + 1) % 3)];
+      const TrianglePatch& other = result.patches[static_cast<std::size_t>(nb)];
+      const Eigen::Vector2d a_this = result.patches[f].corners_in_frame[static_cast<std::size_t>(k)];
+      const Eigen::Vector2d b_this =
+          result.patches[f].corners_in_frame[static_cast<std::size_t>((k + 1) % 3)];
+      const Eigen::Vector2d a_nb = other.frame.PointInFrame(mesh.vertices[static_cast<std::size_t>(va)]).head<2>();
+      const Eigen::Vector2d b_nb = other.frame.PointInFrame(mesh.vertices[static_cast<std::size_t>(vb)]).head<2>();
+      const double angle = std::atan2((b_nb - a_nb).y(), (b_nb - a_nb).x()) -
+                           std::atan2((b_this - a_this).y(), (b_this - a_this).x());
+      u.face = nb;
+      u.rotation = Eigen::Rotation2Dd(angle).toRotationMatrix();
+      u.translation = a_nb - u.rotation * a_this;
+      // This frame's x axis is (cos angle, sin angle) in the neighbour's frame.
+      u.coefficients_to_this = OrthonormalRotation(angle);
+    }
+  }
+
+  // Photos by image id, and the reduced samples by density level.
+  std::map<sfm::ImageId, std::size_t> photo_index;
+  for (std::size_t n = 0; n < photos.size(); ++n) photo_index[photos[n].image_id] = n;
+  std::map<int, ReducedSample> reduced;
+  auto reduced_at = [&](int level) -> const ReducedSample& {
+    auto it = reduced.find(level);
+    if (it != reduced.end()) return it->second;
+    ReducedSample r;
+    const double density = std::pow(2.0, -level / 4.0);
+    const int rw = std::max(1, static_cast<int>(std::lround(sample.width * density)));
+    const int rh = std::max(1, static_cast<int>(std::lround(sample.height * density)));
+    for (const cv::Mat& m : sample_raw) {
+      cv::Mat small;
+      cv::resize(m, small, cv::Size(rw, rh), 0, 0, cv::INTER_AREA);
+      r.raw.push_back(small);
+    }
+    r.rx = static_cast<double>(rw) / sample.width;
+    r.ry = static_cast<double>(rh) / sample.height;
+    return reduced.emplace(level, std::move(r)).first->second;
+  };
+  const int polys = sample.NumPolynomials();
+  auto relit_planes = [&](const ReducedSample& r, const LightList& lights, double gain) {
+    std::vector<cv::Mat> out(3);
+    for (cv::Mat& m : out) m = cv::Mat(r.raw[0].size(), CV_32FC1);
+    std::vector<float> a(static_cast<std::size_t>(polys * 6)), colour(3, 1.0f);
+    for (int y = 0; y < r.raw[0].rows; ++y) {
+      for (int x = 0; x < r.raw[0].cols; ++x) {
+        for (int i = 0; i < polys * 6; ++i) a[static_cast<std::size_t>(i)] = r.raw[static_cast<std::size_t>(i)].at<float>(y, x);
+        if (sample.format == ptm::PtmFormat::kLrgb)
+          for (int c = 0; c < 3; ++c) colour[static_cast<std::size_t>(c)] = r.raw[static_cast<std::size_t>(6 + c)].at<float>(y, x);
+        const Eigen::Vector3f v = RelightMixture(a.data(), colour.data(), sample.format, lights, gain);
+        for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(c)].at<float>(y, x) = v[c];
+      }
+    }
+    return out;
+  };
+
+  // A triangle as seen in one photo: the photo rectified into the triangle frame
+  // at the photo's own surface density, the triangle mask, the local lights.
+  struct Rectified {
+    std::size_t photo = 0;
+    int level = 0;
+    std::vector<cv::Mat> planes;  // RGB display
+    cv::Mat mask;                 // CV_32FC1, 1 inside the triangle and the image
+    int count = 0;
+    LightList lights;
+  };
+  auto rectify = [&](std::size_t f, const sfm::TriangleView& view, Rectified& out) -> bool {
+    const auto it = photo_index.find(view.image_id);
+    if (it == photo_index.end()) return false;
+    const MeshPhoto& photo = photos[it->second];
+    const sfm::Image& image = reconstruction.images.at(view.image_id);
+    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
+    const TrianglePatch& patch = result.patches[f];
+    const double area = 0.5 * std::abs((patch.corners_in_frame[1] - patch.corners_in_frame[0]).x() *
+                                           (patch.corners_in_frame[2] - patch.corners_in_frame[0]).y() -
+                                       (patch.corners_in_frame[1] - patch.corners_in_frame[0]).y() *
+                                           (patch.corners_in_frame[2] - patch.corners_in_frame[0]).x());
+    const double density = std::sqrt(std::max(view.projected_area_px, 1e-6f) / (area / (t * t)));
+    const int level = std::clamp(static_cast<int>(std::lround(-4.0 * std::log2(density))), 0, 40);
+    const ReducedSample& r = reduced_at(level);
+    const int tw = std::max(1, static_cast<int>(std::lround(patch.width * r.rx)));
+    const int th = std::max(1, static_cast<int>(std::lround(patch.height * r.ry)));
+    if (tw > r.raw[0].cols || th > r.raw[0].rows) return false;
+    cv::Mat map_x(th, tw, CV_32FC1), map_y(th, tw, CV_32FC1);
+    out.mask = cv::Mat::zeros(th, tw, CV_32FC1);
+    out.count = 0;
+    for (int j = 0; j < th; ++j) {
+      for (int i = 0; i < tw; ++i) {
+        const Eigen::Vector2d p(patch.x_min + (i + 0.5) / r.rx * t, patch.y_max - (j + 0.5) / r.ry * t);
+        const Eigen::Vector3d world = patch.frame.origin_in_world + p.x() * patch.frame.x_axis +
+                                      p.y() * patch.frame.y_axis;
+        const Eigen::Vector3d cam = image.cam_from_world.rotation * world + image.cam_from_world.translation;
+        const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(cam);
+        map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
+        map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
+        if (px && InsideTriangle(patch.corners_in_frame, p) && px->x() >= 0.5 &&
+            px->y() >= 0.5 && px->x() <= photo.image.cols - 0.5 && px->y() <= photo.image.rows - 0.5) {
+          out.mask.at<float>(j, i) = 1.0f;
+          ++out.count;
+        }
+      }
+    }
+    if (out.count < options.min_photo_pixels) return false;
+    cv::Mat rectified;
+    cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    cv::split(rectified, out.planes);
+    out.lights.clear();
+    for (const sfm::ObjectLight& light : photo.lights) {
+      const Eigen::Vector3d l = patch.frame.DirectionInFrame(light.DirectionFrom(patch.frame.origin_in_world));
+      out.lights.emplace_back(l, light.intensity);
+    }
+    out.photo = it->second;
+    out.level = level;
+    return true;
+  };
+
+  // Views used per face: the best fully visible view, or every fully visible one.
+  auto views_of = [&](std::size_t f) {
+    std::vector<sfm::TriangleView> v;
+    const sfm::TriangleVisibility& tv = visibility.triangles[f];
+    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) return v;
+    for (const sfm::TriangleView& view : tv.views)
+      if (view.fully_visible && view.image_id == tv.best_view) v.push_back(view);
+    if (options.all_views) {
+      std::vector<sfm::TriangleView> others;
+      for (const sfm::TriangleView& view : tv.views)
+        if (view.fully_visible && view.image_id != tv.best_view) others.push_back(view);
+      std::sort(others.begin(), others.end(),
+                [](const auto& a, const auto& b) { return a.angle_rad < b.angle_rad; });
+      for (const auto& view : others)
+        if (static_cast<int>(v.size()) < options.max_views) v.push_back(view);
+    }
+    return v;
+  };
+
+  // 2a. Per-photo gain (exposure x light intensity, linear domain): the photo's
+  // mean over its triangles against the sample's mean relit at their lights.
+  std::vector<double> photo_sum(photos.size(), 0.0), model_sum(photos.size(), 0.0);
+  {
+    const int coarse_level = std::max(0, static_cast<int>(std::ceil(4.0 * std::log2(std::max(sample.width, sample.height) / 16.0))));
+    const ReducedSample& coarse = reduced_at(coarse_level);
+    for (std::size_t f = 0; f < num_faces; ++f) {
+      for (const sfm::TriangleView& view : views_of(f)) {
+        Rectified rect;
+        if (!rectify(f, view, rect)) continue;
+        double photo_linear = 0.0;
+        for (int j = 0; j < rect.mask.rows; ++j)
+          for (int i = 0; i < rect.mask.cols; ++i)
+            if (rect.mask.at<float>(j, i) > 0)
+              for (int c = 0; c < 3; ++c) photo_linear += SrgbToLinear(rect.planes[static_cast<std::size_t>(c)].at<float>(j, i));
+        const std::vector<cv::Mat> relit = relit_planes(coarse, rect.lights, 1.0);
+        double model_linear = 0.0;
+        for (int c = 0; c < 3; ++c) {
+          for (int j = 0; j < relit[0].rows; ++j)
+            for (int i = 0; i < relit[0].cols; ++i)
+              model_linear += SrgbToLinear(relit[static_cast<std::size_t>(c)].at<float>(j, i));
+        }
+        photo_sum[rect.photo] += photo_linear;
+        model_sum[rect.photo] += model_linear / static_cast<double>(relit[0].total()) * rect.count;
+      }
+    }
+  }
+  result.photo_gains.assign(photos.size(), 1.0);
+  for (std::size_t n = 0; n < photos.size(); ++n)
+    if (model_sum[n] > 1e-9 && photo_sum[n] > 0) result.photo_gains[n] = photo_sum[n] / model_sum[n];
+
+  // 2b. Breadth-first synthesis from a seed (the best-seen triangle).
+  int seed_face = 0;
+  float best_area = -1.0f;
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const auto& tv = visibility.triangles[f];
+    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) continue;
+    for (const auto& v : tv.views)
+      if (v.image_id == tv.best_view && v.projected_area_px > best_area) {
+        best_area = v.projected_area_px;
+        seed_face = static_cast<int>(f);
+      }
+  }
+  const std::vector<int> order = sfm::BreadthFirstFaceOrder(mesh, neighbours, seed_face);
+  std::vector<char> done(num_faces, 0);
+  std::mt19937_64 rng(options.seed);
+  std::size_t processed = 0;
+  for (const int face : order) {
+    const std::size_t f = static_cast<std::size_t>(face);
+    TrianglePatch& patch = result.patches[f];
+    const int w = patch.width, h = patch.height;
+
+    // Overlap targets: processed neighbours' patches unfolded into this frame,
+    // on the texels within W_e of the shared edge.
+    std::vector<int> target_texels;
+    std::vector<float> targets;  // coefficient_planes per target texel
+    std::vector<float> value(result.sample_planes.size());
+    for (int j = 0; j < h; ++j) {
+      for (int i = 0; i < w; ++i) {
+        const Eigen::Vector2d p(patch.x_min + (i + 0.5) * t, patch.y_max - (j + 0.5) * t);
+        for (int k = 0; k < 3; ++k) {
+          const Unfolding& u = result.unfoldings[f][static_cast<std::size_t>(k)];
+          if (u.face < 0 || !done[static_cast<std::size_t>(u.face)]) continue;
+          const double d = SegmentDistance(patch.corners_in_frame[static_cast<std::size_t>(k)],
+                                           patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)], p);
+          if (d > options.strip * t) continue;
+          if (!result.SamplePatch(u.face, u.rotation * p + u.translation, value.data())) continue;
+          target_texels.push_back(j * w + i);
+          for (int q = 0; q < coefficient_planes / 6; ++q) {
+            Eigen::Matrix<double, 6, 1> c;
+            for (int m = 0; m < 6; ++m) c[m] = value[static_cast<std::size_t>(q * 6 + m)];
+            c = u.coefficients_to_this * c;
+            for (int m = 0; m < 6; ++m) targets.push_back(static_cast<float>(c[m]));
+          }
+          break;
+        }
+      }
+    }
+    auto overlap_error = [&](int sx, int sy) {
+      if (target_texels.empty()) return 0.0;
+      double e = 0.0;
+      for (std::size_t n = 0; n < target_texels.size(); ++n) {
+        const int i = target_texels[n] % w, j = target_texels[n] / w;
+        for (int c = 0; c < coefficient_planes; ++c) {
+          const double d = result.sample_planes[static_cast<std::size_t>(c)].at<float>(sy + j, sx + i) -
+                           targets[n * static_cast<std::size_t>(coefficient_planes) + static_cast<std::size_t>(c)];
+          e += d * d;
+        }
+      }
+      return e / static_cast<double>(target_texels.size());
+    };
+
+    // Image constraint: S summed over the views (eq. 3 at each photo's density).
+    std::vector<Rectified> rects;
+    for (const sfm::TriangleView& view : views_of(f)) {
+      Rectified r;
+      if (rectify(f, view, r)) rects.push_back(std::move(r));
+    }
+    const int max_sx = sample.width - w, max_sy = sample.height - h;
+    if (!rects.empty()) {
+      cv::Mat total;  // summed RMS score over sample positions (texels)
+      total = cv::Mat::zeros(max_sy + 1, max_sx + 1, CV_32FC1);
+      for (const Rectified& r : rects) {
+        const ReducedSample& red = reduced_at(r.level);
+        const std::vector<cv::Mat> relit = relit_planes(red, r.lights, result.photo_gains[r.photo]);
+        const cv::Mat ssd = MaskedSsd(relit, PlaneEnergy(relit), r.planes, r.mask);
+        for (int sy = 0; sy <= max_sy; ++sy) {
+          const int py = std::min(static_cast<int>(std::lround(sy * red.ry)), ssd.rows - 1);
+          for (int sx = 0; sx <= max_sx; ++sx) {
+            const int px = std::min(static_cast<int>(std::lround(sx * red.rx)), ssd.cols - 1);
+            total.at<float>(sy, sx) += std::sqrt(ssd.at<float>(py, px) / (3.0f * r.count));
+          }
+        }
+      }
+      // Top-k distinct positions at the coarsest density used (neighbouring texel
+      // positions share one photo-density cell and score alike).
+      std::vector<std::pair<float, cv::Point>> all;
+      const int stride = std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx)));
+      for (int sy = 0; sy <= max_sy; sy += stride)
+        for (int sx = 0; sx <= max_sx; sx += stride) all.emplace_back(total.at<float>(sy, sx), cv::Point(sx, sy));
+      const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(options.top_k), all.size());
+      std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k), all.end(),
+                        [](const auto& a, const auto& b) { return a.first < b.first; });
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t c = 0; c < k; ++c) {
+        const double e = overlap_error(all[c].second.x, all[c].second.y);
+        if (e < best) {
+          best = e;
+          patch.sample_x = all[c].second.x;
+          patch.sample_y = all[c].second.y;
+          patch.image_score = all[c].first;
+          patch.overlap_error = e;
+        }
+      }
+      patch.source = PatchSource::kPhotos;
+      patch.views_used = static_cast<int>(rects.size());
+      ++result.num_from_photos;
+    } else if (!target_texels.empty()) {
+      // Overlap constraint alone, at every position of the sample (FFT).
+      std::vector<cv::Mat> target_planes(static_cast<std::size_t>(coefficient_planes));
+      for (cv::Mat& m : target_planes) m = cv::Mat::zeros(h, w, CV_32FC1);
+      cv::Mat mask = cv::Mat::zeros(h, w, CV_32FC1);
+      for (std::size_t n = 0; n < target_texels.size(); ++n) {
+        const int i = target_texels[n] % w, j = target_texels[n] / w;
+        mask.at<float>(j, i) = 1.0f;
+        for (int c = 0; c < coefficient_planes; ++c)
+          target_planes[static_cast<std::size_t>(c)].at<float>(j, i) =
+              targets[n * static_cast<std::size_t>(coefficient_planes) + static_cast<std::size_t>(c)];
+      }
+      const cv::Mat errors = MaskedSsd(sample_coefficients, sample_energy, target_planes, mask);
+      double min_error;
+      cv::minMaxLoc(errors, &min_error);
+      std::vector<cv::Point> near;
+      for (int py = 0; py < errors.rows; ++py)
+        for (int px = 0; px < errors.cols; ++px)
+          if (errors.at<float>(py, px) <= min_error * (1.0 + options.tolerance) + 1e-12) near.emplace_back(px, py);
+      const cv::Point p = near[std::uniform_int_distribution<std::size_t>(0, near.size() - 1)(rng)];
+      patch.sample_x = p.x;
+      patch.sample_y = p.y;
+      patch.overlap_error = errors.at<float>(p.y, p.x) / static_cast<double>(target_texels.size());
+      patch.source = PatchSource::kNeighbours;
+      ++result.num_from_neighbours;
+    } else {
+      patch.sample_x = std::uniform_int_distribution<int>(0, max_sx)(rng);
+      patch.sample_y = std::uniform_int_distribution<int>(0, max_sy)(rng);
+      patch.source = PatchSource::kRandom;
+      ++result.num_random;
+    }
+    done[f] = 1;
+    ++processed;
+    if (progress && (processed % 64 == 0 || processed == num_faces)) progress("synthesis", processed, num_faces);
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace texlume::synth

@@ -1,0 +1,146 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "ptm/ptm.h"
+#include "sfm/lights.h"
+#include "sfm/mesh.h"
+#include "sfm/progress.h"
+#include "sfm/reconstruction.h"
+#include "sfm/visibility.h"
+#include "synth/triangle_frame.h"
+
+namespace texlume::synth {
+
+/// An object photo with its light(s), as used to constrain the synthesis.
+struct MeshPhoto {
+  sfm::ImageId image_id;
+  std::string name;
+  cv::Mat image;  ///< CV_32FC3, RGB, display domain (sRGB-encoded) in [0, 1]
+  std::vector<sfm::ObjectLight> lights;
+};
+
+/// Where the tangent frame's X axis of each triangle comes from.
+enum class TangentFrame {
+  kFirstEdge,     ///< v0 -> v1 (paper 003 §3.0.2)
+  kSmoothField,   ///< a fixed world direction projected onto each face, so anisotropic
+                  ///< materials keep their direction across triangles
+};
+
+/// Settings of SynthesizeMeshPtm (paper 003 Algorithm 2).
+struct MeshSynthesisOptions {
+  /// World units per texel of the sample PTM (COLMAP models have arbitrary scale). > 0.
+  double sample_texel_size = 0.0;
+  /// W_e: texels of strip around each triangle's bounding box (paper: 5-10). [2, 32].
+  int strip = 8;
+  /// Candidates kept by the image score before the neighbour constraint. >= 1.
+  int top_k = 12;
+  /// Constrain with every photo in which the triangle is fully visible (scores
+  /// summed, each under its own light), not only the best view.
+  bool all_views = false;
+  /// Most views used per triangle with all_views. >= 1.
+  int max_views = 4;
+  TangentFrame tangent_frame = TangentFrame::kFirstEdge;
+  /// kSmoothField: the world direction projected onto each face (falls back to
+  /// the orthogonal world axis of smallest normal component where it is nearly
+  /// parallel to the normal).
+  Eigen::Vector3d field_direction_in_world = Eigen::Vector3d::UnitZ();
+  /// Triangles seen in no photo: pick at random among placements whose overlap
+  /// error is within (1 + tolerance) of the best. >= 0.
+  double tolerance = 0.1;
+  /// Fewest rectified photo pixels inside a triangle for the photo to constrain it. >= 1.
+  int min_photo_pixels = 6;
+  /// Refuse up front when the patches would take more texels than this.
+  std::int64_t max_texels = std::int64_t{1} << 30;
+  std::uint32_t seed = 1;
+
+  void Check() const;
+};
+
+/// How a triangle's patch was chosen.
+enum class PatchSource {
+  kPhotos,     ///< image score, then neighbours (Algorithm 2 step 2)
+  kNeighbours, ///< fully visible in no photo: overlap constraint alone
+  kRandom,     ///< no photo and no synthesised neighbour (first of an unseen component)
+};
+
+/// One triangle's patch: the sample PTM's rectangle [sample_x, sample_x + width)
+/// x [sample_y, sample_y + height) (texels, rows down) laid over the triangle's
+/// frame so that texel (i, j) has its centre at frame coordinates
+/// (x_min + (i + 0.5) t, y_max - (j + 0.5) t), t the texel size. The rectangle is
+/// the triangle's bounding box plus W_e texels of strip on every side.
+struct TrianglePatch {
+  TriangleFrame frame;
+  std::array<Eigen::Vector2d, 3> corners_in_frame;  ///< world units
+  double x_min = 0.0, y_max = 0.0;                  ///< world units, frame coordinates
+  int width = 0, height = 0;                        ///< texels
+  int sample_x = 0, sample_y = 0;                   ///< texels, top-left in the sample
+  PatchSource source = PatchSource::kRandom;
+  int views_used = 0;
+  double image_score = 0.0;    ///< summed RMS photo difference of the chosen patch
+  double overlap_error = 0.0;  ///< mean squared orthonormal distance to the neighbours
+};
+
+/// The unfolding of neighbour `face` across a shared edge into a triangle's
+/// frame: p_neighbour = rotation * p + translation (2D, world units), and the
+/// coefficient map from the neighbour's frame to this one (orthonormal space).
+struct Unfolding {
+  int face = -1;  ///< -1: boundary edge
+  Eigen::Matrix2d rotation = Eigen::Matrix2d::Identity();
+  Eigen::Vector2d translation = Eigen::Vector2d::Zero();
+  Eigen::Matrix<double, 6, 6> coefficients_to_this = Eigen::Matrix<double, 6, 6>::Identity();
+};
+
+/// The result of the per-triangle synthesis: patches that reference the sample,
+/// the sample's orthonormal planes they reference, and per-edge unfoldings.
+struct MeshSynthesis {
+  ptm::PtmFormat format = ptm::PtmFormat::kLrgb;
+  double texel_size = 0.0;                ///< world units
+  std::vector<cv::Mat> sample_planes;     ///< orthonormal coefficients (+ LRGB colour)
+  std::vector<TrianglePatch> patches;     ///< per face
+  std::vector<std::array<Unfolding, 3>> unfoldings;  ///< per face, edge k = (v_k, v_k+1)
+  std::vector<double> photo_gains;        ///< per photo (linear-domain exposure x intensity)
+  std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
+  double seconds = 0.0;
+
+  /// Number of coefficient planes (6 LRGB, 18 RGB); colour planes follow for LRGB.
+  int CoefficientPlanes() const { return format == ptm::PtmFormat::kLrgb ? 6 : 18; }
+  /// The face's own patch at frame point p (world units), bilinear; false outside it.
+  bool SamplePatch(int face, const Eigen::Vector2d& p_in_frame, float* planes_out) const;
+  /// Blended value (paper 003 Fig. 4) at a point of the face: near an edge, the
+  /// neighbour's patch unfolded across it and moved into this frame, weighted
+  /// 1/2 at the edge falling to 0 at W_e / 2 texels inside. All planes.
+  void SampleBlended(int face, const Eigen::Vector2d& p_in_frame, int strip,
+                     float* planes_out) const;
+};
+
+/// Per-triangle image-constrained PTM synthesis on a mesh (paper 003 Algorithm 2).
+/// `visibility` from sfm::ComputeVisibility for this mesh and reconstruction;
+/// `photos` the usable photos (each image_id in the reconstruction). Throws
+/// OptionError for bad options and InputError when the patches would not fit the
+/// sample or would exceed max_texels (with the estimate).
+MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
+                                const sfm::Reconstruction& reconstruction,
+                                const sfm::VisibilityResult& visibility,
+                                const std::vector<MeshPhoto>& photos, const ptm::Ptm& sample,
+                                const MeshSynthesisOptions& options,
+                                const ProgressCallback& progress = {});
+
+/// sRGB decoding/encoding of display values in [0, 1] (IEC 61966-2-1).
+float SrgbToLinear(float v);
+float LinearToSrgb(float v);
+
+/// The display value of a PTM texel under several lights (tangent frame) with
+/// intensities, times a gain: the sum is taken in the linear domain,
+/// srgb(gain * sum_i I_i lin(clamp(f(l_i)))). Lights below the horizon add 0.
+Eigen::Vector3f RelightMixture(const float* coefficients_or_l, const float* colour,
+                               ptm::PtmFormat format,
+                               const std::vector<std::pair<Eigen::Vector3d, double>>& lights,
+                               double gain);
+
+}  // namespace texlume::synth

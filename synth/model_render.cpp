@@ -1,0 +1,334 @@
+#include "synth/model_render.h"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "sfm/errors.h"
+
+namespace texlume::synth {
+namespace {
+
+// Bilinear lookup of `count` floats per texel at atlas pixel position (x, y)
+// (pixel centres at +0.5), clamped to the image.
+template <typename Get>
+void Bilinear(int width, int height, double x, double y, int count, const Get& get, float* out) {
+  const double u = std::clamp(x - 0.5, 0.0, width - 1.0), v = std::clamp(y - 0.5, 0.0, height - 1.0);
+  const int x0 = std::min(static_cast<int>(u), std::max(0, width - 2));
+  const int y0 = std::min(static_cast<int>(v), std::max(0, height - 2));
+  const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
+  const float fx = static_cast<float>(u - x0), fy = static_cast<float>(v - y0);
+  for (int c = 0; c < count; ++c) {
+    out[c] = (1 - fy) * ((1 - fx) * get(x0, y0, c) + fx * get(x1, y0, c)) +
+             fy * ((1 - fx) * get(x0, y1, c) + fx * get(x1, y1, c));
+  }
+}
+
+Eigen::Vector2d ToOpenCv(const Eigen::Vector2d& colmap_px) { return colmap_px - Eigen::Vector2d(0.5, 0.5); }
+
+}  // namespace
+
+struct ModelRenderer::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+ModelRenderer::ModelRenderer(const TexturedModel& model) : model_(model), impl_(new Impl) {
+  const sfm::TriangleMesh& mesh = model.mesh;
+  vertex_normals_ = VertexNormals(mesh);
+  face_frames_.resize(mesh.faces.size());
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const Eigen::Vector3d e1 = mesh.Corner(f, 1) - mesh.Corner(f, 0);
+    const Eigen::Vector3d e2 = mesh.Corner(f, 2) - mesh.Corner(f, 0);
+    const Eigen::Vector3d n = e1.cross(e2).normalized();
+    Eigen::Vector3d x = e1;
+    if (f < model.corner_px.size()) {
+      const auto& c = model.corner_px[f];
+      // v up: dv = -dy.
+      const double du1 = c[1].x() - c[0].x(), dv1 = -(c[1].y() - c[0].y());
+      const double du2 = c[2].x() - c[0].x(), dv2 = -(c[2].y() - c[0].y());
+      const double det = du1 * dv2 - du2 * dv1;
+      if (std::abs(det) > 1e-12) x = (e1 * dv2 - e2 * dv1) / det;  // dP/du
+    }
+    x = (x - n * n.dot(x)).normalized();
+    face_frames_[f].col(0) = x;
+    face_frames_[f].col(1) = n.cross(x);
+    face_frames_[f].col(2) = n;
+  }
+  impl_->device = rtcNewDevice(nullptr);
+  if (!impl_->device) throw std::runtime_error("Embree: cannot create a device");
+  impl_->scene = rtcNewScene(impl_->device);
+  RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size()));
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+    for (int c = 0; c < 3; ++c) vertices[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(mesh.vertices[i][c]);
+  auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+      geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.faces.size()));
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    for (int c = 0; c < 3; ++c) indices[3 * f + static_cast<std::size_t>(c)] = static_cast<unsigned>(mesh.faces[f][static_cast<std::size_t>(c)]);
+  rtcCommitGeometry(geometry);
+  rtcAttachGeometry(impl_->scene, geometry);
+  rtcReleaseGeometry(geometry);
+  rtcCommitScene(impl_->scene);
+  if (rtcGetDeviceError(impl_->device) != RTC_ERROR_NONE) throw std::runtime_error("Embree: scene build failed");
+}
+
+ModelRenderer::~ModelRenderer() = default;
+
+RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
+                                   const std::vector<sfm::ObjectLight>& lights, RenderMode mode,
+                                   int samples_per_axis) const {
+  if (samples_per_axis < 1 || samples_per_axis > 8) throw OptionError("samples per axis must be in [1, 8]");
+  if (mode == RenderMode::kBaked && baked.size() != model_.atlases.size())
+    throw OptionError("the baked baseline needs one baked texture per atlas");
+  const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
+  RenderedView out;
+  out.rgb = cv::Mat(height, width, CV_32FC3, cv::Scalar::all(0));
+  out.coverage = cv::Mat(height, width, CV_32FC1, cv::Scalar::all(0));
+  const sfm::Rigid3d world_from_cam = cam_from_world.Inverse();
+  const Eigen::Vector3d origin = world_from_cam.translation;
+  const int n = samples_per_axis;
+  const RTCScene scene = impl_->scene;
+  const sfm::TriangleMesh& mesh = model_.mesh;
+  const Eigen::Vector3f flat_linear(SrgbToLinear(flat_albedo.x()), SrgbToLinear(flat_albedo.y()),
+                                    SrgbToLinear(flat_albedo.z()));
+
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int y = 0; y < height; ++y) {
+    RTCIntersectContext context;
+    std::vector<float> texel(21);
+    for (int x = 0; x < width; ++x) {
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      int hits = 0;
+      for (int sy = 0; sy < n; ++sy) {
+        for (int sx = 0; sx < n; ++sx) {
+          const Eigen::Vector2d pixel(x + (sx + 0.5) / n, y + (sy + 0.5) / n);  // COLMAP pixels
+          const Eigen::Vector3d direction = world_from_cam.rotation * camera.CamRayFromImage(pixel);
+          rtcInitIntersectContext(&context);
+          RTCRayHit rh;
+          rh.ray.org_x = static_cast<float>(origin.x());
+          rh.ray.org_y = static_cast<float>(origin.y());
+          rh.ray.org_z = static_cast<float>(origin.z());
+          rh.ray.dir_x = static_cast<float>(direction.x());
+          rh.ray.dir_y = static_cast<float>(direction.y());
+          rh.ray.dir_z = static_cast<float>(direction.z());
+          rh.ray.tnear = 0.0f;
+          rh.ray.tfar = std::numeric_limits<float>::infinity();
+          rh.ray.mask = 0xFFFFFFFFu;
+          rh.ray.time = 0.0f;
+          rh.ray.flags = 0;
+          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+          rtcIntersect1(scene, &context, &rh);
+          if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+          ++hits;
+          const std::size_t f = rh.hit.primID;
+          const double b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.0 - b1 - b2;
+          const Eigen::Vector3d point = origin + static_cast<double>(rh.ray.tfar) * direction;
+          Eigen::Vector3f value = Eigen::Vector3f::Zero();
+          if (mode == RenderMode::kFlat) {
+            const auto& v = mesh.faces[f];
+            const Eigen::Vector3d normal = (b0 * vertex_normals_[static_cast<std::size_t>(v[0])] +
+                                            b1 * vertex_normals_[static_cast<std::size_t>(v[1])] +
+                                            b2 * vertex_normals_[static_cast<std::size_t>(v[2])]).normalized();
+            double shading = 0.0;
+            for (const sfm::ObjectLight& l : lights) shading += l.intensity * std::max(0.0, normal.dot(l.DirectionFrom(point)));
+            for (int c = 0; c < 3; ++c) value[c] = LinearToSrgb(static_cast<float>(shading) * flat_linear[c]);
+          } else {
+            const auto& c = model_.corner_px[f];
+            const Eigen::Vector2d px = b0 * c[0].cast<double>() + b1 * c[1].cast<double>() + b2 * c[2].cast<double>();
+            const int atlas_index = model_.face_atlas[f];
+            if (mode == RenderMode::kBaked) {
+              const cv::Mat& tex = baked[static_cast<std::size_t>(atlas_index)];
+              Bilinear(tex.cols, tex.rows, px.x(), px.y(), 3,
+                       [&](int xx, int yy, int ch) { return tex.at<cv::Vec3f>(yy, xx)[ch]; }, texel.data());
+              value = Eigen::Vector3f(texel[0], texel[1], texel[2]);
+            } else {
+              const ptm::Ptm& atlas = model_.atlases[static_cast<std::size_t>(atlas_index)];
+              const int coefficient_count = atlas.NumPolynomials() * 6;
+              const bool lrgb = atlas.format == ptm::PtmFormat::kLrgb;
+              Bilinear(atlas.width, atlas.height, px.x(), px.y(), coefficient_count + (lrgb ? 3 : 0),
+                       [&](int xx, int yy, int ch) {
+                         const std::size_t t = static_cast<std::size_t>(yy) * atlas.width + xx;
+                         return ch < coefficient_count ? atlas.Coefficients(t)[ch]
+                                                       : atlas.colour[t * 3 + static_cast<std::size_t>(ch - coefficient_count)];
+                       },
+                       texel.data());
+              std::vector<std::pair<Eigen::Vector3d, double>> local;
+              for (const sfm::ObjectLight& l : lights)
+                local.emplace_back(face_frames_[f].transpose() * l.DirectionFrom(point), l.intensity);
+              value = RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format, local, 1.0);
+            }
+          }
+          sum += value;
+        }
+      }
+      if (hits == 0) continue;
+      // Background is black: average over all rays, as a camera would.
+      const float inv = 1.0f / static_cast<float>(n * n);
+      out.rgb.at<cv::Vec3f>(y, x) = cv::Vec3f(sum.x() * inv, sum.y() * inv, sum.z() * inv);
+      out.coverage.at<float>(y, x) = hits * inv;
+    }
+  }
+  return out;
+}
+
+std::vector<cv::Mat> BakePhotoTextures(const TexturedModel& model,
+                                       const sfm::Reconstruction& reconstruction,
+                                       const sfm::VisibilityResult& visibility,
+                                       const std::vector<MeshPhoto>& photos,
+                                       const std::vector<double>& photo_gains) {
+  std::map<sfm::ImageId, std::size_t> photo_index;
+  for (std::size_t i = 0; i < photos.size(); ++i) photo_index[photos[i].image_id] = i;
+  std::vector<cv::Mat> textures, filled;
+  for (const ptm::Ptm& atlas : model.atlases) {
+    textures.push_back(cv::Mat(atlas.height, atlas.width, CV_32FC3, cv::Scalar::all(0)));
+    filled.push_back(cv::Mat::zeros(atlas.height, atlas.width, CV_8UC1));
+  }
+  const sfm::TriangleMesh& mesh = model.mesh;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const sfm::TriangleVisibility& tv = visibility.triangles[f];
+    const auto it = tv.best_view_source == sfm::BestViewSource::kNone ? photo_index.end() : photo_index.find(tv.best_view);
+    if (it == photo_index.end()) continue;
+    const MeshPhoto& photo = photos[it->second];
+    const double gain = photo_gains[it->second];
+    const sfm::Image& image = reconstruction.images.at(photo.image_id);
+    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
+    cv::Mat& tex = textures[static_cast<std::size_t>(model.face_atlas[f])];
+    cv::Mat& mask = filled[static_cast<std::size_t>(model.face_atlas[f])];
+    const auto& c = model.corner_px[f];
+    Eigen::Vector2f lo = c[0], hi = c[0];
+    for (const auto& p : c) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const double det = (c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x();
+    if (std::abs(det) < 1e-12) continue;
+    for (int y = std::max(0, static_cast<int>(std::floor(lo.y()))); y <= std::min(tex.rows - 1, static_cast<int>(std::ceil(hi.y()))); ++y) {
+      for (int x = std::max(0, static_cast<int>(std::floor(lo.x()))); x <= std::min(tex.cols - 1, static_cast<int>(std::ceil(hi.x()))); ++x) {
+        const Eigen::Vector2d q(x + 0.5, y + 0.5);
+        const Eigen::Vector2d d = q - c[0].cast<double>();
+        const double b1 = (d.x() * (c[2] - c[0]).y() - d.y() * (c[2] - c[0]).x()) / det;
+        const double b2 = ((c[1] - c[0]).x() * d.y() - (c[1] - c[0]).y() * d.x()) / det;
+        const double b0 = 1 - b1 - b2;
+        const double eps = -0.02;
+        if (b0 < eps || b1 < eps || b2 < eps) continue;
+        const Eigen::Vector3d world = b0 * mesh.Corner(f, 0) + b1 * mesh.Corner(f, 1) + b2 * mesh.Corner(f, 2);
+        const auto px = camera.ImageFromCam(image.cam_from_world.rotation * world + image.cam_from_world.translation);
+        if (!px) continue;
+        const Eigen::Vector2d o = ToOpenCv(*px);
+        if (o.x() < -0.5 || o.y() < -0.5 || o.x() > photo.image.cols - 0.5 || o.y() > photo.image.rows - 0.5) continue;
+        float rgb[3];
+        Bilinear(photo.image.cols, photo.image.rows, o.x() + 0.5, o.y() + 0.5, 3,
+                 [&](int xx, int yy, int ch) { return photo.image.at<cv::Vec3f>(yy, xx)[ch]; }, rgb);
+        cv::Vec3f& out = tex.at<cv::Vec3f>(y, x);
+        for (int ch = 0; ch < 3; ++ch) out[ch] = LinearToSrgb(static_cast<float>(SrgbToLinear(rgb[ch]) / gain));
+        mask.at<std::uint8_t>(y, x) = 255;
+      }
+    }
+  }
+  // Unfilled texels: the mean of the filled ones, after a few dilation rings.
+  for (std::size_t a = 0; a < textures.size(); ++a) {
+    const cv::Scalar mean = cv::mean(textures[a], filled[a]);
+    for (int ring = 0; ring < 4; ++ring) {
+      cv::Mat grown;
+      cv::dilate(filled[a], grown, cv::Mat());
+      cv::Mat blurred, weight;
+      cv::Mat masked_tex;
+      textures[a].copyTo(masked_tex);
+      cv::Mat mask_f;
+      filled[a].convertTo(mask_f, CV_32FC1, 1 / 255.0);
+      cv::boxFilter(masked_tex, blurred, -1, cv::Size(3, 3), cv::Point(-1, -1), false);
+      cv::boxFilter(mask_f, weight, -1, cv::Size(3, 3), cv::Point(-1, -1), false);
+      for (int y = 0; y < grown.rows; ++y)
+        for (int x = 0; x < grown.cols; ++x)
+          if (grown.at<std::uint8_t>(y, x) && !filled[a].at<std::uint8_t>(y, x) && weight.at<float>(y, x) > 0)
+            textures[a].at<cv::Vec3f>(y, x) = blurred.at<cv::Vec3f>(y, x) / weight.at<float>(y, x);
+      filled[a] = grown;
+    }
+    for (int y = 0; y < filled[a].rows; ++y)
+      for (int x = 0; x < filled[a].cols; ++x)
+        if (!filled[a].at<std::uint8_t>(y, x))
+          textures[a].at<cv::Vec3f>(y, x) = cv::Vec3f(static_cast<float>(mean[0]), static_cast<float>(mean[1]), static_cast<float>(mean[2]));
+  }
+  return textures;
+}
+
+Eigen::Vector3f MeanAlbedoFromPhotos(const sfm::TriangleMesh& mesh,
+                                     const sfm::Reconstruction& reconstruction,
+                                     const sfm::VisibilityResult& visibility,
+                                     const std::vector<MeshPhoto>& photos,
+                                     const std::vector<double>& photo_gains) {
+  std::map<sfm::ImageId, std::size_t> photo_index;
+  for (std::size_t i = 0; i < photos.size(); ++i) photo_index[photos[i].image_id] = i;
+  const std::vector<Eigen::Vector3d> normals = FaceNormals(mesh);
+  const std::vector<double> areas = FaceAreas(mesh);
+  Eigen::Vector3d colour_sum = Eigen::Vector3d::Zero();
+  double shading_sum = 0.0;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const sfm::TriangleVisibility& tv = visibility.triangles[f];
+    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) continue;
+    const auto it = photo_index.find(tv.best_view);
+    if (it == photo_index.end()) continue;
+    const MeshPhoto& photo = photos[it->second];
+    const sfm::Image& image = reconstruction.images.at(photo.image_id);
+    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
+    const Eigen::Vector3d centroid = (mesh.Corner(f, 0) + mesh.Corner(f, 1) + mesh.Corner(f, 2)) / 3.0;
+    const auto px = camera.ImageFromCam(image.cam_from_world.rotation * centroid + image.cam_from_world.translation);
+    if (!px) continue;
+    const int x = static_cast<int>(px->x()), y = static_cast<int>(px->y());
+    if (x < 0 || y < 0 || x >= photo.image.cols || y >= photo.image.rows) continue;
+    double shading = 0.0;
+    for (const sfm::ObjectLight& l : photo.lights) shading += l.intensity * std::max(0.0, normals[f].dot(l.DirectionFrom(centroid)));
+    if (shading < 0.2) continue;
+    const cv::Vec3f rgb = photo.image.at<cv::Vec3f>(y, x);
+    for (int c = 0; c < 3; ++c) colour_sum[c] += areas[f] * SrgbToLinear(rgb[c]) / photo_gains[it->second];
+    shading_sum += areas[f] * shading;
+  }
+  if (shading_sum <= 0) return Eigen::Vector3f::Constant(0.5f);
+  Eigen::Vector3f out;
+  for (int c = 0; c < 3; ++c) out[c] = LinearToSrgb(static_cast<float>(colour_sum[c] / shading_sum));
+  return out;
+}
+
+double MaskedPsnr(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (int y = 0; y < a.rows; ++y)
+    for (int x = 0; x < a.cols; ++x) {
+      if (!mask.at<std::uint8_t>(y, x)) continue;
+      const cv::Vec3f d = a.at<cv::Vec3f>(y, x) - b.at<cv::Vec3f>(y, x);
+      sum += d.dot(d);
+      count += 3;
+    }
+  if (count == 0) return 0.0;
+  const double mse = sum / static_cast<double>(count);
+  return mse <= 1e-20 ? 200.0 : 10.0 * std::log10(1.0 / mse);
+}
+
+double MaskedSsim(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
+  const double c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;
+  auto blur = [](const cv::Mat& m) {
+    cv::Mat out;
+    cv::GaussianBlur(m, out, cv::Size(11, 11), 1.5);
+    return out;
+  };
+  const cv::Mat mu_a = blur(a), mu_b = blur(b);
+  const cv::Mat aa = blur(a.mul(a)) - mu_a.mul(mu_a), bb = blur(b.mul(b)) - mu_b.mul(mu_b);
+  const cv::Mat ab = blur(a.mul(b)) - mu_a.mul(mu_b);
+  cv::Mat numerator = (2 * mu_a.mul(mu_b) + c1).mul(2 * ab + c2);
+  cv::Mat denominator = (mu_a.mul(mu_a) + mu_b.mul(mu_b) + c1).mul(aa + bb + c2);
+  cv::Mat map;
+  cv::divide(numerator, denominator, map);
+  const cv::Scalar s = cv::mean(map, mask);
+  return (s[0] + s[1] + s[2]) / 3.0;
+}
+
+}  // namespace texlume::synth

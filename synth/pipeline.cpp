@@ -1,0 +1,366 @@
+#include "synth/pipeline.h"
+
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "ptm/ptm_io.h"
+#include "sfm/colmap_io.h"
+#include "sfm/errors.h"
+#include "sfm/file_util.h"
+#include "sfm/lights.h"
+#include "sfm/mesh.h"
+
+namespace texlume::synth {
+namespace fs = std::filesystem;
+namespace {
+
+double Since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// 8-bit BGR of a display RGB float image.
+cv::Mat ToBgr8(const cv::Mat& rgb) {
+  cv::Mat bgr, out;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  bgr.convertTo(out, CV_8UC3, 255.0);
+  return out;
+}
+
+void WritePng(const fs::path& path, const cv::Mat& image) {
+  std::vector<unsigned char> png;
+  if (!cv::imencode(".png", image, png)) throw InputError(path.string(), "PNG encoding failed");
+  WriteFileAtomically(
+      path, [&](std::ostream& o) { o.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size())); },
+      true);
+}
+
+fs::path PngName(const std::string& image_name) {
+  fs::path p(image_name);
+  p.replace_extension(".png");
+  return p;
+}
+
+}  // namespace
+
+cv::Mat ReadPhotoRgb(const fs::path& path) {
+  if (!fs::exists(path)) throw InputError(path.string(), "does not exist");
+  const cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH);
+  if (raw.empty()) throw InputError(path.string(), "is not a readable image");
+  cv::Mat bgr;
+  if (raw.channels() == 1) {
+    cv::cvtColor(raw, bgr, cv::COLOR_GRAY2BGR);
+  } else if (raw.channels() == 4) {
+    cv::cvtColor(raw, bgr, cv::COLOR_BGRA2BGR);
+  } else if (raw.channels() == 3) {
+    bgr = raw;
+  } else {
+    throw InputError(path.string(), "has " + std::to_string(raw.channels()) + " channels");
+  }
+  double scale = 1.0;
+  switch (bgr.depth()) {
+    case CV_8U: scale = 1.0 / 255.0; break;
+    case CV_16U: scale = 1.0 / 65535.0; break;
+    case CV_32F: scale = 1.0; break;
+    default: throw InputError(path.string(), "has an unsupported pixel type");
+  }
+  cv::Mat f, rgb;
+  bgr.convertTo(f, CV_32FC3, scale);
+  cv::cvtColor(f, rgb, cv::COLOR_BGR2RGB);
+  return rgb;
+}
+
+sfm::TriangleMesh SubdivideMidpoint(const sfm::TriangleMesh& mesh) {
+  sfm::TriangleMesh out;
+  out.vertices = mesh.vertices;
+  std::map<std::pair<int, int>, int> midpoint;
+  auto mid = [&](int a, int b) {
+    const std::pair<int, int> key(std::min(a, b), std::max(a, b));
+    const auto it = midpoint.find(key);
+    if (it != midpoint.end()) return it->second;
+    out.vertices.push_back(0.5 * (mesh.vertices[static_cast<std::size_t>(a)] + mesh.vertices[static_cast<std::size_t>(b)]));
+    const int id = static_cast<int>(out.vertices.size() - 1);
+    midpoint.emplace(key, id);
+    return id;
+  };
+  for (const auto& f : mesh.faces) {
+    const int a = mid(f[0], f[1]), b = mid(f[1], f[2]), c = mid(f[2], f[0]);
+    out.faces.push_back({f[0], a, c});
+    out.faces.push_back({a, f[1], b});
+    out.faces.push_back({c, b, f[2]});
+    out.faces.push_back({a, b, c});
+  }
+  return out;
+}
+
+SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress) {
+  options.synthesis.Check();
+  options.atlas.Check();
+  options.visibility.Check();
+  if (options.max_subdivisions < 0 || options.max_subdivisions > 6)
+    throw OptionError("max subdivisions must be in [0, 6]");
+  const auto start = std::chrono::steady_clock::now();
+  SynthJobSummary summary;
+  if (fs::exists(options.out_dir) && (!fs::is_directory(options.out_dir) ||
+                                      (!fs::exists(options.out_dir / "manifest.json") && !fs::is_empty(options.out_dir)))) {
+    throw InputError(options.out_dir.string(), "exists and is not a texlume model folder; not replacing it");
+  }
+
+  // Inputs.
+  const sfm::LoadedModel loaded = sfm::ReadModel(options.model_dir);
+  const sfm::Reconstruction& reconstruction = loaded.reconstruction;
+  const sfm::ObjectLights lights = sfm::ReadObjectLightsFile(options.lights_file);
+  const std::vector<std::string> unlit =
+      sfm::CheckLightsAgainstModel(lights, reconstruction, options.lights_file.string());
+  for (const std::string& name : unlit)
+    summary.warnings.push_back("skipping " + name + ": no light for it in " + options.lights_file.string());
+  sfm::LoadedMesh loaded_mesh = sfm::LoadMesh(options.mesh_file);
+  for (const std::string& problem : loaded_mesh.report.Problems())
+    summary.warnings.push_back(options.mesh_file.string() + ": " + problem);
+  sfm::TriangleMesh mesh = std::move(loaded_mesh.mesh);
+  const ptm::Ptm sample = ptm::ReadPtmAnyFormat(options.sample_file);
+
+  std::vector<MeshPhoto> photos;
+  for (const auto& [id, image] : reconstruction.images) {
+    const auto it = lights.find(image.name);
+    if (it == lights.end()) continue;
+    const fs::path file = options.images_dir / image.name;
+    if (!fs::exists(file)) {
+      summary.warnings.push_back("skipping " + image.name + ": no file " + file.string());
+      continue;
+    }
+    MeshPhoto photo;
+    photo.image_id = id;
+    photo.name = image.name;
+    photo.image = ReadPhotoRgb(file);
+    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
+    if (photo.image.cols != static_cast<int>(camera.width) || photo.image.rows != static_cast<int>(camera.height)) {
+      throw InputError(file.string(), "is " + std::to_string(photo.image.cols) + "x" + std::to_string(photo.image.rows) +
+                                          " but its camera is " + std::to_string(camera.width) + "x" +
+                                          std::to_string(camera.height));
+    }
+    photo.lights = it->second;
+    photos.push_back(std::move(photo));
+  }
+  if (photos.empty()) {
+    throw InputError(options.images_dir.string(), "no usable photo: every image of the model lacks a light or a file");
+  }
+  summary.photos_used = photos.size();
+  summary.seconds_load = Since(start);
+
+  // Visibility (and subdivision while the largest triangle does not fit the sample).
+  auto t = std::chrono::steady_clock::now();
+  auto largest_patch = [&](const sfm::TriangleMesh& m) {
+    double widest = 0;
+    for (std::size_t f = 0; f < m.faces.size(); ++f) {
+      double longest = 0;
+      for (int k = 0; k < 3; ++k) longest = std::max(longest, (m.Corner(f, (k + 1) % 3) - m.Corner(f, k)).norm());
+      widest = std::max(widest, longest);
+    }
+    return widest / options.synthesis.sample_texel_size + 2 * options.synthesis.strip + 2;
+  };
+  while (largest_patch(mesh) > std::min(sample.width, sample.height) &&
+         summary.subdivisions < static_cast<std::size_t>(options.max_subdivisions)) {
+    mesh = SubdivideMidpoint(mesh);
+    ++summary.subdivisions;
+  }
+  if (summary.subdivisions) {
+    summary.warnings.push_back("subdivided the mesh " + std::to_string(summary.subdivisions) +
+                               " time(s) so that every triangle's patch fits the sample");
+  }
+  summary.faces = mesh.faces.size();
+  const sfm::VisibilityResult visibility = sfm::ComputeVisibility(mesh, reconstruction, options.visibility, progress);
+  // Photos used here only (visibility saw every image of the model).
+  std::size_t seen_by_usable = 0;
+  {
+    std::map<sfm::ImageId, bool> usable;
+    for (const MeshPhoto& p : photos) usable[p.image_id] = true;
+    for (const auto& tv : visibility.triangles) {
+      bool seen = false;
+      for (const auto& v : tv.views) seen = seen || (usable.count(v.image_id) && v.visible_fraction > 0);
+      seen_by_usable += seen;
+    }
+  }
+  if (seen_by_usable * 2 < mesh.faces.size()) {
+    throw InputError(options.mesh_file.string(),
+                     std::to_string(mesh.faces.size() - seen_by_usable) + " of " + std::to_string(mesh.faces.size()) +
+                         " triangles project outside every usable photo or face away from it: is the mesh in the "
+                         "frame of the COLMAP model " + options.model_dir.string() + "?");
+  }
+  summary.seconds_visibility = Since(t);
+
+  // Synthesis (Algorithm 2), blending and atlases.
+  t = std::chrono::steady_clock::now();
+  const MeshSynthesis synthesis =
+      SynthesizeMeshPtm(mesh, reconstruction, visibility, photos, sample, options.synthesis, progress);
+  summary.seconds_synthesis = Since(t);
+  summary.from_photos = synthesis.num_from_photos;
+  summary.from_neighbours = synthesis.num_from_neighbours;
+  summary.random = synthesis.num_random;
+  t = std::chrono::steady_clock::now();
+  Atlases atlases = BuildAtlases(mesh, synthesis, options.atlas, progress);
+  summary.seconds_atlas = Since(t);
+  summary.atlases = atlases.ptms.size();
+  summary.charts = static_cast<std::size_t>(atlases.num_charts);
+  summary.occupancy = atlases.occupancy;
+
+  TexturedModel model;
+  model.mesh = mesh;
+  model.atlases = std::move(atlases.ptms);
+  for (const FacePlacement& fp : atlases.faces) {
+    model.face_atlas.push_back(fp.atlas);
+    model.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(), fp.corners_px[2].cast<float>()});
+  }
+
+  // Baselines for `texlume render --baseline`.
+  t = std::chrono::steady_clock::now();
+  const std::vector<cv::Mat> baked = BakePhotoTextures(model, reconstruction, visibility, photos, synthesis.photo_gains);
+  const Eigen::Vector3f flat_albedo = MeanAlbedoFromPhotos(mesh, reconstruction, visibility, photos, synthesis.photo_gains);
+  summary.seconds_baselines = Since(t);
+
+  t = std::chrono::steady_clock::now();
+  nlohmann::json record;
+  record["command"] = "synth";
+  record["inputs"] = {{"model", options.model_dir.string()}, {"images", options.images_dir.string()},
+                      {"lights", options.lights_file.string()}, {"mesh", options.mesh_file.string()},
+                      {"sample", options.sample_file.string()}};
+  const MeshSynthesisOptions& so = options.synthesis;
+  record["settings"] = {{"sample_texel_size", so.sample_texel_size}, {"output_texel_size", so.sample_texel_size},
+                        {"strip", so.strip}, {"top_k", so.top_k}, {"all_views", so.all_views},
+                        {"max_views", so.max_views},
+                        {"tangent_frame", so.tangent_frame == TangentFrame::kSmoothField ? "smooth_field" : "first_edge"},
+                        {"seed", so.seed}, {"atlas_mode", options.atlas.mode == AtlasMode::kCharts ? "charts" : "per_triangle"},
+                        {"atlas_size", options.atlas.atlas_size}, {"gutter", options.atlas.gutter}};
+  record["summary"] = {{"photos_used", summary.photos_used}, {"faces", summary.faces},
+                       {"subdivisions", summary.subdivisions}, {"from_photos", summary.from_photos},
+                       {"from_neighbours_only", summary.from_neighbours}, {"random", summary.random},
+                       {"atlases", summary.atlases}, {"charts", summary.charts}, {"occupancy", summary.occupancy},
+                       {"photo_gains", synthesis.photo_gains}};
+  record["warnings"] = summary.warnings;
+  record["baselines"] = {{"flat_albedo", {flat_albedo.x(), flat_albedo.y(), flat_albedo.z()}},
+                         {"baked", nlohmann::json::array()}};
+  std::vector<std::pair<std::string, cv::Mat>> extra;
+  for (std::size_t a = 0; a < baked.size(); ++a) {
+    const std::string name = "baked_" + std::to_string(a) + ".png";
+    record["baselines"]["baked"].push_back(name);
+    extra.emplace_back(name, ToBgr8(baked[a]));
+  }
+  summary.seconds_export = Since(t);  // the folder write below is counted too
+  record["timings_s"] = {{"load", summary.seconds_load}, {"visibility", summary.seconds_visibility},
+                         {"synthesis", summary.seconds_synthesis}, {"atlas", summary.seconds_atlas},
+                         {"baselines", summary.seconds_baselines},
+                         {"synthesis_per_triangle", summary.seconds_synthesis / std::max<std::size_t>(1, summary.faces)}};
+  WriteModelFolder(options.out_dir, model, record, extra);
+  summary.seconds_export = Since(t);
+  summary.seconds_total = Since(start);
+  return summary;
+}
+
+RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCallback& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.samples_per_axis < 1 || options.samples_per_axis > 8) throw OptionError("samples must be in [1, 8]");
+  if (options.reduced_factor < 1 || options.reduced_factor > 16) throw OptionError("reduced factor must be in [1, 16]");
+  RenderJobSummary summary;
+  const TexturedModel model = ReadModelFolder(options.model_folder);
+  ModelRenderer renderer(model);
+  if (options.mode != RenderMode::kPtm) {
+    std::ifstream in = OpenForReading(options.model_folder / "manifest.json", false);
+    const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
+    const auto& baselines = manifest.is_object() ? manifest.value("baselines", nlohmann::json()) : nlohmann::json();
+    if (!baselines.is_object()) throw InputError((options.model_folder / "manifest.json").string(), "lists no baselines");
+    if (options.mode == RenderMode::kFlat) {
+      const auto& a = baselines.value("flat_albedo", nlohmann::json());
+      if (!a.is_array() || a.size() != 3) throw InputError((options.model_folder / "manifest.json").string(), "has no flat_albedo");
+      renderer.flat_albedo = Eigen::Vector3f(a[0].get<float>(), a[1].get<float>(), a[2].get<float>());
+    } else {
+      const auto& b = baselines.value("baked", nlohmann::json());
+      if (!b.is_array() || b.size() != model.atlases.size())
+        throw InputError((options.model_folder / "manifest.json").string(), "has no baked texture per atlas");
+      for (const auto& name : b) renderer.baked.push_back(ReadPhotoRgb(options.model_folder / name.get<std::string>()));
+    }
+  }
+  const sfm::LoadedModel cameras = sfm::ReadModel(options.cameras_dir);
+  const sfm::ObjectLights lights = sfm::ReadObjectLightsFile(options.lights_file);
+  for (const std::string& name : sfm::CheckLightsAgainstModel(lights, cameras.reconstruction, options.lights_file.string()))
+    summary.warnings.push_back("not rendering " + name + ": no light for it");
+  fs::create_directories(options.out_dir / "masks");
+  std::size_t done = 0;
+  const std::size_t total = cameras.reconstruction.images.size();
+  for (const auto& [id, image] : cameras.reconstruction.images) {
+    ++done;
+    const auto it = lights.find(image.name);
+    if (it == lights.end()) continue;
+    const sfm::Camera& camera = cameras.reconstruction.cameras.at(image.camera_id);
+    const RenderedView view = renderer.Render(camera, image.cam_from_world, it->second, options.mode, options.samples_per_axis);
+    const fs::path name = PngName(image.name);
+    fs::create_directories((options.out_dir / name).parent_path());
+    fs::create_directories((options.out_dir / "masks" / name).parent_path());
+    WritePng(options.out_dir / name, ToBgr8(view.rgb));
+    cv::Mat mask;
+    view.coverage.convertTo(mask, CV_8UC1, 255.0);
+    WritePng(options.out_dir / "masks" / name, mask);
+    ++summary.rendered;
+    if (!options.truth_images_dir.empty()) {
+      const cv::Mat truth = ReadPhotoRgb(options.truth_images_dir / image.name);
+      if (truth.size() != view.rgb.size()) throw InputError((options.truth_images_dir / image.name).string(), "does not match the camera's size");
+      cv::Mat truth_mask;
+      const fs::path mask_path = options.truth_masks_dir.empty() ? fs::path() : options.truth_masks_dir / image.name;
+      if (!mask_path.empty() && fs::exists(mask_path)) {
+        truth_mask = cv::imread(mask_path.string(), cv::IMREAD_GRAYSCALE);
+        if (truth_mask.size() != truth.size()) throw InputError(mask_path.string(), "does not match its image's size");
+      } else {
+        truth_mask = mask > 127;
+      }
+      ViewMetrics m;
+      m.name = image.name;
+      const cv::Mat inside = truth_mask > 127;
+      m.psnr = MaskedPsnr(view.rgb, truth, inside);
+      m.ssim = MaskedSsim(view.rgb, truth, inside);
+      if (options.reduced_factor > 1) {
+        const cv::Size small(truth.cols / options.reduced_factor, truth.rows / options.reduced_factor);
+        cv::Mat a, b, mk;
+        cv::resize(view.rgb, a, small, 0, 0, cv::INTER_AREA);
+        cv::resize(truth, b, small, 0, 0, cv::INTER_AREA);
+        cv::resize(inside, mk, small, 0, 0, cv::INTER_NEAREST);
+        m.psnr_reduced = MaskedPsnr(a, b, mk);
+        m.ssim_reduced = MaskedSsim(a, b, mk);
+      }
+      summary.metrics.push_back(m);
+    }
+    if (progress) progress("render", done, total);
+  }
+  if (summary.rendered == 0) throw InputError(options.lights_file.string(), "gives a light for no image of " + options.cameras_dir.string());
+  for (const ViewMetrics& m : summary.metrics) {
+    const double n = static_cast<double>(summary.metrics.size());
+    summary.mean_psnr += m.psnr / n;
+    summary.mean_ssim += m.ssim / n;
+    summary.mean_psnr_reduced += m.psnr_reduced / n;
+    summary.mean_ssim_reduced += m.ssim_reduced / n;
+  }
+  summary.seconds = Since(start);
+  nlohmann::json record;
+  record["command"] = "render";
+  record["settings"] = {{"model", options.model_folder.string()}, {"cameras", options.cameras_dir.string()},
+                        {"lights", options.lights_file.string()},
+                        {"mode", options.mode == RenderMode::kPtm ? "ptm" : options.mode == RenderMode::kFlat ? "flat" : "baked"},
+                        {"samples_per_axis", options.samples_per_axis}};
+  record["rendered"] = summary.rendered;
+  record["warnings"] = summary.warnings;
+  if (!summary.metrics.empty()) {
+    nlohmann::json views = nlohmann::json::array();
+    for (const ViewMetrics& m : summary.metrics)
+      views.push_back({{"name", m.name}, {"psnr_db", m.psnr}, {"ssim", m.ssim}, {"psnr_reduced_db", m.psnr_reduced},
+                       {"ssim_reduced", m.ssim_reduced}});
+    record["metrics"] = {{"views", views}, {"mean_psnr_db", summary.mean_psnr}, {"mean_ssim", summary.mean_ssim},
+                         {"mean_psnr_reduced_db", summary.mean_psnr_reduced}, {"mean_ssim_reduced", summary.mean_ssim_reduced},
+                         {"reduced_factor", options.reduced_factor}, {"inside", "the ground-truth masks"}};
+  }
+  record["timings_s"] = {{"total", summary.seconds}};
+  WriteFileAtomically(options.out_dir / "render.json", [&](std::ostream& o) { o << record.dump(2) << "\n"; }, false);
+  return summary;
+}
+
+}  // namespace texlume::synth

@@ -1,0 +1,91 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "sfm/progress.h"
+#include "sfm/visibility.h"
+#include "synth/atlas.h"
+#include "synth/mesh_synthesis.h"
+#include "synth/model_render.h"
+
+namespace texlume::synth {
+
+/// Inputs and settings of the main job (`texlume synth`).
+struct SynthJobOptions {
+  std::filesystem::path model_dir;    ///< COLMAP model (.bin or .txt)
+  std::filesystem::path images_dir;   ///< the object photos, by the model's image names
+  std::filesystem::path lights_file;  ///< object-lights JSON (docs/lights.md)
+  std::filesystem::path mesh_file;    ///< coarse mesh in the model's frame
+  std::filesystem::path sample_file;  ///< sample PTM (.ptm or .exr)
+  std::filesystem::path out_dir;      ///< the model folder written
+  MeshSynthesisOptions synthesis;     ///< sample_texel_size required
+  AtlasOptions atlas;
+  sfm::VisibilityOptions visibility;
+  /// Split every triangle in four (midpoints) up to this many times while the
+  /// largest patch does not fit the sample. [0, 6].
+  int max_subdivisions = 4;
+};
+
+/// What the job did (also written to manifest.json).
+struct SynthJobSummary {
+  std::size_t photos_used = 0;
+  std::vector<std::string> warnings;  ///< skipped photos, repaired faces, subdivisions
+  std::size_t faces = 0, subdivisions = 0;
+  std::size_t from_photos = 0, from_neighbours = 0, random = 0;
+  std::size_t atlases = 0, charts = 0;
+  double occupancy = 0.0;
+  double seconds_load = 0, seconds_visibility = 0, seconds_synthesis = 0, seconds_atlas = 0,
+         seconds_baselines = 0, seconds_export = 0, seconds_total = 0;
+};
+
+/// Runs the whole job: reads and checks the inputs, visibility and best views,
+/// per-triangle synthesis (Algorithm 2), blending, atlases, and the model folder
+/// (WriteModelFolder, plus the baselines `texlume render` draws: baked_K.png
+/// and the flat albedo). Photos in the model without a light or a file are
+/// skipped with a warning; it is an InputError when none remains, when most
+/// triangles are seen by no photo (a mesh in another frame), or when the
+/// patches would not fit in memory. Nothing is written on error.
+SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress = {});
+
+/// `texlume render`: the model folder drawn through every image of a COLMAP
+/// model that has a light in `lights_file`.
+struct RenderJobOptions {
+  std::filesystem::path model_folder;
+  std::filesystem::path cameras_dir;
+  std::filesystem::path lights_file;
+  std::filesystem::path out_dir;
+  RenderMode mode = RenderMode::kPtm;
+  int samples_per_axis = 2;
+  /// Optional ground truth: images (and masks) with the same names; PSNR and
+  /// SSIM inside the masks go into render.json.
+  std::filesystem::path truth_images_dir, truth_masks_dir;
+  /// Also compare after reducing both by this factor (the constraint photos'
+  /// resolution when the views are rendered finer); 1 = off.
+  int reduced_factor = 1;
+};
+
+struct ViewMetrics {
+  std::string name;
+  double psnr = 0, ssim = 0, psnr_reduced = 0, ssim_reduced = 0;
+};
+
+struct RenderJobSummary {
+  std::size_t rendered = 0;
+  std::vector<std::string> warnings;
+  std::vector<ViewMetrics> metrics;  ///< with truth
+  double mean_psnr = 0, mean_ssim = 0, mean_psnr_reduced = 0, mean_ssim_reduced = 0;
+  double seconds = 0;
+};
+
+RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCallback& progress = {});
+
+/// Reads photos as CV_32FC3 RGB display values (8- or 16-bit, grey or colour).
+/// Throws InputError naming the file.
+cv::Mat ReadPhotoRgb(const std::filesystem::path& path);
+
+/// 1-to-4 midpoint subdivision (shared edge midpoints welded).
+sfm::TriangleMesh SubdivideMidpoint(const sfm::TriangleMesh& mesh);
+
+}  // namespace texlume::synth
