@@ -140,7 +140,8 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
       double best_area = std::numeric_limits<double>::max();
       Eigen::Matrix2d best = Eigen::Matrix2d::Identity();
       for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector2d e = c[static_cast<std::size_t>((k + 1) % 3)] - c[static_cast<std::size_t>(k)];
+        const Eigen::Vector2d e =
+            c[static_cast<std::size_t>((k + 1) % 3)] - c[static_cast<std::size_t>(k)];
         const Eigen::Matrix2d r = Eigen::Rotation2Dd(-std::atan2(e.y(), e.x())).toRotationMatrix();
         Eigen::Vector2d lo = r * c[0], hi = lo;
         for (const auto& p : c) lo = lo.cwiseMin(r * p), hi = hi.cwiseMax(r * p);
@@ -153,7 +154,8 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
   } else {
     std::vector<std::vector<int>> faces_of_vertex(mesh.vertices.size());
     for (std::size_t f = 0; f < num_faces; ++f)
-      for (int v : mesh.faces[f]) faces_of_vertex[static_cast<std::size_t>(v)].push_back(static_cast<int>(f));
+      for (int v : mesh.faces[f])
+        faces_of_vertex[static_cast<std::size_t>(v)].push_back(static_cast<int>(f));
     auto shares_vertex = [&](int a, int b) {
       for (int v : mesh.faces[static_cast<std::size_t>(a)])
         for (int g : faces_of_vertex[static_cast<std::size_t>(v)])
@@ -173,7 +175,8 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
         std::array<Eigen::Vector2d, 3> c;
         for (int k = 0; k < 3; ++k)
           c[static_cast<std::size_t>(k)] =
-              cf.rotation * synthesis.patches[static_cast<std::size_t>(cf.face)].corners_in_frame[static_cast<std::size_t>(k)] +
+              cf.rotation * synthesis.patches[static_cast<std::size_t>(cf.face)]
+                                .corners_in_frame[static_cast<std::size_t>(k)] +
               cf.translation;
         return c;
       };
@@ -200,7 +203,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
             if (d > clearance) continue;
             const auto it = texels.find(Key(x, y));
             if (it != texels.end()) {
-              if (d < -0.5 * t) return false;                        // overlap
+              if (d < -0.5 * t) return false;                         // overlap
               if (!shares_vertex(cf.face, it->second)) return false;  // too close
             }
             if (d <= 0.0) mine.push_back(Key(x, y));
@@ -220,7 +223,9 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
         const ChartFace from = chart[queue.front()];
         queue.pop_front();
         for (int k = 0; k < 3; ++k) {
-          const Unfolding& u = synthesis.unfoldings[static_cast<std::size_t>(from.face)][static_cast<std::size_t>(k)];
+          const Unfolding& u =
+              synthesis
+                  .unfoldings[static_cast<std::size_t>(from.face)][static_cast<std::size_t>(k)];
           if (u.face < 0 || chart_of[static_cast<std::size_t>(u.face)] >= 0) continue;
           // p_from = R_u^T (p_nb - t_u), so chart = R_from R_u^T p_nb + ...
           ChartFace cf;
@@ -276,7 +281,8 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
       fp.offset = Eigen::Vector2d(x0 + cf.translation.x() / t - chart_lo[c].x(),
                                   y0 + chart_hi[c].y() - cf.translation.y() / t);
       for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector2d q = cf.rotation * synthesis.patches[static_cast<std::size_t>(cf.face)].corners_in_frame[static_cast<std::size_t>(k)];
+        const Eigen::Vector2d q = cf.rotation * synthesis.patches[static_cast<std::size_t>(cf.face)]
+                                                    .corners_in_frame[static_cast<std::size_t>(k)];
         fp.corners_px[static_cast<std::size_t>(k)] =
             Eigen::Vector2d(fp.offset.x() + q.x() / t, fp.offset.y() - q.y() / t);
       }
@@ -292,8 +298,10 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
   for (int a = 0; a < num_atlases; ++a) {
     const int h = std::max(1, used_height[static_cast<std::size_t>(a)]);
     const int w = options.atlas_size;
-    for (std::size_t c = 0; c < num_planes; ++c) planes[static_cast<std::size_t>(a)].push_back(cv::Mat::zeros(h, w, CV_32FC1));
-    claim[static_cast<std::size_t>(a)] = cv::Mat(h, w, CV_32FC1, cv::Scalar(std::numeric_limits<float>::max()));
+    for (std::size_t c = 0; c < num_planes; ++c)
+      planes[static_cast<std::size_t>(a)].push_back(cv::Mat::zeros(h, w, CV_32FC1));
+    claim[static_cast<std::size_t>(a)] =
+        cv::Mat(h, w, CV_32FC1, cv::Scalar(std::numeric_limits<float>::max()));
     atlases.coverage.push_back(cv::Mat::zeros(h, w, CV_8UC1));
   }
   std::size_t inside_texels = 0;
@@ -303,7 +311,8 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     auto& atlas_planes = planes[static_cast<std::size_t>(fp.atlas)];
     cv::Mat& claims = claim[static_cast<std::size_t>(fp.atlas)];
     cv::Mat& coverage = atlases.coverage[static_cast<std::size_t>(fp.atlas)];
-    const Eigen::Matrix<double, 6, 6> to_atlas = OrthonormalFrameRotation(-RotationAngle(fp.rotation));
+    const Eigen::Matrix<double, 6, 6> to_atlas =
+        OrthonormalFrameRotation(-RotationAngle(fp.rotation));
     Eigen::Vector2d lo = fp.corners_px[0], hi = lo;
     for (const auto& p : fp.corners_px) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     const int x0 = std::max(0, static_cast<int>(std::floor(lo.x())) - gutter);
@@ -328,7 +337,8 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
           Eigen::Matrix<double, 6, 1> v;
           for (int i = 0; i < 6; ++i) v[i] = value[static_cast<std::size_t>(poly * 6 + i)];
           v = to_atlas * v;
-          for (int i = 0; i < 6; ++i) value[static_cast<std::size_t>(poly * 6 + i)] = static_cast<float>(v[i]);
+          for (int i = 0; i < 6; ++i)
+            value[static_cast<std::size_t>(poly * 6 + i)] = static_cast<float>(v[i]);
         }
         for (std::size_t c = 0; c < num_planes; ++c) atlas_planes[c].at<float>(y, x) = value[c];
         claims.at<float>(y, x) = key;
@@ -358,12 +368,16 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
           for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
               const int yy = y + dy, xx = x + dx;
-              if (yy < 0 || xx < 0 || yy >= coverage.rows || xx >= coverage.cols || !before.at<std::uint8_t>(yy, xx)) continue;
-              for (std::size_t c = 0; c < num_planes; ++c) sum[c] += atlas_planes[c].at<float>(yy, xx);
+              if (yy < 0 || xx < 0 || yy >= coverage.rows || xx >= coverage.cols ||
+                  !before.at<std::uint8_t>(yy, xx))
+                continue;
+              for (std::size_t c = 0; c < num_planes; ++c)
+                sum[c] += atlas_planes[c].at<float>(yy, xx);
               ++n;
             }
           if (n == 0) continue;
-          for (std::size_t c = 0; c < num_planes; ++c) atlas_planes[c].at<float>(y, x) = static_cast<float>(sum[c] / n);
+          for (std::size_t c = 0; c < num_planes; ++c)
+            atlas_planes[c].at<float>(y, x) = static_cast<float>(sum[c] / n);
           coverage.at<std::uint8_t>(y, x) = 64;
         }
       }
@@ -371,7 +385,8 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     total_texels += coverage.total();
     atlases.ptms.push_back(FromOrthonormalPlanes(atlas_planes, synthesis.format));
   }
-  atlases.occupancy = total_texels ? static_cast<double>(inside_texels) / static_cast<double>(total_texels) : 0.0;
+  atlases.occupancy =
+      total_texels ? static_cast<double>(inside_texels) / static_cast<double>(total_texels) : 0.0;
   atlases.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return atlases;
 }

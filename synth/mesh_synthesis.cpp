@@ -43,7 +43,7 @@ std::vector<cv::Mat> RawPlanes(const ptm::Ptm& p) {
 
 // The sample reduced to a photo density r = 2^(-level/4) photo pixels per texel.
 struct ReducedSample {
-  std::vector<cv::Mat> raw;  // raw coefficient (+ colour) planes
+  std::vector<cv::Mat> raw;   // raw coefficient (+ colour) planes
   double rx = 1.0, ry = 1.0;  // effective density along x and y
 };
 
@@ -109,8 +109,11 @@ void MeshSynthesisOptions::Check() const {
   if (max_views < 1) throw OptionError("max_views must be >= 1");
   if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
   if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
+  if (correction_iterations < 0 || correction_iterations > 5)
+    throw OptionError("correction_iterations must be in [0, 5]");
   if (max_texels < 1) throw OptionError("max_texels must be >= 1");
-  if (!(field_direction_in_world.norm() > 0.0)) throw OptionError("field direction must be nonzero");
+  if (!(field_direction_in_world.norm() > 0.0))
+    throw OptionError("field direction must be nonzero");
 }
 
 bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) const {
@@ -118,7 +121,8 @@ bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) 
   const double u = (p.x() - patch.x_min) / texel_size - 0.5;
   const double v = (patch.y_max - p.y()) / texel_size - 0.5;
   if (u < -0.5 || v < -0.5 || u > patch.width - 0.5 || v > patch.height - 0.5) return false;
-  const double uc = std::clamp(u, 0.0, patch.width - 1.0), vc = std::clamp(v, 0.0, patch.height - 1.0);
+  const double uc = std::clamp(u, 0.0, patch.width - 1.0),
+               vc = std::clamp(v, 0.0, patch.height - 1.0);
   const int x0 = std::min(static_cast<int>(uc), patch.width - 2 < 0 ? 0 : patch.width - 2);
   const int y0 = std::min(static_cast<int>(vc), patch.height - 2 < 0 ? 0 : patch.height - 2);
   const int x1 = std::min(x0 + 1, patch.width - 1), y1 = std::min(y0 + 1, patch.height - 1);
@@ -131,11 +135,25 @@ bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) 
     const float e = m.at<float>(patch.sample_y + y1, patch.sample_x + x1);
     out[c] = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * d + fx * e);
   }
+  if (!patch.correction.empty()) {
+    const cv::Mat& c0 = patch.correction[0];
+    const double gu =
+        std::clamp((u + 0.5) * patch.correction_density.x() - 0.5, 0.0, c0.cols - 1.0);
+    const double gv =
+        std::clamp((v + 0.5) * patch.correction_density.y() - 0.5, 0.0, c0.rows - 1.0);
+    const int gx0 = static_cast<int>(gu), gy0 = static_cast<int>(gv);
+    const int gx1 = std::min(gx0 + 1, c0.cols - 1), gy1 = std::min(gy0 + 1, c0.rows - 1);
+    const float gfx = static_cast<float>(gu - gx0), gfy = static_cast<float>(gv - gy0);
+    for (int i = 0; i < 6; ++i) {
+      const cv::Mat& m = patch.correction[static_cast<std::size_t>(i)];
+      out[i] += (1 - gfy) * ((1 - gfx) * m.at<float>(gy0, gx0) + gfx * m.at<float>(gy0, gx1)) +
+                gfy * ((1 - gfx) * m.at<float>(gy1, gx0) + gfx * m.at<float>(gy1, gx1));
+    }
+  }
   return true;
 }
 
-void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip,
-                                  float* out) const {
+void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip, float* out) const {
   const std::size_t n = sample_planes.size();
   std::vector<float> own(n), other(n);
   if (!SamplePatch(face, p, own.data())) std::fill(own.begin(), own.end(), 0.0f);
@@ -183,8 +201,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   result.texel_size = t;
   result.sample_planes = ToOrthonormalPlanes(sample);
   const int coefficient_planes = result.CoefficientPlanes();
-  const std::vector<cv::Mat> sample_coefficients(
-      result.sample_planes.begin(), result.sample_planes.begin() + coefficient_planes);
+  const std::vector<cv::Mat> sample_coefficients(result.sample_planes.begin(),
+                                                 result.sample_planes.begin() + coefficient_planes);
   const cv::Mat sample_energy = PlaneEnergy(sample_coefficients);
   const std::vector<cv::Mat> sample_raw = RawPlanes(sample);
 
@@ -195,8 +213,9 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   for (std::size_t f = 0; f < num_faces; ++f) {
     TrianglePatch& patch = result.patches[f];
     if (options.tangent_frame == TangentFrame::kSmoothField) {
-      const Eigen::Vector3d n =
-          (mesh.Corner(f, 1) - mesh.Corner(f, 0)).cross(mesh.Corner(f, 2) - mesh.Corner(f, 0)).normalized();
+      const Eigen::Vector3d n = (mesh.Corner(f, 1) - mesh.Corner(f, 0))
+                                    .cross(mesh.Corner(f, 2) - mesh.Corner(f, 0))
+                                    .normalized();
       Eigen::Vector3d d = options.field_direction_in_world.normalized();
       if ((d - n * n.dot(d)).norm() < 0.3) {
         // Near the field's poles: the world axis least aligned with the normal.
@@ -232,19 +251,22 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     total_texels += static_cast<std::int64_t>(patch.width) * patch.height;
   }
   if (total_texels > options.max_texels) {
-    throw InputError("mesh", "at a texel size of " + std::to_string(t) + " world units the " +
-                                 std::to_string(num_faces) + " patches need " +
-                                 std::to_string(total_texels) + " texels (about " +
-                                 std::to_string(total_texels * 4 * static_cast<std::int64_t>(result.sample_planes.size()) >> 20) +
-                                 " MiB per copy), more than the limit of " +
-                                 std::to_string(options.max_texels) +
-                                 "; use a larger texel size or a finer mesh");
+    throw InputError(
+        "mesh",
+        "at a texel size of " + std::to_string(t) + " world units the " +
+            std::to_string(num_faces) + " patches need " + std::to_string(total_texels) +
+            " texels (about " +
+            std::to_string(
+                total_texels * 4 * static_cast<std::int64_t>(result.sample_planes.size()) >> 20) +
+            " MiB per copy), more than the limit of " + std::to_string(options.max_texels) +
+            "; use a larger texel size or a finer mesh");
   }
   if (widest > sample.width || tallest > sample.height) {
-    throw InputError("mesh", "the largest triangle needs a patch of " + std::to_string(widest) +
-                                 " x " + std::to_string(tallest) + " texels (strip included) but the sample is " +
-                                 std::to_string(sample.width) + " x " + std::to_string(sample.height) +
-                                 "; subdivide the mesh (texlume synth --subdivide) or capture a larger sample");
+    throw InputError(
+        "mesh", "the largest triangle needs a patch of " + std::to_string(widest) + " x " +
+                    std::to_string(tallest) + " texels (strip included) but the sample is " +
+                    std::to_string(sample.width) + " x " + std::to_string(sample.height) +
+                    "; subdivide the mesh (texlume synth --subdivide) or capture a larger sample");
   }
 
   // Unfoldings across every shared edge.
@@ -258,11 +280,14 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       const int va = mesh.faces[f][static_cast<std::size_t>(k)];
       const int vb = mesh.faces[f][static_cast<std::size_t>((k + 1) % 3)];
       const TrianglePatch& other = result.patches[static_cast<std::size_t>(nb)];
-      const Eigen::Vector2d a_this = result.patches[f].corners_in_frame[static_cast<std::size_t>(k)];
+      const Eigen::Vector2d a_this =
+          result.patches[f].corners_in_frame[static_cast<std::size_t>(k)];
       const Eigen::Vector2d b_this =
           result.patches[f].corners_in_frame[static_cast<std::size_t>((k + 1) % 3)];
-      const Eigen::Vector2d a_nb = other.frame.PointInFrame(mesh.vertices[static_cast<std::size_t>(va)]).head<2>();
-      const Eigen::Vector2d b_nb = other.frame.PointInFrame(mesh.vertices[static_cast<std::size_t>(vb)]).head<2>();
+      const Eigen::Vector2d a_nb =
+          other.frame.PointInFrame(mesh.vertices[static_cast<std::size_t>(va)]).head<2>();
+      const Eigen::Vector2d b_nb =
+          other.frame.PointInFrame(mesh.vertices[static_cast<std::size_t>(vb)]).head<2>();
       const double angle = std::atan2((b_nb - a_nb).y(), (b_nb - a_nb).x()) -
                            std::atan2((b_this - a_this).y(), (b_this - a_this).x());
       u.face = nb;
@@ -300,10 +325,14 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     std::vector<float> a(static_cast<std::size_t>(polys * 6)), colour(3, 1.0f);
     for (int y = 0; y < r.raw[0].rows; ++y) {
       for (int x = 0; x < r.raw[0].cols; ++x) {
-        for (int i = 0; i < polys * 6; ++i) a[static_cast<std::size_t>(i)] = r.raw[static_cast<std::size_t>(i)].at<float>(y, x);
+        for (int i = 0; i < polys * 6; ++i)
+          a[static_cast<std::size_t>(i)] = r.raw[static_cast<std::size_t>(i)].at<float>(y, x);
         if (sample.format == ptm::PtmFormat::kLrgb)
-          for (int c = 0; c < 3; ++c) colour[static_cast<std::size_t>(c)] = r.raw[static_cast<std::size_t>(6 + c)].at<float>(y, x);
-        const Eigen::Vector3f v = RelightMixture(a.data(), colour.data(), sample.format, lights, gain);
+          for (int c = 0; c < 3; ++c)
+            colour[static_cast<std::size_t>(c)] =
+                r.raw[static_cast<std::size_t>(6 + c)].at<float>(y, x);
+        const Eigen::Vector3f v =
+            RelightMixture(a.data(), colour.data(), sample.format, lights, gain);
         for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(c)].at<float>(y, x) = v[c];
       }
     }
@@ -327,10 +356,11 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     const sfm::Image& image = reconstruction.images.at(view.image_id);
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
     const TrianglePatch& patch = result.patches[f];
-    const double area = 0.5 * std::abs((patch.corners_in_frame[1] - patch.corners_in_frame[0]).x() *
-                                           (patch.corners_in_frame[2] - patch.corners_in_frame[0]).y() -
-                                       (patch.corners_in_frame[1] - patch.corners_in_frame[0]).y() *
-                                           (patch.corners_in_frame[2] - patch.corners_in_frame[0]).x());
+    const double area =
+        0.5 * std::abs((patch.corners_in_frame[1] - patch.corners_in_frame[0]).x() *
+                           (patch.corners_in_frame[2] - patch.corners_in_frame[0]).y() -
+                       (patch.corners_in_frame[1] - patch.corners_in_frame[0]).y() *
+                           (patch.corners_in_frame[2] - patch.corners_in_frame[0]).x());
     const double density = std::sqrt(std::max(view.projected_area_px, 1e-6f) / (area / (t * t)));
     const int level = std::clamp(static_cast<int>(std::lround(-4.0 * std::log2(density))), 0, 40);
     const ReducedSample& r = reduced_at(level);
@@ -342,15 +372,17 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     out.count = 0;
     for (int j = 0; j < th; ++j) {
       for (int i = 0; i < tw; ++i) {
-        const Eigen::Vector2d p(patch.x_min + (i + 0.5) / r.rx * t, patch.y_max - (j + 0.5) / r.ry * t);
-        const Eigen::Vector3d world = patch.frame.origin_in_world + p.x() * patch.frame.x_axis +
-                                      p.y() * patch.frame.y_axis;
-        const Eigen::Vector3d cam = image.cam_from_world.rotation * world + image.cam_from_world.translation;
+        const Eigen::Vector2d p(patch.x_min + (i + 0.5) / r.rx * t,
+                                patch.y_max - (j + 0.5) / r.ry * t);
+        const Eigen::Vector3d world =
+            patch.frame.origin_in_world + p.x() * patch.frame.x_axis + p.y() * patch.frame.y_axis;
+        const Eigen::Vector3d cam =
+            image.cam_from_world.rotation * world + image.cam_from_world.translation;
         const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(cam);
         map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
         map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
-        if (px && InsideTriangle(patch.corners_in_frame, p) && px->x() >= 0.5 &&
-            px->y() >= 0.5 && px->x() <= photo.image.cols - 0.5 && px->y() <= photo.image.rows - 0.5) {
+        if (px && InsideTriangle(patch.corners_in_frame, p) && px->x() >= 0.5 && px->y() >= 0.5 &&
+            px->x() <= photo.image.cols - 0.5 && px->y() <= photo.image.rows - 0.5) {
           out.mask.at<float>(j, i) = 1.0f;
           ++out.count;
         }
@@ -362,7 +394,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     cv::split(rectified, out.planes);
     out.lights.clear();
     for (const sfm::ObjectLight& light : photo.lights) {
-      const Eigen::Vector3d l = patch.frame.DirectionInFrame(light.DirectionFrom(patch.frame.origin_in_world));
+      const Eigen::Vector3d l =
+          patch.frame.DirectionInFrame(light.DirectionFrom(patch.frame.origin_in_world));
       out.lights.emplace_back(l, light.intensity);
     }
     out.photo = it->second;
@@ -393,7 +426,9 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   // mean over its triangles against the sample's mean relit at their lights.
   std::vector<double> photo_sum(photos.size(), 0.0), model_sum(photos.size(), 0.0);
   {
-    const int coarse_level = std::max(0, static_cast<int>(std::ceil(4.0 * std::log2(std::max(sample.width, sample.height) / 16.0))));
+    const int coarse_level = std::max(
+        0,
+        static_cast<int>(std::ceil(4.0 * std::log2(std::max(sample.width, sample.height) / 16.0))));
     const ReducedSample& coarse = reduced_at(coarse_level);
     for (std::size_t f = 0; f < num_faces; ++f) {
       for (const sfm::TriangleView& view : views_of(f)) {
@@ -403,7 +438,9 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
         for (int j = 0; j < rect.mask.rows; ++j)
           for (int i = 0; i < rect.mask.cols; ++i)
             if (rect.mask.at<float>(j, i) > 0)
-              for (int c = 0; c < 3; ++c) photo_linear += SrgbToLinear(rect.planes[static_cast<std::size_t>(c)].at<float>(j, i));
+              for (int c = 0; c < 3; ++c)
+                photo_linear +=
+                    SrgbToLinear(rect.planes[static_cast<std::size_t>(c)].at<float>(j, i));
         const std::vector<cv::Mat> relit = relit_planes(coarse, rect.lights, 1.0);
         double model_linear = 0.0;
         for (int c = 0; c < 3; ++c) {
@@ -418,7 +455,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   }
   result.photo_gains.assign(photos.size(), 1.0);
   for (std::size_t n = 0; n < photos.size(); ++n)
-    if (model_sum[n] > 1e-9 && photo_sum[n] > 0) result.photo_gains[n] = photo_sum[n] / model_sum[n];
+    if (model_sum[n] > 1e-9 && photo_sum[n] > 0)
+      result.photo_gains[n] = photo_sum[n] / model_sum[n];
 
   // 2b. Breadth-first synthesis from a seed (the best-seen triangle).
   int seed_face = 0;
@@ -432,6 +470,163 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
         seed_face = static_cast<int>(f);
       }
   }
+  // Photo-consistency pass of one patch (LRGB): per cell of the primary view's
+  // grid, dq = J^T (J J^T + lambda I)^-1 r over the views, J_n the derivative of
+  // the displayed luminance under photo n's lights (sRGB, gain and light mixture
+  // linearised at the current value) with respect to the orthonormal luminance
+  // coefficients, r_n the photo's luminance minus the prediction (eq. 3's
+  // residual). Cells outside the triangle take their neighbours' change.
+  const Eigen::Matrix<double, 6, 6>& from_orthonormal =
+      ptm::OrthonormalBasis::Hemisphere().FromOrthonormal();
+  auto CorrectPatch = [&](TrianglePatch& patch, const std::vector<Rectified>& rects) {
+    const Rectified& primary = rects[0];
+    const ReducedSample& red0 = reduced_at(primary.level);
+    const int gw = primary.mask.cols, gh = primary.mask.rows;
+    patch.correction_density = Eigen::Vector2d(red0.rx, red0.ry);
+    patch.correction.assign(6, cv::Mat());
+    for (cv::Mat& m : patch.correction) m = cv::Mat::zeros(gh, gw, CV_32FC1);
+    // Per view: frame point of a primary cell -> the view's cell.
+    auto view_cell = [&](const Rectified& r, int i, int j, int& vi, int& vj) {
+      const ReducedSample& red = reduced_at(r.level);
+      vi = static_cast<int>(std::floor((i + 0.5) / red0.rx * red.rx));
+      vj = static_cast<int>(std::floor((j + 0.5) / red0.ry * red.ry));
+      return vi >= 0 && vj >= 0 && vi < r.mask.cols && vj < r.mask.rows &&
+             r.mask.at<float>(vj, vi) > 0;
+    };
+    // Prediction and luminance Jacobian of view r at its cell (vi, vj), with the
+    // current correction (primary grid cell (i, j)).
+    auto predict = [&](const Rectified& r, int vi, int vj, int i, int j,
+                       Eigen::Matrix<double, 1, 6>& jac) {
+      const ReducedSample& red = reduced_at(r.level);
+      const double sx = patch.sample_x * red.rx + vi, sy = patch.sample_y * red.ry + vj;
+      const int x = std::clamp(static_cast<int>(sx), 0, red.raw[0].cols - 1);
+      const int y = std::clamp(static_cast<int>(sy), 0, red.raw[0].rows - 1);
+      Eigen::Matrix<double, 6, 1> q_delta;
+      for (int m = 0; m < 6; ++m)
+        q_delta[m] = patch.correction[static_cast<std::size_t>(m)].at<float>(j, i);
+      const Eigen::Matrix<double, 6, 1> a_delta = from_orthonormal * q_delta;
+      float a[6], colour[3];
+      for (int m = 0; m < 6; ++m)
+        a[m] =
+            red.raw[static_cast<std::size_t>(m)].at<float>(y, x) + static_cast<float>(a_delta[m]);
+      for (int c = 0; c < 3; ++c)
+        colour[c] = red.raw[static_cast<std::size_t>(6 + c)].at<float>(y, x);
+      const double g = result.photo_gains[r.photo];
+      Eigen::Vector3d linear = Eigen::Vector3d::Zero();
+      std::vector<std::pair<double, Eigen::Matrix<double, 1, 6>>>
+          terms;  // d linear / d L_i per channel sum
+      Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
+      for (const auto& [l, intensity] : r.lights) {
+        if (l.z() <= 0) continue;
+        const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
+        const std::array<double, 6> phi = ptm::PtmBasis(l.x(), l.y());
+        const Eigen::Matrix<double, 1, 6> row =
+            Eigen::Map<const Eigen::Matrix<double, 1, 6>>(phi.data()) * from_orthonormal;
+        for (int c = 0; c < 3; ++c) {
+          const double v = lum * colour[c];
+          if (v <= 0.0 || v >= 1.0) continue;  // clamped: no derivative
+          const double h = 1e-3;
+          const double dlin = (SrgbToLinear(static_cast<float>(std::min(1.0, v + h))) -
+                               SrgbToLinear(static_cast<float>(std::max(0.0, v - h)))) /
+                              (std::min(1.0, v + h) - std::max(0.0, v - h));
+          linear[c] += intensity * SrgbToLinear(static_cast<float>(v));
+          dlinear.row(c) += intensity * dlin * colour[c] * row;
+        }
+      }
+      double y_pred = 0.0;
+      jac.setZero();
+      for (int c = 0; c < 3; ++c) {
+        const double lin = g * linear[c];
+        const double d = LinearToSrgb(static_cast<float>(lin));
+        const double h = 1e-4;
+        const double dsrgb = (LinearToSrgb(static_cast<float>(lin + h)) -
+                              LinearToSrgb(static_cast<float>(std::max(0.0, lin - h)))) /
+                             (lin + h - std::max(0.0, lin - h));
+        y_pred += d / 3.0;
+        jac += dsrgb * g * dlinear.row(c) / 3.0;
+      }
+      return y_pred;
+    };
+    auto photo_luminance = [](const Rectified& r, int vi, int vj) {
+      return (r.planes[0].at<float>(vj, vi) + r.planes[1].at<float>(vj, vi) +
+              r.planes[2].at<float>(vj, vi)) /
+             3.0;
+    };
+    auto rms = [&]() {
+      double sum = 0;
+      int n = 0;
+      Eigen::Matrix<double, 1, 6> jac;
+      for (int j = 0; j < gh; ++j)
+        for (int i = 0; i < gw; ++i)
+          for (const Rectified& r : rects) {
+            int vi, vj;
+            if (!view_cell(r, i, j, vi, vj)) continue;
+            const double d = photo_luminance(r, vi, vj) - predict(r, vi, vj, i, j, jac);
+            sum += d * d;
+            ++n;
+          }
+      return n ? std::sqrt(sum / n) : 0.0;
+    };
+    patch.photo_rms_before = rms();
+    cv::Mat known = cv::Mat::zeros(gh, gw, CV_8UC1);
+    for (int it = 0; it < options.correction_iterations; ++it) {
+      for (int j = 0; j < gh; ++j) {
+        for (int i = 0; i < gw; ++i) {
+          Eigen::Matrix<double, Eigen::Dynamic, 6> jac(static_cast<int>(rects.size()), 6);
+          Eigen::VectorXd res(static_cast<int>(rects.size()));
+          int rows = 0;
+          for (const Rectified& r : rects) {
+            int vi, vj;
+            if (!view_cell(r, i, j, vi, vj)) continue;
+            Eigen::Matrix<double, 1, 6> row;
+            res[rows] = photo_luminance(r, vi, vj) - predict(r, vi, vj, i, j, row);
+            jac.row(rows) = row;
+            ++rows;
+          }
+          if (rows == 0) continue;
+          const auto jr = jac.topRows(rows);
+          Eigen::MatrixXd jjt = jr * jr.transpose();
+          const double scale = jjt.trace() / rows;
+          if (!(scale > 1e-12)) continue;
+          jjt.diagonal().array() += 1e-3 * scale;
+          const Eigen::Matrix<double, 6, 1> dq = jr.transpose() * jjt.ldlt().solve(res.head(rows));
+          for (int m = 0; m < 6; ++m)
+            patch.correction[static_cast<std::size_t>(m)].at<float>(j, i) +=
+                static_cast<float>(dq[m]);
+          known.at<std::uint8_t>(j, i) = 1;
+        }
+      }
+    }
+    patch.photo_rms_after = rms();
+    // Extend the change into the strip: rings of neighbour averages.
+    for (int ring = 0; ring < std::max(gw, gh); ++ring) {
+      const cv::Mat before = known.clone();
+      bool any = false;
+      for (int j = 0; j < gh; ++j)
+        for (int i = 0; i < gw; ++i) {
+          if (before.at<std::uint8_t>(j, i)) continue;
+          double sum[6] = {0, 0, 0, 0, 0, 0};
+          int n = 0;
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) {
+              const int jj = j + dj, ii = i + di;
+              if (jj < 0 || ii < 0 || jj >= gh || ii >= gw || !before.at<std::uint8_t>(jj, ii))
+                continue;
+              for (int m = 0; m < 6; ++m)
+                sum[m] += patch.correction[static_cast<std::size_t>(m)].at<float>(jj, ii);
+              ++n;
+            }
+          if (!n) continue;
+          for (int m = 0; m < 6; ++m)
+            patch.correction[static_cast<std::size_t>(m)].at<float>(j, i) =
+                static_cast<float>(sum[m] / n);
+          known.at<std::uint8_t>(j, i) = 1;
+          any = true;
+        }
+      if (!any) break;
+    }
+  };
+
   const std::vector<int> order = sfm::BreadthFirstFaceOrder(mesh, neighbours, seed_face);
   std::vector<char> done(num_faces, 0);
   std::mt19937_64 rng(options.seed);
@@ -452,8 +647,9 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
         for (int k = 0; k < 3; ++k) {
           const Unfolding& u = result.unfoldings[f][static_cast<std::size_t>(k)];
           if (u.face < 0 || !done[static_cast<std::size_t>(u.face)]) continue;
-          const double d = SegmentDistance(patch.corners_in_frame[static_cast<std::size_t>(k)],
-                                           patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)], p);
+          const double d =
+              SegmentDistance(patch.corners_in_frame[static_cast<std::size_t>(k)],
+                              patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)], p);
           if (d > options.strip * t) continue;
           if (!result.SamplePatch(u.face, u.rotation * p + u.translation, value.data())) continue;
           target_texels.push_back(j * w + i);
@@ -473,8 +669,10 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       for (std::size_t n = 0; n < target_texels.size(); ++n) {
         const int i = target_texels[n] % w, j = target_texels[n] / w;
         for (int c = 0; c < coefficient_planes; ++c) {
-          const double d = result.sample_planes[static_cast<std::size_t>(c)].at<float>(sy + j, sx + i) -
-                           targets[n * static_cast<std::size_t>(coefficient_planes) + static_cast<std::size_t>(c)];
+          const double d =
+              result.sample_planes[static_cast<std::size_t>(c)].at<float>(sy + j, sx + i) -
+              targets[n * static_cast<std::size_t>(coefficient_planes) +
+                      static_cast<std::size_t>(c)];
           e += d * d;
         }
       }
@@ -506,10 +704,13 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       // Top-k distinct positions at the coarsest density used (neighbouring texel
       // positions share one photo-density cell and score alike).
       std::vector<std::pair<float, cv::Point>> all;
-      const int stride = std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx)));
+      const int stride =
+          std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx)));
       for (int sy = 0; sy <= max_sy; sy += stride)
-        for (int sx = 0; sx <= max_sx; sx += stride) all.emplace_back(total.at<float>(sy, sx), cv::Point(sx, sy));
-      const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(options.top_k), all.size());
+        for (int sx = 0; sx <= max_sx; sx += stride)
+          all.emplace_back(total.at<float>(sy, sx), cv::Point(sx, sy));
+      const std::size_t k =
+          std::min<std::size_t>(static_cast<std::size_t>(options.top_k), all.size());
       std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k), all.end(),
                         [](const auto& a, const auto& b) { return a.first < b.first; });
       double best = std::numeric_limits<double>::infinity();
@@ -536,7 +737,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
         mask.at<float>(j, i) = 1.0f;
         for (int c = 0; c < coefficient_planes; ++c)
           target_planes[static_cast<std::size_t>(c)].at<float>(j, i) =
-              targets[n * static_cast<std::size_t>(coefficient_planes) + static_cast<std::size_t>(c)];
+              targets[n * static_cast<std::size_t>(coefficient_planes) +
+                      static_cast<std::size_t>(c)];
       }
       const cv::Mat errors = MaskedSsd(sample_coefficients, sample_energy, target_planes, mask);
       double min_error;
@@ -544,7 +746,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       std::vector<cv::Point> near;
       for (int py = 0; py < errors.rows; ++py)
         for (int px = 0; px < errors.cols; ++px)
-          if (errors.at<float>(py, px) <= min_error * (1.0 + options.tolerance) + 1e-12) near.emplace_back(px, py);
+          if (errors.at<float>(py, px) <= min_error * (1.0 + options.tolerance) + 1e-12)
+            near.emplace_back(px, py);
       const cv::Point p = near[std::uniform_int_distribution<std::size_t>(0, near.size() - 1)(rng)];
       patch.sample_x = p.x;
       patch.sample_y = p.y;
@@ -557,9 +760,14 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       patch.source = PatchSource::kRandom;
       ++result.num_random;
     }
+    if (!rects.empty() && options.correction_iterations > 0 &&
+        sample.format == ptm::PtmFormat::kLrgb) {
+      CorrectPatch(patch, rects);
+    }
     done[f] = 1;
     ++processed;
-    if (progress && (processed % 64 == 0 || processed == num_faces)) progress("synthesis", processed, num_faces);
+    if (progress && (processed % 64 == 0 || processed == num_faces))
+      progress("synthesis", processed, num_faces);
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -27,9 +27,9 @@ struct MeshPhoto {
 
 /// Where the tangent frame's X axis of each triangle comes from.
 enum class TangentFrame {
-  kFirstEdge,     ///< v0 -> v1 (paper 003 §3.0.2)
-  kSmoothField,   ///< a fixed world direction projected onto each face, so anisotropic
-                  ///< materials keep their direction across triangles
+  kFirstEdge,    ///< v0 -> v1 (paper 003 §3.0.2)
+  kSmoothField,  ///< a fixed world direction projected onto each face, so anisotropic
+                 ///< materials keep their direction across triangles
 };
 
 /// Settings of SynthesizeMeshPtm (paper 003 Algorithm 2).
@@ -55,6 +55,11 @@ struct MeshSynthesisOptions {
   double tolerance = 0.1;
   /// Fewest rectified photo pixels inside a triangle for the photo to constrain it. >= 1.
   int min_photo_pixels = 6;
+  /// Photo-consistency pass per triangle (beyond the paper, as in the planar
+  /// synthesis): Gauss-Newton rounds of the smallest change of the luminance
+  /// coefficients that makes the patch, relit under each constraint photo's
+  /// lights, equal the rectified photo at its density. 0 = off. [0, 5]. LRGB only.
+  int correction_iterations = 2;
   /// Refuse up front when the patches would take more texels than this.
   std::int64_t max_texels = std::int64_t{1} << 30;
   std::uint32_t seed = 1;
@@ -64,9 +69,9 @@ struct MeshSynthesisOptions {
 
 /// How a triangle's patch was chosen.
 enum class PatchSource {
-  kPhotos,     ///< image score, then neighbours (Algorithm 2 step 2)
-  kNeighbours, ///< fully visible in no photo: overlap constraint alone
-  kRandom,     ///< no photo and no synthesised neighbour (first of an unseen component)
+  kPhotos,      ///< image score, then neighbours (Algorithm 2 step 2)
+  kNeighbours,  ///< fully visible in no photo: overlap constraint alone
+  kRandom,      ///< no photo and no synthesised neighbour (first of an unseen component)
 };
 
 /// One triangle's patch: the sample PTM's rectangle [sample_x, sample_x + width)
@@ -84,6 +89,12 @@ struct TrianglePatch {
   int views_used = 0;
   double image_score = 0.0;    ///< summed RMS photo difference of the chosen patch
   double overlap_error = 0.0;  ///< mean squared orthonormal distance to the neighbours
+  /// Photo-consistency correction of the luminance coefficients (orthonormal
+  /// space, 6 planes, LRGB), on a grid of `correction_density` cells per texel
+  /// over the patch rectangle; empty when none. Added by SamplePatch.
+  std::vector<cv::Mat> correction;
+  Eigen::Vector2d correction_density = Eigen::Vector2d::Ones();
+  double photo_rms_before = 0.0, photo_rms_after = 0.0;  ///< luminance, at photo density
 };
 
 /// The unfolding of neighbour `face` across a shared edge into a triangle's
@@ -100,11 +111,11 @@ struct Unfolding {
 /// the sample's orthonormal planes they reference, and per-edge unfoldings.
 struct MeshSynthesis {
   ptm::PtmFormat format = ptm::PtmFormat::kLrgb;
-  double texel_size = 0.0;                ///< world units
-  std::vector<cv::Mat> sample_planes;     ///< orthonormal coefficients (+ LRGB colour)
-  std::vector<TrianglePatch> patches;     ///< per face
+  double texel_size = 0.0;                           ///< world units
+  std::vector<cv::Mat> sample_planes;                ///< orthonormal coefficients (+ LRGB colour)
+  std::vector<TrianglePatch> patches;                ///< per face
   std::vector<std::array<Unfolding, 3>> unfoldings;  ///< per face, edge k = (v_k, v_k+1)
-  std::vector<double> photo_gains;        ///< per photo (linear-domain exposure x intensity)
+  std::vector<double> photo_gains;  ///< per photo (linear-domain exposure x intensity)
   std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
   double seconds = 0.0;
 

@@ -21,7 +21,8 @@ constexpr const char* kManifestFormat = "texlume-model";
 
 void WriteBytes(const fs::path& path, const std::vector<unsigned char>& bytes) {
   std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
   if (!out) throw InputError(path.string(), "cannot be written");
 }
 
@@ -67,7 +68,8 @@ void WriteObj(const fs::path& path, const TexturedModel& model) {
 std::vector<Eigen::Vector3d> VertexNormals(const sfm::TriangleMesh& mesh) {
   std::vector<Eigen::Vector3d> n(mesh.vertices.size(), Eigen::Vector3d::Zero());
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-    const Eigen::Vector3d a = (mesh.Corner(f, 1) - mesh.Corner(f, 0)).cross(mesh.Corner(f, 2) - mesh.Corner(f, 0));
+    const Eigen::Vector3d a =
+        (mesh.Corner(f, 1) - mesh.Corner(f, 0)).cross(mesh.Corner(f, 2) - mesh.Corner(f, 0));
     for (int v : mesh.faces[f]) n[static_cast<std::size_t>(v)] += a;
   }
   for (auto& v : n) v = v.norm() > 0 ? v.normalized() : Eigen::Vector3d::UnitZ();
@@ -81,7 +83,8 @@ cv::Mat BaseColourImage(const ptm::Ptm& ptm) {
     for (int x = 0; x < ptm.width; ++x)
       for (int c = 0; c < 3; ++c)
         out.at<cv::Vec3b>(y, x)[2 - c] = cv::saturate_cast<std::uint8_t>(
-            255.0f * rgb[(static_cast<std::size_t>(y) * ptm.width + x) * 3 + static_cast<std::size_t>(c)]);
+            255.0f *
+            rgb[(static_cast<std::size_t>(y) * ptm.width + x) * 3 + static_cast<std::size_t>(c)]);
   return out;
 }
 
@@ -107,7 +110,9 @@ void WriteGlb(const fs::path& path, const TexturedModel& model,
               const std::vector<nlohmann::json>& material_extras) {
   const std::vector<Eigen::Vector3d> normals = VertexNormals(model.mesh);
   std::vector<unsigned char> bin;
-  auto align4 = [&]() { while (bin.size() % 4) bin.push_back(0); };
+  auto align4 = [&]() {
+    while (bin.size() % 4) bin.push_back(0);
+  };
   auto append = [&](const void* data, std::size_t bytes) {
     const auto* p = static_cast<const unsigned char*>(data);
     bin.insert(bin.end(), p, p + bytes);
@@ -162,12 +167,21 @@ void WriteGlb(const fs::path& path, const TexturedModel& model,
     const int img_view = add_view(bin.size(), base_colour_png[a].size(), 0);
     append(base_colour_png[a].data(), base_colour_png[a].size());
     const int first = static_cast<int>(accessors.size());
-    accessors.push_back({{"bufferView", pos_view}, {"componentType", 5126}, {"count", count}, {"type", "VEC3"},
-                         {"min", {lo.x(), lo.y(), lo.z()}}, {"max", {hi.x(), hi.y(), hi.z()}}});
-    accessors.push_back({{"bufferView", nrm_view}, {"componentType", 5126}, {"count", count}, {"type", "VEC3"}});
-    accessors.push_back({{"bufferView", uv_view}, {"componentType", 5126}, {"count", count}, {"type", "VEC2"}});
-    accessors.push_back({{"bufferView", idx_view}, {"componentType", 5125}, {"count", count}, {"type", "SCALAR"}});
-    images.push_back({{"bufferView", img_view}, {"mimeType", "image/png"}, {"name", "base_colour_" + std::to_string(a)}});
+    accessors.push_back({{"bufferView", pos_view},
+                         {"componentType", 5126},
+                         {"count", count},
+                         {"type", "VEC3"},
+                         {"min", {lo.x(), lo.y(), lo.z()}},
+                         {"max", {hi.x(), hi.y(), hi.z()}}});
+    accessors.push_back(
+        {{"bufferView", nrm_view}, {"componentType", 5126}, {"count", count}, {"type", "VEC3"}});
+    accessors.push_back(
+        {{"bufferView", uv_view}, {"componentType", 5126}, {"count", count}, {"type", "VEC2"}});
+    accessors.push_back(
+        {{"bufferView", idx_view}, {"componentType", 5125}, {"count", count}, {"type", "SCALAR"}});
+    images.push_back({{"bufferView", img_view},
+                      {"mimeType", "image/png"},
+                      {"name", "base_colour_" + std::to_string(a)}});
     textures.push_back({{"source", images.size() - 1}, {"sampler", 0}});
     nlohmann::json material = {{"name", "atlas_" + std::to_string(a)},
                                {"pbrMetallicRoughness",
@@ -176,10 +190,11 @@ void WriteGlb(const fs::path& path, const TexturedModel& model,
                                  {"roughnessFactor", 1.0}}}};
     if (a < material_extras.size()) material["extras"] = material_extras[a];
     materials.push_back(material);
-    primitives.push_back({{"attributes", {{"POSITION", first}, {"NORMAL", first + 1}, {"TEXCOORD_0", first + 2}}},
-                          {"indices", first + 3},
-                          {"material", materials.size() - 1},
-                          {"mode", 4}});
+    primitives.push_back(
+        {{"attributes", {{"POSITION", first}, {"NORMAL", first + 1}, {"TEXCOORD_0", first + 2}}},
+         {"indices", first + 3},
+         {"material", materials.size() - 1},
+         {"mode", 4}});
   }
   align4();
   gltf["meshes"] = {{{"primitives", primitives}, {"name", "model"}}};
@@ -188,12 +203,13 @@ void WriteGlb(const fs::path& path, const TexturedModel& model,
   gltf["buffers"] = {{{"byteLength", bin.size()}}};
   gltf["images"] = images;
   gltf["textures"] = textures;
-  gltf["samplers"] = {{{"magFilter", 9729}, {"minFilter", 9987}, {"wrapS", 33071}, {"wrapT", 33071}}};
+  gltf["samplers"] = {
+      {{"magFilter", 9729}, {"minFilter", 9987}, {"wrapS", 33071}, {"wrapT", 33071}}};
   gltf["materials"] = materials;
   std::string json = gltf.dump();
   while (json.size() % 4) json.push_back(' ');
-  const std::uint32_t total = 12 + 8 + static_cast<std::uint32_t>(json.size()) + 8 +
-                              static_cast<std::uint32_t>(bin.size());
+  const std::uint32_t total =
+      12 + 8 + static_cast<std::uint32_t>(json.size()) + 8 + static_cast<std::uint32_t>(bin.size());
   WriteFileAtomically(
       path,
       [&](std::ostream& out) {
@@ -206,7 +222,8 @@ void WriteGlb(const fs::path& path, const TexturedModel& model,
         out.write(json.data(), static_cast<std::streamsize>(json.size()));
         u32(static_cast<std::uint32_t>(bin.size()));
         u32(0x004E4942);  // "BIN\0"
-        out.write(reinterpret_cast<const char*>(bin.data()), static_cast<std::streamsize>(bin.size()));
+        out.write(reinterpret_cast<const char*>(bin.data()),
+                  static_cast<std::streamsize>(bin.size()));
       },
       true);
 }
@@ -217,17 +234,22 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
     if (!fs::is_directory(dir)) throw InputError(dir.string(), "exists and is not a folder");
     const bool ours = fs::exists(dir / "manifest.json");
     if (!ours && !fs::is_empty(dir))
-      throw InputError(dir.string(), "exists, is not empty and is not a texlume model folder; not replacing it");
+      throw InputError(dir.string(),
+                       "exists, is not empty and is not a texlume model folder; not replacing it");
   }
-  const fs::path tmp = dir.parent_path() / (dir.filename().string() + ".partial-" + std::to_string(::getpid()));
+  const fs::path tmp =
+      dir.parent_path() / (dir.filename().string() + ".partial-" + std::to_string(::getpid()));
   fs::remove_all(tmp);
   fs::create_directories(tmp);
   try {
     nlohmann::json manifest = record;
     manifest["format"] = kManifestFormat;
     manifest["version"] = 1;
-    manifest["mesh"] = {{"obj", "model.obj"}, {"mtl", "model.mtl"}, {"glb", "model.glb"},
-                        {"vertices", model.mesh.vertices.size()}, {"faces", model.mesh.faces.size()}};
+    manifest["mesh"] = {{"obj", "model.obj"},
+                        {"mtl", "model.mtl"},
+                        {"glb", "model.glb"},
+                        {"vertices", model.mesh.vertices.size()},
+                        {"faces", model.mesh.faces.size()}};
     manifest["ptm_frame"] =
         "per texel: x = dP/du, y = dP/dv (v up, as in OBJ), z = face normal; light directions "
         "point from the surface to the light";
@@ -246,16 +268,24 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
       ptm::WritePtmFile(model.atlases[a], tmp / ptm_file);
       ptm::WritePtmExr(model.atlases[a], tmp / exr_file);
       const std::string format = model.atlases[a].format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB";
-      nlohmann::json entry = {{"ptm", ptm_file}, {"exr", exr_file}, {"base_colour", base},
-                              {"albedo", albedo}, {"width", model.atlases[a].width},
-                              {"height", model.atlases[a].height}, {"format", format}};
+      nlohmann::json entry = {{"ptm", ptm_file},
+                              {"exr", exr_file},
+                              {"base_colour", base},
+                              {"albedo", albedo},
+                              {"width", model.atlases[a].width},
+                              {"height", model.atlases[a].height},
+                              {"format", format}};
       manifest["atlases"].push_back(entry);
-      extras.push_back({{"texlume_ptm",
-                         {{"ptm", ptm_file}, {"exr", exr_file}, {"format", format},
-                          {"frame", manifest["ptm_frame"]},
-                          {"texcoord", "TEXCOORD_0 (glTF v down; the PTM's y axis points to -v)"}}}});
+      extras.push_back(
+          {{"texlume_ptm",
+            {{"ptm", ptm_file},
+             {"exr", exr_file},
+             {"format", format},
+             {"frame", manifest["ptm_frame"]},
+             {"texcoord", "TEXCOORD_0 (glTF v down; the PTM's y axis points to -v)"}}}});
       mtl << "newmtl atlas_" << k << "\nKa 0 0 0\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd " << base
-          << "\n# albedo: " << albedo << "; PTM: " << ptm_file << " (lossless " << exr_file << ")\n\n";
+          << "\n# albedo: " << albedo << "; PTM: " << ptm_file << " (lossless " << exr_file
+          << ")\n\n";
     }
     if (!mtl) throw InputError((dir / "model.mtl").string(), "cannot be written");
     mtl.close();
@@ -265,7 +295,8 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
     for (const auto& [name, image] : extra_images) {
       WriteBytes(tmp / name, EncodePng(image, name));
     }
-    for (const auto& entry : fs::directory_iterator(tmp)) files.push_back(entry.path().filename().string());
+    for (const auto& entry : fs::directory_iterator(tmp))
+      files.push_back(entry.path().filename().string());
     files.push_back("manifest.json");
     std::sort(files.begin(), files.end());
     manifest["files"] = files;
@@ -288,8 +319,8 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
   } catch (const nlohmann::json::exception& e) {
     throw InputError(manifest_path.string(), std::string("is not valid JSON: ") + e.what());
   }
-  if (!manifest.is_object() || manifest.value("format", "") != kManifestFormat || !manifest.contains("atlases") ||
-      !manifest["atlases"].is_array())
+  if (!manifest.is_object() || manifest.value("format", "") != kManifestFormat ||
+      !manifest.contains("atlases") || !manifest["atlases"].is_array())
     throw InputError(manifest_path.string(), "is not a texlume model manifest");
   TexturedModel model;
   for (const auto& entry : manifest["atlases"]) {
@@ -311,41 +342,51 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
     if (!(s >> tag) || tag[0] == '#') continue;
     if (tag == "v") {
       Eigen::Vector3d v;
-      if (!(s >> v.x() >> v.y() >> v.z()) || !v.allFinite()) throw InputError(obj_path.string(), "bad vertex", line_number);
+      if (!(s >> v.x() >> v.y() >> v.z()) || !v.allFinite())
+        throw InputError(obj_path.string(), "bad vertex", line_number);
       model.mesh.vertices.push_back(v);
     } else if (tag == "vt") {
       Eigen::Vector2d t;
-      if (!(s >> t.x() >> t.y()) || !t.allFinite()) throw InputError(obj_path.string(), "bad texture coordinate", line_number);
+      if (!(s >> t.x() >> t.y()) || !t.allFinite())
+        throw InputError(obj_path.string(), "bad texture coordinate", line_number);
       texcoords.push_back(t);
     } else if (tag == "usemtl") {
       std::string name;
       s >> name;
-      if (name.rfind("atlas_", 0) != 0) throw InputError(obj_path.string(), "unknown material " + name, line_number);
+      if (name.rfind("atlas_", 0) != 0)
+        throw InputError(obj_path.string(), "unknown material " + name, line_number);
       try {
         current_atlas = std::stoi(name.substr(6));
       } catch (const std::exception&) {
         current_atlas = -1;
       }
       if (current_atlas < 0 || current_atlas >= static_cast<int>(model.atlases.size()))
-        throw InputError(obj_path.string(), "material " + name + " has no atlas in the manifest", line_number);
+        throw InputError(obj_path.string(), "material " + name + " has no atlas in the manifest",
+                         line_number);
     } else if (tag == "f") {
       std::array<int, 3> v{}, t{};
       for (int k = 0; k < 3; ++k) {
         std::string corner;
         char slash = 0;
-        if (!(s >> corner)) throw InputError(obj_path.string(), "a face needs 3 corners", line_number);
+        if (!(s >> corner))
+          throw InputError(obj_path.string(), "a face needs 3 corners", line_number);
         std::istringstream cs(corner);
-        if (!(cs >> v[static_cast<std::size_t>(k)] >> slash >> t[static_cast<std::size_t>(k)]) || slash != '/')
+        if (!(cs >> v[static_cast<std::size_t>(k)] >> slash >> t[static_cast<std::size_t>(k)]) ||
+            slash != '/')
           throw InputError(obj_path.string(), "face corners must be v/vt", line_number);
-        if (v[static_cast<std::size_t>(k)] < 1 || v[static_cast<std::size_t>(k)] > static_cast<int>(model.mesh.vertices.size()) ||
-            t[static_cast<std::size_t>(k)] < 1 || t[static_cast<std::size_t>(k)] > static_cast<int>(texcoords.size()))
+        if (v[static_cast<std::size_t>(k)] < 1 ||
+            v[static_cast<std::size_t>(k)] > static_cast<int>(model.mesh.vertices.size()) ||
+            t[static_cast<std::size_t>(k)] < 1 ||
+            t[static_cast<std::size_t>(k)] > static_cast<int>(texcoords.size()))
           throw InputError(obj_path.string(), "face index out of range", line_number);
         --v[static_cast<std::size_t>(k)];
         --t[static_cast<std::size_t>(k)];
       }
       std::string more;
-      if (s >> more) throw InputError(obj_path.string(), "only triangles are supported", line_number);
-      if (current_atlas < 0) throw InputError(obj_path.string(), "a face before any usemtl", line_number);
+      if (s >> more)
+        throw InputError(obj_path.string(), "only triangles are supported", line_number);
+      if (current_atlas < 0)
+        throw InputError(obj_path.string(), "a face before any usemtl", line_number);
       model.mesh.faces.push_back(v);
       face_vt.push_back(t);
       model.face_atlas.push_back(current_atlas);
@@ -356,9 +397,11 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
     const ptm::Ptm& atlas = model.atlases[static_cast<std::size_t>(model.face_atlas[f])];
     std::array<Eigen::Vector2f, 3> c;
     for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector2d& t = texcoords[static_cast<std::size_t>(face_vt[f][static_cast<std::size_t>(k)])];
-      c[static_cast<std::size_t>(k)] = Eigen::Vector2f(static_cast<float>(t.x() * atlas.width),
-                                                       static_cast<float>((1.0 - t.y()) * atlas.height));
+      const Eigen::Vector2d& t =
+          texcoords[static_cast<std::size_t>(face_vt[f][static_cast<std::size_t>(k)])];
+      c[static_cast<std::size_t>(k)] =
+          Eigen::Vector2f(static_cast<float>(t.x() * atlas.width),
+                          static_cast<float>((1.0 - t.y()) * atlas.height));
     }
     model.corner_px.push_back(c);
   }

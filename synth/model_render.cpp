@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -18,7 +19,8 @@ namespace {
 // (pixel centres at +0.5), clamped to the image.
 template <typename Get>
 void Bilinear(int width, int height, double x, double y, int count, const Get& get, float* out) {
-  const double u = std::clamp(x - 0.5, 0.0, width - 1.0), v = std::clamp(y - 0.5, 0.0, height - 1.0);
+  const double u = std::clamp(x - 0.5, 0.0, width - 1.0),
+               v = std::clamp(y - 0.5, 0.0, height - 1.0);
   const int x0 = std::min(static_cast<int>(u), std::max(0, width - 2));
   const int y0 = std::min(static_cast<int>(v), std::max(0, height - 2));
   const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
@@ -29,7 +31,9 @@ void Bilinear(int width, int height, double x, double y, int count, const Get& g
   }
 }
 
-Eigen::Vector2d ToOpenCv(const Eigen::Vector2d& colmap_px) { return colmap_px - Eigen::Vector2d(0.5, 0.5); }
+Eigen::Vector2d ToOpenCv(const Eigen::Vector2d& colmap_px) {
+  return colmap_px - Eigen::Vector2d(0.5, 0.5);
+}
 
 }  // namespace
 
@@ -68,19 +72,25 @@ ModelRenderer::ModelRenderer(const TexturedModel& model) : model_(model), impl_(
   if (!impl_->device) throw std::runtime_error("Embree: cannot create a device");
   impl_->scene = rtcNewScene(impl_->device);
   RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-      geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size()));
+  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                               RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                               mesh.vertices.size()));
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
-    for (int c = 0; c < 3; ++c) vertices[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(mesh.vertices[i][c]);
-  auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-      geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), mesh.faces.size()));
+    for (int c = 0; c < 3; ++c)
+      vertices[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(mesh.vertices[i][c]);
+  auto* indices = static_cast<unsigned*>(
+      rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                              3 * sizeof(unsigned), mesh.faces.size()));
   for (std::size_t f = 0; f < mesh.faces.size(); ++f)
-    for (int c = 0; c < 3; ++c) indices[3 * f + static_cast<std::size_t>(c)] = static_cast<unsigned>(mesh.faces[f][static_cast<std::size_t>(c)]);
+    for (int c = 0; c < 3; ++c)
+      indices[3 * f + static_cast<std::size_t>(c)] =
+          static_cast<unsigned>(mesh.faces[f][static_cast<std::size_t>(c)]);
   rtcCommitGeometry(geometry);
   rtcAttachGeometry(impl_->scene, geometry);
   rtcReleaseGeometry(geometry);
   rtcCommitScene(impl_->scene);
-  if (rtcGetDeviceError(impl_->device) != RTC_ERROR_NONE) throw std::runtime_error("Embree: scene build failed");
+  if (rtcGetDeviceError(impl_->device) != RTC_ERROR_NONE)
+    throw std::runtime_error("Embree: scene build failed");
 }
 
 ModelRenderer::~ModelRenderer() = default;
@@ -88,7 +98,8 @@ ModelRenderer::~ModelRenderer() = default;
 RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
                                    const std::vector<sfm::ObjectLight>& lights, RenderMode mode,
                                    int samples_per_axis) const {
-  if (samples_per_axis < 1 || samples_per_axis > 8) throw OptionError("samples per axis must be in [1, 8]");
+  if (samples_per_axis < 1 || samples_per_axis > 8)
+    throw OptionError("samples per axis must be in [1, 8]");
   if (mode == RenderMode::kBaked && baked.size() != model_.atlases.size())
     throw OptionError("the baked baseline needs one baked texture per atlas");
   const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
@@ -140,34 +151,56 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
             const auto& v = mesh.faces[f];
             const Eigen::Vector3d normal = (b0 * vertex_normals_[static_cast<std::size_t>(v[0])] +
                                             b1 * vertex_normals_[static_cast<std::size_t>(v[1])] +
-                                            b2 * vertex_normals_[static_cast<std::size_t>(v[2])]).normalized();
+                                            b2 * vertex_normals_[static_cast<std::size_t>(v[2])])
+                                               .normalized();
             double shading = 0.0;
-            for (const sfm::ObjectLight& l : lights) shading += l.intensity * std::max(0.0, normal.dot(l.DirectionFrom(point)));
-            for (int c = 0; c < 3; ++c) value[c] = LinearToSrgb(static_cast<float>(shading) * flat_linear[c]);
+            for (const sfm::ObjectLight& l : lights)
+              shading += l.intensity * std::max(0.0, normal.dot(l.DirectionFrom(point)));
+            for (int c = 0; c < 3; ++c)
+              value[c] = LinearToSrgb(static_cast<float>(shading) * flat_linear[c]);
           } else {
             const auto& c = model_.corner_px[f];
-            const Eigen::Vector2d px = b0 * c[0].cast<double>() + b1 * c[1].cast<double>() + b2 * c[2].cast<double>();
+            const Eigen::Vector2d px =
+                b0 * c[0].cast<double>() + b1 * c[1].cast<double>() + b2 * c[2].cast<double>();
             const int atlas_index = model_.face_atlas[f];
             if (mode == RenderMode::kBaked) {
               const cv::Mat& tex = baked[static_cast<std::size_t>(atlas_index)];
-              Bilinear(tex.cols, tex.rows, px.x(), px.y(), 3,
-                       [&](int xx, int yy, int ch) { return tex.at<cv::Vec3f>(yy, xx)[ch]; }, texel.data());
+              Bilinear(
+                  tex.cols, tex.rows, px.x(), px.y(), 3,
+                  [&](int xx, int yy, int ch) { return tex.at<cv::Vec3f>(yy, xx)[ch]; },
+                  texel.data());
               value = Eigen::Vector3f(texel[0], texel[1], texel[2]);
             } else {
               const ptm::Ptm& atlas = model_.atlases[static_cast<std::size_t>(atlas_index)];
               const int coefficient_count = atlas.NumPolynomials() * 6;
               const bool lrgb = atlas.format == ptm::PtmFormat::kLrgb;
-              Bilinear(atlas.width, atlas.height, px.x(), px.y(), coefficient_count + (lrgb ? 3 : 0),
-                       [&](int xx, int yy, int ch) {
-                         const std::size_t t = static_cast<std::size_t>(yy) * atlas.width + xx;
-                         return ch < coefficient_count ? atlas.Coefficients(t)[ch]
-                                                       : atlas.colour[t * 3 + static_cast<std::size_t>(ch - coefficient_count)];
-                       },
-                       texel.data());
+              Bilinear(
+                  atlas.width, atlas.height, px.x(), px.y(), coefficient_count + (lrgb ? 3 : 0),
+                  [&](int xx, int yy, int ch) {
+                    const std::size_t t = static_cast<std::size_t>(yy) * atlas.width + xx;
+                    return ch < coefficient_count
+                               ? atlas.Coefficients(t)[ch]
+                               : atlas.colour[t * 3 +
+                                              static_cast<std::size_t>(ch - coefficient_count)];
+                  },
+                  texel.data());
+              // The face frame turned by the smallest rotation that takes the face
+              // normal to the interpolated vertex normal, so shading varies smoothly
+              // across faces of the coarse mesh, as on the surface it approximates.
+              const auto& v = mesh.faces[f];
+              const Eigen::Vector3d smooth = (b0 * vertex_normals_[static_cast<std::size_t>(v[0])] +
+                                              b1 * vertex_normals_[static_cast<std::size_t>(v[1])] +
+                                              b2 * vertex_normals_[static_cast<std::size_t>(v[2])])
+                                                 .normalized();
+              const Eigen::Matrix3d frame =
+                  Eigen::Quaterniond::FromTwoVectors(face_frames_[f].col(2), smooth)
+                      .toRotationMatrix() *
+                  face_frames_[f];
               std::vector<std::pair<Eigen::Vector3d, double>> local;
               for (const sfm::ObjectLight& l : lights)
-                local.emplace_back(face_frames_[f].transpose() * l.DirectionFrom(point), l.intensity);
-              value = RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format, local, 1.0);
+                local.emplace_back(frame.transpose() * l.DirectionFrom(point), l.intensity);
+              value = RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format,
+                                     local, 1.0);
             }
           }
           sum += value;
@@ -198,7 +231,9 @@ std::vector<cv::Mat> BakePhotoTextures(const TexturedModel& model,
   const sfm::TriangleMesh& mesh = model.mesh;
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     const sfm::TriangleVisibility& tv = visibility.triangles[f];
-    const auto it = tv.best_view_source == sfm::BestViewSource::kNone ? photo_index.end() : photo_index.find(tv.best_view);
+    const auto it = tv.best_view_source == sfm::BestViewSource::kNone
+                        ? photo_index.end()
+                        : photo_index.find(tv.best_view);
     if (it == photo_index.end()) continue;
     const MeshPhoto& photo = photos[it->second];
     const double gain = photo_gains[it->second];
@@ -209,10 +244,13 @@ std::vector<cv::Mat> BakePhotoTextures(const TexturedModel& model,
     const auto& c = model.corner_px[f];
     Eigen::Vector2f lo = c[0], hi = c[0];
     for (const auto& p : c) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-    const double det = (c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x();
+    const double det =
+        (c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x();
     if (std::abs(det) < 1e-12) continue;
-    for (int y = std::max(0, static_cast<int>(std::floor(lo.y()))); y <= std::min(tex.rows - 1, static_cast<int>(std::ceil(hi.y()))); ++y) {
-      for (int x = std::max(0, static_cast<int>(std::floor(lo.x()))); x <= std::min(tex.cols - 1, static_cast<int>(std::ceil(hi.x()))); ++x) {
+    for (int y = std::max(0, static_cast<int>(std::floor(lo.y())));
+         y <= std::min(tex.rows - 1, static_cast<int>(std::ceil(hi.y()))); ++y) {
+      for (int x = std::max(0, static_cast<int>(std::floor(lo.x())));
+           x <= std::min(tex.cols - 1, static_cast<int>(std::ceil(hi.x()))); ++x) {
         const Eigen::Vector2d q(x + 0.5, y + 0.5);
         const Eigen::Vector2d d = q - c[0].cast<double>();
         const double b1 = (d.x() * (c[2] - c[0]).y() - d.y() * (c[2] - c[0]).x()) / det;
@@ -220,16 +258,22 @@ std::vector<cv::Mat> BakePhotoTextures(const TexturedModel& model,
         const double b0 = 1 - b1 - b2;
         const double eps = -0.02;
         if (b0 < eps || b1 < eps || b2 < eps) continue;
-        const Eigen::Vector3d world = b0 * mesh.Corner(f, 0) + b1 * mesh.Corner(f, 1) + b2 * mesh.Corner(f, 2);
-        const auto px = camera.ImageFromCam(image.cam_from_world.rotation * world + image.cam_from_world.translation);
+        const Eigen::Vector3d world =
+            b0 * mesh.Corner(f, 0) + b1 * mesh.Corner(f, 1) + b2 * mesh.Corner(f, 2);
+        const auto px = camera.ImageFromCam(image.cam_from_world.rotation * world +
+                                            image.cam_from_world.translation);
         if (!px) continue;
         const Eigen::Vector2d o = ToOpenCv(*px);
-        if (o.x() < -0.5 || o.y() < -0.5 || o.x() > photo.image.cols - 0.5 || o.y() > photo.image.rows - 0.5) continue;
+        if (o.x() < -0.5 || o.y() < -0.5 || o.x() > photo.image.cols - 0.5 ||
+            o.y() > photo.image.rows - 0.5)
+          continue;
         float rgb[3];
-        Bilinear(photo.image.cols, photo.image.rows, o.x() + 0.5, o.y() + 0.5, 3,
-                 [&](int xx, int yy, int ch) { return photo.image.at<cv::Vec3f>(yy, xx)[ch]; }, rgb);
+        Bilinear(
+            photo.image.cols, photo.image.rows, o.x() + 0.5, o.y() + 0.5, 3,
+            [&](int xx, int yy, int ch) { return photo.image.at<cv::Vec3f>(yy, xx)[ch]; }, rgb);
         cv::Vec3f& out = tex.at<cv::Vec3f>(y, x);
-        for (int ch = 0; ch < 3; ++ch) out[ch] = LinearToSrgb(static_cast<float>(SrgbToLinear(rgb[ch]) / gain));
+        for (int ch = 0; ch < 3; ++ch)
+          out[ch] = LinearToSrgb(static_cast<float>(SrgbToLinear(rgb[ch]) / gain));
         mask.at<std::uint8_t>(y, x) = 255;
       }
     }
@@ -249,14 +293,17 @@ std::vector<cv::Mat> BakePhotoTextures(const TexturedModel& model,
       cv::boxFilter(mask_f, weight, -1, cv::Size(3, 3), cv::Point(-1, -1), false);
       for (int y = 0; y < grown.rows; ++y)
         for (int x = 0; x < grown.cols; ++x)
-          if (grown.at<std::uint8_t>(y, x) && !filled[a].at<std::uint8_t>(y, x) && weight.at<float>(y, x) > 0)
+          if (grown.at<std::uint8_t>(y, x) && !filled[a].at<std::uint8_t>(y, x) &&
+              weight.at<float>(y, x) > 0)
             textures[a].at<cv::Vec3f>(y, x) = blurred.at<cv::Vec3f>(y, x) / weight.at<float>(y, x);
       filled[a] = grown;
     }
     for (int y = 0; y < filled[a].rows; ++y)
       for (int x = 0; x < filled[a].cols; ++x)
         if (!filled[a].at<std::uint8_t>(y, x))
-          textures[a].at<cv::Vec3f>(y, x) = cv::Vec3f(static_cast<float>(mean[0]), static_cast<float>(mean[1]), static_cast<float>(mean[2]));
+          textures[a].at<cv::Vec3f>(y, x) =
+              cv::Vec3f(static_cast<float>(mean[0]), static_cast<float>(mean[1]),
+                        static_cast<float>(mean[2]));
   }
   return textures;
 }
@@ -280,21 +327,26 @@ Eigen::Vector3f MeanAlbedoFromPhotos(const sfm::TriangleMesh& mesh,
     const MeshPhoto& photo = photos[it->second];
     const sfm::Image& image = reconstruction.images.at(photo.image_id);
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
-    const Eigen::Vector3d centroid = (mesh.Corner(f, 0) + mesh.Corner(f, 1) + mesh.Corner(f, 2)) / 3.0;
-    const auto px = camera.ImageFromCam(image.cam_from_world.rotation * centroid + image.cam_from_world.translation);
+    const Eigen::Vector3d centroid =
+        (mesh.Corner(f, 0) + mesh.Corner(f, 1) + mesh.Corner(f, 2)) / 3.0;
+    const auto px = camera.ImageFromCam(image.cam_from_world.rotation * centroid +
+                                        image.cam_from_world.translation);
     if (!px) continue;
     const int x = static_cast<int>(px->x()), y = static_cast<int>(px->y());
     if (x < 0 || y < 0 || x >= photo.image.cols || y >= photo.image.rows) continue;
     double shading = 0.0;
-    for (const sfm::ObjectLight& l : photo.lights) shading += l.intensity * std::max(0.0, normals[f].dot(l.DirectionFrom(centroid)));
+    for (const sfm::ObjectLight& l : photo.lights)
+      shading += l.intensity * std::max(0.0, normals[f].dot(l.DirectionFrom(centroid)));
     if (shading < 0.2) continue;
     const cv::Vec3f rgb = photo.image.at<cv::Vec3f>(y, x);
-    for (int c = 0; c < 3; ++c) colour_sum[c] += areas[f] * SrgbToLinear(rgb[c]) / photo_gains[it->second];
+    for (int c = 0; c < 3; ++c)
+      colour_sum[c] += areas[f] * SrgbToLinear(rgb[c]) / photo_gains[it->second];
     shading_sum += areas[f] * shading;
   }
   if (shading_sum <= 0) return Eigen::Vector3f::Constant(0.5f);
   Eigen::Vector3f out;
-  for (int c = 0; c < 3; ++c) out[c] = LinearToSrgb(static_cast<float>(colour_sum[c] / shading_sum));
+  for (int c = 0; c < 3; ++c)
+    out[c] = LinearToSrgb(static_cast<float>(colour_sum[c] / shading_sum));
   return out;
 }
 

@@ -34,7 +34,11 @@ void WritePng(const fs::path& path, const cv::Mat& image) {
   std::vector<unsigned char> png;
   if (!cv::imencode(".png", image, png)) throw InputError(path.string(), "PNG encoding failed");
   WriteFileAtomically(
-      path, [&](std::ostream& o) { o.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size())); },
+      path,
+      [&](std::ostream& o) {
+        o.write(reinterpret_cast<const char*>(png.data()),
+                static_cast<std::streamsize>(png.size()));
+      },
       true);
 }
 
@@ -62,10 +66,17 @@ cv::Mat ReadPhotoRgb(const fs::path& path) {
   }
   double scale = 1.0;
   switch (bgr.depth()) {
-    case CV_8U: scale = 1.0 / 255.0; break;
-    case CV_16U: scale = 1.0 / 65535.0; break;
-    case CV_32F: scale = 1.0; break;
-    default: throw InputError(path.string(), "has an unsupported pixel type");
+    case CV_8U:
+      scale = 1.0 / 255.0;
+      break;
+    case CV_16U:
+      scale = 1.0 / 65535.0;
+      break;
+    case CV_32F:
+      scale = 1.0;
+      break;
+    default:
+      throw InputError(path.string(), "has an unsupported pixel type");
   }
   cv::Mat f, rgb;
   bgr.convertTo(f, CV_32FC3, scale);
@@ -81,7 +92,8 @@ sfm::TriangleMesh SubdivideMidpoint(const sfm::TriangleMesh& mesh) {
     const std::pair<int, int> key(std::min(a, b), std::max(a, b));
     const auto it = midpoint.find(key);
     if (it != midpoint.end()) return it->second;
-    out.vertices.push_back(0.5 * (mesh.vertices[static_cast<std::size_t>(a)] + mesh.vertices[static_cast<std::size_t>(b)]));
+    out.vertices.push_back(0.5 * (mesh.vertices[static_cast<std::size_t>(a)] +
+                                  mesh.vertices[static_cast<std::size_t>(b)]));
     const int id = static_cast<int>(out.vertices.size() - 1);
     midpoint.emplace(key, id);
     return id;
@@ -104,9 +116,11 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
     throw OptionError("max subdivisions must be in [0, 6]");
   const auto start = std::chrono::steady_clock::now();
   SynthJobSummary summary;
-  if (fs::exists(options.out_dir) && (!fs::is_directory(options.out_dir) ||
-                                      (!fs::exists(options.out_dir / "manifest.json") && !fs::is_empty(options.out_dir)))) {
-    throw InputError(options.out_dir.string(), "exists and is not a texlume model folder; not replacing it");
+  if (fs::exists(options.out_dir) &&
+      (!fs::is_directory(options.out_dir) ||
+       (!fs::exists(options.out_dir / "manifest.json") && !fs::is_empty(options.out_dir)))) {
+    throw InputError(options.out_dir.string(),
+                     "exists and is not a texlume model folder; not replacing it");
   }
 
   // Inputs.
@@ -116,7 +130,8 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
   const std::vector<std::string> unlit =
       sfm::CheckLightsAgainstModel(lights, reconstruction, options.lights_file.string());
   for (const std::string& name : unlit)
-    summary.warnings.push_back("skipping " + name + ": no light for it in " + options.lights_file.string());
+    summary.warnings.push_back("skipping " + name + ": no light for it in " +
+                               options.lights_file.string());
   sfm::LoadedMesh loaded_mesh = sfm::LoadMesh(options.mesh_file);
   for (const std::string& problem : loaded_mesh.report.Problems())
     summary.warnings.push_back(options.mesh_file.string() + ": " + problem);
@@ -137,16 +152,19 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
     photo.name = image.name;
     photo.image = ReadPhotoRgb(file);
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
-    if (photo.image.cols != static_cast<int>(camera.width) || photo.image.rows != static_cast<int>(camera.height)) {
-      throw InputError(file.string(), "is " + std::to_string(photo.image.cols) + "x" + std::to_string(photo.image.rows) +
-                                          " but its camera is " + std::to_string(camera.width) + "x" +
+    if (photo.image.cols != static_cast<int>(camera.width) ||
+        photo.image.rows != static_cast<int>(camera.height)) {
+      throw InputError(file.string(), "is " + std::to_string(photo.image.cols) + "x" +
+                                          std::to_string(photo.image.rows) + " but its camera is " +
+                                          std::to_string(camera.width) + "x" +
                                           std::to_string(camera.height));
     }
     photo.lights = it->second;
     photos.push_back(std::move(photo));
   }
   if (photos.empty()) {
-    throw InputError(options.images_dir.string(), "no usable photo: every image of the model lacks a light or a file");
+    throw InputError(options.images_dir.string(),
+                     "no usable photo: every image of the model lacks a light or a file");
   }
   summary.photos_used = photos.size();
   summary.seconds_load = Since(start);
@@ -157,7 +175,8 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
     double widest = 0;
     for (std::size_t f = 0; f < m.faces.size(); ++f) {
       double longest = 0;
-      for (int k = 0; k < 3; ++k) longest = std::max(longest, (m.Corner(f, (k + 1) % 3) - m.Corner(f, k)).norm());
+      for (int k = 0; k < 3; ++k)
+        longest = std::max(longest, (m.Corner(f, (k + 1) % 3) - m.Corner(f, k)).norm());
       widest = std::max(widest, longest);
     }
     return widest / options.synthesis.sample_texel_size + 2 * options.synthesis.strip + 2;
@@ -172,7 +191,8 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
                                " time(s) so that every triangle's patch fits the sample");
   }
   summary.faces = mesh.faces.size();
-  const sfm::VisibilityResult visibility = sfm::ComputeVisibility(mesh, reconstruction, options.visibility, progress);
+  const sfm::VisibilityResult visibility =
+      sfm::ComputeVisibility(mesh, reconstruction, options.visibility, progress);
   // Photos used here only (visibility saw every image of the model).
   std::size_t seen_by_usable = 0;
   {
@@ -180,22 +200,26 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
     for (const MeshPhoto& p : photos) usable[p.image_id] = true;
     for (const auto& tv : visibility.triangles) {
       bool seen = false;
-      for (const auto& v : tv.views) seen = seen || (usable.count(v.image_id) && v.visible_fraction > 0);
+      for (const auto& v : tv.views)
+        seen = seen || (usable.count(v.image_id) && v.visible_fraction > 0);
       seen_by_usable += seen;
     }
   }
   if (seen_by_usable * 2 < mesh.faces.size()) {
     throw InputError(options.mesh_file.string(),
-                     std::to_string(mesh.faces.size() - seen_by_usable) + " of " + std::to_string(mesh.faces.size()) +
-                         " triangles project outside every usable photo or face away from it: is the mesh in the "
-                         "frame of the COLMAP model " + options.model_dir.string() + "?");
+                     std::to_string(mesh.faces.size() - seen_by_usable) + " of " +
+                         std::to_string(mesh.faces.size()) +
+                         " triangles project outside every usable photo or face away from it: is "
+                         "the mesh in the "
+                         "frame of the COLMAP model " +
+                         options.model_dir.string() + "?");
   }
   summary.seconds_visibility = Since(t);
 
   // Synthesis (Algorithm 2), blending and atlases.
   t = std::chrono::steady_clock::now();
-  const MeshSynthesis synthesis =
-      SynthesizeMeshPtm(mesh, reconstruction, visibility, photos, sample, options.synthesis, progress);
+  const MeshSynthesis synthesis = SynthesizeMeshPtm(mesh, reconstruction, visibility, photos,
+                                                    sample, options.synthesis, progress);
   summary.seconds_synthesis = Since(t);
   summary.from_photos = synthesis.num_from_photos;
   summary.from_neighbours = synthesis.num_from_neighbours;
@@ -212,32 +236,49 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
   model.atlases = std::move(atlases.ptms);
   for (const FacePlacement& fp : atlases.faces) {
     model.face_atlas.push_back(fp.atlas);
-    model.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(), fp.corners_px[2].cast<float>()});
+    model.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
+                               fp.corners_px[2].cast<float>()});
   }
 
   // Baselines for `texlume render --baseline`.
   t = std::chrono::steady_clock::now();
-  const std::vector<cv::Mat> baked = BakePhotoTextures(model, reconstruction, visibility, photos, synthesis.photo_gains);
-  const Eigen::Vector3f flat_albedo = MeanAlbedoFromPhotos(mesh, reconstruction, visibility, photos, synthesis.photo_gains);
+  const std::vector<cv::Mat> baked =
+      BakePhotoTextures(model, reconstruction, visibility, photos, synthesis.photo_gains);
+  const Eigen::Vector3f flat_albedo =
+      MeanAlbedoFromPhotos(mesh, reconstruction, visibility, photos, synthesis.photo_gains);
   summary.seconds_baselines = Since(t);
 
   t = std::chrono::steady_clock::now();
   nlohmann::json record;
   record["command"] = "synth";
-  record["inputs"] = {{"model", options.model_dir.string()}, {"images", options.images_dir.string()},
-                      {"lights", options.lights_file.string()}, {"mesh", options.mesh_file.string()},
+  record["inputs"] = {{"model", options.model_dir.string()},
+                      {"images", options.images_dir.string()},
+                      {"lights", options.lights_file.string()},
+                      {"mesh", options.mesh_file.string()},
                       {"sample", options.sample_file.string()}};
   const MeshSynthesisOptions& so = options.synthesis;
-  record["settings"] = {{"sample_texel_size", so.sample_texel_size}, {"output_texel_size", so.sample_texel_size},
-                        {"strip", so.strip}, {"top_k", so.top_k}, {"all_views", so.all_views},
-                        {"max_views", so.max_views},
-                        {"tangent_frame", so.tangent_frame == TangentFrame::kSmoothField ? "smooth_field" : "first_edge"},
-                        {"seed", so.seed}, {"atlas_mode", options.atlas.mode == AtlasMode::kCharts ? "charts" : "per_triangle"},
-                        {"atlas_size", options.atlas.atlas_size}, {"gutter", options.atlas.gutter}};
-  record["summary"] = {{"photos_used", summary.photos_used}, {"faces", summary.faces},
-                       {"subdivisions", summary.subdivisions}, {"from_photos", summary.from_photos},
-                       {"from_neighbours_only", summary.from_neighbours}, {"random", summary.random},
-                       {"atlases", summary.atlases}, {"charts", summary.charts}, {"occupancy", summary.occupancy},
+  record["settings"] = {
+      {"sample_texel_size", so.sample_texel_size},
+      {"output_texel_size", so.sample_texel_size},
+      {"strip", so.strip},
+      {"top_k", so.top_k},
+      {"all_views", so.all_views},
+      {"max_views", so.max_views},
+      {"tangent_frame",
+       so.tangent_frame == TangentFrame::kSmoothField ? "smooth_field" : "first_edge"},
+      {"seed", so.seed},
+      {"atlas_mode", options.atlas.mode == AtlasMode::kCharts ? "charts" : "per_triangle"},
+      {"atlas_size", options.atlas.atlas_size},
+      {"gutter", options.atlas.gutter}};
+  record["summary"] = {{"photos_used", summary.photos_used},
+                       {"faces", summary.faces},
+                       {"subdivisions", summary.subdivisions},
+                       {"from_photos", summary.from_photos},
+                       {"from_neighbours_only", summary.from_neighbours},
+                       {"random", summary.random},
+                       {"atlases", summary.atlases},
+                       {"charts", summary.charts},
+                       {"occupancy", summary.occupancy},
                        {"photo_gains", synthesis.photo_gains}};
   record["warnings"] = summary.warnings;
   record["baselines"] = {{"flat_albedo", {flat_albedo.x(), flat_albedo.y(), flat_albedo.z()}},
@@ -249,10 +290,13 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
     extra.emplace_back(name, ToBgr8(baked[a]));
   }
   summary.seconds_export = Since(t);  // the folder write below is counted too
-  record["timings_s"] = {{"load", summary.seconds_load}, {"visibility", summary.seconds_visibility},
-                         {"synthesis", summary.seconds_synthesis}, {"atlas", summary.seconds_atlas},
+  record["timings_s"] = {{"load", summary.seconds_load},
+                         {"visibility", summary.seconds_visibility},
+                         {"synthesis", summary.seconds_synthesis},
+                         {"atlas", summary.seconds_atlas},
                          {"baselines", summary.seconds_baselines},
-                         {"synthesis_per_triangle", summary.seconds_synthesis / std::max<std::size_t>(1, summary.faces)}};
+                         {"synthesis_per_triangle",
+                          summary.seconds_synthesis / std::max<std::size_t>(1, summary.faces)}};
   WriteModelFolder(options.out_dir, model, record, extra);
   summary.seconds_export = Since(t);
   summary.seconds_total = Since(start);
@@ -261,30 +305,39 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
 
 RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
-  if (options.samples_per_axis < 1 || options.samples_per_axis > 8) throw OptionError("samples must be in [1, 8]");
-  if (options.reduced_factor < 1 || options.reduced_factor > 16) throw OptionError("reduced factor must be in [1, 16]");
+  if (options.samples_per_axis < 1 || options.samples_per_axis > 8)
+    throw OptionError("samples must be in [1, 8]");
+  if (options.reduced_factor < 1 || options.reduced_factor > 16)
+    throw OptionError("reduced factor must be in [1, 16]");
   RenderJobSummary summary;
   const TexturedModel model = ReadModelFolder(options.model_folder);
   ModelRenderer renderer(model);
   if (options.mode != RenderMode::kPtm) {
     std::ifstream in = OpenForReading(options.model_folder / "manifest.json", false);
     const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
-    const auto& baselines = manifest.is_object() ? manifest.value("baselines", nlohmann::json()) : nlohmann::json();
-    if (!baselines.is_object()) throw InputError((options.model_folder / "manifest.json").string(), "lists no baselines");
+    const auto& baselines =
+        manifest.is_object() ? manifest.value("baselines", nlohmann::json()) : nlohmann::json();
+    if (!baselines.is_object())
+      throw InputError((options.model_folder / "manifest.json").string(), "lists no baselines");
     if (options.mode == RenderMode::kFlat) {
       const auto& a = baselines.value("flat_albedo", nlohmann::json());
-      if (!a.is_array() || a.size() != 3) throw InputError((options.model_folder / "manifest.json").string(), "has no flat_albedo");
-      renderer.flat_albedo = Eigen::Vector3f(a[0].get<float>(), a[1].get<float>(), a[2].get<float>());
+      if (!a.is_array() || a.size() != 3)
+        throw InputError((options.model_folder / "manifest.json").string(), "has no flat_albedo");
+      renderer.flat_albedo =
+          Eigen::Vector3f(a[0].get<float>(), a[1].get<float>(), a[2].get<float>());
     } else {
       const auto& b = baselines.value("baked", nlohmann::json());
       if (!b.is_array() || b.size() != model.atlases.size())
-        throw InputError((options.model_folder / "manifest.json").string(), "has no baked texture per atlas");
-      for (const auto& name : b) renderer.baked.push_back(ReadPhotoRgb(options.model_folder / name.get<std::string>()));
+        throw InputError((options.model_folder / "manifest.json").string(),
+                         "has no baked texture per atlas");
+      for (const auto& name : b)
+        renderer.baked.push_back(ReadPhotoRgb(options.model_folder / name.get<std::string>()));
     }
   }
   const sfm::LoadedModel cameras = sfm::ReadModel(options.cameras_dir);
   const sfm::ObjectLights lights = sfm::ReadObjectLightsFile(options.lights_file);
-  for (const std::string& name : sfm::CheckLightsAgainstModel(lights, cameras.reconstruction, options.lights_file.string()))
+  for (const std::string& name :
+       sfm::CheckLightsAgainstModel(lights, cameras.reconstruction, options.lights_file.string()))
     summary.warnings.push_back("not rendering " + name + ": no light for it");
   fs::create_directories(options.out_dir / "masks");
   std::size_t done = 0;
@@ -294,7 +347,8 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
     const auto it = lights.find(image.name);
     if (it == lights.end()) continue;
     const sfm::Camera& camera = cameras.reconstruction.cameras.at(image.camera_id);
-    const RenderedView view = renderer.Render(camera, image.cam_from_world, it->second, options.mode, options.samples_per_axis);
+    const RenderedView view = renderer.Render(camera, image.cam_from_world, it->second,
+                                              options.mode, options.samples_per_axis);
     const fs::path name = PngName(image.name);
     fs::create_directories((options.out_dir / name).parent_path());
     fs::create_directories((options.out_dir / "masks" / name).parent_path());
@@ -305,12 +359,16 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
     ++summary.rendered;
     if (!options.truth_images_dir.empty()) {
       const cv::Mat truth = ReadPhotoRgb(options.truth_images_dir / image.name);
-      if (truth.size() != view.rgb.size()) throw InputError((options.truth_images_dir / image.name).string(), "does not match the camera's size");
+      if (truth.size() != view.rgb.size())
+        throw InputError((options.truth_images_dir / image.name).string(),
+                         "does not match the camera's size");
       cv::Mat truth_mask;
-      const fs::path mask_path = options.truth_masks_dir.empty() ? fs::path() : options.truth_masks_dir / image.name;
+      const fs::path mask_path =
+          options.truth_masks_dir.empty() ? fs::path() : options.truth_masks_dir / image.name;
       if (!mask_path.empty() && fs::exists(mask_path)) {
         truth_mask = cv::imread(mask_path.string(), cv::IMREAD_GRAYSCALE);
-        if (truth_mask.size() != truth.size()) throw InputError(mask_path.string(), "does not match its image's size");
+        if (truth_mask.size() != truth.size())
+          throw InputError(mask_path.string(), "does not match its image's size");
       } else {
         truth_mask = mask > 127;
       }
@@ -320,7 +378,8 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
       m.psnr = MaskedPsnr(view.rgb, truth, inside);
       m.ssim = MaskedSsim(view.rgb, truth, inside);
       if (options.reduced_factor > 1) {
-        const cv::Size small(truth.cols / options.reduced_factor, truth.rows / options.reduced_factor);
+        const cv::Size small(truth.cols / options.reduced_factor,
+                             truth.rows / options.reduced_factor);
         cv::Mat a, b, mk;
         cv::resize(view.rgb, a, small, 0, 0, cv::INTER_AREA);
         cv::resize(truth, b, small, 0, 0, cv::INTER_AREA);
@@ -332,7 +391,9 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
     }
     if (progress) progress("render", done, total);
   }
-  if (summary.rendered == 0) throw InputError(options.lights_file.string(), "gives a light for no image of " + options.cameras_dir.string());
+  if (summary.rendered == 0)
+    throw InputError(options.lights_file.string(),
+                     "gives a light for no image of " + options.cameras_dir.string());
   for (const ViewMetrics& m : summary.metrics) {
     const double n = static_cast<double>(summary.metrics.size());
     summary.mean_psnr += m.psnr / n;
@@ -343,23 +404,35 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
   summary.seconds = Since(start);
   nlohmann::json record;
   record["command"] = "render";
-  record["settings"] = {{"model", options.model_folder.string()}, {"cameras", options.cameras_dir.string()},
+  record["settings"] = {{"model", options.model_folder.string()},
+                        {"cameras", options.cameras_dir.string()},
                         {"lights", options.lights_file.string()},
-                        {"mode", options.mode == RenderMode::kPtm ? "ptm" : options.mode == RenderMode::kFlat ? "flat" : "baked"},
+                        {"mode", options.mode == RenderMode::kPtm    ? "ptm"
+                                 : options.mode == RenderMode::kFlat ? "flat"
+                                                                     : "baked"},
                         {"samples_per_axis", options.samples_per_axis}};
   record["rendered"] = summary.rendered;
   record["warnings"] = summary.warnings;
   if (!summary.metrics.empty()) {
     nlohmann::json views = nlohmann::json::array();
     for (const ViewMetrics& m : summary.metrics)
-      views.push_back({{"name", m.name}, {"psnr_db", m.psnr}, {"ssim", m.ssim}, {"psnr_reduced_db", m.psnr_reduced},
+      views.push_back({{"name", m.name},
+                       {"psnr_db", m.psnr},
+                       {"ssim", m.ssim},
+                       {"psnr_reduced_db", m.psnr_reduced},
                        {"ssim_reduced", m.ssim_reduced}});
-    record["metrics"] = {{"views", views}, {"mean_psnr_db", summary.mean_psnr}, {"mean_ssim", summary.mean_ssim},
-                         {"mean_psnr_reduced_db", summary.mean_psnr_reduced}, {"mean_ssim_reduced", summary.mean_ssim_reduced},
-                         {"reduced_factor", options.reduced_factor}, {"inside", "the ground-truth masks"}};
+    record["metrics"] = {{"views", views},
+                         {"mean_psnr_db", summary.mean_psnr},
+                         {"mean_ssim", summary.mean_ssim},
+                         {"mean_psnr_reduced_db", summary.mean_psnr_reduced},
+                         {"mean_ssim_reduced", summary.mean_ssim_reduced},
+                         {"reduced_factor", options.reduced_factor},
+                         {"inside", "the ground-truth masks"}};
   }
   record["timings_s"] = {{"total", summary.seconds}};
-  WriteFileAtomically(options.out_dir / "render.json", [&](std::ostream& o) { o << record.dump(2) << "\n"; }, false);
+  WriteFileAtomically(
+      options.out_dir / "render.json", [&](std::ostream& o) { o << record.dump(2) << "\n"; },
+      false);
   return summary;
 }
 

@@ -79,7 +79,8 @@ struct RenderJobSummary {
   double seconds = 0;
 };
 
-RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCallback& progress = {});
+RenderJobSummary RunRenderJob(const RenderJobOptions& options,
+                              const ProgressCallback& progress = {});
 
 /// Reads photos as CV_32FC3 RGB display values (8- or 16-bit, grey or colour).
 /// Throws InputError naming the file.
