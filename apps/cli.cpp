@@ -387,11 +387,12 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
 }
 
 int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const Arguments a(args,
-                    {"model", "images", "lights", "mesh", "sample", "sample-texel-size", "out",
-                     "strip", "top-k", "max-views", "atlas", "atlas-size", "gutter", "seed",
-                     "tangent-field", "max-subdivisions", "max-buffer-size"},
-                    {"all-views"});
+  const Arguments a(
+      args,
+      {"model", "images", "lights", "mesh", "sample", "sample-texel-size", "out", "strip", "top-k",
+       "max-views", "atlas", "atlas-size", "gutter", "seed", "tangent-field", "max-subdivisions",
+       "max-buffer-size", "correction-iterations", "correction-sigma"},
+      {"all-views", "no-additive-correction", "channel-correction"});
   synth::SynthJobOptions o;
   o.model_dir = a.Require("model");
   o.images_dir = a.Require("images");
@@ -409,6 +410,11 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
   o.synthesis.all_views = a.Has("all-views");
   o.synthesis.max_views = a.GetInt("max-views", o.synthesis.max_views);
   o.synthesis.seed = static_cast<std::uint32_t>(a.GetInt("seed", 1));
+  o.synthesis.correction_iterations =
+      a.GetInt("correction-iterations", o.synthesis.correction_iterations);
+  o.synthesis.correction_sigma = a.GetDouble("correction-sigma", o.synthesis.correction_sigma);
+  o.synthesis.additive_correction = !a.Has("no-additive-correction");
+  o.synthesis.channel_correction = a.Has("channel-correction");
   if (const auto field = a.Get("tangent-field")) {
     const std::vector<double> d = ParseList(*field, 3, "--tangent-field");
     o.synthesis.tangent_frame = synth::TangentFrame::kSmoothField;

@@ -109,6 +109,7 @@ void MeshSynthesisOptions::Check() const {
   if (max_views < 1) throw OptionError("max_views must be >= 1");
   if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
   if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
+  if (!(correction_sigma > 0.0)) throw OptionError("correction_sigma must be > 0");
   if (correction_iterations < 0 || correction_iterations > 5)
     throw OptionError("correction_iterations must be in [0, 5]");
   if (max_texels < 1) throw OptionError("max_texels must be >= 1");
@@ -144,10 +145,18 @@ bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) 
     const int gx0 = static_cast<int>(gu), gy0 = static_cast<int>(gv);
     const int gx1 = std::min(gx0 + 1, c0.cols - 1), gy1 = std::min(gy0 + 1, c0.rows - 1);
     const float gfx = static_cast<float>(gu - gx0), gfy = static_cast<float>(gv - gy0);
-    for (int i = 0; i < 6; ++i) {
-      const cv::Mat& m = patch.correction[static_cast<std::size_t>(i)];
-      out[i] += (1 - gfy) * ((1 - gfx) * m.at<float>(gy0, gx0) + gfx * m.at<float>(gy0, gx1)) +
-                gfy * ((1 - gfx) * m.at<float>(gy1, gx0) + gfx * m.at<float>(gy1, gx1));
+    auto at = [&](const cv::Mat& m) {
+      return (1 - gfy) * ((1 - gfx) * m.at<float>(gy0, gx0) + gfx * m.at<float>(gy0, gx1)) +
+             gfy * ((1 - gfx) * m.at<float>(gy1, gx0) + gfx * m.at<float>(gy1, gx1));
+    };
+    for (int i = 0; i < 6; ++i) out[i] += at(patch.correction[static_cast<std::size_t>(i)]);
+    for (int c = 0; c < 3 && c < static_cast<int>(patch.channel_gain.size()); ++c) {
+      const float k = at(patch.channel_gain[static_cast<std::size_t>(c)]);
+      if (format == ptm::PtmFormat::kLrgb) {
+        out[6 + c] *= k;
+      } else {
+        for (int i = 0; i < 6; ++i) out[6 * c + i] *= k;
+      }
     }
   }
   return true;
@@ -422,18 +431,32 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     return v;
   };
 
-  // 2a. Per-photo gain (exposure x light intensity, linear domain): the photo's
-  // mean over its triangles against the sample's mean relit at their lights.
-  std::vector<double> photo_sum(photos.size(), 0.0), model_sum(photos.size(), 0.0);
+  // 2a. Per-photo gain (exposure x light intensity, linear domain). For every
+  // triangle fully visible in a photo, m = photo mean / sample mean relit at the
+  // triangle's lights = a_T g_n (a_T the triangle's albedo relative to the
+  // sample's). log m = log a_T + log g_n is solved by alternating least squares
+  // over all such pairs, with the mean log a_T fixed at 0 (the object's mean
+  // albedo is the sample's), so stains and colour do not leak into the gains.
+  struct Ratio {
+    std::size_t face, photo;
+    double log_m, weight;
+  };
+  std::vector<Ratio> ratios;
   {
     const int coarse_level = std::max(
         0,
         static_cast<int>(std::ceil(4.0 * std::log2(std::max(sample.width, sample.height) / 16.0))));
     const ReducedSample& coarse = reduced_at(coarse_level);
     for (std::size_t f = 0; f < num_faces; ++f) {
-      for (const sfm::TriangleView& view : views_of(f)) {
+      int used = 0;
+      for (const sfm::TriangleView& view : visibility.triangles[f].views) {
+        if (!view.fully_visible || used >= 8) continue;
         Rectified rect;
         if (!rectify(f, view, rect)) continue;
+        // Grazing or hidden lights: the PTM is least reliable there (and shadows).
+        bool steep = true;
+        for (const auto& [l, intensity] : rect.lights) steep = steep && l.z() > 0.5;
+        if (!steep) continue;
         double photo_linear = 0.0;
         for (int j = 0; j < rect.mask.rows; ++j)
           for (int i = 0; i < rect.mask.cols; ++i)
@@ -448,15 +471,37 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
             for (int i = 0; i < relit[0].cols; ++i)
               model_linear += SrgbToLinear(relit[static_cast<std::size_t>(c)].at<float>(j, i));
         }
-        photo_sum[rect.photo] += photo_linear;
-        model_sum[rect.photo] += model_linear / static_cast<double>(relit[0].total()) * rect.count;
+        model_linear *= rect.count / static_cast<double>(relit[0].total());
+        // Dim triangles (grazing light, shadow) say little about the gain.
+        if (!(model_linear > 0.02 * 3 * rect.count) || !(photo_linear > 1e-6)) continue;
+        ratios.push_back({f, rect.photo, std::log(photo_linear / model_linear), model_linear});
+        ++used;
       }
     }
   }
+  std::vector<double> log_gain(photos.size(), 0.0), log_albedo(num_faces, 0.0);
+  for (int it = 0; it < 20; ++it) {
+    std::vector<double> sum(num_faces, 0.0), weight(num_faces, 0.0);
+    for (const Ratio& r : ratios) {
+      sum[r.face] += r.weight * (r.log_m - log_gain[r.photo]);
+      weight[r.face] += r.weight;
+    }
+    double mean = 0.0, total = 0.0;
+    for (std::size_t f = 0; f < num_faces; ++f)
+      if (weight[f] > 0)
+        log_albedo[f] = sum[f] / weight[f], mean += weight[f] * log_albedo[f], total += weight[f];
+    if (total > 0) mean /= total;
+    for (double& v : log_albedo) v -= mean;
+    std::vector<double> gsum(photos.size(), 0.0), gweight(photos.size(), 0.0);
+    for (const Ratio& r : ratios) {
+      gsum[r.photo] += r.weight * (r.log_m - log_albedo[r.face]);
+      gweight[r.photo] += r.weight;
+    }
+    for (std::size_t n = 0; n < photos.size(); ++n)
+      if (gweight[n] > 0) log_gain[n] = gsum[n] / gweight[n];
+  }
   result.photo_gains.assign(photos.size(), 1.0);
-  for (std::size_t n = 0; n < photos.size(); ++n)
-    if (model_sum[n] > 1e-9 && photo_sum[n] > 0)
-      result.photo_gains[n] = photo_sum[n] / model_sum[n];
+  for (std::size_t n = 0; n < photos.size(); ++n) result.photo_gains[n] = std::exp(log_gain[n]);
 
   // 2b. Breadth-first synthesis from a seed (the best-seen triangle).
   int seed_face = 0;
@@ -485,6 +530,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     patch.correction_density = Eigen::Vector2d(red0.rx, red0.ry);
     patch.correction.assign(6, cv::Mat());
     for (cv::Mat& m : patch.correction) m = cv::Mat::zeros(gh, gw, CV_32FC1);
+    patch.channel_gain.assign(3, cv::Mat());
+    for (cv::Mat& m : patch.channel_gain) m = cv::Mat::ones(gh, gw, CV_32FC1);
     // Per view: frame point of a primary cell -> the view's cell.
     auto view_cell = [&](const Rectified& r, int i, int j, int& vi, int& vj) {
       const ReducedSample& red = reduced_at(r.level);
@@ -496,7 +543,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     // Prediction and luminance Jacobian of view r at its cell (vi, vj), with the
     // current correction (primary grid cell (i, j)).
     auto predict = [&](const Rectified& r, int vi, int vj, int i, int j,
-                       Eigen::Matrix<double, 1, 6>& jac) {
+                       Eigen::Matrix<double, 1, 6>& jac,
+                       Eigen::Vector3d* channel_linear = nullptr) {
       const ReducedSample& red = reduced_at(r.level);
       const double sx = patch.sample_x * red.rx + vi, sy = patch.sample_y * red.ry + vj;
       const int x = std::clamp(static_cast<int>(sx), 0, red.raw[0].cols - 1);
@@ -537,6 +585,7 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       jac.setZero();
       for (int c = 0; c < 3; ++c) {
         const double lin = g * linear[c];
+        if (channel_linear) (*channel_linear)[c] = lin;
         const double d = LinearToSrgb(static_cast<float>(lin));
         const double h = 1e-4;
         const double dsrgb = (LinearToSrgb(static_cast<float>(lin + h)) -
@@ -570,6 +619,52 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     patch.photo_rms_before = rms();
     cv::Mat known = cv::Mat::zeros(gh, gw, CV_8UC1);
     for (int it = 0; it < options.correction_iterations; ++it) {
+      // Per-channel factors at low frequency (stains, colour): photo over
+      // prediction in the linear domain, summed over the views and smoothed over
+      // a few photo pixels (normalised convolution), taken back to display values
+      // (x^(1/2.2)). Finer detail stays the sample's.
+      std::vector<cv::Mat> photo_sum(3), model_sum(3);
+      if (options.channel_correction) {
+        for (int c = 0; c < 3; ++c)
+          photo_sum[static_cast<std::size_t>(c)] = cv::Mat::zeros(gh, gw, CV_32FC1),
+          model_sum[static_cast<std::size_t>(c)] = cv::Mat::zeros(gh, gw, CV_32FC1);
+        for (int j = 0; j < gh; ++j) {
+          for (int i = 0; i < gw; ++i) {
+            for (const Rectified& r : rects) {
+              int vi, vj;
+              if (!view_cell(r, i, j, vi, vj)) continue;
+              Eigen::Matrix<double, 1, 6> row;
+              Eigen::Vector3d lin;
+              predict(r, vi, vj, i, j, row, &lin);
+              for (int c = 0; c < 3; ++c) {
+                photo_sum[static_cast<std::size_t>(c)].at<float>(j, i) +=
+                    SrgbToLinear(r.planes[static_cast<std::size_t>(c)].at<float>(vj, vi));
+                model_sum[static_cast<std::size_t>(c)].at<float>(j, i) +=
+                    static_cast<float>(lin[c]);
+              }
+              known.at<std::uint8_t>(j, i) = 1;
+            }
+          }
+        }
+        for (int c = 0; c < 3; ++c) {
+          cv::Mat p, m;
+          cv::GaussianBlur(photo_sum[static_cast<std::size_t>(c)], p, cv::Size(0, 0),
+                           options.correction_sigma);
+          cv::GaussianBlur(model_sum[static_cast<std::size_t>(c)], m, cv::Size(0, 0),
+                           options.correction_sigma);
+          for (int j = 0; j < gh; ++j)
+            for (int i = 0; i < gw; ++i) {
+              if (!known.at<std::uint8_t>(j, i) || !(m.at<float>(j, i) > 1e-4f) ||
+                  !(p.at<float>(j, i) > 1e-4f))
+                continue;
+              float& k = patch.channel_gain[static_cast<std::size_t>(c)].at<float>(j, i);
+              k = std::clamp(k * static_cast<float>(
+                                     std::pow(p.at<float>(j, i) / m.at<float>(j, i), 1.0 / 2.2)),
+                             0.25f, 4.0f);
+            }
+        }
+      }
+      if (!options.additive_correction) continue;
       for (int j = 0; j < gh; ++j) {
         for (int i = 0; i < gw; ++i) {
           Eigen::Matrix<double, Eigen::Dynamic, 6> jac(static_cast<int>(rects.size()), 6);
@@ -584,6 +679,7 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
             ++rows;
           }
           if (rows == 0) continue;
+          known.at<std::uint8_t>(j, i) = 1;
           const auto jr = jac.topRows(rows);
           Eigen::MatrixXd jjt = jr * jr.transpose();
           const double scale = jjt.trace() / rows;

@@ -60,6 +60,14 @@ struct MeshSynthesisOptions {
   /// coefficients that makes the patch, relit under each constraint photo's
   /// lights, equal the rectified photo at its density. 0 = off. [0, 5]. LRGB only.
   int correction_iterations = 2;
+  /// The additive luminance change above.
+  bool additive_correction = true;
+  /// Low-frequency per-channel factors (albedo-like: stains, colour), before the
+  /// additive change. Off by default: on the synthetic scenes it lowered PSNR
+  /// under held-out lights (docs/synth.md).
+  bool channel_correction = false;
+  /// Smoothing of the per-channel factors, in photo pixels (Gaussian sigma). > 0.
+  double correction_sigma = 2.0;
   /// Refuse up front when the patches would take more texels than this.
   std::int64_t max_texels = std::int64_t{1} << 30;
   std::uint32_t seed = 1;
@@ -93,6 +101,9 @@ struct TrianglePatch {
   /// space, 6 planes, LRGB), on a grid of `correction_density` cells per texel
   /// over the patch rectangle; empty when none. Added by SamplePatch.
   std::vector<cv::Mat> correction;
+  /// Per-channel factors (3 planes on the same grid) for albedo-like
+  /// differences: LRGB colour times the factor, RGB polynomial times it.
+  std::vector<cv::Mat> channel_gain;
   Eigen::Vector2d correction_density = Eigen::Vector2d::Ones();
   double photo_rms_before = 0.0, photo_rms_after = 0.0;  ///< luminance, at photo density
 };
