@@ -387,12 +387,28 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
 }
 
 int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const Arguments a(
-      args,
-      {"model", "images", "lights", "mesh", "sample", "sample-texel-size", "out", "strip", "top-k",
-       "max-views", "atlas", "atlas-size", "gutter", "seed", "tangent-field", "max-subdivisions",
-       "max-buffer-size", "correction-iterations", "correction-sigma"},
-      {"all-views", "no-additive-correction", "channel-correction"});
+  const Arguments a(args,
+                    {"model",
+                     "images",
+                     "lights",
+                     "mesh",
+                     "sample",
+                     "sample-texel-size",
+                     "out",
+                     "strip",
+                     "top-k",
+                     "max-views",
+                     "atlas",
+                     "atlas-size",
+                     "gutter",
+                     "seed",
+                     "tangent-field",
+                     "max-subdivisions",
+                     "max-buffer-size",
+                     "correction-iterations",
+                     "correction-sigma",
+                     "chart-angle"},
+                    {"all-views", "no-additive-correction", "channel-correction"});
   synth::SynthJobOptions o;
   o.model_dir = a.Require("model");
   o.images_dir = a.Require("images");
@@ -427,6 +443,8 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
   o.atlas.mode = atlas == "charts" ? synth::AtlasMode::kCharts : synth::AtlasMode::kPerTriangle;
   o.atlas.atlas_size = a.GetInt("atlas-size", o.atlas.atlas_size);
   o.atlas.gutter = a.GetInt("gutter", o.atlas.gutter);
+  o.atlas.max_chart_normal_angle_deg =
+      a.GetDouble("chart-angle", o.atlas.max_chart_normal_angle_deg);
   o.atlas.blend_strip = o.synthesis.strip;
   o.max_subdivisions = a.GetInt("max-subdivisions", o.max_subdivisions);
   o.visibility.max_buffer_dimension = a.GetInt("max-buffer-size", 0);

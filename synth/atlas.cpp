@@ -52,6 +52,8 @@ void AtlasOptions::Check() const {
   if (atlas_size < 64 || atlas_size > 16384) throw OptionError("atlas size must be in [64, 16384]");
   if (gutter < 1 || gutter > 16) throw OptionError("gutter must be in [1, 16] texels");
   if (blend_strip < 2 || blend_strip > 32) throw OptionError("blend strip must be in [2, 32]");
+  if (!(max_chart_normal_angle_deg > 0.0 && max_chart_normal_angle_deg <= 180.0))
+    throw OptionError("max chart normal angle must be in (0, 180] degrees");
 }
 
 Eigen::Matrix<double, 6, 6> OrthonormalFrameRotation(double angle_rad) {
@@ -164,6 +166,8 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     };
     std::vector<int> chart_of(num_faces, -1);
     const double max_extent = (options.atlas_size - 2 * gutter - 2) * t;
+    const double min_cos =
+        std::cos(options.max_chart_normal_angle_deg * 3.14159265358979323846 / 180.0);
     for (std::size_t seed = 0; seed < num_faces; ++seed) {
       if (chart_of[seed] >= 0) continue;
       const int chart_id = static_cast<int>(charts.size());
@@ -227,6 +231,9 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
               synthesis
                   .unfoldings[static_cast<std::size_t>(from.face)][static_cast<std::size_t>(k)];
           if (u.face < 0 || chart_of[static_cast<std::size_t>(u.face)] >= 0) continue;
+          if (synthesis.patches[static_cast<std::size_t>(u.face)].frame.z_axis.dot(
+                  synthesis.patches[seed].frame.z_axis) < min_cos)
+            continue;
           // p_from = R_u^T (p_nb - t_u), so chart = R_from R_u^T p_nb + ...
           ChartFace cf;
           cf.face = u.face;

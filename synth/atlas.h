@@ -29,6 +29,9 @@ struct AtlasOptions {
   int gutter = 2;
   /// Blend width across mesh edges (W_e, texels; the synthesis strip). [2, 32].
   int blend_strip = 8;
+  /// kCharts: a face joins a chart only while its normal is within this angle of
+  /// the chart's first face (compact charts pack with less waste). (0, 180].
+  double max_chart_normal_angle_deg = 180.0;
   void Check() const;
 };
 
