@@ -4,6 +4,6 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install_deps.sh
 ./scripts/build.sh --target texlume
-./build/apps/texlume demo --out texlume_demo
+./build/apps/texlume demo --out out
 echo
-echo "Demo outputs are in $(pwd)/texlume_demo (run.json records settings and timings)."
+echo "Demo outputs are in $(pwd)/out: open out/report.html (run.json records settings and timings)."

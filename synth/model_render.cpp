@@ -375,8 +375,12 @@ double MaskedSsim(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask) {
   const cv::Mat mu_a = blur(a), mu_b = blur(b);
   const cv::Mat aa = blur(a.mul(a)) - mu_a.mul(mu_a), bb = blur(b.mul(b)) - mu_b.mul(mu_b);
   const cv::Mat ab = blur(a.mul(b)) - mu_a.mul(mu_b);
-  cv::Mat numerator = (2 * mu_a.mul(mu_b) + c1).mul(2 * ab + c2);
-  cv::Mat denominator = (mu_a.mul(mu_a) + mu_b.mul(mu_b) + c1).mul(aa + bb + c2);
+  cv::Mat n1 = 2 * mu_a.mul(mu_b), n2 = 2 * ab, d1 = mu_a.mul(mu_a) + mu_b.mul(mu_b), d2 = aa + bb;
+  cv::add(n1, cv::Scalar::all(c1), n1);
+  cv::add(n2, cv::Scalar::all(c2), n2);
+  cv::add(d1, cv::Scalar::all(c1), d1);
+  cv::add(d2, cv::Scalar::all(c2), d2);
+  const cv::Mat numerator = n1.mul(n2), denominator = d1.mul(d2);
   cv::Mat map;
   cv::divide(numerator, denominator, map);
   const cv::Scalar s = cv::mean(map, mask);

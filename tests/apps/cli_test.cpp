@@ -104,7 +104,7 @@ TEST_F(CliTest, BadMeshLightsAndMissingImagesAreCleanErrors) {
   EXPECT_NE(out.find("image_000.png"), std::string::npos) << out;
 }
 
-TEST(Cli, DemoWritesTheSceneInspectsItAndRecordsTheRun) {
+TEST(Cli, DemoRunsTheWholeJobAndWritesTheReport) {
   TempDir tmp;
   std::string out;
   EXPECT_EQ(
@@ -112,12 +112,46 @@ TEST(Cli, DemoWritesTheSceneInspectsItAndRecordsTheRun) {
       << out;
   EXPECT_NE(out.find("Images: 36"), std::string::npos) << out;
   EXPECT_NE(out.find("Images missing on disk: 0"), std::string::npos) << out;
+  EXPECT_NE(out.find("texlume synth"), std::string::npos) << out;
   for (const std::string f :
        {"scene/object/sparse/cameras.bin", "scene/object/sparse_txt/images.txt",
         "scene/object/mesh.ply", "scene/object/lights.json", "scene/material/capture/lights.lp",
-        "scene/MANIFEST.md", "run.json"}) {
+        "scene/MANIFEST.md", "run.json", "sample.ptm", "model/model.glb", "model/manifest.json",
+        "render_texlume/render.json", "render_flat/render.json", "render_baked/render.json",
+        "report.html"}) {
     EXPECT_TRUE(std::filesystem::exists(tmp / "demo" / f)) << f;
   }
+  const std::string report = testing::ReadText(tmp / "demo/report.html");
+  EXPECT_NE(report.find("flat baseline"), std::string::npos);
+  EXPECT_NE(report.find("render_texlume/view_00_light_00.png"), std::string::npos);
+}
+
+TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
+  TempDir tmp;
+  std::string out;
+  // No texel size: a usage error (2); a missing model: an input error naming it (1).
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e --out f", &out), 2);
+  EXPECT_NE(out.find("sample-texel-size"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth --model " + (tmp / "none").string() +
+                        " --images b --lights c --mesh d "
+                        "--sample e --sample-texel-size 0.01 --out " +
+                        (tmp / "f").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("none"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "f"));
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --atlas boxes",
+                    &out),
+            2);
+  EXPECT_EQ(Texlume("render --model " + (tmp / "nomodel").string() +
+                        " --cameras c --lights l "
+                        "--out " +
+                        (tmp / "r").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("manifest.json"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("render --model m --cameras c --lights l --out r --baseline shiny", &out), 2);
 }
 
 TEST(Cli, SceneRefusesUnknownKindsAndMaterials) {

@@ -101,9 +101,9 @@ TEST_F(MeshPipelineTest, EveryTriangleGetsAPatchMostFromThePhotos) {
   EXPECT_GT(summary_->from_photos, summary_->faces * 6 / 10);
   EXPECT_LE(summary_->random, 1u);  // one connected mesh: at most the seed
   EXPECT_EQ(summary_->photos_used, 12u);
-  for (const char* file : {"model.obj", "model.mtl", "model.glb", "manifest.json",
-                           "ptm_atlas_0.ptm", "ptm_atlas_0.exr", "base_colour_0.png",
-                           "albedo_0.png", "baked_0.png"}) {
+  for (const char* file :
+       {"model.obj", "model.mtl", "model.glb", "manifest.json", "ptm_atlas_0.ptm",
+        "ptm_atlas_0.exr", "base_colour_0.png", "albedo_0.png", "baked_0.png"}) {
     EXPECT_TRUE(fs::exists(tmp_->path() / "model" / file)) << file;
   }
   const nlohmann::json manifest =
@@ -136,7 +136,8 @@ TEST_F(MeshPipelineTest, AtlasFramesAgreeWithTriangleFrames) {
     std::mt19937 rng(5);
     double worst = 0.0;
     for (int trial = 0; trial < 200; ++trial) {
-      const std::size_t f = std::uniform_int_distribution<std::size_t>(0, mesh.faces.size() - 1)(rng);
+      const std::size_t f =
+          std::uniform_int_distribution<std::size_t>(0, mesh.faces.size() - 1)(rng);
       const FacePlacement& fp = atlases.faces[f];
       const TrianglePatch& patch = synthesis.patches[f];
       const Eigen::Vector2d p_frame =
@@ -172,11 +173,14 @@ TEST_F(MeshPipelineTest, AtlasFramesAgreeWithTriangleFrames) {
       for (int l = 0; l < 4; ++l) {
         const Eigen::Vector3d light_world =
             (patch.frame.z_axis + 0.6 * std::cos(l * 1.7) * patch.frame.x_axis +
-             0.6 * std::sin(l * 1.7) * patch.frame.y_axis).normalized();
+             0.6 * std::sin(l * 1.7) * patch.frame.y_axis)
+                .normalized();
         const Eigen::Vector3d in_frame = patch.frame.DirectionInFrame(light_world);
-        const Eigen::Vector3d in_uv(x_uv.dot(light_world), y_uv.dot(light_world), n.dot(light_world));
+        const Eigen::Vector3d in_uv(x_uv.dot(light_world), y_uv.dot(light_world),
+                                    n.dot(light_world));
         std::array<float, 6> af;
-        for (int i = 0; i < 6; ++i) af[static_cast<std::size_t>(i)] = static_cast<float>(a_at_texel[i]);
+        for (int i = 0; i < 6; ++i)
+          af[static_cast<std::size_t>(i)] = static_cast<float>(a_at_texel[i]);
         const double expected = ptm::EvaluatePolynomial(af.data(), in_frame.x(), in_frame.y());
         const double got = ptm::EvaluatePolynomial(atlas.Coefficients(texel), in_uv.x(), in_uv.y());
         worst = std::max(worst, std::abs(expected - got));
@@ -205,7 +209,8 @@ TEST_F(MeshPipelineTest, BlendingMakesEdgesContinuous) {
       const Unfolding& u = synthesis.unfoldings[f][static_cast<std::size_t>(k)];
       if (u.face < 0) continue;
       const auto& c = synthesis.patches[f].corners_in_frame;
-      const Eigen::Vector2d mid = 0.5 * (c[static_cast<std::size_t>(k)] + c[static_cast<std::size_t>((k + 1) % 3)]);
+      const Eigen::Vector2d mid =
+          0.5 * (c[static_cast<std::size_t>(k)] + c[static_cast<std::size_t>((k + 1) % 3)]);
       const Eigen::Vector2d mid_nb = u.rotation * mid + u.translation;
       auto diff = [&](bool blend) {
         if (blend) {
@@ -216,7 +221,8 @@ TEST_F(MeshPipelineTest, BlendingMakesEdgesContinuous) {
           synthesis.SamplePatch(u.face, mid_nb, b.data());
         }
         Eigen::Matrix<double, 6, 1> qa, qb;
-        for (int i = 0; i < 6; ++i) qa[i] = a[static_cast<std::size_t>(i)], qb[i] = b[static_cast<std::size_t>(i)];
+        for (int i = 0; i < 6; ++i)
+          qa[i] = a[static_cast<std::size_t>(i)], qb[i] = b[static_cast<std::size_t>(i)];
         return (qa - u.coefficients_to_this * qb).squaredNorm();
       };
       raw += diff(false);
@@ -232,7 +238,8 @@ TEST(PackSkyline, RectanglesDoNotOverlapAndStayInTheirBins) {
   std::mt19937 rng(2);
   std::vector<std::pair<int, int>> sizes;
   for (int i = 0; i < 300; ++i)
-    sizes.emplace_back(std::uniform_int_distribution<int>(3, 60)(rng), std::uniform_int_distribution<int>(3, 60)(rng));
+    sizes.emplace_back(std::uniform_int_distribution<int>(3, 60)(rng),
+                       std::uniform_int_distribution<int>(3, 60)(rng));
   const auto placed = PackSkyline(sizes, 256, 256);
   int bins = 0;
   for (const auto& p : placed) bins = std::max(bins, p[0] + 1);
@@ -245,7 +252,8 @@ TEST(PackSkyline, RectanglesDoNotOverlapAndStayInTheirBins) {
     ASSERT_GE(y, 0);
     ASSERT_LE(x + sizes[i].first, 256);
     ASSERT_LE(y + sizes[i].second, 256);
-    cv::Mat roi = used[static_cast<std::size_t>(bin)](cv::Rect(x, y, sizes[i].first, sizes[i].second));
+    cv::Mat roi =
+        used[static_cast<std::size_t>(bin)](cv::Rect(x, y, sizes[i].first, sizes[i].second));
     ASSERT_EQ(cv::countNonZero(roi), 0) << "rectangle " << i << " overlaps";
     roi.setTo(1);
     area += sizes[i].first * sizes[i].second;
@@ -257,12 +265,15 @@ TEST(PackSkyline, RectanglesDoNotOverlapAndStayInTheirBins) {
 TEST_F(MeshPipelineTest, AtlasFacesDoNotOverlapAndChartsPackTighter) {
   const TexturedModel model = ReadModelFolder(tmp_->path() / "model");
   std::vector<cv::Mat> owner;
-  for (const ptm::Ptm& a : model.atlases) owner.push_back(cv::Mat(a.height, a.width, CV_32SC1, cv::Scalar(-1)));
+  for (const ptm::Ptm& a : model.atlases)
+    owner.push_back(cv::Mat(a.height, a.width, CV_32SC1, cv::Scalar(-1)));
   int overlaps = 0;
   for (std::size_t f = 0; f < model.mesh.faces.size(); ++f) {
     cv::Mat& o = owner[static_cast<std::size_t>(model.face_atlas[f])];
     std::vector<cv::Point> poly;
-    for (const auto& c : model.corner_px[f]) poly.emplace_back(static_cast<int>(std::lround(c.x() * 16)), static_cast<int>(std::lround(c.y() * 16)));
+    for (const auto& c : model.corner_px[f])
+      poly.emplace_back(static_cast<int>(std::lround(c.x() * 16)),
+                        static_cast<int>(std::lround(c.y() * 16)));
     cv::Mat mask = cv::Mat::zeros(o.size(), CV_8UC1);
     cv::fillConvexPoly(mask, poly, 255, cv::LINE_8, 4);
     cv::erode(mask, mask, cv::Mat());  // texels strictly inside
@@ -311,7 +322,8 @@ TEST_F(MeshPipelineTest, ModelFolderRoundTripsAndTheGlbIsWellFormed) {
   EXPECT_EQ(u32(24 + json_length), 0x004E4942u);
   EXPECT_EQ(gltf["buffers"][0]["byteLength"].get<std::uint32_t>(), bin_length);
   for (const auto& view : gltf["bufferViews"]) {
-    EXPECT_LE(view["byteOffset"].get<std::size_t>() + view["byteLength"].get<std::size_t>(), bin_length);
+    EXPECT_LE(view["byteOffset"].get<std::size_t>() + view["byteLength"].get<std::size_t>(),
+              bin_length);
     EXPECT_EQ(view["byteOffset"].get<std::size_t>() % 4, 0u);
   }
   std::size_t triangles = 0;
@@ -341,9 +353,12 @@ TEST_F(MeshPipelineTest, RendersHeldOutViewsAndComparesWithTheBaselines) {
   const fs::path held = tmp_->path() / "scene/object/held_out";
   for (const auto& entry : fs::directory_iterator(held / "masks")) {
     const cv::Mat truth = cv::imread(entry.path().string(), cv::IMREAD_GRAYSCALE) > 127;
-    const cv::Mat ours = cv::imread((tmp_->path() / "render_ptm/masks" / entry.path().filename()).string(), cv::IMREAD_GRAYSCALE) > 127;
+    const cv::Mat ours =
+        cv::imread((tmp_->path() / "render_ptm/masks" / entry.path().filename()).string(),
+                   cv::IMREAD_GRAYSCALE) > 127;
     ASSERT_EQ(truth.size(), ours.size());
-    const double iou = static_cast<double>(cv::countNonZero(truth & ours)) / cv::countNonZero(truth | ours);
+    const double iou =
+        static_cast<double>(cv::countNonZero(truth & ours)) / cv::countNonZero(truth | ours);
     EXPECT_GT(iou, 0.95) << entry.path();
   }
   EXPECT_TRUE(fs::exists(tmp_->path() / "render_ptm/render.json"));
