@@ -408,7 +408,8 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
                      "max-buffer-size",
                      "correction-iterations",
                      "correction-sigma",
-                     "chart-angle"},
+                     "chart-angle",
+                     "chart-size"},
                     {"all-views", "no-additive-correction", "channel-correction"});
   synth::SynthJobOptions o;
   o.model_dir = a.Require("model");
@@ -446,6 +447,7 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
   o.atlas.gutter = a.GetInt("gutter", o.atlas.gutter);
   o.atlas.max_chart_normal_angle_deg =
       a.GetDouble("chart-angle", o.atlas.max_chart_normal_angle_deg);
+  o.atlas.max_chart_size = a.GetInt("chart-size", o.atlas.max_chart_size);
   o.atlas.blend_strip = o.synthesis.strip;
   o.max_subdivisions = a.GetInt("max-subdivisions", o.max_subdivisions);
   o.visibility.max_buffer_dimension = a.GetInt("max-buffer-size", 0);

@@ -52,6 +52,8 @@ void AtlasOptions::Check() const {
   if (atlas_size < 64 || atlas_size > 16384) throw OptionError("atlas size must be in [64, 16384]");
   if (gutter < 1 || gutter > 16) throw OptionError("gutter must be in [1, 16] texels");
   if (blend_strip < 2 || blend_strip > 32) throw OptionError("blend strip must be in [2, 32]");
+  if (max_chart_size < 0 || max_chart_size > atlas_size)
+    throw OptionError("max chart size must be in [0, atlas size]");
   if (!(max_chart_normal_angle_deg > 0.0 && max_chart_normal_angle_deg <= 180.0))
     throw OptionError("max chart normal angle must be in (0, 180] degrees");
 }
@@ -165,7 +167,11 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
       return false;
     };
     std::vector<int> chart_of(num_faces, -1);
-    const double max_extent = (options.atlas_size - 2 * gutter - 2) * t;
+    const double max_extent =
+        ((options.max_chart_size > 0 ? std::min(options.max_chart_size, options.atlas_size)
+                                     : options.atlas_size) -
+         2 * gutter - 2) *
+        t;
     const double min_cos =
         std::cos(options.max_chart_normal_angle_deg * 3.14159265358979323846 / 180.0);
     for (std::size_t seed = 0; seed < num_faces; ++seed) {
@@ -266,8 +272,79 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     chart_hi.push_back(ihi);
     sizes.emplace_back(ihi.x() - ilo.x(), ihi.y() - ilo.y());
   }
-  const std::vector<std::array<int, 3>> packed =
-      PackSkyline(sizes, options.atlas_size, options.atlas_size);
+  std::vector<std::array<int, 3>> packed;
+  if (options.mode == AtlasMode::kPerTriangle) {
+    packed = PackSkyline(sizes, options.atlas_size, options.atlas_size);
+  } else {
+    // Charts are packed by their shapes: each chart's texels within the gutter
+    // of its triangles, at cells of kCell texels (conservative), placed at the
+    // lowest, then leftmost, cell position where they overlap nothing, so charts
+    // nest in each other's concavities.
+    constexpr int kCell = 4;
+    const int grid = options.atlas_size / kCell;
+    std::vector<std::vector<cv::Point>> cells(charts.size());
+    std::vector<cv::Size> cell_size(charts.size());
+    for (std::size_t c = 0; c < charts.size(); ++c) {
+      const int cw = (sizes[c].first + kCell - 1) / kCell,
+                ch = (sizes[c].second + kCell - 1) / kCell;
+      cell_size[c] = cv::Size(cw, ch);
+      cv::Mat mask = cv::Mat::zeros(ch, cw, CV_8UC1);
+      for (const ChartFace& cf : charts[c]) {
+        std::array<Eigen::Vector2d, 3> corners;
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector2d q =
+              (cf.rotation * synthesis.patches[static_cast<std::size_t>(cf.face)]
+                                 .corners_in_frame[static_cast<std::size_t>(k)] +
+               cf.translation) /
+              t;
+          corners[static_cast<std::size_t>(k)] =
+              Eigen::Vector2d(q.x() - chart_lo[c].x(), chart_hi[c].y() - q.y());
+        }
+        Eigen::Vector2d lo = corners[0], hi = lo;
+        for (const auto& p : corners) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+        for (int y = std::max(0, static_cast<int>(lo.y()) - gutter - 1);
+             y <= std::min(sizes[c].second - 1, static_cast<int>(hi.y()) + gutter + 1); ++y)
+          for (int x = std::max(0, static_cast<int>(lo.x()) - gutter - 1);
+               x <= std::min(sizes[c].first - 1, static_cast<int>(hi.x()) + gutter + 1); ++x)
+            if (SignedDistance(corners, Eigen::Vector2d(x + 0.5, y + 0.5)) <= gutter + 0.5)
+              mask.at<std::uint8_t>(y / kCell, x / kCell) = 1;
+      }
+      cv::findNonZero(mask, cells[c]);
+    }
+    std::vector<std::size_t> order(charts.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return cells[a].size() > cells[b].size();
+    });
+    std::vector<cv::Mat> occupied;
+    packed.resize(charts.size());
+    for (const std::size_t c : order) {
+      if (cell_size[c].width > grid || cell_size[c].height > grid)
+        throw OptionError("a chart of " + std::to_string(sizes[c].first) + " x " +
+                          std::to_string(sizes[c].second) + " texels does not fit an atlas of " +
+                          std::to_string(options.atlas_size));
+      bool placed = false;
+      for (std::size_t bin = 0; !placed; ++bin) {
+        if (bin == occupied.size()) occupied.push_back(cv::Mat::zeros(grid, grid, CV_8UC1));
+        cv::Mat& occ = occupied[bin];
+        for (int y = 0; y + cell_size[c].height <= grid && !placed; ++y) {
+          for (int x = 0; x + cell_size[c].width <= grid && !placed; ++x) {
+            bool free = true;
+            for (const cv::Point& p : cells[c])
+              if (occ.at<std::uint8_t>(y + p.y, x + p.x)) {
+                free = false;
+                break;
+              }
+            if (!free) continue;
+            for (const cv::Point& p : cells[c]) occ.at<std::uint8_t>(y + p.y, x + p.x) = 1;
+            packed[c] = {static_cast<int>(bin), x * kCell, y * kCell};
+            placed = true;
+          }
+        }
+      }
+      if (progress) progress("packing", static_cast<std::size_t>(&c - &order[0]) + 1, order.size());
+    }
+  }
 
   Atlases atlases;
   atlases.num_charts = static_cast<int>(charts.size());

@@ -32,6 +32,9 @@ struct AtlasOptions {
   /// kCharts: a face joins a chart only while its normal is within this angle of
   /// the chart's first face (compact charts pack with less waste). (0, 180].
   double max_chart_normal_angle_deg = 180.0;
+  /// kCharts: largest chart side in texels (0 = the atlas size); smaller charts
+  /// nest better. [0, atlas_size].
+  int max_chart_size = 256;
   void Check() const;
 };
 
