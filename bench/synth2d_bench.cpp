@@ -20,6 +20,7 @@
 #include "datasets_synthetic/scene.h"
 #include "ptm/fit.h"
 #include "sfm/lights.h"
+#include "synth/mesh_synthesis.h"
 #include "synth/planar_synthesis.h"
 #include "synth/template_match.h"
 
@@ -149,14 +150,12 @@ int main(int argc, char** argv) {
   // (linear domain, per channel, exact with 3 lights), upscaled, relit.
   auto to_linear = [](cv::Mat m) {
     for (float* p = m.ptr<float>(); p != m.ptr<float>() + m.total() * 3; ++p)
-      *p = *p <= 0.04045f ? *p / 12.92f : std::pow((*p + 0.055f) / 1.055f, 2.4f);
+      *p = synth::SrgbToLinear(*p);
     return m;
   };
   auto to_srgb = [](cv::Mat m) {
-    for (float* p = m.ptr<float>(); p != m.ptr<float>() + m.total() * 3; ++p) {
-      const float v = std::clamp(*p, 0.0f, 1.0f);
-      *p = v <= 0.0031308f ? v * 12.92f : 1.055f * std::pow(v, 1 / 2.4f) - 0.055f;
-    }
+    for (float* p = m.ptr<float>(); p != m.ptr<float>() + m.total() * 3; ++p)
+      *p = synth::LinearToSrgb(*p);
     return m;
   };
   std::vector<cv::Mat> up_linear;

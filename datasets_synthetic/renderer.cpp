@@ -1,7 +1,5 @@
 #include "datasets_synthetic/renderer.h"
 
-#include <embree3/rtcore.h>
-
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
@@ -9,6 +7,7 @@
 #include <string>
 
 #include "sfm/errors.h"
+#include "synth/ray_caster.h"
 
 namespace texlume::datasets {
 namespace {
@@ -111,12 +110,7 @@ DisplacedGeometry DisplacePatches(const std::vector<SurfacePatch>& patches,
 }
 
 struct Renderer::Impl {
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
-  ~Impl() {
-    if (scene) rtcReleaseScene(scene);
-    if (device) rtcReleaseDevice(device);
-  }
+  std::unique_ptr<synth::RayCaster> caster;
 };
 
 Renderer::Renderer(DisplacedGeometry geometry, std::vector<const BakedMaterial*> materials)
@@ -124,34 +118,8 @@ Renderer::Renderer(DisplacedGeometry geometry, std::vector<const BakedMaterial*>
   for (std::uint16_t p : geometry_.triangle_patch) {
     if (p >= materials_.size()) throw std::invalid_argument("Renderer: missing material");
   }
-  impl_->device = rtcNewDevice(nullptr);
-  if (!impl_->device) throw std::runtime_error("Embree: cannot create a device");
-  impl_->scene = rtcNewScene(impl_->device);
-  RTCGeometry mesh = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(mesh, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                               RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                               geometry_.positions.size()));
-  for (std::size_t i = 0; i < geometry_.positions.size(); ++i) {
-    for (int c = 0; c < 3; ++c)
-      vertices[3 * i + static_cast<std::size_t>(c)] = geometry_.positions[i][c];
-  }
-  auto* indices = static_cast<unsigned*>(
-      rtcSetNewGeometryBuffer(mesh, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                              3 * sizeof(unsigned), geometry_.triangles.size()));
-  for (std::size_t i = 0; i < geometry_.triangles.size(); ++i) {
-    for (int c = 0; c < 3; ++c)
-      indices[3 * i + static_cast<std::size_t>(c)] =
-          geometry_.triangles[i][static_cast<std::size_t>(c)];
-  }
-  rtcCommitGeometry(mesh);
-  rtcAttachGeometry(impl_->scene, mesh);
-  rtcReleaseGeometry(mesh);
-  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
-  rtcCommitScene(impl_->scene);
-  const RTCError error = rtcGetDeviceError(impl_->device);
-  if (error != RTC_ERROR_NONE) {
-    throw std::runtime_error("Embree: scene build failed (error " + std::to_string(error) + ")");
-  }
+  impl_->caster = std::make_unique<synth::RayCaster>(geometry_.positions, geometry_.triangles,
+                                                     /*high_quality=*/true);
 }
 
 Renderer::~Renderer() = default;
@@ -170,11 +138,9 @@ Rendering Renderer::Render(int width, int height, const RayAt& ray_at,
   const double inv_samples = 1.0 / (n * n);
   std::vector<Eigen::Vector3d> light_dirs;
   for (const auto& l : lights) light_dirs.push_back(l.direction_in_world.normalized());
-  const RTCScene scene = impl_->scene;
 
 #pragma omp parallel for schedule(dynamic, 4)
   for (int y = 0; y < height; ++y) {
-    RTCIntersectContext context;
     for (int x = 0; x < width; ++x) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       int hits = 0;
@@ -182,26 +148,12 @@ Rendering Renderer::Render(int width, int height, const RayAt& ray_at,
         for (int sx = 0; sx < n; ++sx) {
           Eigen::Vector3d origin, direction;
           if (!ray_at(x + (sx + 0.5) / n, y + (sy + 0.5) / n, origin, direction)) continue;
-          rtcInitIntersectContext(&context);
-          RTCRayHit rh;
-          rh.ray.org_x = static_cast<float>(origin.x());
-          rh.ray.org_y = static_cast<float>(origin.y());
-          rh.ray.org_z = static_cast<float>(origin.z());
-          rh.ray.dir_x = static_cast<float>(direction.x());
-          rh.ray.dir_y = static_cast<float>(direction.y());
-          rh.ray.dir_z = static_cast<float>(direction.z());
-          rh.ray.tnear = 0.0f;
-          rh.ray.tfar = std::numeric_limits<float>::infinity();
-          rh.ray.mask = 0xFFFFFFFFu;
-          rh.ray.time = 0.0f;
-          rh.ray.flags = 0;
-          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-          rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-          rtcIntersect1(scene, &context, &rh);
-          if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+          const std::optional<synth::RayCaster::Hit> hit =
+              impl_->caster->Intersect(origin, direction);
+          if (!hit) continue;
           ++hits;
-          const auto& tri = geometry_.triangles[rh.hit.primID];
-          const double b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.0 - b1 - b2;
+          const auto& tri = geometry_.triangles[hit->triangle];
+          const double b1 = hit->b1, b2 = hit->b2, b0 = 1.0 - b1 - b2;
           auto interp3 = [&](const std::vector<Eigen::Vector3f>& a) {
             return (b0 * a[tri[0]].cast<double>() + b1 * a[tri[1]].cast<double>() +
                     b2 * a[tri[2]].cast<double>())
@@ -211,18 +163,18 @@ Rendering Renderer::Render(int width, int height, const RayAt& ray_at,
                                      b1 * geometry_.uv[tri[1]].cast<double>() +
                                      b2 * geometry_.uv[tri[2]].cast<double>();
           const Eigen::Vector3d base_normal = interp3(geometry_.normal).normalized();
-          const BakedMaterial& material = *materials_[geometry_.triangle_patch[rh.hit.primID]];
+          const BakedMaterial& material = *materials_[geometry_.triangle_patch[hit->triangle]];
           // Shading normal of the displaced surface: (S_u + h_u N) x (S_v + h_v N).
           const Eigen::Vector2d grad = material.HeightGradient(uv.x(), uv.y());
           const Eigen::Vector3d tu = interp3(geometry_.d_du) + grad.x() * base_normal;
           const Eigen::Vector3d tv = interp3(geometry_.d_dv) + grad.y() * base_normal;
           Eigen::Vector3d normal = tu.cross(tv);
           normal = normal.norm() > 1e-9 ? Eigen::Vector3d(normal.normalized()) : base_normal;
-          Eigen::Vector3d geometric_normal(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+          Eigen::Vector3d geometric_normal = hit->geometric_normal;
           geometric_normal.normalize();
           if (geometric_normal.dot(direction) > 0) geometric_normal = -geometric_normal;
           const Eigen::Vector3d albedo = material.Albedo(uv.x(), uv.y());
-          const Eigen::Vector3d position = origin + static_cast<double>(rh.ray.tfar) * direction;
+          const Eigen::Vector3d position = origin + static_cast<double>(hit->distance) * direction;
           const Eigen::Vector3d to_viewer = -direction;
           Eigen::Vector3d radiance = options.ambient * albedo;
           for (std::size_t li = 0; li < lights.size(); ++li) {
@@ -230,22 +182,8 @@ Rendering Renderer::Render(int width, int height, const RayAt& ray_at,
             const double n_dot_l = normal.dot(l);
             if (n_dot_l <= 0.0) continue;
             if (options.shadows) {
-              RTCRay shadow;
               const Eigen::Vector3d start = position + 1e-5 * geometric_normal;
-              shadow.org_x = static_cast<float>(start.x());
-              shadow.org_y = static_cast<float>(start.y());
-              shadow.org_z = static_cast<float>(start.z());
-              shadow.dir_x = static_cast<float>(l.x());
-              shadow.dir_y = static_cast<float>(l.y());
-              shadow.dir_z = static_cast<float>(l.z());
-              shadow.tnear = 1e-5f;
-              shadow.tfar = std::numeric_limits<float>::infinity();
-              shadow.mask = 0xFFFFFFFFu;
-              shadow.time = 0.0f;
-              shadow.flags = 0;
-              rtcInitIntersectContext(&context);
-              rtcOccluded1(scene, &context, &shadow);
-              if (shadow.tfar < 0.0f) continue;  // occluded
+              if (impl_->caster->Occluded(start, l, 1e-5f)) continue;
             }
             double specular = 0.0;
             if (material.options().specular > 0.0) {

@@ -70,4 +70,9 @@ Eigen::Matrix<double, 6, 6> FrameRotation(double angle_rad) {
   return expand;
 }
 
+Eigen::Matrix<double, 6, 6> OrthonormalFrameRotation(double angle_rad) {
+  const OrthonormalBasis& basis = OrthonormalBasis::Hemisphere();
+  return basis.ToOrthonormal() * FrameRotation(angle_rad) * basis.FromOrthonormal();
+}
+
 }  // namespace texlume::ptm

@@ -34,4 +34,8 @@ class OrthonormalBasis {
 /// L'(lu', lv') = L(lu, lv) for every light.
 Eigen::Matrix<double, 6, 6> FrameRotation(double angle_rad);
 
+/// FrameRotation in the orthonormal coordinates of OrthonormalBasis::Hemisphere
+/// (L^T M L^-T): what moves orthonormal coefficient vectors between frames.
+Eigen::Matrix<double, 6, 6> OrthonormalFrameRotation(double angle_rad);
+
 }  // namespace texlume::ptm

@@ -15,25 +15,6 @@
 namespace texlume::synth {
 namespace {
 
-// Signed distance from p to the triangle: negative inside (minus the distance to
-// the nearest edge), positive outside.
-double SignedDistance(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
-  const double orientation =
-      (c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x();
-  bool inside = true;
-  double nearest = std::numeric_limits<double>::max();
-  for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector2d& a = c[static_cast<std::size_t>(k)];
-    const Eigen::Vector2d& b = c[static_cast<std::size_t>((k + 1) % 3)];
-    const Eigen::Vector2d ab = b - a;
-    const double cross = ab.x() * (p - a).y() - ab.y() * (p - a).x();
-    if (cross * orientation < 0) inside = false;
-    const double s = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
-    nearest = std::min(nearest, (a + s * ab - p).norm());
-  }
-  return inside ? -nearest : nearest;
-}
-
 double RotationAngle(const Eigen::Matrix2d& r) { return std::atan2(r(1, 0), r(0, 0)); }
 
 struct ChartFace {
@@ -56,11 +37,6 @@ void AtlasOptions::Check() const {
     throw OptionError("max chart size must be in [0, atlas size]");
   if (!(max_chart_normal_angle_deg > 0.0 && max_chart_normal_angle_deg <= 180.0))
     throw OptionError("max chart normal angle must be in (0, 180] degrees");
-}
-
-Eigen::Matrix<double, 6, 6> OrthonormalFrameRotation(double angle_rad) {
-  const auto& basis = ptm::OrthonormalBasis::Hemisphere();
-  return basis.ToOrthonormal() * ptm::FrameRotation(angle_rad) * basis.FromOrthonormal();
 }
 
 std::vector<std::array<int, 3>> PackSkyline(const std::vector<std::pair<int, int>>& sizes,
@@ -209,7 +185,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
         for (int y = y0; y <= y1; ++y) {
           for (int x = x0; x <= x1; ++x) {
             const Eigen::Vector2d p((x + 0.5) * t, (y + 0.5) * t);
-            const double d = SignedDistance(c, p);
+            const double d = SignedDistanceToTriangle(c, p);
             if (d > clearance) continue;
             const auto it = texels.find(Key(x, y));
             if (it != texels.end()) {
@@ -306,7 +282,8 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
              y <= std::min(sizes[c].second - 1, static_cast<int>(hi.y()) + gutter + 1); ++y)
           for (int x = std::max(0, static_cast<int>(lo.x()) - gutter - 1);
                x <= std::min(sizes[c].first - 1, static_cast<int>(hi.x()) + gutter + 1); ++x)
-            if (SignedDistance(corners, Eigen::Vector2d(x + 0.5, y + 0.5)) <= gutter + 0.5)
+            if (SignedDistanceToTriangle(corners, Eigen::Vector2d(x + 0.5, y + 0.5)) <=
+                gutter + 0.5)
               mask.at<std::uint8_t>(y / kCell, x / kCell) = 1;
       }
       cv::findNonZero(mask, cells[c]);
@@ -396,7 +373,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     cv::Mat& claims = claim[static_cast<std::size_t>(fp.atlas)];
     cv::Mat& coverage = atlases.coverage[static_cast<std::size_t>(fp.atlas)];
     const Eigen::Matrix<double, 6, 6> to_atlas =
-        OrthonormalFrameRotation(-RotationAngle(fp.rotation));
+        ptm::OrthonormalFrameRotation(-RotationAngle(fp.rotation));
     Eigen::Vector2d lo = fp.corners_px[0], hi = lo;
     for (const auto& p : fp.corners_px) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     const int x0 = std::max(0, static_cast<int>(std::floor(lo.x())) - gutter);
@@ -406,7 +383,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) {
         const Eigen::Vector2d q(x + 0.5, y + 0.5);
-        const double d = SignedDistance(fp.corners_px, q);
+        const double d = SignedDistanceToTriangle(fp.corners_px, q);
         if (d > gutter + 0.5) continue;
         const float key = static_cast<float>(std::max(d, 0.0));
         if (d <= 0.0) {

@@ -78,8 +78,4 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
 std::vector<std::array<int, 3>> PackSkyline(const std::vector<std::pair<int, int>>& sizes,
                                             int bin_width, int bin_height);
 
-/// Orthonormal-space coefficient map when the frame's x axis turns to
-/// (cos angle, sin angle) of the old frame.
-Eigen::Matrix<double, 6, 6> OrthonormalFrameRotation(double angle_rad);
-
 }  // namespace texlume::synth

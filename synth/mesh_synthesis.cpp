@@ -47,28 +47,6 @@ struct ReducedSample {
   double rx = 1.0, ry = 1.0;  // effective density along x and y
 };
 
-Eigen::Matrix<double, 6, 6> OrthonormalRotation(double angle_rad) {
-  const auto& basis = ptm::OrthonormalBasis::Hemisphere();
-  return basis.ToOrthonormal() * ptm::FrameRotation(angle_rad) * basis.FromOrthonormal();
-}
-
-bool InsideTriangle(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
-  auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return a.x() * b.y() - a.y() * b.x();
-  };
-  const double d0 = cross(c[1] - c[0], p - c[0]);
-  const double d1 = cross(c[2] - c[1], p - c[1]);
-  const double d2 = cross(c[0] - c[2], p - c[2]);
-  return (d0 >= 0 && d1 >= 0 && d2 >= 0) || (d0 <= 0 && d1 <= 0 && d2 <= 0);
-}
-
-double SegmentDistance(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
-                       const Eigen::Vector2d& p) {
-  const Eigen::Vector2d ab = b - a;
-  const double s = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
-  return (a + s * ab - p).norm();
-}
-
 }  // namespace
 
 float SrgbToLinear(float v) {
@@ -163,10 +141,10 @@ bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) 
 }
 
 void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip, float* out) const {
-  const std::size_t n = sample_planes.size();
-  std::vector<float> own(n), other(n);
-  if (!SamplePatch(face, p, own.data())) std::fill(own.begin(), own.end(), 0.0f);
-  std::vector<double> sum(n, 0.0);
+  const std::size_t n = sample_planes.size();  // <= kMaxPlanes
+  std::array<float, kMaxPlanes> own{}, other{};
+  if (!SamplePatch(face, p, own.data())) own.fill(0.0f);
+  std::array<double, kMaxPlanes> sum{};
   double own_weight = 1.0;
   const TrianglePatch& patch = patches[static_cast<std::size_t>(face)];
   const double half_width = 0.5 * strip * texel_size;
@@ -176,7 +154,7 @@ void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip,
     if (u.face < 0) continue;
     const Eigen::Vector2d& a = patch.corners_in_frame[static_cast<std::size_t>(k)];
     const Eigen::Vector2d& b = patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)];
-    const double d = SegmentDistance(a, b, p);
+    const double d = DistanceToSegment(a, b, p);
     if (d >= half_width) continue;
     if (!SamplePatch(u.face, u.rotation * p + u.translation, other.data())) continue;
     const double w = 0.5 * (1.0 - d / half_width);  // 1/2 at the edge, 0 at W_e / 2
@@ -303,7 +281,7 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       u.rotation = Eigen::Rotation2Dd(angle).toRotationMatrix();
       u.translation = a_nb - u.rotation * a_this;
       // This frame's x axis is (cos angle, sin angle) in the neighbour's frame.
-      u.coefficients_to_this = OrthonormalRotation(angle);
+      u.coefficients_to_this = ptm::OrthonormalFrameRotation(angle);
     }
   }
 
@@ -390,8 +368,9 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
         const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(cam);
         map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
         map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
-        if (px && InsideTriangle(patch.corners_in_frame, p) && px->x() >= 0.5 && px->y() >= 0.5 &&
-            px->x() <= photo.image.cols - 0.5 && px->y() <= photo.image.rows - 0.5) {
+        if (px && SignedDistanceToTriangle(patch.corners_in_frame, p) <= 0.0 && px->x() >= 0.5 &&
+            px->y() >= 0.5 && px->x() <= photo.image.cols - 0.5 &&
+            px->y() <= photo.image.rows - 0.5) {
           out.mask.at<float>(j, i) = 1.0f;
           ++out.count;
         }
@@ -561,8 +540,6 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
         colour[c] = red.raw[static_cast<std::size_t>(6 + c)].at<float>(y, x);
       const double g = result.photo_gains[r.photo];
       Eigen::Vector3d linear = Eigen::Vector3d::Zero();
-      std::vector<std::pair<double, Eigen::Matrix<double, 1, 6>>>
-          terms;  // d linear / d L_i per channel sum
       Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
       for (const auto& [l, intensity] : r.lights) {
         if (l.z() <= 0) continue;
@@ -601,22 +578,6 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
               r.planes[2].at<float>(vj, vi)) /
              3.0;
     };
-    auto rms = [&]() {
-      double sum = 0;
-      int n = 0;
-      Eigen::Matrix<double, 1, 6> jac;
-      for (int j = 0; j < gh; ++j)
-        for (int i = 0; i < gw; ++i)
-          for (const Rectified& r : rects) {
-            int vi, vj;
-            if (!view_cell(r, i, j, vi, vj)) continue;
-            const double d = photo_luminance(r, vi, vj) - predict(r, vi, vj, i, j, jac);
-            sum += d * d;
-            ++n;
-          }
-      return n ? std::sqrt(sum / n) : 0.0;
-    };
-    patch.photo_rms_before = rms();
     cv::Mat known = cv::Mat::zeros(gh, gw, CV_8UC1);
     for (int it = 0; it < options.correction_iterations; ++it) {
       // Per-channel factors at low frequency (stains, colour): photo over
@@ -689,11 +650,9 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
           for (int m = 0; m < 6; ++m)
             patch.correction[static_cast<std::size_t>(m)].at<float>(j, i) +=
                 static_cast<float>(dq[m]);
-          known.at<std::uint8_t>(j, i) = 1;
         }
       }
     }
-    patch.photo_rms_after = rms();
     // Extend the change into the strip: rings of neighbour averages.
     for (int ring = 0; ring < std::max(gw, gh); ++ring) {
       const cv::Mat before = known.clone();
@@ -744,8 +703,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
           const Unfolding& u = result.unfoldings[f][static_cast<std::size_t>(k)];
           if (u.face < 0 || !done[static_cast<std::size_t>(u.face)]) continue;
           const double d =
-              SegmentDistance(patch.corners_in_frame[static_cast<std::size_t>(k)],
-                              patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)], p);
+              DistanceToSegment(patch.corners_in_frame[static_cast<std::size_t>(k)],
+                                patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)], p);
           if (d > options.strip * t) continue;
           if (!result.SamplePatch(u.face, u.rotation * p + u.translation, value.data())) continue;
           target_texels.push_back(j * w + i);
@@ -837,14 +796,7 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
                       static_cast<std::size_t>(c)];
       }
       const cv::Mat errors = MaskedSsd(sample_coefficients, sample_energy, target_planes, mask);
-      double min_error;
-      cv::minMaxLoc(errors, &min_error);
-      std::vector<cv::Point> near;
-      for (int py = 0; py < errors.rows; ++py)
-        for (int px = 0; px < errors.cols; ++px)
-          if (errors.at<float>(py, px) <= min_error * (1.0 + options.tolerance) + 1e-12)
-            near.emplace_back(px, py);
-      const cv::Point p = near[std::uniform_int_distribution<std::size_t>(0, near.size() - 1)(rng)];
+      const cv::Point p = PickWithinTolerance(errors, options.tolerance, rng);
       patch.sample_x = p.x;
       patch.sample_y = p.y;
       patch.overlap_error = errors.at<float>(p.y, p.x) / static_cast<double>(target_texels.size());

@@ -105,7 +105,6 @@ struct TrianglePatch {
   /// differences: LRGB colour times the factor, RGB polynomial times it.
   std::vector<cv::Mat> channel_gain;
   Eigen::Vector2d correction_density = Eigen::Vector2d::Ones();
-  double photo_rms_before = 0.0, photo_rms_after = 0.0;  ///< luminance, at photo density
 };
 
 /// The unfolding of neighbour `face` across a shared edge into a triangle's
@@ -130,6 +129,8 @@ struct MeshSynthesis {
   std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
   double seconds = 0.0;
 
+  /// Most planes a texel has (RGB: 18 coefficients; LRGB: 6 + 3 colour).
+  static constexpr std::size_t kMaxPlanes = 18;
   /// Number of coefficient planes (6 LRGB, 18 RGB); colour planes follow for LRGB.
   int CoefficientPlanes() const { return format == ptm::PtmFormat::kLrgb ? 6 : 18; }
   /// The face's own patch at frame point p (world units), bilinear; false outside it.

@@ -19,19 +19,6 @@ namespace {
 
 constexpr const char* kManifestFormat = "texlume-model";
 
-void WriteBytes(const fs::path& path, const std::vector<unsigned char>& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()),
-            static_cast<std::streamsize>(bytes.size()));
-  if (!out) throw InputError(path.string(), "cannot be written");
-}
-
-std::vector<unsigned char> EncodePng(const cv::Mat& bgr8, const std::string& label) {
-  std::vector<unsigned char> png;
-  if (!cv::imencode(".png", bgr8, png)) throw InputError(label, "PNG encoding failed");
-  return png;
-}
-
 void WriteObj(const fs::path& path, const TexturedModel& model) {
   std::ofstream out(path);
   out << "# texlume relightable model: base colour textures per atlas; the PTM atlases are\n"
@@ -64,6 +51,22 @@ void WriteObj(const fs::path& path, const TexturedModel& model) {
 }
 
 }  // namespace
+
+std::vector<unsigned char> EncodePng(const cv::Mat& image, const std::string& label) {
+  std::vector<unsigned char> png;
+  if (!cv::imencode(".png", image, png)) throw InputError(label, "PNG encoding failed");
+  return png;
+}
+
+void WriteBytesAtomically(const fs::path& path, const std::vector<unsigned char>& bytes) {
+  WriteFileAtomically(
+      path,
+      [&](std::ostream& out) {
+        out.write(reinterpret_cast<const char*>(bytes.data()),
+                  static_cast<std::streamsize>(bytes.size()));
+      },
+      true);
+}
 
 std::vector<Eigen::Vector3d> VertexNormals(const sfm::TriangleMesh& mesh) {
   std::vector<Eigen::Vector3d> n(mesh.vertices.size(), Eigen::Vector3d::Zero());
@@ -263,8 +266,8 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
       const std::string base = "base_colour_" + k + ".png", albedo = "albedo_" + k + ".png";
       const std::string ptm_file = "ptm_atlas_" + k + ".ptm", exr_file = "ptm_atlas_" + k + ".exr";
       pngs.push_back(EncodePng(BaseColourImage(model.atlases[a]), base));
-      WriteBytes(tmp / base, pngs.back());
-      WriteBytes(tmp / albedo, EncodePng(AlbedoImage(model.atlases[a]), albedo));
+      WriteBytesAtomically(tmp / base, pngs.back());
+      WriteBytesAtomically(tmp / albedo, EncodePng(AlbedoImage(model.atlases[a]), albedo));
       ptm::WritePtmFile(model.atlases[a], tmp / ptm_file);
       ptm::WritePtmExr(model.atlases[a], tmp / exr_file);
       const std::string format = model.atlases[a].format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB";
@@ -293,7 +296,7 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
     WriteGlb(tmp / "model.glb", model, pngs, extras);
     nlohmann::json files = nlohmann::json::array();
     for (const auto& [name, image] : extra_images) {
-      WriteBytes(tmp / name, EncodePng(image, name));
+      WriteBytesAtomically(tmp / name, EncodePng(image, name));
     }
     for (const auto& entry : fs::directory_iterator(tmp))
       files.push_back(entry.path().filename().string());

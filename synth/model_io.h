@@ -46,6 +46,12 @@ TexturedModel ReadModelFolder(const std::filesystem::path& dir);
 cv::Mat BaseColourImage(const ptm::Ptm& ptm);
 cv::Mat AlbedoImage(const ptm::Ptm& ptm);
 
+/// PNG bytes of an 8- or 16-bit image; throws InputError(label) on failure.
+std::vector<unsigned char> EncodePng(const cv::Mat& image, const std::string& label);
+/// Writes bytes under a temporary name, then renames (no half-written file).
+void WriteBytesAtomically(const std::filesystem::path& path,
+                          const std::vector<unsigned char>& bytes);
+
 /// Smooth (area-weighted) vertex normals.
 std::vector<Eigen::Vector3d> VertexNormals(const sfm::TriangleMesh& mesh);
 

@@ -1,7 +1,5 @@
 #include "synth/model_render.h"
 
-#include <embree3/rtcore.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -11,6 +9,7 @@
 #include <stdexcept>
 
 #include "sfm/errors.h"
+#include "synth/ray_caster.h"
 
 namespace texlume::synth {
 namespace {
@@ -38,12 +37,7 @@ Eigen::Vector2d ToOpenCv(const Eigen::Vector2d& colmap_px) {
 }  // namespace
 
 struct ModelRenderer::Impl {
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
-  ~Impl() {
-    if (scene) rtcReleaseScene(scene);
-    if (device) rtcReleaseDevice(device);
-  }
+  std::unique_ptr<RayCaster> caster;
 };
 
 ModelRenderer::ModelRenderer(const TexturedModel& model) : model_(model), impl_(new Impl) {
@@ -68,29 +62,13 @@ ModelRenderer::ModelRenderer(const TexturedModel& model) : model_(model), impl_(
     face_frames_[f].col(1) = n.cross(x);
     face_frames_[f].col(2) = n;
   }
-  impl_->device = rtcNewDevice(nullptr);
-  if (!impl_->device) throw std::runtime_error("Embree: cannot create a device");
-  impl_->scene = rtcNewScene(impl_->device);
-  RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                               RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                               mesh.vertices.size()));
-  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
-    for (int c = 0; c < 3; ++c)
-      vertices[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(mesh.vertices[i][c]);
-  auto* indices = static_cast<unsigned*>(
-      rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                              3 * sizeof(unsigned), mesh.faces.size()));
-  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
-    for (int c = 0; c < 3; ++c)
-      indices[3 * f + static_cast<std::size_t>(c)] =
-          static_cast<unsigned>(mesh.faces[f][static_cast<std::size_t>(c)]);
-  rtcCommitGeometry(geometry);
-  rtcAttachGeometry(impl_->scene, geometry);
-  rtcReleaseGeometry(geometry);
-  rtcCommitScene(impl_->scene);
-  if (rtcGetDeviceError(impl_->device) != RTC_ERROR_NONE)
-    throw std::runtime_error("Embree: scene build failed");
+  std::vector<Eigen::Vector3f> positions;
+  for (const Eigen::Vector3d& v : mesh.vertices) positions.push_back(v.cast<float>());
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  for (const auto& f : mesh.faces)
+    triangles.push_back({static_cast<std::uint32_t>(f[0]), static_cast<std::uint32_t>(f[1]),
+                         static_cast<std::uint32_t>(f[2])});
+  impl_->caster = std::make_unique<RayCaster>(positions, triangles);
 }
 
 ModelRenderer::~ModelRenderer() = default;
@@ -109,15 +87,14 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
   const sfm::Rigid3d world_from_cam = cam_from_world.Inverse();
   const Eigen::Vector3d origin = world_from_cam.translation;
   const int n = samples_per_axis;
-  const RTCScene scene = impl_->scene;
   const sfm::TriangleMesh& mesh = model_.mesh;
   const Eigen::Vector3f flat_linear(SrgbToLinear(flat_albedo.x()), SrgbToLinear(flat_albedo.y()),
                                     SrgbToLinear(flat_albedo.z()));
 
 #pragma omp parallel for schedule(dynamic, 4)
   for (int y = 0; y < height; ++y) {
-    RTCIntersectContext context;
     std::vector<float> texel(21);
+    std::vector<std::pair<Eigen::Vector3d, double>> local;  // lights in the face frame
     for (int x = 0; x < width; ++x) {
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
       int hits = 0;
@@ -125,27 +102,12 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
         for (int sx = 0; sx < n; ++sx) {
           const Eigen::Vector2d pixel(x + (sx + 0.5) / n, y + (sy + 0.5) / n);  // COLMAP pixels
           const Eigen::Vector3d direction = world_from_cam.rotation * camera.CamRayFromImage(pixel);
-          rtcInitIntersectContext(&context);
-          RTCRayHit rh;
-          rh.ray.org_x = static_cast<float>(origin.x());
-          rh.ray.org_y = static_cast<float>(origin.y());
-          rh.ray.org_z = static_cast<float>(origin.z());
-          rh.ray.dir_x = static_cast<float>(direction.x());
-          rh.ray.dir_y = static_cast<float>(direction.y());
-          rh.ray.dir_z = static_cast<float>(direction.z());
-          rh.ray.tnear = 0.0f;
-          rh.ray.tfar = std::numeric_limits<float>::infinity();
-          rh.ray.mask = 0xFFFFFFFFu;
-          rh.ray.time = 0.0f;
-          rh.ray.flags = 0;
-          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-          rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-          rtcIntersect1(scene, &context, &rh);
-          if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+          const std::optional<RayCaster::Hit> hit = impl_->caster->Intersect(origin, direction);
+          if (!hit) continue;
           ++hits;
-          const std::size_t f = rh.hit.primID;
-          const double b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.0 - b1 - b2;
-          const Eigen::Vector3d point = origin + static_cast<double>(rh.ray.tfar) * direction;
+          const std::size_t f = hit->triangle;
+          const double b1 = hit->b1, b2 = hit->b2, b0 = 1.0 - b1 - b2;
+          const Eigen::Vector3d point = origin + hit->distance * direction;
           Eigen::Vector3f value = Eigen::Vector3f::Zero();
           if (mode == RenderMode::kFlat) {
             const auto& v = mesh.faces[f];
@@ -196,7 +158,7 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
                   Eigen::Quaterniond::FromTwoVectors(face_frames_[f].col(2), smooth)
                       .toRotationMatrix() *
                   face_frames_[f];
-              std::vector<std::pair<Eigen::Vector3d, double>> local;
+              local.clear();
               for (const sfm::ObjectLight& l : lights)
                 local.emplace_back(frame.transpose() * l.DirectionFrom(point), l.intensity);
               value = RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format,

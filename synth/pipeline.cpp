@@ -31,15 +31,7 @@ cv::Mat ToBgr8(const cv::Mat& rgb) {
 }
 
 void WritePng(const fs::path& path, const cv::Mat& image) {
-  std::vector<unsigned char> png;
-  if (!cv::imencode(".png", image, png)) throw InputError(path.string(), "PNG encoding failed");
-  WriteFileAtomically(
-      path,
-      [&](std::ostream& o) {
-        o.write(reinterpret_cast<const char*>(png.data()),
-                static_cast<std::streamsize>(png.size()));
-      },
-      true);
+  WriteBytesAtomically(path, EncodePng(image, path.string()));
 }
 
 fs::path PngName(const std::string& image_name) {
@@ -289,7 +281,6 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
     record["baselines"]["baked"].push_back(name);
     extra.emplace_back(name, ToBgr8(baked[a]));
   }
-  summary.seconds_export = Since(t);  // the folder write below is counted too
   record["timings_s"] = {{"load", summary.seconds_load},
                          {"visibility", summary.seconds_visibility},
                          {"synthesis", summary.seconds_synthesis},

@@ -306,15 +306,7 @@ PlanarSynthesisResult SynthesizePlanarPtm(const ptm::Ptm& sample,
       } else {
         // Unconstrained quilting: overlap error at every sample position (FFT).
         const cv::Mat errors = MaskedSsd(sample_coefficients, sample_energy, out_block, mask);
-        double min_error;
-        cv::minMaxLoc(errors, &min_error);
-        std::vector<cv::Point> near;
-        for (int py = 0; py < errors.rows; ++py)
-          for (int px = 0; px < errors.cols; ++px)
-            if (errors.at<float>(py, px) <= min_error * (1.0 + options.tolerance) + 1e-12)
-              near.emplace_back(px, py);
-        std::uniform_int_distribution<std::size_t> pick(0, near.size() - 1);
-        const cv::Point p = near[pick(rng)];
+        const cv::Point p = PickWithinTolerance(errors, options.tolerance, rng);
         placement.sample_x = p.x;
         placement.sample_y = p.y;
         placement.overlap_error = errors.at<float>(p.y, p.x) / overlap_texels;

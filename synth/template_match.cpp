@@ -53,4 +53,14 @@ cv::Mat MaskedSsdBruteForce(const std::vector<cv::Mat>& image_planes,
   return out;
 }
 
+cv::Point PickWithinTolerance(const cv::Mat& errors, double tolerance, std::mt19937_64& rng) {
+  double min_error;
+  cv::minMaxLoc(errors, &min_error);
+  std::vector<cv::Point> near;
+  for (int y = 0; y < errors.rows; ++y)
+    for (int x = 0; x < errors.cols; ++x)
+      if (errors.at<float>(y, x) <= min_error * (1.0 + tolerance) + 1e-12) near.emplace_back(x, y);
+  return near[std::uniform_int_distribution<std::size_t>(0, near.size() - 1)(rng)];
+}
+
 }  // namespace texlume::synth

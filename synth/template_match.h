@@ -1,6 +1,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <random>
 #include <vector>
 
 namespace texlume::synth {
@@ -21,5 +22,9 @@ cv::Mat PlaneEnergy(const std::vector<cv::Mat>& planes);
 /// The same by nested loops: the reference the tests hold the fast path to.
 cv::Mat MaskedSsdBruteForce(const std::vector<cv::Mat>& image_planes,
                             const std::vector<cv::Mat>& template_planes, const cv::Mat& mask);
+
+/// Classic quilting's choice: a position at random (uniform, from `rng`) among
+/// those whose error is within (1 + tolerance) of the smallest in `errors`.
+cv::Point PickWithinTolerance(const cv::Mat& errors, double tolerance, std::mt19937_64& rng);
 
 }  // namespace texlume::synth

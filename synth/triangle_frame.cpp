@@ -1,6 +1,8 @@
 #include "synth/triangle_frame.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <limits>
 
 namespace texlume::synth {
 
@@ -23,6 +25,28 @@ TriangleFrame MakeTriangleFrame(const sfm::TriangleMesh& mesh, std::size_t face,
   frame.x_axis = x.normalized();
   frame.y_axis = frame.z_axis.cross(frame.x_axis);
   return frame;
+}
+
+double DistanceToSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                         const Eigen::Vector2d& p) {
+  const Eigen::Vector2d ab = b - a;
+  const double s = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+  return (a + s * ab - p).norm();
+}
+
+double SignedDistanceToTriangle(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
+  const double orientation =
+      (c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x();
+  bool inside = true;
+  double nearest = std::numeric_limits<double>::max();
+  for (std::size_t k = 0; k < 3; ++k) {
+    const Eigen::Vector2d& a = c[k];
+    const Eigen::Vector2d& b = c[(k + 1) % 3];
+    const double cross = (b - a).x() * (p - a).y() - (b - a).y() * (p - a).x();
+    if (cross * orientation < 0) inside = false;
+    nearest = std::min(nearest, DistanceToSegment(a, b, p));
+  }
+  return inside ? -nearest : nearest;
 }
 
 }  // namespace texlume::synth

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 
 #include "sfm/mesh.h"
 
@@ -34,5 +35,14 @@ TriangleFrame MakeTriangleFrame(const sfm::TriangleMesh& mesh, std::size_t face)
 /// is (nearly) parallel to the normal.
 TriangleFrame MakeTriangleFrame(const sfm::TriangleMesh& mesh, std::size_t face,
                                 const Eigen::Vector3d& tangent_in_world);
+
+/// Distance from p to the segment [a, b] (2D).
+double DistanceToSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                         const Eigen::Vector2d& p);
+
+/// Signed distance from p to a 2D triangle (either winding): minus the distance
+/// to the nearest edge inside (edges included), the distance outside.
+double SignedDistanceToTriangle(const std::array<Eigen::Vector2d, 3>& corners,
+                                const Eigen::Vector2d& p);
 
 }  // namespace texlume::synth
