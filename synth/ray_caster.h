@@ -28,7 +28,8 @@ class RayCaster {
     Eigen::Vector3d geometric_normal = Eigen::Vector3d::Zero();  ///< Embree's Ng, unnormalised
   };
   /// The nearest triangle along origin + s direction, s in [0, inf).
-  std::optional<Hit> Intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
+  std::optional<Hit> Intersect(const Eigen::Vector3d& origin,
+                               const Eigen::Vector3d& direction) const;
   /// Whether any triangle lies along origin + s direction, s in [near, inf).
   bool Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, float near) const;
 
