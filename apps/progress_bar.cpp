@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 
 namespace texlume::apps {
@@ -15,7 +16,8 @@ void ProgressBar::Update(std::string_view stage, std::size_t done, std::size_t t
     stage_start_ = now;
     last_line_ = now - std::chrono::hours(1);
   }
-  const double fraction = total ? static_cast<double>(done) / static_cast<double>(total) : 1.0;
+  const double fraction =
+      total ? std::min(1.0, static_cast<double>(done) / static_cast<double>(total)) : 1.0;
   const double elapsed = std::chrono::duration<double>(now - stage_start_).count();
   const double left = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
   if (terminal_) {

@@ -82,6 +82,7 @@ void SceneOptions::Check() const {
   in(max_lights_per_image, 1, 3, "max_lights_per_image");
   in(num_held_out_views, 0, 100, "num_held_out_views");
   in(held_out_lights_per_view, 1, 20, "held_out_lights_per_view");
+  in(held_out_scale, 1, 4, "held_out_scale");
   in(capture_size, 16, 4096, "capture_size");
   in(num_capture_lights, 6, 500, "num_capture_lights");
   in(num_held_out_capture_lights, 0, 500, "num_held_out_capture_lights");
@@ -409,7 +410,8 @@ SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::p
   // Held-out views x held-out lights: ground truth for relighting from new views.
   if (options.num_held_out_views > 0) {
     sfm::Reconstruction held;
-    held.cameras = object.reconstruction.cameras;
+    const sfm::Camera held_camera = camera.Scaled(options.held_out_scale);
+    held.cameras[held_camera.camera_id] = held_camera;
     sfm::ObjectLights held_lights;
     std::uint32_t next_id = 1;
     done = 0;
@@ -439,7 +441,7 @@ SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::p
         ShadingOptions shading = options.shading;
         shading.exposure = 1.0;
         const Rendering r =
-            renderer.RenderPerspective(camera, pose, {{light.normalized(), 1.0}}, shading);
+            renderer.RenderPerspective(held_camera, pose, {{light.normalized(), 1.0}}, shading);
         WritePngAtomically(dir / "object/held_out/images" / image.name,
                            LinearToSrgb8(r.linear_rgb));
         WritePngAtomically(dir / "object/held_out/masks" / image.name, CoverageMask(r));
@@ -472,7 +474,8 @@ SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::p
                       {"width", options.image_width},
                       {"height", options.image_height},
                       {"focal_px", options.focal_px},
-                      {"distance", options.camera_distance}};
+                      {"distance", options.camera_distance},
+                      {"held_out_scale", options.held_out_scale}};
   record["shading"] = {
       {"ambient", options.shading.ambient},
       {"samples_per_pixel", options.shading.samples_per_axis * options.shading.samples_per_axis},

@@ -33,6 +33,10 @@ struct SceneOptions {
   bool vary_exposure = true;
   int num_held_out_views = 4;        ///< [0, 100]
   int held_out_lights_per_view = 3;  ///< [1, 20]
+  /// Held-out views are rendered at this many times the photos' resolution (the
+  /// same camera, its size, focal length and principal point scaled), so models
+  /// can be compared at full resolution and at the photos'. [1, 4]
+  int held_out_scale = 1;
 
   // Material sample captures (orthographic, rectified to the material frame).
   int capture_size = 256;                ///< texels per side, [16, 4096]

@@ -175,6 +175,18 @@ Eigen::Vector2d DistortNormalized(CameraModelId model, std::span<const double> p
   return u;
 }
 
+Camera Camera::Scaled(double factor) const {
+  if (!(factor > 0.0) || !std::isfinite(factor))
+    throw std::invalid_argument("camera scale factor must be positive");
+  Camera c = *this;
+  c.width = static_cast<std::uint64_t>(std::llround(static_cast<double>(width) * factor));
+  c.height = static_cast<std::uint64_t>(std::llround(static_cast<double>(height) * factor));
+  // Pixel corners map to pixel corners: (0, 0) stays, (w, h) becomes (f w, f h).
+  const int scaled = Info(model).single_focal ? 3 : 4;
+  for (int i = 0; i < scaled; ++i) c.params[static_cast<std::size_t>(i)] *= factor;
+  return c;
+}
+
 Eigen::Vector2d Camera::FocalLength() const {
   return Info(model).single_focal ? Eigen::Vector2d(params[0], params[0])
                                   : Eigen::Vector2d(params[0], params[1]);

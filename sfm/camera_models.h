@@ -76,6 +76,11 @@ struct Camera {
   /// True when the pixel position lies inside [0, width] x [0, height].
   bool IsInImage(const Eigen::Vector2d& pixel) const;
 
+  /// The same camera for images `factor` times larger along each axis: size,
+  /// focal lengths and principal point scaled (distortion, on the normalised
+  /// plane, unchanged). factor > 0.
+  Camera Scaled(double factor) const;
+
   /// Focal lengths (fx, fy) in pixels and principal point (cx, cy) in pixels.
   Eigen::Vector2d FocalLength() const;
   Eigen::Vector2d PrincipalPoint() const;

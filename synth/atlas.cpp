@@ -295,7 +295,8 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     });
     std::vector<cv::Mat> occupied;
     packed.resize(charts.size());
-    for (const std::size_t c : order) {
+    for (std::size_t n = 0; n < order.size(); ++n) {
+      const std::size_t c = order[n];
       if (cell_size[c].width > grid || cell_size[c].height > grid)
         throw OptionError("a chart of " + std::to_string(sizes[c].first) + " x " +
                           std::to_string(sizes[c].second) + " texels does not fit an atlas of " +
@@ -319,7 +320,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
           }
         }
       }
-      if (progress) progress("packing", static_cast<std::size_t>(&c - &order[0]) + 1, order.size());
+      if (progress) progress("packing", n + 1, order.size());
     }
   }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -62,8 +63,20 @@ float LinearToSrgb(float v) {
 Eigen::Vector3f RelightMixture(const float* coefficients, const float* colour,
                                ptm::PtmFormat format, const LightList& lights, double gain) {
   Eigen::Vector3f linear = Eigen::Vector3f::Zero();
-  for (const auto& [l, intensity] : lights) {
-    if (l.z() <= 0.0) continue;
+  const double z_horizon = std::sin(kHorizonElevationDeg * std::numbers::pi / 180.0);
+  for (const auto& [l_in, intensity] : lights) {
+    if (l_in.z() <= 0.0) continue;
+    // Below kHorizonElevationDeg the biquadratic is extrapolated beyond any
+    // capture light and overshoots: take its value at that elevation (same
+    // azimuth) fading linearly with l_z to 0 at the horizon.
+    Eigen::Vector3d l = l_in;
+    double fall = 1.0;
+    if (l.z() < z_horizon) {
+      fall = l.z() / z_horizon;
+      const double r = std::hypot(l.x(), l.y());
+      const double s = std::sqrt(1.0 - z_horizon * z_horizon) / r;
+      l = Eigen::Vector3d(l.x() * s, l.y() * s, z_horizon);
+    }
     for (int c = 0; c < 3; ++c) {
       double v;
       if (format == ptm::PtmFormat::kLrgb) {
@@ -71,7 +84,7 @@ Eigen::Vector3f RelightMixture(const float* coefficients, const float* colour,
       } else {
         v = ptm::EvaluatePolynomial(coefficients + 6 * c, l.x(), l.y());
       }
-      linear[c] += static_cast<float>(intensity) * SrgbToLinear(static_cast<float>(v));
+      linear[c] += static_cast<float>(intensity * fall) * SrgbToLinear(static_cast<float>(v));
     }
   }
   Eigen::Vector3f out;
@@ -88,6 +101,8 @@ void MeshSynthesisOptions::Check() const {
   if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
   if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
   if (!(correction_sigma > 0.0)) throw OptionError("correction_sigma must be > 0");
+  if (!(correction_noise > 0.0) || !std::isfinite(correction_noise))
+    throw OptionError("correction_noise must be > 0");
   if (correction_iterations < 0 || correction_iterations > 5)
     throw OptionError("correction_iterations must be in [0, 5]");
   if (max_texels < 1) throw OptionError("max_texels must be >= 1");
@@ -127,7 +142,32 @@ bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) 
       return (1 - gfy) * ((1 - gfx) * m.at<float>(gy0, gx0) + gfx * m.at<float>(gy0, gx1)) +
              gfy * ((1 - gfx) * m.at<float>(gy1, gx0) + gfx * m.at<float>(gy1, gx1));
     };
-    for (int i = 0; i < 6; ++i) out[i] += at(patch.correction[static_cast<std::size_t>(i)]);
+    {
+      // The additive change: Catmull-Rom (bicubic) over the 4 x 4 nearest cells,
+      // which keeps the photo's detail sharper than bilinear.
+      const int bx = static_cast<int>(std::floor(gu)), by = static_cast<int>(std::floor(gv));
+      auto weights = [](double t, double w[4]) {
+        const double t2 = t * t, t3 = t2 * t;
+        w[0] = -0.5 * t3 + t2 - 0.5 * t;
+        w[1] = 1.5 * t3 - 2.5 * t2 + 1.0;
+        w[2] = -1.5 * t3 + 2.0 * t2 + 0.5 * t;
+        w[3] = 0.5 * t3 - 0.5 * t2;
+      };
+      double wx[4], wy[4];
+      weights(gu - bx, wx);
+      weights(gv - by, wy);
+      for (int i = 0; i < 6; ++i) {
+        const cv::Mat& m = patch.correction[static_cast<std::size_t>(i)];
+        double acc = 0.0;
+        for (int a = 0; a < 4; ++a) {
+          const float* row = m.ptr<float>(std::clamp(by - 1 + a, 0, m.rows - 1));
+          double r = 0.0;
+          for (int b = 0; b < 4; ++b) r += wx[b] * row[std::clamp(bx - 1 + b, 0, m.cols - 1)];
+          acc += wy[a] * r;
+        }
+        out[i] += static_cast<float>(acc);
+      }
+    }
     for (int c = 0; c < 3 && c < static_cast<int>(patch.channel_gain.size()); ++c) {
       const float k = at(patch.channel_gain[static_cast<std::size_t>(c)]);
       if (format == ptm::PtmFormat::kLrgb) {
@@ -336,6 +376,9 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     int count = 0;
     LightList lights;
   };
+  // Cells within W_e / 2 of the triangle (its blending zone) are constrained
+  // too, so that the blend across an edge mixes two photo-corrected patches.
+  const double mask_margin = 0.5 * options.strip * t;
   auto rectify = [&](std::size_t f, const sfm::TriangleView& view, Rectified& out) -> bool {
     const auto it = photo_index.find(view.image_id);
     if (it == photo_index.end()) return false;
@@ -368,8 +411,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
         const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(cam);
         map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
         map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
-        if (px && SignedDistanceToTriangle(patch.corners_in_frame, p) <= 0.0 && px->x() >= 0.5 &&
-            px->y() >= 0.5 && px->x() <= photo.image.cols - 0.5 &&
+        if (px && SignedDistanceToTriangle(patch.corners_in_frame, p) <= mask_margin &&
+            px->x() >= 0.5 && px->y() >= 0.5 && px->x() <= photo.image.cols - 0.5 &&
             px->y() <= photo.image.rows - 0.5) {
           out.mask.at<float>(j, i) = 1.0f;
           ++out.count;
@@ -378,7 +421,7 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     }
     if (out.count < options.min_photo_pixels) return false;
     cv::Mat rectified;
-    cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
     cv::split(rectified, out.planes);
     out.lights.clear();
     for (const sfm::ObjectLight& light : photo.lights) {
@@ -502,11 +545,34 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   // residual). Cells outside the triangle take their neighbours' change.
   const Eigen::Matrix<double, 6, 6>& from_orthonormal =
       ptm::OrthonormalBasis::Hemisphere().FromOrthonormal();
+  std::map<int, Eigen::Matrix<double, 6, 6>> priors;
+  auto prior_at = [&](int level) -> Eigen::Matrix<double, 6, 6> {
+    auto it = priors.find(level);
+    if (it != priors.end()) return it->second;
+    const ReducedSample& red = reduced_at(level);
+    const int n = static_cast<int>(red.raw[0].total());
+    Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Matrix<double, 6, 6> second = Eigen::Matrix<double, 6, 6>::Zero();
+    const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
+    for (int y = 0; y < red.raw[0].rows; ++y)
+      for (int x = 0; x < red.raw[0].cols; ++x) {
+        Eigen::Matrix<double, 6, 1> a;
+        for (int m = 0; m < 6; ++m) a[m] = red.raw[static_cast<std::size_t>(m)].at<float>(y, x);
+        const Eigen::Matrix<double, 6, 1> q = to * a;
+        mean += q;
+        second += q * q.transpose();
+      }
+    mean /= n;
+    Eigen::Matrix<double, 6, 6> cov = second / n - mean * mean.transpose();
+    cov.diagonal().array() += 1e-6 * cov.trace() / 6.0;  // keeps it positive definite
+    return priors.emplace(level, cov).first->second;
+  };
   auto CorrectPatch = [&](TrianglePatch& patch, const std::vector<Rectified>& rects) {
     const Rectified& primary = rects[0];
     const ReducedSample& red0 = reduced_at(primary.level);
     const int gw = primary.mask.cols, gh = primary.mask.rows;
     patch.correction_density = Eigen::Vector2d(red0.rx, red0.ry);
+    const Eigen::Matrix<double, 6, 6> prior = prior_at(primary.level);
     patch.correction.assign(6, cv::Mat());
     for (cv::Mat& m : patch.correction) m = cv::Mat::zeros(gh, gw, CV_32FC1);
     patch.channel_gain.assign(3, cv::Mat());
@@ -525,19 +591,26 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
                        Eigen::Matrix<double, 1, 6>& jac,
                        Eigen::Vector3d* channel_linear = nullptr) {
       const ReducedSample& red = reduced_at(r.level);
-      const double sx = patch.sample_x * red.rx + vi, sy = patch.sample_y * red.ry + vj;
-      const int x = std::clamp(static_cast<int>(sx), 0, red.raw[0].cols - 1);
-      const int y = std::clamp(static_cast<int>(sy), 0, red.raw[0].rows - 1);
+      // Cell (vi, vj)'s centre in the reduced sample's pixel coordinates (centres
+      // at integers): (sample_x + (vi + 0.5) / rx) rx - 0.5; bilinear there.
+      const double sx = std::clamp(patch.sample_x * red.rx + vi, 0.0, red.raw[0].cols - 1.0);
+      const double sy = std::clamp(patch.sample_y * red.ry + vj, 0.0, red.raw[0].rows - 1.0);
+      const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
+      const int x1 = std::min(x0 + 1, red.raw[0].cols - 1),
+                y1 = std::min(y0 + 1, red.raw[0].rows - 1);
+      const float fx = static_cast<float>(sx - x0), fy = static_cast<float>(sy - y0);
+      auto sample_at = [&](const cv::Mat& m) {
+        return (1 - fy) * ((1 - fx) * m.at<float>(y0, x0) + fx * m.at<float>(y0, x1)) +
+               fy * ((1 - fx) * m.at<float>(y1, x0) + fx * m.at<float>(y1, x1));
+      };
       Eigen::Matrix<double, 6, 1> q_delta;
       for (int m = 0; m < 6; ++m)
         q_delta[m] = patch.correction[static_cast<std::size_t>(m)].at<float>(j, i);
       const Eigen::Matrix<double, 6, 1> a_delta = from_orthonormal * q_delta;
       float a[6], colour[3];
       for (int m = 0; m < 6; ++m)
-        a[m] =
-            red.raw[static_cast<std::size_t>(m)].at<float>(y, x) + static_cast<float>(a_delta[m]);
-      for (int c = 0; c < 3; ++c)
-        colour[c] = red.raw[static_cast<std::size_t>(6 + c)].at<float>(y, x);
+        a[m] = sample_at(red.raw[static_cast<std::size_t>(m)]) + static_cast<float>(a_delta[m]);
+      for (int c = 0; c < 3; ++c) colour[c] = sample_at(red.raw[static_cast<std::size_t>(6 + c)]);
       const double g = result.photo_gains[r.photo];
       Eigen::Vector3d linear = Eigen::Vector3d::Zero();
       Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
@@ -607,23 +680,32 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
             }
           }
         }
+        std::vector<cv::Mat> pb(3), mb(3);
         for (int c = 0; c < 3; ++c) {
-          cv::Mat p, m;
-          cv::GaussianBlur(photo_sum[static_cast<std::size_t>(c)], p, cv::Size(0, 0),
+          cv::GaussianBlur(photo_sum[static_cast<std::size_t>(c)], pb[c], cv::Size(0, 0),
                            options.correction_sigma);
-          cv::GaussianBlur(model_sum[static_cast<std::size_t>(c)], m, cv::Size(0, 0),
+          cv::GaussianBlur(model_sum[static_cast<std::size_t>(c)], mb[c], cv::Size(0, 0),
                            options.correction_sigma);
-          for (int j = 0; j < gh; ++j)
-            for (int i = 0; i < gw; ++i) {
-              if (!known.at<std::uint8_t>(j, i) || !(m.at<float>(j, i) > 1e-4f) ||
-                  !(p.at<float>(j, i) > 1e-4f))
-                continue;
-              float& k = patch.channel_gain[static_cast<std::size_t>(c)].at<float>(j, i);
-              k = std::clamp(k * static_cast<float>(
-                                     std::pow(p.at<float>(j, i) / m.at<float>(j, i), 1.0 / 2.2)),
-                             0.25f, 4.0f);
-            }
         }
+        for (int j = 0; j < gh; ++j)
+          for (int i = 0; i < gw; ++i) {
+            if (!known.at<std::uint8_t>(j, i)) continue;
+            double ratio[3];
+            bool ok = true;
+            for (int c = 0; c < 3; ++c) {
+              const float p = pb[c].at<float>(j, i), m = mb[c].at<float>(j, i);
+              ok = ok && m > 1e-4f && p > 1e-4f;
+              ratio[c] = ok ? std::pow(p / m, 1.0 / 2.2) : 1.0;
+            }
+            if (!ok) continue;
+            // Chromaticity only: the luminance is the additive change's.
+            const double mean = (ratio[0] + ratio[1] + ratio[2]) / 3.0;
+            for (double& r : ratio) r /= mean;
+            for (int c = 0; c < 3; ++c) {
+              float& k = patch.channel_gain[static_cast<std::size_t>(c)].at<float>(j, i);
+              k = std::clamp(k * static_cast<float>(ratio[c]), 0.25f, 4.0f);
+            }
+          }
       }
       if (!options.additive_correction) continue;
       for (int j = 0; j < gh; ++j) {
@@ -642,14 +724,21 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
           if (rows == 0) continue;
           known.at<std::uint8_t>(j, i) = 1;
           const auto jr = jac.topRows(rows);
-          Eigen::MatrixXd jjt = jr * jr.transpose();
-          const double scale = jjt.trace() / rows;
-          if (!(scale > 1e-12)) continue;
-          jjt.diagonal().array() += 1e-3 * scale;
-          const Eigen::Matrix<double, 6, 1> dq = jr.transpose() * jjt.ldlt().solve(res.head(rows));
+          Eigen::Matrix<double, 6, 1> q0;
           for (int m = 0; m < 6; ++m)
-            patch.correction[static_cast<std::size_t>(m)].at<float>(j, i) +=
-                static_cast<float>(dq[m]);
+            q0[m] = patch.correction[static_cast<std::size_t>(m)].at<float>(j, i);
+          // Gauss-Newton step of the MAP estimate: q = Sigma J^T (J Sigma J^T +
+          // s^2 I)^-1 (r + J q0), s^2 = correction_noise x the mean predicted variance.
+          const Eigen::MatrixXd js = jr * prior;
+          Eigen::MatrixXd a = js * jr.transpose();
+          const double scale = a.trace() / rows;
+          if (!(scale > 1e-12)) continue;
+          a.diagonal().array() += options.correction_noise * scale;
+          const Eigen::Matrix<double, 6, 1> q_new =
+              js.transpose() * a.ldlt().solve(res.head(rows) + jr * q0);
+          for (int m = 0; m < 6; ++m)
+            patch.correction[static_cast<std::size_t>(m)].at<float>(j, i) =
+                static_cast<float>(q_new[m]);
         }
       }
     }

@@ -41,8 +41,8 @@ struct MeshSynthesisOptions {
   /// Candidates kept by the image score before the neighbour constraint. >= 1.
   int top_k = 12;
   /// Constrain with every photo in which the triangle is fully visible (scores
-  /// summed, each under its own light), not only the best view.
-  bool all_views = false;
+  /// summed, each under its own light), not only the best view (paper 003).
+  bool all_views = true;
   /// Most views used per triangle with all_views. >= 1.
   int max_views = 4;
   TangentFrame tangent_frame = TangentFrame::kFirstEdge;
@@ -56,16 +56,20 @@ struct MeshSynthesisOptions {
   /// Fewest rectified photo pixels inside a triangle for the photo to constrain it. >= 1.
   int min_photo_pixels = 6;
   /// Photo-consistency pass per triangle (beyond the paper, as in the planar
-  /// synthesis): Gauss-Newton rounds of the smallest change of the luminance
-  /// coefficients that makes the patch, relit under each constraint photo's
-  /// lights, equal the rectified photo at its density. 0 = off. [0, 5]. LRGB only.
+  /// synthesis): Gauss-Newton rounds of the most probable change of the
+  /// luminance coefficients (a Gaussian prior with the sample's own coefficient
+  /// covariance at the photo's density) that makes the patch, relit under each
+  /// constraint photo's lights, equal the rectified photos at their density.
+  /// 0 = off. [0, 5]. LRGB only.
   int correction_iterations = 2;
   /// The additive luminance change above.
   bool additive_correction = true;
-  /// Low-frequency per-channel factors (albedo-like: stains, colour), before the
-  /// additive change. Off by default: on the synthetic scenes it lowered PSNR
-  /// under held-out lights (docs/synth.md).
-  bool channel_correction = false;
+  /// Photo noise of that estimate, as a share of the variance the prior predicts
+  /// at the photo pixel: small trusts the photos, large keeps the sample. > 0.
+  double correction_noise = 0.1;
+  /// Low-frequency per-channel factors normalised to keep the luminance
+  /// (chromaticity: stains, colour), before the additive change.
+  bool channel_correction = true;
   /// Smoothing of the per-channel factors, in photo pixels (Gaussian sigma). > 0.
   double correction_sigma = 2.0;
   /// Refuse up front when the patches would take more texels than this.
@@ -154,13 +158,20 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
                                 const MeshSynthesisOptions& options,
                                 const ProgressCallback& progress = {});
 
+/// Lights lower than this (degrees above the tangent plane) are evaluated at this
+/// elevation and faded linearly in l_z to 0 at the horizon (RelightMixture): RTI
+/// domes rarely light below it, and the biquadratic overshoots there. Recorded in
+/// the model's manifest and glTF extras so that viewers do the same.
+inline constexpr double kHorizonElevationDeg = 15.0;
+
 /// sRGB decoding/encoding of display values in [0, 1] (IEC 61966-2-1).
 float SrgbToLinear(float v);
 float LinearToSrgb(float v);
 
 /// The display value of a PTM texel under several lights (tangent frame) with
 /// intensities, times a gain: the sum is taken in the linear domain,
-/// srgb(gain * sum_i I_i lin(clamp(f(l_i)))). Lights below the horizon add 0.
+/// srgb(gain * sum_i I_i lin(clamp(f(l_i)))). Lights below the horizon add 0;
+/// lights below kHorizonElevationDeg fade (see there).
 Eigen::Vector3f RelightMixture(const float* coefficients_or_l, const float* colour,
                                ptm::PtmFormat format,
                                const std::vector<std::pair<Eigen::Vector3d, double>>& lights,

@@ -256,6 +256,11 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
     manifest["ptm_frame"] =
         "per texel: x = dP/du, y = dP/dv (v up, as in OBJ), z = face normal; light directions "
         "point from the surface to the light";
+    manifest["ptm_evaluation"] = {
+        {"domain", "display (sRGB-encoded); several lights sum in the linear domain"},
+        {"horizon_elevation_deg", kHorizonElevationDeg},
+        {"below_horizon_elevation",
+         "value at horizon_elevation_deg (same azimuth) times l_z / sin(horizon_elevation_deg)"}};
     manifest["atlases"] = nlohmann::json::array();
     std::vector<std::vector<unsigned char>> pngs;
     std::vector<nlohmann::json> extras;
@@ -285,6 +290,7 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
              {"exr", exr_file},
              {"format", format},
              {"frame", manifest["ptm_frame"]},
+             {"evaluation", manifest["ptm_evaluation"]},
              {"texcoord", "TEXCOORD_0 (glTF v down; the PTM's y axis points to -v)"}}}});
       mtl << "newmtl atlas_" << k << "\nKa 0 0 0\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd " << base
           << "\n# albedo: " << albedo << "; PTM: " << ptm_file << " (lossless " << exr_file

@@ -89,6 +89,24 @@ TEST_P(CameraModelTest, UnprojectProjectFromPixelsAcrossTheImage) {
   }
 }
 
+TEST_P(CameraModelTest, ScaledCameraProjectsToScaledPixels) {
+  const Camera camera = MakeCamera(CameraModelId(GetParam()));
+  const Camera twice = camera.Scaled(2.0);
+  ASSERT_NO_THROW(twice.Check());
+  EXPECT_EQ(twice.width, 2 * camera.width);
+  EXPECT_EQ(twice.height, 2 * camera.height);
+  for (double y = 0.0; y <= 1200.0; y += 200.0) {
+    for (double x = 0.0; x <= 1600.0; x += 200.0) {
+      const Eigen::Vector3d ray = camera.CamRayFromImage({x, y});
+      const auto pixel = twice.ImageFromCam(ray);
+      ASSERT_TRUE(pixel.has_value());
+      EXPECT_LT((*pixel - Eigen::Vector2d(2 * x, 2 * y)).norm(), 1e-6)
+          << CameraModelName(camera.model) << " at " << x << "," << y;
+    }
+  }
+  EXPECT_THROW(camera.Scaled(0.0), std::invalid_argument);
+}
+
 INSTANTIATE_TEST_SUITE_P(AllColmapModels, CameraModelTest, ::testing::Range(0, kNumCameraModels),
                          [](const ::testing::TestParamInfo<int>& param_info) {
                            return std::string(CameraModelName(CameraModelId(param_info.param)));
