@@ -16,6 +16,7 @@
 #include "sfm/colmap_io.h"
 #include "sfm/errors.h"
 #include "sfm/file_util.h"
+#include "synth/model_io.h"
 
 namespace texlume::datasets {
 namespace {
@@ -148,17 +149,7 @@ std::vector<Eigen::Vector3d> DomeLights(int count, double min_elevation_deg,
 }
 
 void WritePngAtomically(const std::filesystem::path& path, const cv::Mat& image) {
-  std::vector<unsigned char> bytes;
-  if (!cv::imencode(".png", image, bytes)) {
-    throw std::runtime_error(path.string() + ": cannot encode PNG");
-  }
-  WriteFileAtomically(
-      path,
-      [&](std::ostream& out) {
-        out.write(reinterpret_cast<const char*>(bytes.data()),
-                  static_cast<std::streamsize>(bytes.size()));
-      },
-      true);
+  synth::WriteBytesAtomically(path, synth::EncodePng(image, path.string()));
 }
 
 PlanarSurfaceRenders RenderPlanarSurface(const PlanarSurfaceOptions& options,

@@ -63,7 +63,7 @@ float LinearToSrgb(float v) {
 Eigen::Vector3f RelightMixture(const float* coefficients, const float* colour,
                                ptm::PtmFormat format, const LightList& lights, double gain) {
   Eigen::Vector3f linear = Eigen::Vector3f::Zero();
-  const double z_horizon = std::sin(kHorizonElevationDeg * std::numbers::pi / 180.0);
+  static const double z_horizon = std::sin(kHorizonElevationDeg * std::numbers::pi / 180.0);
   for (const auto& [l_in, intensity] : lights) {
     if (l_in.z() <= 0.0) continue;
     // Below kHorizonElevationDeg the biquadratic is extrapolated beyond any
