@@ -27,6 +27,201 @@ std::int64_t Key(int x, int y) {
   return (static_cast<std::int64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
 }
 
+constexpr double kPi = 3.14159265358979323846;
+/// Turns tried for every chart when packing (every 360/16 = 22.5 degrees).
+constexpr int kPackingRotations = 16;
+
+/// A chart turned by `angle`: its texel box (chart units / t, x right, y up;
+/// gutters included) and, row by row (y down from the box top), the runs of
+/// texels the bake writes: those within the gutter of one of its triangles.
+struct ChartOutline {
+  struct Run {
+    int row, x, length;
+  };
+  double angle = 0.0;
+  Eigen::Vector2i lo, hi;
+  std::vector<Run> runs;
+  double area = 0.0;  ///< texels inside the outline
+  int Width() const { return hi.x() - lo.x(); }
+  int Height() const { return hi.y() - lo.y(); }
+};
+
+ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
+                     const std::vector<TrianglePatch>& patches, double t, int gutter) {
+  ChartOutline o;
+  o.angle = angle;
+  const Eigen::Matrix2d turn = Eigen::Rotation2Dd(angle).toRotationMatrix();
+  std::vector<std::array<Eigen::Vector2d, 3>> corners;  // texels, chart frame
+  Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
+  Eigen::Vector2d hi = -lo;
+  for (const ChartFace& cf : chart) {
+    std::array<Eigen::Vector2d, 3> c;
+    for (std::size_t k = 0; k < 3; ++k) {
+      c[k] = turn *
+             (cf.rotation * patches[static_cast<std::size_t>(cf.face)].corners_in_frame[k] +
+              cf.translation) /
+             t;
+      lo = lo.cwiseMin(c[k]);
+      hi = hi.cwiseMax(c[k]);
+    }
+    corners.push_back(c);
+  }
+  o.lo = Eigen::Vector2i(static_cast<int>(std::floor(lo.x())) - gutter,
+                         static_cast<int>(std::floor(lo.y())) - gutter);
+  o.hi = Eigen::Vector2i(static_cast<int>(std::ceil(hi.x())) + gutter,
+                         static_cast<int>(std::ceil(hi.y())) + gutter);
+  const int w = o.Width(), h = o.Height();
+  cv::Mat mask = cv::Mat::zeros(h, w, CV_8UC1);
+  for (auto c : corners) {
+    for (auto& p : c) p = Eigen::Vector2d(p.x() - o.lo.x(), o.hi.y() - p.y());  // box, y down
+    Eigen::Vector2d clo = c[0], chi = clo;
+    for (const auto& p : c) clo = clo.cwiseMin(p), chi = chi.cwiseMax(p);
+    // Texels the bake writes for this face: centre within gutter + 0.5 of it.
+    for (int y = std::max(0, static_cast<int>(clo.y()) - gutter - 1);
+         y <= std::min(h - 1, static_cast<int>(chi.y()) + gutter + 1); ++y)
+      for (int x = std::max(0, static_cast<int>(clo.x()) - gutter - 1);
+           x <= std::min(w - 1, static_cast<int>(chi.x()) + gutter + 1); ++x)
+        if (SignedDistanceToTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5)) <= gutter + 0.5)
+          mask.at<std::uint8_t>(y, x) = 1;
+  }
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w;) {
+      if (!mask.at<std::uint8_t>(y, x)) {
+        ++x;
+        continue;
+      }
+      int end = x;
+      while (end < w && mask.at<std::uint8_t>(y, end)) ++end;
+      o.runs.push_back({y, x, end - x});
+      o.area += end - x;
+      x = end;
+    }
+  // Longest runs first: they reject a blocked position soonest.
+  std::stable_sort(
+      o.runs.begin(), o.runs.end(),
+      [](const ChartOutline::Run& a, const ChartOutline::Run& b) { return a.length > b.length; });
+  return o;
+}
+
+/// One atlas being packed: per texel, the length of the free (> 0) or used
+/// (< 0) run of texels that starts there, to its right.
+struct PackingBin {
+  int size = 0;
+  std::vector<std::int16_t> run;  // size x size, row-major (|run| <= 16384)
+  int used_rows = 0;
+  explicit PackingBin(int bin_size)
+      : size(bin_size), run(static_cast<std::size_t>(bin_size) * bin_size) {
+    for (int y = 0; y < size; ++y) UpdateRow(y, nullptr);
+  }
+  int At(int x, int y) const {
+    return run[static_cast<std::size_t>(y) * static_cast<std::size_t>(size) +
+               static_cast<std::size_t>(x)];
+  }
+  /// Rebuilds row y's runs; `used` marks texels to take (nullptr: all free).
+  void UpdateRow(int y, const std::vector<char>* used) {
+    std::int16_t* r = &run[static_cast<std::size_t>(y) * static_cast<std::size_t>(size)];
+    for (int x = size - 1; x >= 0; --x) {
+      const bool taken = used ? (*used)[static_cast<std::size_t>(x)] != 0 : false;
+      const int next = x + 1 < size ? r[x + 1] : 0;
+      r[x] =
+          static_cast<std::int16_t>(taken ? (next < 0 ? next - 1 : -1) : (next > 0 ? next + 1 : 1));
+    }
+  }
+  /// 0 when the outline fits with its box's top-left at (x, y); otherwise how
+  /// far right the next position that can fit on the blocking row is.
+  int Skip(const ChartOutline& o, int x, int y) const {
+    for (const ChartOutline::Run& r : o.runs) {
+      const int v = At(x + r.x, y + r.row);
+      if (v >= r.length) continue;
+      if (v < 0) return -v;                   // blocked at the run's start: pass the used run
+      if (x + r.x + v >= size) return size;   // free to the edge but too short
+      return v - At(x + r.x + v, y + r.row);  // pass the free run and the used one after it
+    }
+    return 0;
+  }
+  /// The first position, by rows then columns, where the outline fits, with the
+  /// outline's row `y + Height()` not above `max_bottom`; (-1, -1): none.
+  std::pair<int, int> FirstFit(const ChartOutline& o, int max_bottom) const {
+    for (int y = 0; y + o.Height() <= std::min(size, max_bottom); ++y)
+      for (int x = 0; x + o.Width() <= size;) {
+        const int skip = Skip(o, x, y);
+        if (skip == 0) return {x, y};
+        x += skip;
+      }
+    return {-1, -1};
+  }
+  void Take(const ChartOutline& o, int x0, int y0) {
+    std::vector<std::vector<char>> rows(static_cast<std::size_t>(o.Height()));
+    for (const ChartOutline::Run& r : o.runs) {
+      auto& row = rows[static_cast<std::size_t>(r.row)];
+      if (row.empty()) {
+        row.resize(static_cast<std::size_t>(size));
+        const std::int16_t* cur =
+            &run[static_cast<std::size_t>(y0 + r.row) * static_cast<std::size_t>(size)];
+        for (int x = 0; x < size; ++x) row[static_cast<std::size_t>(x)] = cur[x] < 0;
+      }
+      std::fill(row.begin() + x0 + r.x, row.begin() + x0 + r.x + r.length, 1);
+    }
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (!rows[i].empty()) UpdateRow(y0 + static_cast<int>(i), &rows[i]);
+    used_rows = std::max(used_rows, y0 + o.Height());
+  }
+};
+
+/// Where PackOutlines drops a chart: with its outline at `rotation`, the
+/// outline box's top-left at texel (x, y) of atlas `bin` (y down).
+struct OutlineDrop {
+  int bin = 0, rotation = 0, x = 0, y = 0;
+};
+
+struct OutlinePacking {
+  std::vector<OutlineDrop> drops;  ///< per chart
+  std::int64_t texels = 0;         ///< atlas texels used (the last atlas cropped)
+};
+
+/// Which position (and rotation) a chart takes.
+enum class DropRule {
+  kLowestBottom,    ///< the outline box's bottom row nearest the atlas top, then leftmost
+  kLowestPosition,  ///< the outline box's top row nearest the atlas top, then leftmost
+};
+
+/// Bottom-left packing of outlines (texel-exact, so charts fill each other's
+/// concavities and holes): charts go in `order`, each into the first atlas
+/// where it fits, at the rotation and position `rule` prefers.
+OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlines,
+                            const std::vector<std::size_t>& order, int bin_size, DropRule rule) {
+  OutlinePacking packing;
+  packing.drops.resize(outlines.size());
+  std::vector<PackingBin> bins;
+  for (const std::size_t c : order) {
+    for (std::size_t bin = 0;; ++bin) {
+      if (bin == bins.size()) bins.emplace_back(bin_size);
+      const std::size_t num_rotations = outlines[c].size();
+      std::vector<std::pair<int, int>> fit(num_rotations);
+#pragma omp parallel for schedule(dynamic, 1)
+      for (std::size_t r = 0; r < num_rotations; ++r)
+        fit[r] = bins[bin].FirstFit(outlines[c][r], bin_size);
+      int best = -1;
+      auto key = [&](std::size_t r) {
+        const int y = fit[r].second;
+        return std::make_tuple(rule == DropRule::kLowestBottom ? y + outlines[c][r].Height() : y,
+                               fit[r].first, y);
+      };
+      for (std::size_t r = 0; r < num_rotations; ++r)
+        if (fit[r].first >= 0 && (best < 0 || key(r) < key(static_cast<std::size_t>(best))))
+          best = static_cast<int>(r);
+      if (best < 0) continue;
+      const auto [x, y] = fit[static_cast<std::size_t>(best)];
+      bins[bin].Take(outlines[c][static_cast<std::size_t>(best)], x, y);
+      packing.drops[c] = {static_cast<int>(bin), best, x, y};
+      break;
+    }
+  }
+  for (std::size_t bin = 0; bin < bins.size(); ++bin)
+    packing.texels += static_cast<std::int64_t>(bin_size) *
+                      (bin + 1 < bins.size() ? bin_size : bins[bin].used_rows);
+  return packing;
+}
 }  // namespace
 
 void AtlasOptions::Check() const {
@@ -148,9 +343,30 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
                                      : options.atlas_size) -
          2 * gutter - 2) *
         t;
-    const double min_cos =
-        std::cos(options.max_chart_normal_angle_deg * 3.14159265358979323846 / 180.0);
-    for (std::size_t seed = 0; seed < num_faces; ++seed) {
+    const double min_cos = std::cos(options.max_chart_normal_angle_deg * kPi / 180.0);
+    // Seeds in breadth-first order over face adjacency, so each new chart starts
+    // at the border of the charted region and few fragments are left between.
+    std::vector<int> seed_order;
+    {
+      std::vector<char> seen(num_faces, 0);
+      for (std::size_t root = 0; root < num_faces; ++root) {
+        if (seen[root]) continue;
+        std::deque<int> bfs = {static_cast<int>(root)};
+        seen[root] = 1;
+        while (!bfs.empty()) {
+          const int f = bfs.front();
+          bfs.pop_front();
+          seed_order.push_back(f);
+          for (const Unfolding& u : synthesis.unfoldings[static_cast<std::size_t>(f)])
+            if (u.face >= 0 && !seen[static_cast<std::size_t>(u.face)]) {
+              seen[static_cast<std::size_t>(u.face)] = 1;
+              bfs.push_back(u.face);
+            }
+        }
+      }
+    }
+    for (const int seed_face : seed_order) {
+      const auto seed = static_cast<std::size_t>(seed_face);
       if (chart_of[seed] >= 0) continue;
       const int chart_id = static_cast<int>(charts.size());
       std::vector<ChartFace> chart;
@@ -204,6 +420,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
         return true;
       };
       try_add({static_cast<int>(seed), Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero()});
+      // Breadth-first over the mesh edges, each neighbour unfolded across the edge.
       std::deque<std::size_t> queue = {0};
       while (!queue.empty()) {
         const ChartFace from = chart[queue.front()];
@@ -231,96 +448,66 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
   // 2. Chart boxes in texels (with gutters), packed.
   std::vector<std::pair<int, int>> sizes;
   std::vector<Eigen::Vector2i> chart_lo, chart_hi;
-  for (const auto& chart : charts) {
-    Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
-    Eigen::Vector2d hi = -lo;
-    for (const ChartFace& cf : chart)
-      for (const auto& p : synthesis.patches[static_cast<std::size_t>(cf.face)].corners_in_frame) {
-        const Eigen::Vector2d q = (cf.rotation * p + cf.translation) / t;
-        lo = lo.cwiseMin(q);
-        hi = hi.cwiseMax(q);
-      }
-    const Eigen::Vector2i ilo(static_cast<int>(std::floor(lo.x())) - gutter,
-                              static_cast<int>(std::floor(lo.y())) - gutter);
-    const Eigen::Vector2i ihi(static_cast<int>(std::ceil(hi.x())) + gutter,
-                              static_cast<int>(std::ceil(hi.y())) + gutter);
-    chart_lo.push_back(ilo);
-    chart_hi.push_back(ihi);
-    sizes.emplace_back(ihi.x() - ilo.x(), ihi.y() - ilo.y());
-  }
   std::vector<std::array<int, 3>> packed;
   if (options.mode == AtlasMode::kPerTriangle) {
+    for (const auto& chart : charts) {
+      const ChartOutline outline = Outline(chart, 0.0, synthesis.patches, t, gutter);
+      chart_lo.push_back(outline.lo);
+      chart_hi.push_back(outline.hi);
+      sizes.emplace_back(outline.Width(), outline.Height());
+    }
     packed = PackSkyline(sizes, options.atlas_size, options.atlas_size);
   } else {
-    // Charts are packed by their shapes: each chart's texels within the gutter
-    // of its triangles, at cells of kCell texels (conservative), placed at the
-    // lowest, then leftmost, cell position where they overlap nothing, so charts
-    // nest in each other's concavities.
-    constexpr int kCell = 4;
-    const int grid = options.atlas_size / kCell;
-    std::vector<std::vector<cv::Point>> cells(charts.size());
-    std::vector<cv::Size> cell_size(charts.size());
+    // Charts are packed by their outlines (the texels the bake writes), largest
+    // first, each at the best of kPackingRotations turns and the first position
+    // where it overlaps nothing, so charts nest in each other's concavities.
+    std::vector<std::vector<ChartOutline>> outlines(charts.size());
+    std::vector<double> area(charts.size(), 0.0);
+#pragma omp parallel for schedule(dynamic, 1)
     for (std::size_t c = 0; c < charts.size(); ++c) {
-      const int cw = (sizes[c].first + kCell - 1) / kCell,
-                ch = (sizes[c].second + kCell - 1) / kCell;
-      cell_size[c] = cv::Size(cw, ch);
-      cv::Mat mask = cv::Mat::zeros(ch, cw, CV_8UC1);
-      for (const ChartFace& cf : charts[c]) {
-        std::array<Eigen::Vector2d, 3> corners;
-        for (int k = 0; k < 3; ++k) {
-          const Eigen::Vector2d q =
-              (cf.rotation * synthesis.patches[static_cast<std::size_t>(cf.face)]
-                                 .corners_in_frame[static_cast<std::size_t>(k)] +
-               cf.translation) /
-              t;
-          corners[static_cast<std::size_t>(k)] =
-              Eigen::Vector2d(q.x() - chart_lo[c].x(), chart_hi[c].y() - q.y());
-        }
-        Eigen::Vector2d lo = corners[0], hi = lo;
-        for (const auto& p : corners) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-        for (int y = std::max(0, static_cast<int>(lo.y()) - gutter - 1);
-             y <= std::min(sizes[c].second - 1, static_cast<int>(hi.y()) + gutter + 1); ++y)
-          for (int x = std::max(0, static_cast<int>(lo.x()) - gutter - 1);
-               x <= std::min(sizes[c].first - 1, static_cast<int>(hi.x()) + gutter + 1); ++x)
-            if (SignedDistanceToTriangle(corners, Eigen::Vector2d(x + 0.5, y + 0.5)) <=
-                gutter + 0.5)
-              mask.at<std::uint8_t>(y / kCell, x / kCell) = 1;
-      }
-      cv::findNonZero(mask, cells[c]);
+      for (int r = 0; r < kPackingRotations; ++r)
+        outlines[c].push_back(
+            Outline(charts[c], 2.0 * kPi * r / kPackingRotations, synthesis.patches, t, gutter));
+      for (const auto& o : outlines[c]) area[c] = std::max(area[c], o.area);
     }
     std::vector<std::size_t> order(charts.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return cells[a].size() > cells[b].size();
-    });
-    std::vector<cv::Mat> occupied;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return area[a] > area[b]; });
+    for (const auto& chart_outlines : outlines) {
+      bool fits = false;
+      for (const auto& o : chart_outlines)
+        fits = fits || (o.Width() <= options.atlas_size && o.Height() <= options.atlas_size);
+      if (!fits)
+        throw OptionError("a chart of " + std::to_string(chart_outlines[0].Width()) + " x " +
+                          std::to_string(chart_outlines[0].Height()) +
+                          " texels does not fit an atlas of " + std::to_string(options.atlas_size));
+    }
+    // Both drop rules; the layout with fewer atlas texels wins.
+    OutlinePacking best_packing;
+    for (const DropRule rule : {DropRule::kLowestBottom, DropRule::kLowestPosition}) {
+      OutlinePacking packing = PackOutlines(outlines, order, options.atlas_size, rule);
+      if (best_packing.drops.empty() || packing.texels < best_packing.texels)
+        best_packing = std::move(packing);
+      if (progress) progress("packing", rule == DropRule::kLowestBottom ? 1 : 2, 2);
+    }
+    sizes.resize(charts.size());
+    chart_lo.resize(charts.size());
+    chart_hi.resize(charts.size());
     packed.resize(charts.size());
-    for (std::size_t n = 0; n < order.size(); ++n) {
-      const std::size_t c = order[n];
-      if (cell_size[c].width > grid || cell_size[c].height > grid)
-        throw OptionError("a chart of " + std::to_string(sizes[c].first) + " x " +
-                          std::to_string(sizes[c].second) + " texels does not fit an atlas of " +
-                          std::to_string(options.atlas_size));
-      bool placed = false;
-      for (std::size_t bin = 0; !placed; ++bin) {
-        if (bin == occupied.size()) occupied.push_back(cv::Mat::zeros(grid, grid, CV_8UC1));
-        cv::Mat& occ = occupied[bin];
-        for (int y = 0; y + cell_size[c].height <= grid && !placed; ++y) {
-          for (int x = 0; x + cell_size[c].width <= grid && !placed; ++x) {
-            bool free = true;
-            for (const cv::Point& p : cells[c])
-              if (occ.at<std::uint8_t>(y + p.y, x + p.x)) {
-                free = false;
-                break;
-              }
-            if (!free) continue;
-            for (const cv::Point& p : cells[c]) occ.at<std::uint8_t>(y + p.y, x + p.x) = 1;
-            packed[c] = {static_cast<int>(bin), x * kCell, y * kCell};
-            placed = true;
-          }
-        }
+    for (std::size_t c = 0; c < charts.size(); ++c) {
+      const OutlineDrop& drop = best_packing.drops[c];
+      const ChartOutline& o = outlines[c][static_cast<std::size_t>(drop.rotation)];
+      // Turn the chart to the chosen rotation.
+      const Eigen::Matrix2d turn = Eigen::Rotation2Dd(o.angle).toRotationMatrix();
+      for (ChartFace& cf : charts[c]) {
+        cf.rotation = turn * cf.rotation;
+        cf.translation = turn * cf.translation;
       }
-      if (progress) progress("packing", n + 1, order.size());
+      chart_lo[c] = o.lo;
+      chart_hi[c] = o.hi;
+      sizes[c] = {o.Width(), o.Height()};
+      packed[c] = {drop.bin, drop.x, drop.y};
     }
   }
 

@@ -34,7 +34,7 @@ struct AtlasOptions {
   double max_chart_normal_angle_deg = 180.0;
   /// kCharts: largest chart side in texels (0 = the atlas size); smaller charts
   /// nest better. [0, atlas_size].
-  int max_chart_size = 256;
+  int max_chart_size = 192;
   void Check() const;
 };
 
@@ -65,8 +65,9 @@ struct Atlases {
   double seconds = 0.0;
 };
 
-/// Lays out the faces (per triangle or in charts), packs the boxes into atlases
-/// (skyline, tallest first, one at a time), and bakes every texel from the
+/// Lays out the faces (per triangle or in charts), packs them into atlases
+/// (per-triangle boxes: skyline, tallest first; charts: by their outlines at 16
+/// rotations on a per-column skyline, largest first), and bakes every texel from the
 /// synthesis, blended across mesh edges in the orthonormal space (paper 003
 /// Fig. 4) and rotated into the atlas frame; gutters are dilated.
 Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthesis,
