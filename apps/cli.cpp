@@ -1,15 +1,18 @@
 #include "apps/cli.h"
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "apps/http_server.h"
 #include "apps/progress_bar.h"
 #include "datasets_synthetic/object_scene.h"
 #include "datasets_synthetic/scene.h"
@@ -22,6 +25,7 @@
 #include "sfm/lights.h"
 #include "synth/pipeline.h"
 #include "synth/planar_synthesis.h"
+#include "synth/web_model.h"
 
 namespace texlume::apps {
 
@@ -566,6 +570,91 @@ std::string ReportRow(const std::string& name, const synth::RenderJobSummary& s)
 }
 
 }  // namespace
+
+namespace {
+std::atomic<bool> g_stop_serving{false};
+extern "C" void StopServing(int /*signal*/) { g_stop_serving.store(true); }
+
+/// Where the viewer's page and npm packages are: $TEXLUME_WEB_DIR, else the
+/// source tree's web/ (the build records it).
+std::filesystem::path WebDir() {
+  if (const char* env = std::getenv("TEXLUME_WEB_DIR")) return env;
+  return TEXLUME_SOURCE_WEB_DIR;
+}
+
+/// A file below `root` for a request path below a prefix; nullopt when the path
+/// tries to leave `root` or names no regular file.
+std::optional<std::filesystem::path> FileBelow(const std::filesystem::path& root,
+                                               const std::string& rest) {
+  if (rest.empty() || rest.find("..") != std::string::npos || rest.find('\\') != std::string::npos)
+    return std::nullopt;
+  const std::filesystem::path file = root / rest;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) return std::nullopt;
+  return file;
+}
+}  // namespace
+
+int RunViewCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  std::vector<std::string> rest;
+  std::filesystem::path model_dir;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i].rfind("--", 0) == 0) {
+      rest.push_back(args[i]);
+      if (i + 1 < args.size()) rest.push_back(args[++i]);
+    } else if (model_dir.empty()) {
+      model_dir = args[i];
+    } else {
+      throw UsageError("view takes one model folder, not also '" + args[i] + "'");
+    }
+  }
+  const Arguments a(rest, {"port", "host"}, {});
+  if (model_dir.empty()) throw UsageError("view: give the model folder written by texlume synth");
+  const int port = a.GetInt("port", 8080);
+  if (port < 0 || port > 65535) throw UsageError("--port must be in [0, 65535]");
+  const std::string host = a.Get("host").value_or("127.0.0.1");
+  const std::filesystem::path web = WebDir();
+  const std::filesystem::path three = web / "node_modules/three";
+  if (!std::filesystem::exists(web / "viewer/index.html") ||
+      !std::filesystem::exists(three / "build/three.module.js"))
+    throw InputError(web.string(),
+                     "has no viewer or no three.js; run ./scripts/install_deps.sh "
+                     "(it runs npm ci in web/), or set TEXLUME_WEB_DIR");
+  const auto t0 = std::chrono::steady_clock::now();
+  const synth::WebModel model = synth::BuildWebModel(model_dir);
+  const double prepare_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  HttpServer server(host, port);
+  const HttpHandler handler = [&](const std::string& path) -> HttpResponse {
+    auto file_response = [](const std::filesystem::path& f) {
+      std::ifstream in(f, std::ios::binary);
+      HttpResponse r;
+      r.content_type = ContentTypeOf(f.filename().string());
+      r.body.assign(std::istreambuf_iterator<char>(in), {});
+      return r;
+    };
+    if (path == "/" || path == "/index.html") return file_response(web / "viewer/index.html");
+    if (path.rfind("/viewer/", 0) == 0)
+      if (const auto f = FileBelow(web / "viewer", path.substr(8))) return file_response(*f);
+    if (path.rfind("/three/", 0) == 0)
+      if (const auto f = FileBelow(three, path.substr(7))) return file_response(*f);
+    if (path.rfind("/model/", 0) == 0) {
+      const auto it = model.files.find(path.substr(7));
+      if (it != model.files.end()) return {200, ContentTypeOf(it->first), it->second};
+    }
+    return {404, "text/plain", {}};
+  };
+  out << "texlume view: " << model.scene["faces"].get<std::size_t>() << " triangles, "
+      << model.scene["atlases"].size() << " atlas(es), prepared in " << prepare_s << " s\n"
+      << "Serving " << model_dir.string() << " at http://" << host << ":" << server.port()
+      << "/ (Ctrl-C stops)" << std::endl;
+  g_stop_serving.store(false);
+  std::signal(SIGINT, StopServing);
+  std::signal(SIGTERM, StopServing);
+  server.Serve(handler, g_stop_serving);
+  err << "texlume view: stopped\n";
+  return kExitOk;
+}
 
 int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
   const Arguments a(args, {"out", "seed", "kind", "material"}, {});

@@ -56,6 +56,9 @@ int RunLightsFromSphereCommand(const std::vector<std::string>& args, std::ostrea
 int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 /// `texlume synth`: the relightable model from photos (paper 003 Algorithm 2).
 int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// `texlume view MODEL [--port N] [--host H]`: serves the browser viewer of a model
+/// folder on localhost until interrupted (docs/viewer.md).
+int RunViewCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 /// `texlume render`: a model folder drawn through COLMAP cameras under given lights.
 int RunRenderCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 /// `texlume demo`: builds a synthetic scene and inspects it. Returns the exit code.

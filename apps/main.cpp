@@ -41,6 +41,9 @@ constexpr const char* kUsage =
     "         [--baseline flat|baked] [--samples N] [--truth DIR [--truth-masks DIR]]\n"
     "         [--reduced-factor R]\n"
     "      Render a model folder for every image of a COLMAP model under its light(s).\n"
+    "  view MODEL_DIR [--port N] [--host ADDRESS]\n"
+    "      Serve the model's relighting preview in the browser (http://127.0.0.1:8080/;\n"
+    "      --port 0 picks a free port).\n"
     "  scene --out DIR [--kind sphere|cylinder|plane|torus] [--material stone|brick|grooves]\n"
     "        [--seed S] [--images N] [--camera-model pinhole|opencv] [--width W] [--height H]\n"
     "        [--capture-size N] [--capture-lights N] [--held-out-lights N] [--held-out-views N]\n"
@@ -83,6 +86,7 @@ int main(int argc, char** argv) {
     if (command == "synth2d") return RunSynth2dCommand(args, std::cout, std::cerr);
     if (command == "synth") return RunSynthCommand(args, std::cout, std::cerr);
     if (command == "render") return RunRenderCommand(args, std::cout, std::cerr);
+    if (command == "view") return RunViewCommand(args, std::cout, std::cerr);
     if (command == "scene") return RunSceneCommand(args, std::cout, std::cerr);
     if (command == "demo") return RunDemoCommand(args, std::cout, std::cerr);
     throw UsageError("unknown command '" + command + "'");

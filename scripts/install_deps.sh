@@ -14,7 +14,12 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # the real COLMAP program, used by the cross-check tests
   colmap
+  # the browser tests of the viewer (driven by playwright-core from npm)
+  chromium
 )
+# Node.js and npm install the viewer's packages (web/package-lock.json); the
+# machine's own are used when present.
+if ! command -v npm > /dev/null; then PACKAGES+=(nodejs npm); fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
@@ -25,12 +30,22 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install_deps: all ${#PACKAGES[@]} packages already installed"
-  exit 0
+else
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  echo "install_deps: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -q
+  $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-echo "install_deps: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -q
-$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+# The viewer's web packages (three.js; playwright-core and gltf-validator for the
+# tests), exactly as pinned in web/package-lock.json.
+web="$(cd "$(dirname "$0")/../web" && pwd)"
+if [ ! -f "$web/node_modules/.package-lock.json" ] ||
+   [ "$web/package-lock.json" -nt "$web/node_modules/.package-lock.json" ]; then
+  echo "install_deps: npm ci in $web"
+  (cd "$web" && npm ci --no-audit --no-fund)
+else
+  echo "install_deps: web packages already installed"
+fi

@@ -23,6 +23,7 @@
 #include "synth/model_io.h"
 #include "synth/model_render.h"
 #include "synth/pipeline.h"
+#include "synth/web_model.h"
 #include "tests/test_util.h"
 
 namespace texlume::synth {
@@ -418,6 +419,60 @@ TEST(SubdivideMidpoint, SplitsEveryTriangleInFourAndWeldsMidpoints) {
   double area = 0;
   for (double a : sfm::FaceAreas(s)) area += a;
   EXPECT_NEAR(area, 1.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace texlume::synth
+
+namespace texlume::synth {
+namespace {
+
+// The browser viewer's model: every face corner in the vertex streams, charts as
+// the atlas built them, coefficient planes within half a quantisation step.
+TEST_F(MeshPipelineTest, WebModelKeepsChartsAndCoefficientsWithinHalfAStep) {
+  const WebModel web = BuildWebModel(tmp_->path() / "model");
+  const TexturedModel model = ReadModelFolder(tmp_->path() / "model");
+  const nlohmann::json& scene = web.scene;
+  ASSERT_EQ(scene["faces"].get<std::size_t>(), model.mesh.faces.size());
+  const std::size_t vertices = model.mesh.faces.size() * 3;
+  EXPECT_EQ(web.files.at("geometry.bin").size(), vertices * (3 + 3 + 3 + 2 + 1 + 1) * 4);
+  const nlohmann::json manifest =
+      nlohmann::json::parse(testing::ReadText(tmp_->path() / "model/manifest.json"));
+  EXPECT_EQ(scene["charts"].get<int>(), manifest["summary"]["charts"].get<int>());
+  const ptm::Ptm& atlas = model.atlases[0];
+  const nlohmann::json& planes = scene["atlases"][0]["coefficients"];
+  ASSERT_EQ(planes.size(), atlas.format == ptm::PtmFormat::kLrgb ? 2u : 6u);
+  const std::vector<unsigned char>& png = web.files.at(planes[0]["file"].get<std::string>());
+  const cv::Mat bgr = cv::imdecode(png, cv::IMREAD_COLOR);
+  ASSERT_EQ(bgr.cols, atlas.width);
+  ASSERT_EQ(bgr.rows, atlas.height);
+  double worst = 0.0, step = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const double scale = planes[0]["scale"][static_cast<std::size_t>(c)].get<double>();
+    const double bias = planes[0]["bias"][static_cast<std::size_t>(c)].get<double>();
+    step = std::max(step, scale / 255.0);
+    for (int y = 0; y < atlas.height; y += 7)
+      for (int x = 0; x < atlas.width; x += 7) {
+        const std::size_t t = static_cast<std::size_t>(y) * static_cast<std::size_t>(atlas.width) +
+                              static_cast<std::size_t>(x);
+        const double expected = atlas.format == ptm::PtmFormat::kLrgb ? atlas.Coefficients(t)[c]
+                                                                      : atlas.Coefficients(t, c)[0];
+        const double got = bgr.at<cv::Vec3b>(y, x)[2 - c] / 255.0 * scale + bias;
+        worst = std::max(worst, std::abs(got - expected));
+      }
+  }
+  EXPECT_LE(worst, 0.5 * step + 1e-6);
+  EXPECT_TRUE(web.files.count("scene.json"));
+}
+
+TEST(QuantisePlane, ConstantPlanesAndExtremesAreExact) {
+  const QuantisedPlane constant = QuantisePlane({0.25f, 0.25f});
+  EXPECT_EQ(constant.bias, 0.25f);
+  EXPECT_EQ(constant.bytes[0], 0);
+  const QuantisedPlane q = QuantisePlane({-1.0f, 0.5f, 3.0f});
+  EXPECT_EQ(q.bytes[0], 0);
+  EXPECT_EQ(q.bytes[2], 255);
+  EXPECT_NEAR(q.bytes[1] / 255.0 * q.scale + q.bias, 0.5, 0.5 * q.scale / 255.0);
 }
 
 }  // namespace

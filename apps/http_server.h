@@ -1,0 +1,42 @@
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace texlume::apps {
+
+/// One answer of a request handler.
+struct HttpResponse {
+  int status = 200;
+  std::string content_type = "application/octet-stream";
+  std::vector<unsigned char> body;
+};
+
+/// Request path (no query string, percent-decoded) -> response.
+using HttpHandler = std::function<HttpResponse(const std::string& path)>;
+
+/// A small HTTP/1.1 server for local previews: GET and HEAD only, one request
+/// per connection (Connection: close), requests handled one after another.
+class HttpServer {
+ public:
+  /// Binds to host:port (port 0: any free port). Throws std::runtime_error
+  /// naming the address when it cannot.
+  HttpServer(const std::string& host, int port);
+  ~HttpServer();
+  HttpServer(const HttpServer&) = delete;
+  HttpServer& operator=(const HttpServer&) = delete;
+  int port() const { return port_; }
+  /// Serves until `stop` turns true (checked every 200 ms).
+  void Serve(const HttpHandler& handler, const std::atomic<bool>& stop);
+
+ private:
+  int socket_ = -1;
+  int port_ = 0;
+};
+
+/// The MIME type of a file name by its extension.
+std::string ContentTypeOf(const std::string& name);
+
+}  // namespace texlume::apps

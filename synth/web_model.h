@@ -1,0 +1,39 @@
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "synth/model_io.h"
+
+namespace texlume::synth {
+
+/// A model folder prepared for the browser viewer (docs/viewer.md): a scene
+/// description, the geometry as float32 vertex streams, and the PTM atlases as
+/// 8-bit PNG planes with a scale and bias per coefficient.
+struct WebModel {
+  nlohmann::json scene;                                     ///< "scene.json"
+  std::map<std::string, std::vector<unsigned char>> files;  ///< name -> bytes, scene.json included
+};
+
+/// Charts of a model: faces are in one chart when they share a mesh edge whose
+/// two corners have the same texture coordinates on both sides (within 1e-3
+/// texels) in the same atlas. Returns the chart id of every face (0-based).
+std::vector<int> ChartsOfModel(const TexturedModel& model);
+
+/// Quantises one PTM coefficient plane to 8 bits: value = byte / 255 * scale + bias,
+/// bias = the plane's minimum, scale = its range (1 when the plane is constant).
+struct QuantisedPlane {
+  std::vector<unsigned char> bytes;
+  double scale = 1.0, bias = 0.0;
+};
+QuantisedPlane QuantisePlane(const std::vector<float>& values);
+
+/// Builds the web model of a model folder written by WriteModelFolder (reads
+/// its manifest, OBJ, EXR atlases and baked textures). Throws InputError naming
+/// the file on anything malformed.
+WebModel BuildWebModel(const std::filesystem::path& model_dir);
+
+}  // namespace texlume::synth

@@ -1,0 +1,165 @@
+// End-to-end tests of `texlume view` in headless Chromium (Debian's chromium,
+// driven by playwright-core) and of the exported GLB against the Khronos glTF
+// validator. Run by tests/web/viewer_test.sh, which builds a small model:
+//   TEXLUME=build/apps/texlume TEXLUME_MODEL=DIR node --test web/test/
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import { readFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { chromium } from 'playwright-core';
+import validator from 'gltf-validator';
+import { decodePng } from './png.mjs';
+
+const texlume = process.env.TEXLUME;
+const modelDir = process.env.TEXLUME_MODEL;
+const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
+if (!texlume || !modelDir) throw new Error('set TEXLUME (the program) and TEXLUME_MODEL (a model folder)');
+
+let server, browser, page, url;
+const consoleErrors = [];
+
+before(async () => {
+  server = spawn(texlume, ['view', modelDir, '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
+  url = await new Promise((resolve, reject) => {
+    let text = '';
+    const timer = setTimeout(() => reject(new Error('texlume view printed no address in 60 s')), 60000);
+    server.stdout.on('data', (chunk) => {
+      text += chunk;
+      const match = text.match(/at (http:\/\/[^ ]+\/)/);
+      if (match) { clearTimeout(timer); resolve(match[1]); }
+    });
+    server.on('exit', (code) => reject(new Error(`texlume view exited with ${code}`)));
+  });
+  browser = await chromium.launch({
+    executablePath: chromiumPath,
+    args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
+  });
+  page = await browser.newPage({ viewport: { width: 800, height: 600 } });
+  page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
+  page.on('pageerror', (e) => consoleErrors.push(e.message));
+  await page.goto(url);
+  await page.waitForFunction(
+      () => window.texlumeViewer && (window.texlumeViewer.ready || window.texlumeViewer.errors.length),
+      null, { timeout: 120000 });
+  const firstFrameMs = await page.evaluate(() => window.texlumeViewer.firstFrameMs);
+  console.log(`viewer: first frame ${firstFrameMs?.toFixed(0)} ms after the page started loading`);
+});
+
+after(async () => {
+  if (browser) await browser.close();
+  if (server) server.kill('SIGTERM');
+});
+
+// The canvas alone (panel hidden), decoded.
+async function shot() {
+  await page.evaluate(() => {
+    document.getElementById('panel').style.visibility = 'hidden';
+    window.texlumeViewer.renderNow();
+  });
+  const png = await page.screenshot();
+  await page.evaluate(() => { document.getElementById('panel').style.visibility = 'visible'; });
+  return decodePng(png);
+}
+
+const background = [32, 33, 36];
+function objectMask(image) {
+  const mask = new Uint8Array(image.width * image.height);
+  for (let i = 0; i < mask.length; ++i) {
+    let d = 0;
+    for (let k = 0; k < 3; ++k) d += Math.abs(image.rgb[i * 3 + k] - background[k]);
+    mask[i] = d > 12 ? 1 : 0;
+  }
+  return mask;
+}
+
+// Mean luminance of the object's left and right halves (split at its centroid).
+function halves(image, mask) {
+  let sx = 0, n = 0;
+  for (let i = 0; i < mask.length; ++i) if (mask[i]) { sx += i % image.width; ++n; }
+  const cx = sx / n;
+  const sum = [0, 0], count = [0, 0];
+  for (let i = 0; i < mask.length; ++i) {
+    if (!mask[i]) continue;
+    const side = i % image.width < cx ? 0 : 1;
+    sum[side] += 0.2126 * image.rgb[i * 3] + 0.7152 * image.rgb[i * 3 + 1] + 0.0722 * image.rgb[i * 3 + 2];
+    ++count[side];
+  }
+  return { left: sum[0] / count[0], right: sum[1] / count[1], pixels: n };
+}
+
+// Fraction of pixels that changed by more than 8 levels in some channel.
+function changed(a, b) {
+  let n = 0;
+  for (let i = 0; i < a.width * a.height; ++i)
+    for (let k = 0; k < 3; ++k)
+      if (Math.abs(a.rgb[i * 3 + k] - b.rgb[i * 3 + k]) > 8) { ++n; break; }
+  return n / (a.width * a.height);
+}
+
+// Drags on the light sphere to a point (fractions of its box, y down).
+async function dragLight(fx, fy) {
+  const box = await page.locator('#light').boundingBox();
+  await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+  await page.mouse.down();
+  await page.mouse.move(box.x + box.width * fx, box.y + box.height * fy, { steps: 4 });
+  await page.mouse.up();
+}
+
+test('the page loads the model with no console errors', async () => {
+  const state = await page.evaluate(() => ({ ready: window.texlumeViewer.ready, errors: window.texlumeViewer.errors }));
+  assert.deepEqual(state.errors, []);
+  assert.equal(state.ready, true);
+  const image = await shot();
+  assert.ok(halves(image, objectMask(image)).pixels > 0.05 * image.width * image.height,
+            'the model covers the view');
+  assert.deepEqual(consoleErrors, []);
+});
+
+test('dragging the light to either side brightens the side facing it', async () => {
+  await dragLight(0.06, 0.5);
+  const lightText = await page.locator('#light-value').textContent();
+  assert.match(lightText, /^\(-0\.\d+/, 'the light sphere reads a light from the left');
+  const fromLeft = await shot();
+  await dragLight(0.94, 0.5);
+  const fromRight = await shot();
+  const l = halves(fromLeft, objectMask(fromLeft)), r = halves(fromRight, objectMask(fromRight));
+  console.log(`light from the left: left ${l.left.toFixed(1)}, right ${l.right.toFixed(1)}; ` +
+              `from the right: left ${r.left.toFixed(1)}, right ${r.right.toFixed(1)}`);
+  assert.ok(l.left > l.right + 10, 'lit from the left, the left half is brighter');
+  assert.ok(r.right > r.left + 10, 'lit from the right, the right half is brighter');
+  assert.ok(l.left > r.left + 10 && r.right > l.right + 10, 'each half follows the light');
+});
+
+test('every shading mode and overlay changes the picture', async () => {
+  await page.evaluate(() => window.texlumeViewer.setLight(0.5, 0.3, 0.81));
+  const ptm = await shot();
+  const cases = [
+    ['baked 2D texture', 'radio', 'baked'],
+    ['flat (mean albedo)', 'radio', 'flat'],
+    ['triangle seams', 'checkbox', 'seams'],
+    ['atlas charts', 'checkbox', 'charts'],
+    ['specular enhancement', 'checkbox', 'specular'],
+  ];
+  for (const [label, kind, value] of cases) {
+    const input = kind === 'radio' ? page.locator(`input[name=mode][value=${value}]`) : page.locator(`#${value}`);
+    await input.click();
+    const image = await shot();
+    const fraction = changed(ptm, image);
+    console.log(`${label}: ${(100 * fraction).toFixed(1)} % of the pixels changed`);
+    assert.ok(fraction > 0.005, `${label} changes the picture`);
+    if (kind === 'radio') await page.locator('input[name=mode][value=ptm]').click();
+    else await input.click();
+    assert.ok(changed(ptm, await shot()) < 0.001, `${label} switched off restores the PTM view`);
+  }
+  assert.deepEqual(consoleErrors, []);
+});
+
+test('the exported GLB passes the Khronos glTF validator with no errors', async () => {
+  const bytes = new Uint8Array(readFileSync(join(modelDir, 'model.glb')));
+  const report = await validator.validateBytes(bytes, { maxIssues: 100 });
+  const errors = report.issues.messages.filter((m) => m.severity === 0);
+  console.log(`glTF validator: ${report.issues.numErrors} errors, ${report.issues.numWarnings} warnings, ` +
+              `${report.issues.numInfos} infos`);
+  assert.equal(report.issues.numErrors, 0, JSON.stringify(errors, null, 1));
+});

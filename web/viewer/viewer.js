@@ -1,0 +1,352 @@
+// texlume viewer: a PTM-textured model relit per fragment (docs/viewer.md).
+// The page is served by `texlume view`, which prepares /model/scene.json,
+// /model/geometry.bin and the 8-bit coefficient planes of every atlas.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+
+const statusEl = document.getElementById('status');
+const canvas = document.getElementById('view');
+const api = { ready: false, errors: [], firstFrameMs: null, loadStartMs: performance.now() };
+window.texlumeViewer = api;
+
+const vertexShader = /* glsl */ `
+attribute vec3 ptmTangent;
+attribute vec3 barycentric;
+attribute float chartId;
+varying vec2 vUv;
+varying vec3 vNormal;
+varying vec3 vTangent;
+varying vec3 vBarycentric;
+varying float vChart;
+varying vec3 vWorldPosition;
+void main() {
+  vUv = uv;
+  vNormal = normalize(mat3(modelMatrix) * normal);
+  vTangent = normalize(mat3(modelMatrix) * ptmTangent);
+  vBarycentric = barycentric;
+  vChart = chartId;
+  vec4 world = modelMatrix * vec4(position, 1.0);
+  vWorldPosition = world.xyz;
+  gl_Position = projectionMatrix * viewMatrix * world;
+}`;
+
+const fragmentShader = /* glsl */ `
+precision highp float;
+uniform sampler2D coefficients0, coefficients1, coefficients2, coefficients3, coefficients4,
+    coefficients5, colourTexture, bakedTexture;
+uniform vec3 coefficientScale[6];
+uniform vec3 coefficientBias[6];
+uniform bool lrgb;
+uniform int mode;            // 0 PTM, 1 baked 2D texture, 2 flat
+uniform bool showSeams, showCharts;
+uniform float specular;      // ks of the specular enhancement, 0 = off
+uniform vec3 lightWorld;     // unit vector towards the light
+uniform vec3 flatAlbedo;     // display domain
+uniform float horizonZ;      // sin of the horizon elevation (PTM evaluation)
+varying vec2 vUv;
+varying vec3 vNormal;
+varying vec3 vTangent;
+varying vec3 vBarycentric;
+varying float vChart;
+varying vec3 vWorldPosition;
+
+float srgbToLinear(float v) { return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4); }
+vec3 srgbToLinear(vec3 v) { return vec3(srgbToLinear(v.r), srgbToLinear(v.g), srgbToLinear(v.b)); }
+float linearToSrgb(float v) {
+  v = max(v, 0.0);
+  return v <= 0.0031308 ? v * 12.92 : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+}
+vec3 linearToSrgb(vec3 v) { return vec3(linearToSrgb(v.r), linearToSrgb(v.g), linearToSrgb(v.b)); }
+
+// Plane k of the atlas: 8-bit values times scale plus bias (docs/viewer.md).
+vec3 plane(sampler2D t, int k) {
+  return texture2D(t, vUv).rgb * coefficientScale[k] + coefficientBias[k];
+}
+
+// Paper 003 eq. 1: L = a0 lu^2 + a1 lv^2 + a2 lu lv + a3 lu + a4 lv + a5.
+float biquadratic(vec3 a012, vec3 a345, vec2 l) {
+  return a012.x * l.x * l.x + a012.y * l.y * l.y + a012.z * l.x * l.y + a345.x * l.x +
+         a345.y * l.y + a345.z;
+}
+
+// The luminance coefficients (LRGB: its own; RGB: the channels' mean).
+void luminance(out vec3 a012, out vec3 a345) {
+  if (lrgb) {
+    a012 = plane(coefficients0, 0);
+    a345 = plane(coefficients1, 1);
+  } else {
+    vec3 c0 = plane(coefficients0, 0), c1 = plane(coefficients1, 1), c2 = plane(coefficients2, 2);
+    vec3 c3 = plane(coefficients3, 3), c4 = plane(coefficients4, 4), c5 = plane(coefficients5, 5);
+    const vec3 third = vec3(1.0 / 3.0);
+    a012 = vec3(dot(c0, third), dot(c1, third), dot(c2, third));
+    a345 = vec3(dot(c3, third), dot(c4, third), dot(c5, third));
+  }
+}
+
+// The PTM's RGB (display domain) for a light l in the texel frame (eqs. 1-2).
+vec3 evaluate(vec2 l) {
+  if (lrgb) {
+    return biquadratic(plane(coefficients0, 0), plane(coefficients1, 1), l) *
+           texture2D(colourTexture, vUv).rgb;
+  }
+  vec3 c0 = plane(coefficients0, 0), c1 = plane(coefficients1, 1), c2 = plane(coefficients2, 2);
+  vec3 c3 = plane(coefficients3, 3), c4 = plane(coefficients4, 4), c5 = plane(coefficients5, 5);
+  return c0 * l.x * l.x + c1 * l.y * l.y + c2 * l.x * l.y + c3 * l.x + c4 * l.y + c5;
+}
+
+// As texlume's renderer: lights below the horizon elevation are evaluated at it
+// (same azimuth), fading linearly with l_z to 0 at the horizon.
+vec3 relight(vec3 l) {
+  if (l.z <= 0.0) return vec3(0.0);
+  float fall = 1.0;
+  if (l.z < horizonZ) {
+    fall = l.z / horizonZ;
+    float r = max(length(l.xy), 1e-6);
+    l = vec3(l.xy * sqrt(1.0 - horizonZ * horizonZ) / r, horizonZ);
+  }
+  return linearToSrgb(srgbToLinear(max(evaluate(l.xy), vec3(0.0))) * fall);
+}
+
+// The direction of the biquadratic's maximum (Malzbender et al. 2001, eq. 16).
+vec3 ptmNormal() {
+  vec3 a012, a345;
+  luminance(a012, a345);
+  float det = 4.0 * a012.x * a012.y - a012.z * a012.z;
+  vec2 n;
+  if (abs(det) < 1e-12 || !(a012.x < 0.0 && det > 0.0)) {
+    n = a345.xy;
+    float len = length(n);
+    if (len < 1e-12) return vec3(0.0, 0.0, 1.0);
+    n = n / max(len, 1.0) * min(1.0, len);
+  } else {
+    n = vec2(a012.z * a345.y - 2.0 * a012.y * a345.x, a012.z * a345.x - 2.0 * a012.x * a345.y) / det;
+    if (dot(n, n) > 1.0) n = normalize(n);
+  }
+  return vec3(n, sqrt(max(0.0, 1.0 - dot(n, n))));
+}
+
+vec3 chartColour(float id) {
+  return 0.5 + 0.5 * cos(6.2831853 * (fract(id * 0.618034) + vec3(0.0, 0.33, 0.67)));
+}
+
+void main() {
+  vec3 n = normalize(vNormal);
+  vec3 t = normalize(vTangent - n * dot(n, vTangent));
+  vec3 b = cross(n, t);  // the atlas frame's y (v up)
+  vec3 l = vec3(dot(lightWorld, t), dot(lightWorld, b), dot(lightWorld, n));
+  vec3 colour;
+  if (mode == 0) {
+    colour = relight(l);
+    if (specular > 0.0 && l.z > 0.0) {
+      vec3 toEye = normalize(cameraPosition - vWorldPosition);
+      vec3 v = vec3(dot(toEye, t), dot(toEye, b), dot(toEye, n));
+      vec3 h = normalize(l + v);
+      colour += specular * pow(max(dot(ptmNormal(), h), 0.0), 40.0);
+    }
+  } else if (mode == 1) {
+    colour = texture2D(bakedTexture, vUv).rgb;
+  } else {
+    colour = linearToSrgb(srgbToLinear(flatAlbedo) * max(l.z, 0.0));
+  }
+  if (showCharts) colour = mix(colour, chartColour(vChart), 0.45);
+  if (showSeams) {
+    float d = min(vBarycentric.x, min(vBarycentric.y, vBarycentric.z));
+    float line = 1.0 - smoothstep(0.0, 1.5 * fwidth(d), d);
+    colour = mix(colour, vec3(1.0, 0.85, 0.1), line);
+  }
+  gl_FragColor = vec4(clamp(colour, 0.0, 1.0), 1.0);
+}`;
+
+function fail(message) {
+  statusEl.textContent = message;
+  statusEl.className = 'error';
+  api.errors.push(message);
+  console.error(message);
+}
+
+async function fetchOk(url, kind) {
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
+  return kind === 'json' ? response.json() : response.arrayBuffer();
+}
+
+function loadTexture(loader, name) {
+  return new Promise((resolve, reject) => {
+    loader.load(`/model/${name}`, (texture) => {
+      texture.colorSpace = THREE.NoColorSpace;  // raw values: coefficients, display-domain colour
+      texture.minFilter = THREE.LinearFilter;   // no mipmaps: gutters cover bilinear reads only
+      texture.magFilter = THREE.LinearFilter;
+      texture.generateMipmaps = false;
+      resolve(texture);
+    }, undefined, () => reject(new Error(`/model/${name} could not be loaded`)));
+  });
+}
+
+async function main() {
+  const scene = await fetchOk('/model/scene.json', 'json');
+  if (scene.format !== 'texlume-web-1') throw new Error('scene.json: unknown format ' + scene.format);
+  const bytes = await fetchOk('/model/' + scene.geometry.file, 'binary');
+  const g = scene.geometry;
+  const attribute = (name) => {
+    const a = g.attributes[name];
+    return new Float32Array(bytes, a.byte_offset, g.vertices * a.components);
+  };
+  const position = attribute('position'), normal = attribute('normal'),
+        tangent = attribute('tangent'), uv = attribute('uv'), chart = attribute('chart');
+  const barycentric = new Float32Array(g.vertices * 3);
+  for (let v = 0; v < g.vertices; ++v) barycentric[v * 3 + (v % 3)] = 1;
+
+  const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+  renderer.setPixelRatio(window.devicePixelRatio);
+  renderer.outputColorSpace = THREE.LinearSRGBColorSpace;  // shaders write display values as they are
+  const world = new THREE.Scene();
+  world.background = new THREE.Color().setRGB(32 / 255, 33 / 255, 36 / 255, THREE.LinearSRGBColorSpace);
+  const loader = new THREE.TextureLoader();
+  const placeholder = new THREE.DataTexture(new Uint8Array([128, 128, 128, 255]), 1, 1);
+  placeholder.needsUpdate = true;
+  const uniformsShared = {
+    lightWorld: { value: new THREE.Vector3(0, 0, 1) },
+    mode: { value: 0 },
+    showSeams: { value: false },
+    showCharts: { value: false },
+    specular: { value: 0 },
+    flatAlbedo: { value: new THREE.Vector3(...scene.flat_albedo) },
+    horizonZ: { value: Math.sin(scene.horizon_elevation_deg * Math.PI / 180) },
+  };
+  const materials = [];
+  for (const range of g.ranges) {
+    const atlas = scene.atlases[range.atlas];
+    const planes = await Promise.all(atlas.coefficients.map((p) => loadTexture(loader, p.file)));
+    const colour = atlas.colour ? await loadTexture(loader, atlas.colour) : placeholder;
+    const bakedName = atlas.baked || atlas.base_colour;
+    const baked = bakedName ? await loadTexture(loader, bakedName) : placeholder;
+    const scale = [], bias = [];
+    for (let k = 0; k < 6; ++k) {
+      const p = atlas.coefficients[Math.min(k, atlas.coefficients.length - 1)];
+      scale.push(new THREE.Vector3(...p.scale));
+      bias.push(new THREE.Vector3(...p.bias));
+    }
+    const uniforms = { ...uniformsShared, lrgb: { value: atlas.format === 'LRGB' },
+      coefficientScale: { value: scale }, coefficientBias: { value: bias },
+      colourTexture: { value: colour }, bakedTexture: { value: baked } };
+    for (let k = 0; k < 6; ++k)
+      uniforms['coefficients' + k] = { value: planes[Math.min(k, planes.length - 1)] };
+    const material = new THREE.ShaderMaterial({ uniforms, vertexShader, fragmentShader });
+    materials.push(material);
+    const geometry = new THREE.BufferGeometry();
+    const slice = (array, components) => new THREE.BufferAttribute(
+        array.subarray(range.first_vertex * components, (range.first_vertex + range.vertices) * components),
+        components);
+    geometry.setAttribute('position', slice(position, 3));
+    geometry.setAttribute('normal', slice(normal, 3));
+    geometry.setAttribute('ptmTangent', slice(tangent, 3));
+    geometry.setAttribute('uv', slice(uv, 2));
+    geometry.setAttribute('chartId', slice(chart, 1));
+    geometry.setAttribute('barycentric', slice(barycentric, 3));
+    geometry.computeBoundingSphere();
+    world.add(new THREE.Mesh(geometry, material));
+  }
+
+  const lo = new THREE.Vector3(...scene.bounds.min), hi = new THREE.Vector3(...scene.bounds.max);
+  const centre = lo.clone().add(hi).multiplyScalar(0.5);
+  const radius = Math.max(hi.clone().sub(lo).length() * 0.5, 1e-6);
+  const camera = new THREE.PerspectiveCamera(35, 1, radius * 0.01, radius * 100);
+  camera.position.copy(centre).add(new THREE.Vector3(0, 0, radius * 3.2));
+  const controls = new OrbitControls(camera, canvas);
+  controls.target.copy(centre);
+  controls.update();
+
+  // The light is held in the camera's frame (x right, y up, z towards the viewer),
+  // as on an RTI viewer's light sphere, so it stays put while the model turns.
+  const lightView = new THREE.Vector3(-0.5, 0.5, Math.sqrt(0.5));
+  const render = () => {
+    const w = canvas.clientWidth, h = canvas.clientHeight;
+    if (canvas.width !== Math.floor(w * renderer.getPixelRatio()) ||
+        canvas.height !== Math.floor(h * renderer.getPixelRatio())) {
+      renderer.setSize(w, h, false);
+      camera.aspect = w / Math.max(h, 1);
+      camera.updateProjectionMatrix();
+    }
+    uniformsShared.lightWorld.value.copy(lightView).applyQuaternion(camera.quaternion).normalize();
+    renderer.render(world, camera);
+  };
+  let pending = false;
+  const requestRender = () => {
+    if (pending) return;
+    pending = true;
+    requestAnimationFrame(() => { pending = false; render(); });
+  };
+  controls.addEventListener('change', requestRender);
+  window.addEventListener('resize', requestRender);
+
+  // Light sphere: drag to set the light direction.
+  const lightCanvas = document.getElementById('light');
+  const lightValue = document.getElementById('light-value');
+  const drawLightSphere = () => {
+    const c = lightCanvas.getContext('2d');
+    const r = lightCanvas.width / 2 - 2;
+    c.clearRect(0, 0, lightCanvas.width, lightCanvas.height);
+    const grad = c.createRadialGradient(r + 2 + lightView.x * r, r + 2 - lightView.y * r, 2, r + 2, r + 2, r * 1.4);
+    grad.addColorStop(0, '#f1f3f4');
+    grad.addColorStop(1, '#3c4043');
+    c.fillStyle = grad;
+    c.beginPath();
+    c.arc(r + 2, r + 2, r, 0, 2 * Math.PI);
+    c.fill();
+    c.fillStyle = '#fbbc04';
+    c.beginPath();
+    c.arc(r + 2 + lightView.x * r, r + 2 - lightView.y * r, 4, 0, 2 * Math.PI);
+    c.fill();
+    lightValue.textContent = `(${lightView.x.toFixed(2)}, ${lightView.y.toFixed(2)}, ${lightView.z.toFixed(2)})`;
+  };
+  const setLight = (x, y, z) => {
+    lightView.set(x, y, z);
+    if (lightView.lengthSq() === 0) lightView.set(0, 0, 1);
+    lightView.normalize();
+    drawLightSphere();
+    requestRender();
+  };
+  const lightFromPointer = (event) => {
+    const rect = lightCanvas.getBoundingClientRect();
+    let x = ((event.clientX - rect.left) / rect.width) * 2 - 1;
+    let y = 1 - ((event.clientY - rect.top) / rect.height) * 2;
+    const d = Math.hypot(x, y);
+    if (d > 1) { x /= d; y /= d; }
+    setLight(x, y, Math.sqrt(Math.max(0, 1 - x * x - y * y)));
+  };
+  lightCanvas.addEventListener('pointerdown', (e) => {
+    lightCanvas.setPointerCapture(e.pointerId);
+    lightFromPointer(e);
+  });
+  lightCanvas.addEventListener('pointermove', (e) => {
+    if (lightCanvas.hasPointerCapture(e.pointerId)) lightFromPointer(e);
+  });
+
+  for (const input of document.querySelectorAll('input[name=mode]')) {
+    input.addEventListener('change', () => {
+      uniformsShared.mode.value = { ptm: 0, baked: 1, flat: 2 }[input.value];
+      requestRender();
+    });
+  }
+  const toggle = (id, uniform, on) => document.getElementById(id).addEventListener('change', (e) => {
+    uniformsShared[uniform].value = e.target.checked ? on : (typeof on === 'number' ? 0 : false);
+    requestRender();
+  });
+  toggle('seams', 'showSeams', true);
+  toggle('charts', 'showCharts', true);
+  toggle('specular', 'specular', 0.6);
+
+  drawLightSphere();
+  render();
+  api.firstFrameMs = performance.now() - api.loadStartMs;
+  statusEl.textContent = `${scene.faces} triangles, ${scene.atlases.length} atlas(es), ` +
+      `${scene.charts} charts; first frame after ${(api.firstFrameMs / 1000).toFixed(2)} s`;
+  Object.assign(api, {
+    setLight,
+    renderNow: render,
+    faces: scene.faces,
+    ready: true,
+  });
+}
+
+main().catch((e) => fail('texlume viewer: ' + e.message));
