@@ -154,6 +154,16 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
   EXPECT_EQ(Texlume("render --model m --cameras c --lights l --out r --baseline shiny", &out), 2);
 }
 
+TEST(Cli, ViewRefusesBadCommandLinesAndFoldersThatAreNotModels) {
+  TempDir tmp;
+  std::string out;
+  EXPECT_EQ(Texlume("view", &out), 2);
+  EXPECT_EQ(Texlume("view a b", &out), 2);
+  EXPECT_EQ(Texlume("view " + tmp.path().string() + " --port 70000", &out), 2);
+  EXPECT_EQ(Texlume("view " + (tmp / "nomodel").string() + " --port 0", &out), 1);
+  EXPECT_NE(out.find("manifest.json"), std::string::npos) << out;
+}
+
 TEST(Cli, SceneRefusesUnknownKindsAndMaterials) {
   TempDir tmp;
   std::string out;
