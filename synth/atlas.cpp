@@ -46,12 +46,14 @@ struct ChartOutline {
   int Height() const { return hi.y() - lo.y(); }
 };
 
-ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
-                     const std::vector<TrianglePatch>& patches, double t, int gutter) {
+/// A chart's corners turned by `angle` (texels, chart frame) and its texel box
+/// with the gutters (o.lo, o.hi); the outline's runs are left empty.
+ChartOutline Box(const std::vector<ChartFace>& chart, double angle,
+                 const std::vector<TrianglePatch>& patches, double t, int gutter,
+                 std::vector<std::array<Eigen::Vector2d, 3>>* corners) {
   ChartOutline o;
   o.angle = angle;
   const Eigen::Matrix2d turn = Eigen::Rotation2Dd(angle).toRotationMatrix();
-  std::vector<std::array<Eigen::Vector2d, 3>> corners;  // texels, chart frame
   Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
   Eigen::Vector2d hi = -lo;
   for (const ChartFace& cf : chart) {
@@ -64,12 +66,19 @@ ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
       lo = lo.cwiseMin(c[k]);
       hi = hi.cwiseMax(c[k]);
     }
-    corners.push_back(c);
+    if (corners) corners->push_back(c);
   }
   o.lo = Eigen::Vector2i(static_cast<int>(std::floor(lo.x())) - gutter,
                          static_cast<int>(std::floor(lo.y())) - gutter);
   o.hi = Eigen::Vector2i(static_cast<int>(std::ceil(hi.x())) + gutter,
                          static_cast<int>(std::ceil(hi.y())) + gutter);
+  return o;
+}
+
+ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
+                     const std::vector<TrianglePatch>& patches, double t, int gutter) {
+  std::vector<std::array<Eigen::Vector2d, 3>> corners;  // texels, chart frame
+  ChartOutline o = Box(chart, angle, patches, t, gutter, &corners);
   const int w = o.Width(), h = o.Height();
   cv::Mat mask = cv::Mat::zeros(h, w, CV_8UC1);
   for (auto c : corners) {
@@ -451,7 +460,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
   std::vector<std::array<int, 3>> packed;
   if (options.mode == AtlasMode::kPerTriangle) {
     for (const auto& chart : charts) {
-      const ChartOutline outline = Outline(chart, 0.0, synthesis.patches, t, gutter);
+      const ChartOutline outline = Box(chart, 0.0, synthesis.patches, t, gutter, nullptr);
       chart_lo.push_back(outline.lo);
       chart_hi.push_back(outline.hi);
       sizes.emplace_back(outline.Width(), outline.Height());

@@ -319,7 +319,7 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
   }
 }
 
-TexturedModel ReadModelFolder(const fs::path& dir) {
+nlohmann::json ReadModelManifest(const fs::path& dir) {
   const fs::path manifest_path = dir / "manifest.json";
   std::ifstream in = OpenForReading(manifest_path, false);
   nlohmann::json manifest;
@@ -331,6 +331,34 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
   if (!manifest.is_object() || manifest.value("format", "") != kManifestFormat ||
       !manifest.contains("atlases") || !manifest["atlases"].is_array())
     throw InputError(manifest_path.string(), "is not a texlume model manifest");
+  return manifest;
+}
+
+Eigen::Matrix3d AtlasFaceFrame(const TexturedModel& model, std::size_t f) {
+  const sfm::TriangleMesh& mesh = model.mesh;
+  const Eigen::Vector3d e1 = mesh.Corner(f, 1) - mesh.Corner(f, 0);
+  const Eigen::Vector3d e2 = mesh.Corner(f, 2) - mesh.Corner(f, 0);
+  const Eigen::Vector3d n = e1.cross(e2).normalized();
+  Eigen::Vector3d x = e1;
+  if (f < model.corner_px.size()) {
+    const auto& c = model.corner_px[f];
+    // v up: dv = -dy.
+    const double du1 = c[1].x() - c[0].x(), dv1 = -(c[1].y() - c[0].y());
+    const double du2 = c[2].x() - c[0].x(), dv2 = -(c[2].y() - c[0].y());
+    const double det = du1 * dv2 - du2 * dv1;
+    if (std::abs(det) > 1e-12) x = (e1 * dv2 - e2 * dv1) / det;  // dP/du
+  }
+  x = (x - n * n.dot(x)).normalized();
+  Eigen::Matrix3d frame;
+  frame.col(0) = x;
+  frame.col(1) = n.cross(x);
+  frame.col(2) = n;
+  return frame;
+}
+
+TexturedModel ReadModelFolder(const fs::path& dir) {
+  const fs::path manifest_path = dir / "manifest.json";
+  const nlohmann::json manifest = ReadModelManifest(dir);
   TexturedModel model;
   for (const auto& entry : manifest["atlases"]) {
     if (!entry.is_object() || !entry.contains("exr") || !entry["exr"].is_string())

@@ -37,6 +37,16 @@ void WriteModelFolder(const std::filesystem::path& dir, const TexturedModel& mod
                       const nlohmann::json& record,
                       const std::vector<std::pair<std::string, cv::Mat>>& extra_images = {});
 
+/// Reads and checks a model folder's manifest.json (format "texlume-model", an
+/// "atlases" array). Throws InputError naming the file otherwise.
+nlohmann::json ReadModelManifest(const std::filesystem::path& dir);
+
+/// The frame face f's atlas coefficients are in, as columns in world
+/// coordinates: x = dP/du made orthogonal to the normal, y = n x x (dP/dv
+/// direction, v up), z = the face normal (x = the first edge without texture
+/// coordinates).
+Eigen::Matrix3d AtlasFaceFrame(const TexturedModel& model, std::size_t f);
+
 /// Reads a model folder written by WriteModelFolder (its manifest, OBJ and EXR
 /// atlases). Throws InputError naming the file on anything malformed.
 TexturedModel ReadModelFolder(const std::filesystem::path& dir);

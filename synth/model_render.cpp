@@ -44,24 +44,7 @@ ModelRenderer::ModelRenderer(const TexturedModel& model) : model_(model), impl_(
   const sfm::TriangleMesh& mesh = model.mesh;
   vertex_normals_ = VertexNormals(mesh);
   face_frames_.resize(mesh.faces.size());
-  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-    const Eigen::Vector3d e1 = mesh.Corner(f, 1) - mesh.Corner(f, 0);
-    const Eigen::Vector3d e2 = mesh.Corner(f, 2) - mesh.Corner(f, 0);
-    const Eigen::Vector3d n = e1.cross(e2).normalized();
-    Eigen::Vector3d x = e1;
-    if (f < model.corner_px.size()) {
-      const auto& c = model.corner_px[f];
-      // v up: dv = -dy.
-      const double du1 = c[1].x() - c[0].x(), dv1 = -(c[1].y() - c[0].y());
-      const double du2 = c[2].x() - c[0].x(), dv2 = -(c[2].y() - c[0].y());
-      const double det = du1 * dv2 - du2 * dv1;
-      if (std::abs(det) > 1e-12) x = (e1 * dv2 - e2 * dv1) / det;  // dP/du
-    }
-    x = (x - n * n.dot(x)).normalized();
-    face_frames_[f].col(0) = x;
-    face_frames_[f].col(1) = n.cross(x);
-    face_frames_[f].col(2) = n;
-  }
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) face_frames_[f] = AtlasFaceFrame(model, f);
   std::vector<Eigen::Vector3f> positions;
   for (const Eigen::Vector3d& v : mesh.vertices) positions.push_back(v.cast<float>());
   std::vector<std::array<std::uint32_t, 3>> triangles;

@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "sfm/errors.h"
+#include "sfm/file_util.h"
 #include "synth/mesh_synthesis.h"
 
 namespace texlume::synth {
@@ -25,8 +26,7 @@ int Find(std::vector<int>& parent, int i) {
 }
 
 std::vector<unsigned char> ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), "cannot be read");
+  std::ifstream in = OpenForReading(path, true);
   return std::vector<unsigned char>(std::istreambuf_iterator<char>(in), {});
 }
 
@@ -102,14 +102,7 @@ QuantisedPlane QuantisePlane(const std::vector<float>& values) {
 
 WebModel BuildWebModel(const fs::path& model_dir) {
   const TexturedModel model = ReadModelFolder(model_dir);
-  const fs::path manifest_path = model_dir / "manifest.json";
-  nlohmann::json manifest;
-  try {
-    std::ifstream in(manifest_path);
-    manifest = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(manifest_path.string(), std::string("is not valid JSON: ") + e.what());
-  }
+  const nlohmann::json manifest = ReadModelManifest(model_dir);
   WebModel web;
   nlohmann::json& scene = web.scene;
   scene["format"] = "texlume-web-1";
@@ -142,20 +135,9 @@ WebModel BuildWebModel(const fs::path& model_dir) {
     if (ranges.empty() || ranges.back()["atlas"].get<int>() != atlas)
       ranges.push_back({{"atlas", atlas}, {"first_vertex", i * 3}, {"vertices", 0}});
     ranges.back()["vertices"] = ranges.back()["vertices"].get<std::size_t>() + 3;
-    const Eigen::Vector3d p0 = model.mesh.Corner(f, 0), p1 = model.mesh.Corner(f, 1),
-                          p2 = model.mesh.Corner(f, 2);
-    const Eigen::Vector3d e1 = p1 - p0, e2 = p2 - p0;
-    Eigen::Vector3d nrm = e1.cross(e2);
-    nrm = nrm.norm() > 0 ? nrm.normalized() : Eigen::Vector3d::UnitZ();
-    // The atlas PTM frame: x = dP/du made orthogonal to the normal, v up.
+    const Eigen::Matrix3d frame = AtlasFaceFrame(model, f);
+    const Eigen::Vector3d x_axis = frame.col(0), nrm = frame.col(2);
     const auto& c = model.corner_px[f];
-    const double du1 = c[1].x() - c[0].x(), dv1 = -(c[1].y() - c[0].y());
-    const double du2 = c[2].x() - c[0].x(), dv2 = -(c[2].y() - c[0].y());
-    const double det = du1 * dv2 - du2 * dv1;
-    Eigen::Vector3d x_axis =
-        std::abs(det) > 1e-12 ? Eigen::Vector3d((e1 * dv2 - e2 * dv1) / det) : Eigen::Vector3d(e1);
-    x_axis -= nrm * nrm.dot(x_axis);
-    x_axis = x_axis.norm() > 0 ? x_axis.normalized() : nrm.unitOrthogonal();
     const ptm::Ptm& atlas_ptm = model.atlases[static_cast<std::size_t>(atlas)];
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d p = model.mesh.Corner(f, k);
