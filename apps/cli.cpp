@@ -25,6 +25,7 @@
 #include "sfm/lights.h"
 #include "synth/pipeline.h"
 #include "synth/planar_synthesis.h"
+#include "synth/report.h"
 #include "synth/web_model.h"
 
 namespace texlume::apps {
@@ -415,7 +416,8 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
                      "correction-noise",
                      "chart-angle",
                      "chart-size"},
-                    {"best-view-only", "no-additive-correction", "no-channel-correction"});
+                    {"best-view-only", "no-additive-correction", "no-channel-correction",
+                     "no-report"});
   synth::SynthJobOptions o;
   o.model_dir = a.Require("model");
   o.images_dir = a.Require("images");
@@ -457,6 +459,7 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
   o.atlas.blend_strip = o.synthesis.strip;
   o.max_subdivisions = a.GetInt("max-subdivisions", o.max_subdivisions);
   o.visibility.max_buffer_dimension = a.GetInt("max-buffer-size", 0);
+  o.write_report = !a.Has("no-report");
   ProgressBar bar;
   const synth::SynthJobSummary s = synth::RunSynthJob(o, bar.Callback());
   for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
@@ -464,7 +467,8 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
       << s.from_neighbours << " from neighbours only, " << s.random << " seeds) from "
       << s.photos_used << " photos into " << s.atlases << " atlas(es), " << s.charts
       << " charts, occupancy " << s.occupancy << ", in " << s.seconds_total
-      << " s: " << o.out_dir.string() << " (see manifest.json)\n";
+      << " s: " << o.out_dir.string() << " (see manifest.json"
+      << (o.write_report ? " and report.html" : "") << ")\n";
   return kExitOk;
 }
 
@@ -557,19 +561,6 @@ int RunSceneCommand(const std::vector<std::string>& args, std::ostream& out,
       << " s (see MANIFEST.md and scene.json)\n";
   return kExitOk;
 }
-
-namespace {
-
-// One table row of the demo report.
-std::string ReportRow(const std::string& name, const synth::RenderJobSummary& s) {
-  char line[256];
-  std::snprintf(line, sizeof line,
-                "<tr><td>%s</td><td>%.2f</td><td>%.3f</td><td>%.2f</td><td>%.3f</td></tr>\n",
-                name.c_str(), s.mean_psnr, s.mean_ssim, s.mean_psnr_reduced, s.mean_ssim_reduced);
-  return line;
-}
-
-}  // namespace
 
 namespace {
 std::atomic<bool> g_stop_serving{false};
@@ -710,7 +701,7 @@ int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std:
   out << "3. texlume fit --images " << capture.string() << " --lights "
       << (capture / "lights.lp").string() << " --out " << sample.string() << "\n";
   const ptm::RtiCapture rti = ptm::ReadRtiCapture(capture / "lights.lp", capture);
-  const ptm::Ptm sample_ptm = ptm::FitPtmFromFiles(rti.files, rti.lights, {}).ptm;
+  const ptm::Ptm sample_ptm = ptm::FitPtmFromFiles(rti.files, rti.lights, {}, bar.Callback()).ptm;
   ptm::WritePtmFile(sample_ptm, sample);
   ptm::WritePtmExr(sample_ptm, dir / "sample.exr");
   const double seconds_fit = since(t);
@@ -764,39 +755,64 @@ int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std:
   const synth::RenderJobSummary baked = render(synth::RenderMode::kBaked, "baked");
   const double seconds_render = since(t);
 
-  // The report: metrics and side-by-side pictures (relative links).
-  std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>texlume demo</title>"
-          "<style>body{font-family:sans-serif;margin:2em}td,th{padding:4px 10px}"
-          "img{width:320px}</style></head><body>\n<h1>texlume demo: a "
-       << material << " " << kind
-       << "</h1>\n<p>Held-out views under held-out lights, against ground truth, inside the "
-          "object masks (PSNR in dB, SSIM), at full resolution (twice the photos') and reduced "
-          "to the photos' resolution. Baselines: the coarse mesh flat-shaded with the mean "
-          "albedo, and the photos baked into an ordinary texture.</p>\n"
-          "<table border=\"1\"><tr><th>model</th><th>PSNR full</th><th>SSIM full</th>"
-          "<th>PSNR photo res.</th><th>SSIM photo res.</th></tr>\n"
-       << ReportRow("texlume (PTM atlases)", ours) << ReportRow("flat baseline", flat)
-       << ReportRow("baked baseline", baked) << "</table>\n<p>" << synthesis.faces << " triangles, "
-       << synthesis.from_photos << " constrained by photos; " << synthesis.atlases
-       << " atlas(es), occupancy " << synthesis.occupancy << "; synthesis "
-       << synthesis.seconds_synthesis
-       << " s. Model: <a href=\"model/model.glb\">"
-          "model.glb</a>, <a href=\"model/model.obj\">model.obj</a>, <a "
-          "href=\"model/manifest.json\">manifest.json</a>.</p>\n<table><tr><th>ground truth</th>"
-          "<th>texlume</th><th>flat</th><th>baked</th></tr>\n";
-  for (const synth::ViewMetrics& m : ours.metrics) {
-    std::filesystem::path png(m.name);
-    png.replace_extension(".png");
-    html << "<tr><td><img src=\"scene/object/held_out/images/" << m.name << "\"></td>";
-    for (const char* name : {"texlume", "flat", "baked"})
-      html << "<td><img src=\"render_" << name << "/" << png.string() << "\"></td>";
-    html << "</tr>\n";
+  // The report: the sample, the photos, held-out views beside the truth and the
+  // baselines, error maps, a light sweep, the atlases, metrics and timings.
+  t = std::chrono::steady_clock::now();
+  out << "\n6. The report\n";
+  const synth::TexturedModel model = synth::ReadModelFolder(job.out_dir);
+  const synth::ModelBaselines baselines = synth::ReadModelBaselines(job.out_dir, model);
+  synth::ReportInputs rep;
+  rep.title = "texlume demo: a " + material + " " + kind;
+  rep.intro =
+      "A synthetic heritage scene with ground truth: the " + material + " " + kind +
+      " photographed under known lights, and an RTI capture of the material sample. texlume "
+      "fitted the sample PTM, synthesised the relightable model from the photos and rendered it "
+      "from held-out views under held-out lights (twice the photos' resolution), beside the "
+      "ground truth and two baselines: the coarse mesh flat-shaded with the mean albedo, and the "
+      "photos baked into an ordinary texture.";
+  rep.model = &model;
+  rep.flat_albedo = baselines.flat_albedo;
+  rep.baked = baselines.baked;
+  rep.sample = &sample_ptm;
+  {
+    const sfm::LoadedModel photos_model = sfm::ReadModel(job.model_dir);
+    const sfm::ObjectLights photo_lights = sfm::ReadObjectLightsFile(job.lights_file);
+    for (const auto& [id, image] : photos_model.reconstruction.images)
+      if (const auto it = photo_lights.find(image.name); it != photo_lights.end())
+        rep.photos.push_back({image.name, job.images_dir / image.name, it->second});
+    const sfm::LoadedModel held_model = sfm::ReadModel(held / "sparse");
+    const sfm::ObjectLights held_lights = sfm::ReadObjectLightsFile(held / "lights.json");
+    for (const auto& [id, image] : held_model.reconstruction.images) {
+      const auto it = held_lights.find(image.name);
+      if (it == held_lights.end()) continue;
+      synth::ReportView view;
+      view.name = image.name;
+      view.camera = held_model.reconstruction.cameras.at(image.camera_id);
+      view.cam_from_world = image.cam_from_world;
+      view.lights = it->second;
+      view.reference_image = held / "images" / image.name;
+      view.reference_mask = held / "masks" / image.name;
+      rep.views.push_back(std::move(view));
+    }
   }
-  html << "</table>\n<h2>Base colour atlas</h2><img style=\"width:640px\" "
-          "src=\"model/base_colour_0.png\">\n</body></html>\n";
-  WriteFileAtomically(
-      dir / "report.html", [&](std::ostream& o) { o << html.str(); }, false);
+  rep.views_heading = "Held-out views under held-out lights";
+  rep.metrics = {{"texlume (PTM atlases)", ours}, {"flat baseline", flat}, {"baked baseline", baked}};
+  rep.occupancy = synthesis.occupancy;
+  rep.facts = {{"triangles", std::to_string(synthesis.faces) + " (" +
+                                 std::to_string(synthesis.from_photos) + " constrained by photos)"},
+               {"photos", std::to_string(synthesis.photos_used)},
+               {"atlases", std::to_string(synthesis.atlases) + ", " +
+                               std::to_string(synthesis.charts) + " charts"}};
+  rep.timings_s = {{"scene", seconds_scene},     {"inspect", seconds_inspect},
+                   {"fit", seconds_fit},         {"synth (with the model's report)", seconds_synth},
+                   {"render (3 models)", seconds_render}};
+  rep.links = {{"model.glb", "model/model.glb"},
+               {"model.obj", "model/model.obj"},
+               {"manifest.json", "model/manifest.json"},
+               {"the model's own report (photo views)", "model/report.html"},
+               {"run.json", "run.json"}};
+  synth::WriteReport(dir, rep, bar.Callback());
+  const double seconds_report = since(t);
 
   nlohmann::json run;
   run["command"] = "demo";
@@ -806,7 +822,8 @@ int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std:
                      {"num_images", options.num_images},
                      {"held_out_scale", options.held_out_scale}};
   run["timings_s"] = {{"scene", seconds_scene}, {"inspect", seconds_inspect}, {"fit", seconds_fit},
-                      {"synth", seconds_synth}, {"render", seconds_render},   {"total", since(t0)}};
+                      {"synth", seconds_synth}, {"render", seconds_render},   {"report", seconds_report},
+                      {"total", since(t0)}};
   run["inspect"] = nlohmann::json::parse(sfm::InspectReportToJson(report));
   auto metrics = [](const synth::RenderJobSummary& s) {
     return nlohmann::json{{"psnr_db", s.mean_psnr},

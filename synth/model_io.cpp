@@ -232,7 +232,8 @@ void WriteGlb(const fs::path& path, const TexturedModel& model,
 }
 
 void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlohmann::json& record,
-                      const std::vector<std::pair<std::string, cv::Mat>>& extra_images) {
+                      const std::vector<std::pair<std::string, cv::Mat>>& extra_images,
+                      const std::function<void(const fs::path&)>& write_more) {
   if (fs::exists(dir)) {
     if (!fs::is_directory(dir)) throw InputError(dir.string(), "exists and is not a folder");
     const bool ours = fs::exists(dir / "manifest.json");
@@ -304,8 +305,9 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
     for (const auto& [name, image] : extra_images) {
       WriteBytesAtomically(tmp / name, EncodePng(image, name));
     }
-    for (const auto& entry : fs::directory_iterator(tmp))
-      files.push_back(entry.path().filename().string());
+    if (write_more) write_more(tmp);
+    for (const auto& entry : fs::recursive_directory_iterator(tmp))
+      if (entry.is_regular_file()) files.push_back(entry.path().lexically_relative(tmp).string());
     files.push_back("manifest.json");
     std::sort(files.begin(), files.end());
     manifest["files"] = files;

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
@@ -32,10 +33,13 @@ struct TexturedModel {
 /// `extras`); manifest.json listing every file with `record` (settings, timings)
 /// merged in. Everything is written under a temporary name first and renamed
 /// into place, so a failure leaves no half-written folder.
-/// `extra_images`: further PNGs to include (name -> 8-bit BGR image).
+/// `extra_images`: further PNGs to include (name -> 8-bit BGR image);
+/// `write_more`, when set, writes further files into the temporary folder it
+/// is given (listed in the manifest too, by their paths relative to `dir`).
 void WriteModelFolder(const std::filesystem::path& dir, const TexturedModel& model,
                       const nlohmann::json& record,
-                      const std::vector<std::pair<std::string, cv::Mat>>& extra_images = {});
+                      const std::vector<std::pair<std::string, cv::Mat>>& extra_images = {},
+                      const std::function<void(const std::filesystem::path&)>& write_more = {});
 
 /// Reads and checks a model folder's manifest.json (format "texlume-model", an
 /// "atlases" array). Throws InputError naming the file otherwise.

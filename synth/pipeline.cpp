@@ -13,6 +13,7 @@
 #include "sfm/file_util.h"
 #include "sfm/lights.h"
 #include "sfm/mesh.h"
+#include "synth/report.h"
 
 namespace texlume::synth {
 namespace fs = std::filesystem;
@@ -20,14 +21,6 @@ namespace {
 
 double Since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
-// 8-bit BGR of a display RGB float image.
-cv::Mat ToBgr8(const cv::Mat& rgb) {
-  cv::Mat bgr, out;
-  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-  bgr.convertTo(out, CV_8UC3, 255.0);
-  return out;
 }
 
 void WritePng(const fs::path& path, const cv::Mat& image) {
@@ -41,6 +34,13 @@ fs::path PngName(const std::string& image_name) {
 }
 
 }  // namespace
+
+cv::Mat ToBgr8(const cv::Mat& display_rgb) {
+  cv::Mat bgr, out;
+  cv::cvtColor(display_rgb, bgr, cv::COLOR_RGB2BGR);
+  bgr.convertTo(out, CV_8UC3, 255.0);
+  return out;
+}
 
 cv::Mat ReadPhotoRgb(const fs::path& path) {
   if (!fs::exists(path)) throw InputError(path.string(), "does not exist");
@@ -294,10 +294,88 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
                          {"baselines", summary.seconds_baselines},
                          {"synthesis_per_triangle",
                           summary.seconds_synthesis / std::max<std::size_t>(1, summary.faces)}};
-  WriteModelFolder(options.out_dir, model, record, extra);
-  summary.seconds_export = Since(t);
+  std::function<void(const fs::path&)> write_report;
+  if (options.write_report) {
+    write_report = [&](const fs::path& folder) {
+      ReportInputs report;
+      report.title = "texlume synth: " + options.mesh_file.filename().string();
+      report.intro =
+          "The relightable model texlume synthesised from the photos and the material sample: "
+          "the mesh covered with PTM atlases whose detail comes from the sample, chosen triangle "
+          "by triangle to agree with the photos under their lights. Below, the model is drawn "
+          "from some of the photos' own views under their lights beside the photo (divided by "
+          "its estimated exposure) and the two baselines; texlume render measures it on "
+          "held-out views.";
+      report.model = &model;
+      report.flat_albedo = flat_albedo;
+      report.baked = baked;
+      report.sample = &sample;
+      for (std::size_t i = 0; i < photos.size(); ++i) {
+        const MeshPhoto& p = photos[i];
+        const sfm::Image& image = reconstruction.images.at(p.image_id);
+        report.photos.push_back({p.name, options.images_dir / p.name, p.lights});
+        ReportView view;
+        view.name = p.name;
+        view.camera = reconstruction.cameras.at(image.camera_id);
+        view.cam_from_world = image.cam_from_world;
+        view.lights = p.lights;
+        view.reference_image = options.images_dir / p.name;
+        view.reference_gain = i < synthesis.photo_gains.size() ? synthesis.photo_gains[i] : 1.0;
+        report.views.push_back(std::move(view));
+      }
+      report.views_heading = "Photo views under the photos' lights";
+      report.occupancy = summary.occupancy;
+      report.facts = {
+          {"triangles", std::to_string(summary.faces) + " (" +
+                            std::to_string(summary.from_photos) + " constrained by photos, " +
+                            std::to_string(summary.from_neighbours) + " by neighbours only)"},
+          {"photos used", std::to_string(summary.photos_used)},
+          {"sample texel size", std::to_string(so.sample_texel_size) + " world units"},
+          {"atlases", std::to_string(summary.atlases) + " of " +
+                          std::to_string(options.atlas.atlas_size) + " texels, " +
+                          std::to_string(summary.charts) + " charts"}};
+      for (const std::string& w : summary.warnings) report.facts.emplace_back("warning", w);
+      report.timings_s = {{"load", summary.seconds_load},
+                          {"visibility", summary.seconds_visibility},
+                          {"synthesis", summary.seconds_synthesis},
+                          {"atlas", summary.seconds_atlas},
+                          {"baselines", summary.seconds_baselines}};
+      report.links = {{"model.glb", "model.glb"},
+                      {"model.obj", "model.obj"},
+                      {"manifest.json", "manifest.json"}};
+      summary.seconds_report = WriteReport(folder, report, progress).seconds;
+    };
+  }
+  WriteModelFolder(options.out_dir, model, record, extra, write_report);
+  summary.seconds_export = Since(t) - summary.seconds_report;
   summary.seconds_total = Since(start);
   return summary;
+}
+
+ModelBaselines ReadModelBaselines(const fs::path& model_folder, const TexturedModel& model) {
+  const fs::path manifest_path = model_folder / "manifest.json";
+  const nlohmann::json manifest = ReadModelManifest(model_folder);
+  const auto& baselines = manifest.value("baselines", nlohmann::json());
+  if (!baselines.is_object()) throw InputError(manifest_path.string(), "lists no baselines");
+  ModelBaselines out;
+  const auto& a = baselines.value("flat_albedo", nlohmann::json());
+  if (!a.is_array() || a.size() != 3 || !a[0].is_number() || !a[1].is_number() ||
+      !a[2].is_number())
+    throw InputError(manifest_path.string(), "has no flat_albedo of three numbers");
+  out.flat_albedo = Eigen::Vector3f(a[0].get<float>(), a[1].get<float>(), a[2].get<float>());
+  const auto& b = baselines.value("baked", nlohmann::json());
+  if (!b.is_array() || b.size() != model.atlases.size())
+    throw InputError(manifest_path.string(), "has no baked texture per atlas");
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    if (!b[k].is_string())
+      throw InputError(manifest_path.string(), "names a baked texture with no file name");
+    const fs::path file = model_folder / b[k].get<std::string>();
+    out.baked.push_back(ReadPhotoRgb(file));
+    if (out.baked.back().cols != model.atlases[k].width ||
+        out.baked.back().rows != model.atlases[k].height)
+      throw InputError(file.string(), "is not the size of its atlas");
+  }
+  return out;
 }
 
 RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCallback& progress) {
@@ -310,26 +388,9 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
   const TexturedModel model = ReadModelFolder(options.model_folder);
   ModelRenderer renderer(model);
   if (options.mode != RenderMode::kPtm) {
-    std::ifstream in = OpenForReading(options.model_folder / "manifest.json", false);
-    const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
-    const auto& baselines =
-        manifest.is_object() ? manifest.value("baselines", nlohmann::json()) : nlohmann::json();
-    if (!baselines.is_object())
-      throw InputError((options.model_folder / "manifest.json").string(), "lists no baselines");
-    if (options.mode == RenderMode::kFlat) {
-      const auto& a = baselines.value("flat_albedo", nlohmann::json());
-      if (!a.is_array() || a.size() != 3)
-        throw InputError((options.model_folder / "manifest.json").string(), "has no flat_albedo");
-      renderer.flat_albedo =
-          Eigen::Vector3f(a[0].get<float>(), a[1].get<float>(), a[2].get<float>());
-    } else {
-      const auto& b = baselines.value("baked", nlohmann::json());
-      if (!b.is_array() || b.size() != model.atlases.size())
-        throw InputError((options.model_folder / "manifest.json").string(),
-                         "has no baked texture per atlas");
-      for (const auto& name : b)
-        renderer.baked.push_back(ReadPhotoRgb(options.model_folder / name.get<std::string>()));
-    }
+    ModelBaselines baselines = ReadModelBaselines(options.model_folder, model);
+    renderer.flat_albedo = baselines.flat_albedo;
+    renderer.baked = std::move(baselines.baked);
   }
   const sfm::LoadedModel cameras = sfm::ReadModel(options.cameras_dir);
   const sfm::ObjectLights lights = sfm::ReadObjectLightsFile(options.lights_file);

@@ -26,6 +26,10 @@ struct SynthJobOptions {
   /// Split every triangle in four (midpoints) up to this many times while the
   /// largest patch does not fit the sample. [0, 6].
   int max_subdivisions = 4;
+  /// Also write report.html (and report/) into the model folder: the sample,
+  /// the photos, the model from photo views beside the photos and the
+  /// baselines, a light sweep, the atlases, timings (synth/report.h).
+  bool write_report = true;
 };
 
 /// What the job did (also written to manifest.json).
@@ -37,7 +41,7 @@ struct SynthJobSummary {
   std::size_t atlases = 0, charts = 0;
   double occupancy = 0.0;
   double seconds_load = 0, seconds_visibility = 0, seconds_synthesis = 0, seconds_atlas = 0,
-         seconds_baselines = 0, seconds_export = 0, seconds_total = 0;
+         seconds_baselines = 0, seconds_report = 0, seconds_export = 0, seconds_total = 0;
 };
 
 /// Runs the whole job: reads and checks the inputs, visibility and best views,
@@ -82,9 +86,22 @@ struct RenderJobSummary {
 RenderJobSummary RunRenderJob(const RenderJobOptions& options,
                               const ProgressCallback& progress = {});
 
+/// The baselines `texlume synth` stored in a model folder (manifest.json's
+/// "baselines": the flat albedo and one baked texture per atlas).
+struct ModelBaselines {
+  Eigen::Vector3f flat_albedo = Eigen::Vector3f::Constant(0.5f);
+  std::vector<cv::Mat> baked;  ///< CV_32FC3 display RGB, per atlas
+};
+/// Throws InputError naming the manifest or texture when missing or malformed.
+ModelBaselines ReadModelBaselines(const std::filesystem::path& model_folder,
+                                  const TexturedModel& model);
+
 /// Reads photos as CV_32FC3 RGB display values (8- or 16-bit, grey or colour).
 /// Throws InputError naming the file.
 cv::Mat ReadPhotoRgb(const std::filesystem::path& path);
+
+/// 8-bit BGR (for PNG) of a CV_32FC3 display RGB image in [0, 1].
+cv::Mat ToBgr8(const cv::Mat& display_rgb);
 
 /// 1-to-4 midpoint subdivision (shared edge midpoints welded).
 sfm::TriangleMesh SubdivideMidpoint(const sfm::TriangleMesh& mesh);
