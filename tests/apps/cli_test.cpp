@@ -123,7 +123,10 @@ TEST(Cli, DemoRunsTheWholeJobAndWritesTheReport) {
   }
   const std::string report = testing::ReadText(tmp / "demo/report.html");
   EXPECT_NE(report.find("flat baseline"), std::string::npos);
-  EXPECT_NE(report.find("render_texlume/view_00_light_00.png"), std::string::npos);
+  EXPECT_NE(report.find("Held-out views under held-out lights"), std::string::npos);
+  EXPECT_NE(report.find("report/view_0_texlume_error.png"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(tmp / "demo/report/view_0_texlume_error.png"));
+  EXPECT_TRUE(std::filesystem::exists(tmp / "demo/model/report.html"));
 }
 
 TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
