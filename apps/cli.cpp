@@ -515,7 +515,7 @@ int RunSceneCommand(const std::vector<std::string>& args, std::ostream& out,
   const Arguments a(args,
                     {"kind", "material", "out", "seed", "images", "camera-model", "width", "height",
                      "capture-size", "capture-lights", "held-out-lights", "texel-size", "relief",
-                     "specular", "held-out-views", "held-out-scale", "samples"},
+                     "specular", "held-out-views", "held-out-scale", "samples", "mesh-resolution"},
                     {"no-btf", "fixed-exposure"});
   datasets::SceneOptions options;
   const std::string kind = a.Get("kind").value_or("sphere");
@@ -550,6 +550,7 @@ int RunSceneCommand(const std::vector<std::string>& args, std::ostream& out,
       a.GetInt("held-out-lights", options.num_held_out_capture_lights);
   options.num_held_out_views = a.GetInt("held-out-views", options.num_held_out_views);
   options.held_out_scale = a.GetInt("held-out-scale", options.held_out_scale);
+  options.mesh_resolution = a.GetInt("mesh-resolution", options.mesh_resolution);
   options.shading.samples_per_axis = a.GetInt("samples", options.shading.samples_per_axis);
   options.write_btf = !a.Has("no-btf");
   options.vary_exposure = !a.Has("fixed-exposure");

@@ -50,7 +50,7 @@ constexpr const char* kUsage =
     "        [--capture-size N] [--capture-lights N] [--held-out-lights N] [--held-out-views N]\n"
     "        [--held-out-scale N] [--texel-size T] [--relief R] [--specular KS] [--samples N] "
     "[--no-btf]\n"
-    "        [--fixed-exposure]\n"
+    "        [--fixed-exposure] [--mesh-resolution N]\n"
     "      Write a synthetic heritage scene with ground truth (docs/synthetic_scenes.md).\n"
     "  demo [--out DIR] [--kind SHAPE] [--material MATERIAL] [--seed S]\n"
     "      The whole job on a synthetic scene: scene, inspect, fit, synth, render held-out\n"

@@ -69,6 +69,8 @@ nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 void SceneOptions::Check() const {
   material.Check();
+  if (mesh_resolution < 0 || mesh_resolution > 7)
+    throw OptionError("mesh resolution must be in [0, 7]");
   auto in = [](double v, double lo, double hi, const char* what) {
     if (!(v >= lo && v <= hi)) {
       throw OptionError(std::string(what) + " must be in [" + std::to_string(lo) + ", " +
@@ -349,7 +351,7 @@ SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::p
   // --------------------------------------------------------------------- object
   ObjectSceneOptions object_options;
   object_options.shape = options.shape;
-  object_options.resolution = 0;
+  object_options.resolution = options.mesh_resolution;
   object_options.num_images = options.num_images;
   object_options.image_width = options.image_width;
   object_options.image_height = options.image_height;

@@ -37,6 +37,10 @@ struct SceneOptions {
   /// same camera, its size, focal length and principal point scaled), so models
   /// can be compared at full resolution and at the photos'. [1, 4]
   int held_out_scale = 1;
+  /// The coarse mesh: 0 = the shape's standard one (CoarseMesh: 1280 triangles
+  /// on the sphere); 1..7 as ObjectSceneOptions::resolution (the sphere's
+  /// icosphere level: 20 * 4^N triangles).
+  int mesh_resolution = 0;
 
   // Material sample captures (orthographic, rectified to the material frame).
   int capture_size = 256;                ///< texels per side, [16, 4096]

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <functional>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -197,8 +198,10 @@ enum class DropRule {
 /// Bottom-left packing of outlines (texel-exact, so charts fill each other's
 /// concavities and holes): charts go in `order`, each into the first atlas
 /// where it fits, at the rotation and position `rule` prefers.
+/// `placed` is called after each chart.
 OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlines,
-                            const std::vector<std::size_t>& order, int bin_size, DropRule rule) {
+                            const std::vector<std::size_t>& order, int bin_size, DropRule rule,
+                            const std::function<void()>& placed) {
   OutlinePacking packing;
   packing.drops.resize(outlines.size());
   std::vector<PackingBin> bins;
@@ -225,6 +228,7 @@ OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlin
       packing.drops[c] = {static_cast<int>(bin), best, x, y};
       break;
     }
+    if (placed) placed();
   }
   for (std::size_t bin = 0; bin < bins.size(); ++bin)
     packing.texels += static_cast<std::int64_t>(bin_size) *
@@ -494,11 +498,18 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     }
     // Both drop rules; the layout with fewer atlas texels wins.
     OutlinePacking best_packing;
+    std::size_t placed = 0;
+    const std::size_t to_place = 2 * charts.size();
+    const auto count_placed = [&] {
+      ++placed;
+      if (progress && (placed % 8 == 0 || placed == to_place))
+        progress("packing", placed, to_place);
+    };
     for (const DropRule rule : {DropRule::kLowestBottom, DropRule::kLowestPosition}) {
-      OutlinePacking packing = PackOutlines(outlines, order, options.atlas_size, rule);
+      OutlinePacking packing =
+          PackOutlines(outlines, order, options.atlas_size, rule, count_placed);
       if (best_packing.drops.empty() || packing.texels < best_packing.texels)
         best_packing = std::move(packing);
-      if (progress) progress("packing", rule == DropRule::kLowestBottom ? 1 : 2, 2);
     }
     sizes.resize(charts.size());
     chart_lo.resize(charts.size());
