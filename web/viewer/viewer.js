@@ -165,42 +165,28 @@ function fail(message) {
   console.error(message);
 }
 
-async function fetchOk(url, kind) {
-  const response = await fetch(url);
-  if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
-  return kind === 'json' ? response.json() : response.arrayBuffer();
-}
-
-// PNGs are decoded off the main thread (createImageBitmap, flipped so that the
-// first row is at v = 1, no colour-space conversion or premultiplication: the
-// bytes are raw coefficients), so uploading them to the GPU is a plain copy.
-function loadTexture(loader, name) {
-  return new Promise((resolve, reject) => {
-    loader.load(`/model/${name}`, (bitmap) => {
-      const texture = new THREE.Texture(bitmap);
-      texture.flipY = false;                    // flipped while decoding
-      texture.colorSpace = THREE.NoColorSpace;  // raw values: coefficients, display-domain colour
-      texture.minFilter = THREE.LinearFilter;   // no mipmaps: gutters cover bilinear reads only
-      texture.magFilter = THREE.LinearFilter;
-      texture.generateMipmaps = false;
-      texture.needsUpdate = true;
-      resolve(texture);
-    }, undefined, () => reject(new Error(`/model/${name} could not be loaded`)));
-  });
+// A texture of raw values from a decoded PNG (prefetch.js flipped it already).
+function textureOf(bitmap) {
+  const texture = new THREE.Texture(bitmap);
+  texture.flipY = false;                    // flipped while decoding
+  texture.colorSpace = THREE.NoColorSpace;  // raw values: coefficients, display-domain colour
+  texture.minFilter = THREE.LinearFilter;   // no mipmaps: gutters cover bilinear reads only
+  texture.magFilter = THREE.LinearFilter;
+  texture.generateMipmaps = false;
+  texture.needsUpdate = true;
+  return texture;
 }
 
 async function main() {
-  const scene = await fetchOk('/model/scene.json', 'json');
+  // prefetch.js started fetching the model and decoding its PTM textures.
+  const prefetch = window.texlumePrefetch;
+  if (!prefetch) throw new Error('/viewer/prefetch.js did not run');
+  api.marks.prefetchStart = prefetch.started;
+  const scene = await prefetch.scene;
   if (scene.format !== 'texlume-web-1') throw new Error('scene.json: unknown format ' + scene.format);
   api.marks.scene = performance.now();
-  // Every texture of every atlas is fetched and decoded at once, with the geometry.
-  const loader = new THREE.ImageBitmapLoader();
-  loader.setOptions({ imageOrientation: 'flipY', premultiplyAlpha: 'none', colorSpaceConversion: 'none' });
-  const texturesOfAtlas = scene.atlases.map((atlas) => Promise.all([
-    Promise.all(atlas.coefficients.map((p) => loadTexture(loader, p.file))),
-    atlas.colour ? loadTexture(loader, atlas.colour) : null,
-  ]));
-  const bytes = await fetchOk('/model/' + scene.geometry.file, 'binary');
+  const texturesOfAtlas = await prefetch.ptmTextures;
+  const bytes = await prefetch.geometry;
   api.marks.geometry = performance.now();
   const g = scene.geometry;
   const attribute = (name) => {
@@ -231,8 +217,9 @@ async function main() {
   const materials = [];
   for (const range of g.ranges) {
     const atlas = scene.atlases[range.atlas];
-    const [planes, colourOrNull] = await texturesOfAtlas[range.atlas];
-    const colour = colourOrNull || placeholder;
+    const [planeBitmaps, colourBitmap] = await texturesOfAtlas[range.atlas];
+    const planes = planeBitmaps.map(textureOf);
+    const colour = colourBitmap ? textureOf(colourBitmap) : placeholder;
     const scale = [], bias = [];
     for (let k = 0; k < 6; ++k) {
       const p = atlas.coefficients[Math.min(k, atlas.coefficients.length - 1)];
@@ -378,7 +365,7 @@ async function main() {
   // first frame; `ready` once they are in.
   const baked = await Promise.all(scene.atlases.map((atlas) => {
     const name = atlas.baked || atlas.base_colour;
-    return name ? loadTexture(loader, name) : placeholder;
+    return name ? prefetch.decode(name).then(textureOf) : placeholder;
   }));
   g.ranges.forEach((range, i) => { materials[i].uniforms.bakedTexture.value = baked[range.atlas]; });
   requestRender();
