@@ -393,31 +393,31 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
 }
 
 int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const Arguments a(args,
-                    {"model",
-                     "images",
-                     "lights",
-                     "mesh",
-                     "sample",
-                     "sample-texel-size",
-                     "out",
-                     "strip",
-                     "top-k",
-                     "max-views",
-                     "atlas",
-                     "atlas-size",
-                     "gutter",
-                     "seed",
-                     "tangent-field",
-                     "max-subdivisions",
-                     "max-buffer-size",
-                     "correction-iterations",
-                     "correction-sigma",
-                     "correction-noise",
-                     "chart-angle",
-                     "chart-size"},
-                    {"best-view-only", "no-additive-correction", "no-channel-correction",
-                     "no-report"});
+  const Arguments a(
+      args,
+      {"model",
+       "images",
+       "lights",
+       "mesh",
+       "sample",
+       "sample-texel-size",
+       "out",
+       "strip",
+       "top-k",
+       "max-views",
+       "atlas",
+       "atlas-size",
+       "gutter",
+       "seed",
+       "tangent-field",
+       "max-subdivisions",
+       "max-buffer-size",
+       "correction-iterations",
+       "correction-sigma",
+       "correction-noise",
+       "chart-angle",
+       "chart-size"},
+      {"best-view-only", "no-additive-correction", "no-channel-correction", "no-report"});
   synth::SynthJobOptions o;
   o.model_dir = a.Require("model");
   o.images_dir = a.Require("images");
@@ -797,15 +797,18 @@ int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std:
     }
   }
   rep.views_heading = "Held-out views under held-out lights";
-  rep.metrics = {{"texlume (PTM atlases)", ours}, {"flat baseline", flat}, {"baked baseline", baked}};
+  rep.metrics = {
+      {"texlume (PTM atlases)", ours}, {"flat baseline", flat}, {"baked baseline", baked}};
   rep.occupancy = synthesis.occupancy;
   rep.facts = {{"triangles", std::to_string(synthesis.faces) + " (" +
                                  std::to_string(synthesis.from_photos) + " constrained by photos)"},
                {"photos", std::to_string(synthesis.photos_used)},
                {"atlases", std::to_string(synthesis.atlases) + ", " +
                                std::to_string(synthesis.charts) + " charts"}};
-  rep.timings_s = {{"scene", seconds_scene},     {"inspect", seconds_inspect},
-                   {"fit", seconds_fit},         {"synth (with the model's report)", seconds_synth},
+  rep.timings_s = {{"scene", seconds_scene},
+                   {"inspect", seconds_inspect},
+                   {"fit", seconds_fit},
+                   {"synth (with the model's report)", seconds_synth},
                    {"render (3 models)", seconds_render}};
   rep.links = {{"model.glb", "model/model.glb"},
                {"model.obj", "model/model.obj"},
@@ -822,8 +825,9 @@ int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std:
                      {"seed", options.seed},
                      {"num_images", options.num_images},
                      {"held_out_scale", options.held_out_scale}};
-  run["timings_s"] = {{"scene", seconds_scene}, {"inspect", seconds_inspect}, {"fit", seconds_fit},
-                      {"synth", seconds_synth}, {"render", seconds_render},   {"report", seconds_report},
+  run["timings_s"] = {{"scene", seconds_scene},   {"inspect", seconds_inspect},
+                      {"fit", seconds_fit},       {"synth", seconds_synth},
+                      {"render", seconds_render}, {"report", seconds_report},
                       {"total", since(t0)}};
   run["inspect"] = nlohmann::json::parse(sfm::InspectReportToJson(report));
   auto metrics = [](const synth::RenderJobSummary& s) {

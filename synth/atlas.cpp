@@ -2,10 +2,10 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <functional>
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <limits>
 #include <unordered_map>
 

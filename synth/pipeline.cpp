@@ -326,9 +326,9 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
       report.views_heading = "Photo views under the photos' lights";
       report.occupancy = summary.occupancy;
       report.facts = {
-          {"triangles", std::to_string(summary.faces) + " (" +
-                            std::to_string(summary.from_photos) + " constrained by photos, " +
-                            std::to_string(summary.from_neighbours) + " by neighbours only)"},
+          {"triangles", std::to_string(summary.faces) + " (" + std::to_string(summary.from_photos) +
+                            " constrained by photos, " + std::to_string(summary.from_neighbours) +
+                            " by neighbours only)"},
           {"photos used", std::to_string(summary.photos_used)},
           {"sample texel size", std::to_string(so.sample_texel_size) + " world units"},
           {"atlases", std::to_string(summary.atlases) + " of " +
@@ -359,8 +359,7 @@ ModelBaselines ReadModelBaselines(const fs::path& model_folder, const TexturedMo
   if (!baselines.is_object()) throw InputError(manifest_path.string(), "lists no baselines");
   ModelBaselines out;
   const auto& a = baselines.value("flat_albedo", nlohmann::json());
-  if (!a.is_array() || a.size() != 3 || !a[0].is_number() || !a[1].is_number() ||
-      !a[2].is_number())
+  if (!a.is_array() || a.size() != 3 || !a[0].is_number() || !a[1].is_number() || !a[2].is_number())
     throw InputError(manifest_path.string(), "has no flat_albedo of three numbers");
   out.flat_albedo = Eigen::Vector3f(a[0].get<float>(), a[1].get<float>(), a[2].get<float>());
   const auto& b = baselines.value("baked", nlohmann::json());

@@ -48,14 +48,14 @@ struct ReportMetrics {
 /// Everything the report shows. Pointers are borrowed for the call.
 struct ReportInputs {
   std::string title;
-  std::string intro;                    ///< one paragraph of plain text
+  std::string intro;                     ///< one paragraph of plain text
   const TexturedModel* model = nullptr;  ///< required
   Eigen::Vector3f flat_albedo = Eigen::Vector3f::Constant(0.5f);
-  std::vector<cv::Mat> baked;         ///< per atlas (display RGB); empty = no baked column
-  const ptm::Ptm* sample = nullptr;   ///< the material sample; null = no sample section
-  std::vector<ReportPhoto> photos;    ///< the constraint photos
-  std::vector<ReportView> views;      ///< at most `max_views` are drawn, evenly spread
-  std::string views_heading;          ///< e.g. "Held-out views under held-out lights"
+  std::vector<cv::Mat> baked;          ///< per atlas (display RGB); empty = no baked column
+  const ptm::Ptm* sample = nullptr;    ///< the material sample; null = no sample section
+  std::vector<ReportPhoto> photos;     ///< the constraint photos
+  std::vector<ReportView> views;       ///< at most `max_views` are drawn, evenly spread
+  std::string views_heading;           ///< e.g. "Held-out views under held-out lights"
   std::vector<ReportMetrics> metrics;  ///< optional full-resolution tables
   std::vector<std::pair<std::string, std::string>> facts;  ///< summary lines (name, value)
   std::vector<std::pair<std::string, double>> timings_s;   ///< stage, seconds

@@ -1,6 +1,7 @@
 // The main job (issue 6): per-triangle synthesis, blending, atlases, export,
 // rendering, on a small synthetic sphere with ground truth.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <cstring>
@@ -9,7 +10,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
-#include <unistd.h>
 
 #include "datasets_synthetic/scene.h"
 #include "ptm/coefficient_space.h"
