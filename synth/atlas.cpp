@@ -476,12 +476,19 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     // where it overlaps nothing, so charts nest in each other's concavities.
     std::vector<std::vector<ChartOutline>> outlines(charts.size());
     std::vector<double> area(charts.size(), 0.0);
+    std::size_t outlined = 0;
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::size_t c = 0; c < charts.size(); ++c) {
       for (int r = 0; r < kPackingRotations; ++r)
         outlines[c].push_back(
             Outline(charts[c], 2.0 * kPi * r / kPackingRotations, synthesis.patches, t, gutter));
       for (const auto& o : outlines[c]) area[c] = std::max(area[c], o.area);
+#pragma omp critical(texlume_chart_outlines)
+      {
+        ++outlined;
+        if (progress && (outlined % 8 == 0 || outlined == charts.size()))
+          progress("chart outlines", outlined, charts.size());
+      }
     }
     std::vector<std::size_t> order(charts.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
