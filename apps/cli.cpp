@@ -162,13 +162,7 @@ void WriteRgbPng(const std::filesystem::path& path, const std::vector<float>& rg
                     bytes)) {
     throw std::runtime_error(path.string() + ": cannot encode the image (use .png, .jpg or .tif)");
   }
-  WriteFileAtomically(
-      path,
-      [&](std::ostream& o) {
-        o.write(reinterpret_cast<const char*>(bytes.data()),
-                static_cast<std::streamsize>(bytes.size()));
-      },
-      true);
+  synth::WriteBytesAtomically(path, bytes);
 }
 
 }  // namespace
@@ -780,7 +774,7 @@ int RunDemoCommand(const std::vector<std::string>& args, std::ostream& out, std:
     const sfm::ObjectLights photo_lights = sfm::ReadObjectLightsFile(job.lights_file);
     for (const auto& [id, image] : photos_model.reconstruction.images)
       if (const auto it = photo_lights.find(image.name); it != photo_lights.end())
-        rep.photos.push_back({image.name, job.images_dir / image.name, it->second});
+        rep.photos.push_back({image.name, job.images_dir / image.name, it->second, {}});
     const sfm::LoadedModel held_model = sfm::ReadModel(held / "sparse");
     const sfm::ObjectLights held_lights = sfm::ReadObjectLightsFile(held / "lights.json");
     for (const auto& [id, image] : held_model.reconstruction.images) {

@@ -313,13 +313,14 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
       for (std::size_t i = 0; i < photos.size(); ++i) {
         const MeshPhoto& p = photos[i];
         const sfm::Image& image = reconstruction.images.at(p.image_id);
-        report.photos.push_back({p.name, options.images_dir / p.name, p.lights});
+        report.photos.push_back({p.name, options.images_dir / p.name, p.lights, p.image});
         ReportView view;
         view.name = p.name;
         view.camera = reconstruction.cameras.at(image.camera_id);
         view.cam_from_world = image.cam_from_world;
         view.lights = p.lights;
         view.reference_image = options.images_dir / p.name;
+        view.reference = p.image;
         view.reference_gain = i < synthesis.photo_gains.size() ? synthesis.photo_gains[i] : 1.0;
         report.views.push_back(std::move(view));
       }

@@ -234,7 +234,7 @@ ReportSummary WriteReport(const fs::path& dir, const ReportInputs& in,
            << " photos that constrain the synthesis, with their lights (world frame).</p>\n";
       for (const std::size_t i : photo_ids) {
         const ReportPhoto& p = in.photos[i];
-        const cv::Mat image = ResizedToWidth(ReadPhotoRgb(p.file), 200);
+        const cv::Mat image = ResizedToWidth(p.image.empty() ? ReadPhotoRgb(p.file) : p.image, 200);
         const std::string src = write_picture("photo_" + std::to_string(i) + ".png", ToBgr8(image));
         html << Figure(src, HtmlEscape(p.name) + "<br>" + LightsText(p.lights), 200);
         advance();
@@ -270,8 +270,8 @@ ReportSummary WriteReport(const fs::path& dir, const ReportInputs& in,
         const std::string stem = "view_" + std::to_string(i);
         cv::Mat reference, inside;
         html << "<tr>";
-        if (!v.reference_image.empty()) {
-          const cv::Mat full = ReadPhotoRgb(v.reference_image);
+        if (!v.reference_image.empty() || !v.reference.empty()) {
+          const cv::Mat full = v.reference.empty() ? ReadPhotoRgb(v.reference_image) : v.reference;
           if (full.cols != static_cast<int>(v.camera.width) ||
               full.rows != static_cast<int>(v.camera.height))
             throw InputError(v.reference_image.string(), "does not match its camera's size");

@@ -24,6 +24,9 @@ struct ReportView {
   std::vector<sfm::ObjectLight> lights;
   /// The reference (ground truth or the photo); empty = none.
   std::filesystem::path reference_image;
+  /// The reference already in memory (CV_32FC3 display RGB, the camera's size);
+  /// used instead of reading `reference_image`, which then only names it.
+  cv::Mat reference;
   /// Its object mask; empty = where the model covers the pixel.
   std::filesystem::path reference_mask;
   /// The reference's exposure relative to the model (a photo's gain, linear
@@ -36,6 +39,7 @@ struct ReportPhoto {
   std::string name;
   std::filesystem::path file;
   std::vector<sfm::ObjectLight> lights;
+  cv::Mat image;  ///< CV_32FC3 display RGB when already in memory; else `file` is read
 };
 
 /// Mean metrics of one model over the held-out views, as `texlume render`

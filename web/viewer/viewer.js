@@ -10,16 +10,21 @@ const canvas = document.getElementById('view');
 const api = { ready: false, errors: [], firstFrameMs: null, marks: { moduleStart: performance.now() } };
 window.texlumeViewer = api;
 
-const vertexShader = /* glsl */ `
-attribute vec3 ptmTangent;
-attribute vec3 barycentric;
-attribute float chartId;
+// What the vertex shader hands to the fragment shader.
+const varyings = /* glsl */ `
 varying vec2 vUv;
 varying vec3 vNormal;
 varying vec3 vTangent;
 varying vec3 vBarycentric;
 varying float vChart;
 varying vec3 vWorldPosition;
+`;
+
+const vertexShader = /* glsl */ `
+attribute vec3 ptmTangent;
+attribute vec3 barycentric;
+attribute float chartId;
+${varyings}
 void main() {
   vUv = uv;
   vNormal = normalize(mat3(modelMatrix) * normal);
@@ -44,13 +49,7 @@ uniform float specular;      // ks of the specular enhancement, 0 = off
 uniform vec3 lightWorld;     // unit vector towards the light
 uniform vec3 flatAlbedo;     // display domain
 uniform float horizonZ;      // sin of the horizon elevation (PTM evaluation)
-varying vec2 vUv;
-varying vec3 vNormal;
-varying vec3 vTangent;
-varying vec3 vBarycentric;
-varying float vChart;
-varying vec3 vWorldPosition;
-
+${varyings}
 float srgbToLinear(float v) { return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4); }
 vec3 srgbToLinear(vec3 v) { return vec3(srgbToLinear(v.r), srgbToLinear(v.g), srgbToLinear(v.b)); }
 float linearToSrgb(float v) {
