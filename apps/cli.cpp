@@ -607,16 +607,21 @@ int RunViewCommand(const std::vector<std::string>& args, std::ostream& out, std:
                      "has no viewer or no three.js; run ./scripts/install_deps.sh "
                      "(it runs npm ci in web/), or set TEXLUME_WEB_DIR");
   const auto t0 = std::chrono::steady_clock::now();
-  const synth::WebModel model = synth::BuildWebModel(model_dir);
+  synth::WebModel model = synth::BuildWebModel(model_dir);
   const double prepare_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Served without a copy per request.
+  std::map<std::string, std::shared_ptr<const std::vector<unsigned char>>> model_files;
+  for (auto& [name, bytes] : model.files)
+    model_files[name] = std::make_shared<const std::vector<unsigned char>>(std::move(bytes));
   HttpServer server(host, port);
   const HttpHandler handler = [&](const std::string& path) -> HttpResponse {
     auto file_response = [](const std::filesystem::path& f) {
       std::ifstream in(f, std::ios::binary);
       HttpResponse r;
       r.content_type = ContentTypeOf(f.filename().string());
-      r.body.assign(std::istreambuf_iterator<char>(in), {});
+      r.body = std::make_shared<const std::vector<unsigned char>>(
+          std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
       return r;
     };
     if (path == "/" || path == "/index.html") return file_response(web / "viewer/index.html");
@@ -625,8 +630,8 @@ int RunViewCommand(const std::vector<std::string>& args, std::ostream& out, std:
     if (path.rfind("/three/", 0) == 0)
       if (const auto f = FileBelow(three, path.substr(7))) return file_response(*f);
     if (path.rfind("/model/", 0) == 0) {
-      const auto it = model.files.find(path.substr(7));
-      if (it != model.files.end()) return {200, ContentTypeOf(it->first), it->second};
+      const auto it = model_files.find(path.substr(7));
+      if (it != model_files.end()) return {200, ContentTypeOf(it->first), it->second};
     }
     return {404, "text/plain", {}};
   };

@@ -8,9 +8,12 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <condition_variable>
 #include <cstring>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 namespace texlume::apps {
 namespace {
@@ -84,22 +87,25 @@ void Answer(int fd, const HttpHandler& handler) {
       response = handler(path);
     } catch (const std::exception& e) {
       const std::string what = e.what();
-      response = {500, "text/plain", std::vector<unsigned char>(what.begin(), what.end())};
+      response = {500, "text/plain",
+                  std::make_shared<const std::vector<unsigned char>>(what.begin(), what.end())};
     }
   }
-  if (response.status != 200 && response.body.empty()) {
-    const std::string text = std::to_string(response.status) + " " + Reason(response.status);
-    response.body.assign(text.begin(), text.end());
-    response.content_type = "text/plain";
+  if (!response.body || (response.status != 200 && response.body->empty())) {
+    const std::string text = response.status == 200 ? std::string()
+                                                    : std::to_string(response.status) + " " +
+                                                          Reason(response.status);
+    response.body = std::make_shared<const std::vector<unsigned char>>(text.begin(), text.end());
+    if (response.status != 200) response.content_type = "text/plain";
   }
   std::ostringstream head;
   head << "HTTP/1.1 " << response.status << " " << Reason(response.status) << "\r\n"
        << "Content-Type: " << response.content_type << "\r\n"
-       << "Content-Length: " << response.body.size() << "\r\n"
+       << "Content-Length: " << response.body->size() << "\r\n"
        << "Cache-Control: no-store\r\nConnection: close\r\n\r\n";
   const std::string h = head.str();
   if (!SendAll(fd, h.data(), h.size())) return;
-  if (method != "HEAD") SendAll(fd, response.body.data(), response.body.size());
+  if (method != "HEAD") SendAll(fd, response.body->data(), response.body->size());
 }
 
 }  // namespace
@@ -147,16 +153,47 @@ HttpServer::~HttpServer() {
 }
 
 void HttpServer::Serve(const HttpHandler& handler, const std::atomic<bool>& stop) {
+  struct Connection {
+    std::thread thread;
+    std::shared_ptr<std::atomic<bool>> answered;
+  };
+  std::mutex mutex;
+  std::condition_variable answered_one;
+  int active = 0;
+  std::vector<Connection> connections;
   while (!stop.load()) {
     pollfd p{socket_, POLLIN, 0};
-    const int ready = ::poll(&p, 1, 200);
-    if (ready <= 0) continue;
+    if (::poll(&p, 1, 200) <= 0) continue;
+    {
+      std::unique_lock lock(mutex);
+      answered_one.wait(lock, [&] { return active < kMaxConnections; });
+      ++active;
+    }
     const int fd = ::accept4(socket_, nullptr, nullptr, SOCK_CLOEXEC);
-    if (fd < 0) continue;
-    Answer(fd, handler);
-    ::shutdown(fd, SHUT_WR);
-    ::close(fd);
+    if (fd < 0) {
+      std::lock_guard lock(mutex);
+      --active;
+      continue;
+    }
+    // Join the threads that have answered, so the list stays short.
+    std::erase_if(connections, [](Connection& c) {
+      if (!c.answered->load()) return false;
+      c.thread.join();
+      return true;
+    });
+    auto answered = std::make_shared<std::atomic<bool>>(false);
+    connections.push_back({std::thread([fd, answered, &handler, &mutex, &answered_one, &active] {
+                             Answer(fd, handler);
+                             ::shutdown(fd, SHUT_WR);
+                             ::close(fd);
+                             answered->store(true);
+                             std::lock_guard lock(mutex);
+                             --active;
+                             answered_one.notify_all();
+                           }),
+                           answered});
   }
+  for (Connection& c : connections) c.thread.join();
 }
 
 }  // namespace texlume::apps
