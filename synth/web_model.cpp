@@ -30,21 +30,20 @@ std::vector<unsigned char> ReadBytes(const fs::path& path) {
   return std::vector<unsigned char>(std::istreambuf_iterator<char>(in), {});
 }
 
-/// 8-bit PNG of three planes of `width` x `height` bytes (R, G, B).
-std::vector<unsigned char> PlanesPng(const std::array<const QuantisedPlane*, 3>& planes, int width,
+/// 8-bit RGBA PNG of up to four planes of `width` x `height` bytes (R, G, B, A;
+/// missing planes are 0).
+std::vector<unsigned char> PlanesPng(const std::vector<const QuantisedPlane*>& planes, int width,
                                      int height, const std::string& label) {
-  cv::Mat bgr(height, width, CV_8UC3);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
-                            static_cast<std::size_t>(x);
-      cv::Vec3b& p = bgr.at<cv::Vec3b>(y, x);
-      for (int c = 0; c < 3; ++c)
-        p[2 - c] = planes[static_cast<std::size_t>(c)]
-                       ? planes[static_cast<std::size_t>(c)]->bytes[i]
-                       : static_cast<unsigned char>(0);
+  cv::Mat bgra(height, width, CV_8UC4, cv::Scalar::all(0));
+  constexpr int kBgraOfRgba[4] = {2, 1, 0, 3};
+  for (std::size_t c = 0; c < planes.size(); ++c)
+    for (int y = 0; y < height; ++y) {
+      const unsigned char* in =
+          planes[c]->bytes.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
+      unsigned char* out = bgra.ptr<unsigned char>(y) + kBgraOfRgba[c];
+      for (int x = 0; x < width; ++x) out[4 * x] = in[x];
     }
-  return EncodePng(bgr, label);
+  return EncodePng(bgra, label);
 }
 
 }  // namespace
@@ -105,7 +104,7 @@ WebModel BuildWebModel(const fs::path& model_dir) {
   const nlohmann::json manifest = ReadModelManifest(model_dir);
   WebModel web;
   nlohmann::json& scene = web.scene;
-  scene["format"] = "texlume-web-1";
+  scene["format"] = "texlume-web-2";
   scene["faces"] = model.mesh.faces.size();
   scene["horizon_elevation_deg"] = kHorizonElevationDeg;
   const std::vector<int> chart = ChartsOfModel(model);
@@ -176,7 +175,11 @@ WebModel BuildWebModel(const fs::path& model_dir) {
   scene["bounds"] = {{"min", {lo.x(), lo.y(), lo.z()}}, {"max", {hi.x(), hi.y(), hi.z()}}};
   web.files["geometry.bin"] = std::move(geometry);
 
-  // Atlases: coefficient planes, three per PNG, 8 bits with scale and bias.
+  // Atlases: the PTM's values as 8-bit channels with a scale and bias each,
+  // four per RGBA PNG (docs/viewer.md, "Web model"):
+  //   LRGB: a0..a5 of the luminance, then the colour's r and g, with the colour
+  //         rescaled to sum to 3 (b = 3 - r - g) and the luminance by the inverse;
+  //   RGB:  coefficient k of channel c at 3 k + c.
   scene["atlases"] = nlohmann::json::array();
   const nlohmann::json& entries = manifest["atlases"];
   const nlohmann::json baked = manifest.contains("baselines") && manifest["baselines"].is_object()
@@ -186,45 +189,42 @@ WebModel BuildWebModel(const fs::path& model_dir) {
     const ptm::Ptm& ptm = model.atlases[a];
     const std::string k = std::to_string(a);
     const std::size_t texels = ptm.NumTexels();
-    const int polys = ptm.NumPolynomials();
-    nlohmann::json entry = {{"width", ptm.width},
-                            {"height", ptm.height},
-                            {"format", ptm.format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB"}};
-    // LRGB: coefficients (a0, a1, a2) and (a3, a4, a5). RGB: coefficient i of
-    // the (R, G, B) polynomials in PNG i.
-    std::vector<QuantisedPlane> planes;
-    for (int p = 0; p < polys; ++p)
-      for (int i = 0; i < 6; ++i) {
-        std::vector<float> values(texels);
-        for (std::size_t t = 0; t < texels; ++t) values[t] = ptm.Coefficients(t, p)[i];
-        planes.push_back(QuantisePlane(values));
+    const bool lrgb = ptm.format == ptm::PtmFormat::kLrgb;
+    nlohmann::json entry = {
+        {"width", ptm.width}, {"height", ptm.height}, {"format", lrgb ? "LRGB" : "RGB"}};
+    const std::size_t num_channels = lrgb ? 8 : 18;
+    std::vector<std::vector<float>> channels(num_channels, std::vector<float>(texels));
+    for (std::size_t t = 0; t < texels; ++t) {
+      if (lrgb) {
+        // L (r, g, b) = (L s) (r, g, b) / s with s = (r + g + b) / 3 (eq. 2).
+        const float* colour = &ptm.colour[t * 3];
+        const float s = (colour[0] + colour[1] + colour[2]) / 3.0f;
+        for (int i = 0; i < 6; ++i)
+          channels[static_cast<std::size_t>(i)][t] = ptm.Coefficients(t)[i] * s;
+        channels[6][t] = s > 1e-6f ? colour[0] / s : 1.0f;  // black: any colour
+        channels[7][t] = s > 1e-6f ? colour[1] / s : 1.0f;
+      } else {
+        for (int i = 0; i < 6; ++i)
+          for (int c = 0; c < 3; ++c)
+            channels[static_cast<std::size_t>(3 * i + c)][t] = ptm.Coefficients(t, c)[i];
       }
-    auto plane = [&](int poly, int i) { return &planes[static_cast<std::size_t>(poly * 6 + i)]; };
-    nlohmann::json pngs = nlohmann::json::array();
-    for (int png = 0; png < (polys == 1 ? 2 : 6); ++png) {
-      std::array<const QuantisedPlane*, 3> rgb;
-      for (int c = 0; c < 3; ++c)
-        rgb[static_cast<std::size_t>(c)] = polys == 1 ? plane(0, png * 3 + c) : plane(c, png);
-      const std::string name = "coefficients_" + k + "_" + std::to_string(png) + ".png";
-      web.files[name] = PlanesPng(rgb, ptm.width, ptm.height, name);
+    }
+    std::vector<QuantisedPlane> quantised(num_channels);
+    for (std::size_t c = 0; c < num_channels; ++c) quantised[c] = QuantisePlane(channels[c]);
+    nlohmann::json textures = nlohmann::json::array();
+    for (std::size_t first = 0; first < num_channels; first += 4) {
+      std::vector<const QuantisedPlane*> rgba;
       nlohmann::json scale = nlohmann::json::array(), bias = nlohmann::json::array();
-      for (const QuantisedPlane* q : rgb) scale.push_back(q->scale), bias.push_back(q->bias);
-      pngs.push_back({{"file", name}, {"scale", scale}, {"bias", bias}});
-    }
-    entry["coefficients"] = pngs;
-    if (polys == 1) {
-      std::array<QuantisedPlane, 3> colour;
-      for (int c = 0; c < 3; ++c) {
-        colour[static_cast<std::size_t>(c)].bytes.resize(texels);
-        for (std::size_t t = 0; t < texels; ++t)
-          colour[static_cast<std::size_t>(c)].bytes[t] = static_cast<unsigned char>(std::clamp(
-              std::lround(ptm.colour[t * 3 + static_cast<std::size_t>(c)] * 255.0), 0L, 255L));
+      for (std::size_t c = first; c < std::min(first + 4, num_channels); ++c) {
+        rgba.push_back(&quantised[c]);
+        scale.push_back(quantised[c].scale);
+        bias.push_back(quantised[c].bias);
       }
-      const std::string name = "colour_" + k + ".png";
-      web.files[name] =
-          PlanesPng({&colour[0], &colour[1], &colour[2]}, ptm.width, ptm.height, name);
-      entry["colour"] = name;
+      const std::string name = "ptm_" + k + "_" + std::to_string(first / 4) + ".png";
+      web.files[name] = PlanesPng(rgba, ptm.width, ptm.height, name);
+      textures.push_back({{"file", name}, {"scale", scale}, {"bias", bias}});
     }
+    entry["textures"] = textures;
     if (a < entries.size() && entries[a].contains("base_colour")) {
       const std::string name = entries[a]["base_colour"].get<std::string>();
       web.files[name] = ReadBytes(model_dir / name);

@@ -12,7 +12,7 @@ namespace texlume::synth {
 
 /// A model folder prepared for the browser viewer (docs/viewer.md): a scene
 /// description, the geometry as float32 vertex streams, and the PTM atlases as
-/// 8-bit PNG planes with a scale and bias per coefficient.
+/// 8-bit channels with a scale and bias each, four per RGBA PNG.
 struct WebModel {
   nlohmann::json scene;                                     ///< "scene.json"
   std::map<std::string, std::vector<unsigned char>> files;  ///< name -> bytes, scene.json included
@@ -23,7 +23,7 @@ struct WebModel {
 /// texels) in the same atlas. Returns the chart id of every face (0-based).
 std::vector<int> ChartsOfModel(const TexturedModel& model);
 
-/// Quantises one PTM coefficient plane to 8 bits: value = byte / 255 * scale + bias,
+/// Quantises one channel (a plane of PTM values) to 8 bits: value = byte / 255 * scale + bias,
 /// bias = the plane's minimum, scale = its range (1 when the plane is constant).
 struct QuantisedPlane {
   std::vector<unsigned char> bytes;

@@ -430,8 +430,9 @@ namespace texlume::synth {
 namespace {
 
 // The browser viewer's model: every face corner in the vertex streams, charts as
-// the atlas built them, coefficient planes within half a quantisation step.
-TEST_F(MeshPipelineTest, WebModelKeepsChartsAndCoefficientsWithinHalfAStep) {
+// the atlas built them, every channel within half a quantisation step, and the
+// PTM evaluated from the web channels as from the atlas.
+TEST_F(MeshPipelineTest, WebModelKeepsChartsAndThePtmWithinQuantisation) {
   const WebModel web = BuildWebModel(tmp_->path() / "model");
   const TexturedModel model = ReadModelFolder(tmp_->path() / "model");
   const nlohmann::json& scene = web.scene;
@@ -442,28 +443,65 @@ TEST_F(MeshPipelineTest, WebModelKeepsChartsAndCoefficientsWithinHalfAStep) {
       nlohmann::json::parse(testing::ReadText(tmp_->path() / "model/manifest.json"));
   EXPECT_EQ(scene["charts"].get<int>(), manifest["summary"]["charts"].get<int>());
   const ptm::Ptm& atlas = model.atlases[0];
-  const nlohmann::json& planes = scene["atlases"][0]["coefficients"];
-  ASSERT_EQ(planes.size(), atlas.format == ptm::PtmFormat::kLrgb ? 2u : 6u);
-  const std::vector<unsigned char>& png = web.files.at(planes[0]["file"].get<std::string>());
-  const cv::Mat bgr = cv::imdecode(png, cv::IMREAD_COLOR);
-  ASSERT_EQ(bgr.cols, atlas.width);
-  ASSERT_EQ(bgr.rows, atlas.height);
-  double worst = 0.0, step = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    const double scale = planes[0]["scale"][static_cast<std::size_t>(c)].get<double>();
-    const double bias = planes[0]["bias"][static_cast<std::size_t>(c)].get<double>();
-    step = std::max(step, scale / 255.0);
-    for (int y = 0; y < atlas.height; y += 7)
-      for (int x = 0; x < atlas.width; x += 7) {
-        const std::size_t t = static_cast<std::size_t>(y) * static_cast<std::size_t>(atlas.width) +
-                              static_cast<std::size_t>(x);
-        const double expected = atlas.format == ptm::PtmFormat::kLrgb ? atlas.Coefficients(t)[c]
-                                                                      : atlas.Coefficients(t, c)[0];
-        const double got = bgr.at<cv::Vec3b>(y, x)[2 - c] / 255.0 * scale + bias;
-        worst = std::max(worst, std::abs(got - expected));
-      }
+  const bool lrgb = atlas.format == ptm::PtmFormat::kLrgb;
+  const nlohmann::json& textures = scene["atlases"][0]["textures"];
+  ASSERT_EQ(textures.size(), lrgb ? 2u : 5u);  // 8 or 18 channels, four per texture
+  // Channel i of the web model at texel (x, y), and the largest half step.
+  std::vector<cv::Mat> bgra;
+  double half_step = 0.0;
+  for (const auto& t : textures) {
+    bgra.push_back(cv::imdecode(web.files.at(t["file"].get<std::string>()), cv::IMREAD_UNCHANGED));
+    ASSERT_EQ(bgra.back().type(), CV_8UC4);
+    ASSERT_EQ(bgra.back().cols, atlas.width);
+    ASSERT_EQ(bgra.back().rows, atlas.height);
+    for (const auto& scale : t["scale"]) half_step = std::max(half_step, scale.get<double>() / 510.0);
   }
-  EXPECT_LE(worst, 0.5 * step + 1e-6);
+  auto channel = [&](std::size_t i, int x, int y) {
+    const nlohmann::json& t = textures[i / 4];
+    const int bgra_of_rgba[4] = {2, 1, 0, 3};
+    return bgra[i / 4].at<cv::Vec4b>(y, x)[bgra_of_rgba[i % 4]] / 255.0 *
+               t["scale"][i % 4].get<double>() +
+           t["bias"][i % 4].get<double>();
+  };
+  double worst_channel = 0.0, worst_rgb = 0.0;
+  for (int y = 0; y < atlas.height; y += 7)
+    for (int x = 0; x < atlas.width; x += 7) {
+      const std::size_t t = static_cast<std::size_t>(y) * static_cast<std::size_t>(atlas.width) +
+                            static_cast<std::size_t>(x);
+      // What each channel holds (docs/viewer.md).
+      std::array<double, 18> expected{};
+      if (lrgb) {
+        const double s = (atlas.colour[t * 3] + atlas.colour[t * 3 + 1] + atlas.colour[t * 3 + 2]) / 3.0;
+        for (int i = 0; i < 6; ++i) expected[static_cast<std::size_t>(i)] = atlas.Coefficients(t)[i] * s;
+        expected[6] = s > 1e-6 ? atlas.colour[t * 3] / s : 1.0;
+        expected[7] = s > 1e-6 ? atlas.colour[t * 3 + 1] / s : 1.0;
+      } else {
+        for (int i = 0; i < 6; ++i)
+          for (int c = 0; c < 3; ++c)
+            expected[static_cast<std::size_t>(3 * i + c)] = atlas.Coefficients(t, c)[i];
+      }
+      for (std::size_t i = 0; i < (lrgb ? 8u : 18u); ++i)
+        worst_channel = std::max(worst_channel, std::abs(channel(i, x, y) - expected[i]));
+      // The PTM under a light at 40 degrees, from the web channels.
+      const double lu = 0.45, lv = -0.41;
+      const auto basis = ptm::PtmBasis(lu, lv);
+      Eigen::Vector3d rgb = Eigen::Vector3d::Zero();
+      if (lrgb) {
+        double luminance = 0.0;
+        for (std::size_t i = 0; i < 6; ++i) luminance += basis[i] * channel(i, x, y);
+        const double r = channel(6, x, y), g = channel(7, x, y);
+        rgb = luminance * Eigen::Vector3d(r, g, 3.0 - r - g);
+      } else {
+        for (int c = 0; c < 3; ++c)
+          for (std::size_t i = 0; i < 6; ++i)
+            rgb[c] += basis[i] * channel(3 * i + static_cast<std::size_t>(c), x, y);
+      }
+      worst_rgb = std::max(worst_rgb, (rgb - atlas.Evaluate(t, lu, lv).cast<double>()).cwiseAbs().maxCoeff());
+    }
+  EXPECT_LE(worst_channel, half_step + 1e-6);
+  EXPECT_LT(worst_rgb, 0.03);  // display values in [0, 1]: 8 bits per channel
+  std::printf("web model: worst channel error %.4f (half step %.4f), worst RGB error %.4f\n",
+              worst_channel, half_step, worst_rgb);
   EXPECT_TRUE(web.files.count("scene.json"));
 }
 

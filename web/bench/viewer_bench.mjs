@@ -16,6 +16,9 @@ if (!texlume || models.length === 0) {
   process.exit(2);
 }
 const kFrames = 30;
+// Each model is opened this many times (alternating); the run with the median
+// first frame is reported, with the range over all runs (the machine is noisy).
+const kRuns = Number(process.env.RUNS || 3);
 
 async function serve(modelDir) {
   const server = spawn(texlume, ['view', modelDir, '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
@@ -40,7 +43,9 @@ const browser = await chromium.launch({
 const rows = [];
 try {
   // The first model twice: the first run (a cold browser) is not reported.
-  for (const [run, modelDir] of [models[0], ...models].entries()) {
+  const schedule = [models[0]];
+  for (let r = 0; r < kRuns; ++r) schedule.push(...models);
+  for (const [run, modelDir] of schedule.entries()) {
     const { server, url, prepareS, serveS } = await serve(modelDir);
     try {
       const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
@@ -78,17 +83,22 @@ try {
 } finally {
   await browser.close();
 }
-console.log('| model | triangles | server prepare (s) | page opened to: scripts / geometry / PTM textures decoded / uploaded / first frame / baked textures (ms) | frame while relighting, median / worst (ms) |');
-console.log('| --- | --- | --- | --- | --- |');
-for (const r of rows) {
+const median = models.map((model) => {
+  const runs = rows.filter((r) => r.model === model).sort((a, b) => a.firstFrameMs - b.firstFrameMs);
+  return { ...runs[runs.length >> 1], minFirstFrameMs: runs[0].firstFrameMs, maxFirstFrameMs: runs[runs.length - 1].firstFrameMs };
+});
+console.log(`| model | triangles | server prepare (s) | page opened to: scripts / geometry / PTM textures decoded / uploaded / first frame / baked textures (ms), median of ${kRuns} runs | first frame, range (ms) | frame while relighting, median / worst (ms) |`);
+console.log('| --- | --- | --- | --- | --- | --- |');
+for (const r of median) {
   const m = r.marks;
   console.log(`| ${r.model} | ${r.faces} | ${r.prepareS.toFixed(2)} | ` +
       `${[m.moduleStart, m.geometry, m.textures, m.uploaded, r.firstFrameMs, m.baked].map((t) => t.toFixed(0)).join(' / ')} | ` +
+      `${r.minFirstFrameMs.toFixed(0)}-${r.maxFirstFrameMs.toFixed(0)} | ` +
       `${r.medianFrameMs.toFixed(1)} / ${r.worstFrameMs.toFixed(1)} |`);
 }
-if (rows.length > 1) {
-  const base = rows[0];
-  for (const r of rows.slice(1))
+if (median.length > 1) {
+  const base = median[0];
+  for (const r of median.slice(1))
     console.log(`${r.model} / ${base.model}: triangles x${(r.faces / base.faces).toFixed(1)}, ` +
         `prepare x${(r.prepareS / base.prepareS).toFixed(2)}, first frame x${(r.firstFrameMs / base.firstFrameMs).toFixed(2)}, ` +
         `frame x${(r.medianFrameMs / base.medianFrameMs).toFixed(2)}`);

@@ -1,5 +1,6 @@
 // A small PNG decoder for the browser tests (8-bit greyscale, RGB, RGBA;
-// non-interlaced, as Chromium writes screenshots).
+// non-interlaced, as Chromium writes screenshots): `rgb` per pixel, and the
+// decoded `pixels` with their `channels`.
 import { inflateSync } from 'node:zlib';
 
 export function decodePng(buffer) {
@@ -46,5 +47,5 @@ export function decodePng(buffer) {
   const rgb = new Uint8Array(width * height * 3);
   for (let i = 0; i < width * height; ++i)
     for (let k = 0; k < 3; ++k) rgb[i * 3 + k] = out[i * channels + Math.min(k, channels - 1)];
-  return { width, height, rgb };
+  return { width, height, rgb, channels, pixels: out };
 }

@@ -25,11 +25,8 @@
     decode,
     scene,
     geometry: scene.then((s) => fetchOk('/model/' + s.geometry.file, 'binary')),
-    // Per atlas: [coefficient planes], colour plane or null.
-    ptmTextures: scene.then((s) => s.atlases.map((atlas) => Promise.all([
-      Promise.all(atlas.coefficients.map((p) => decode(p.file))),
-      atlas.colour ? decode(atlas.colour) : null,
-    ]))),
+    // Per atlas: its PTM textures, decoded.
+    ptmTextures: scene.then((s) => s.atlases.map((atlas) => Promise.all(atlas.textures.map((t) => decode(t.file))))),
   };
   // Rejections are handled by viewer.js; keep the console free of unhandled ones meanwhile.
   for (const p of [prefetch.scene, prefetch.geometry, prefetch.ptmTextures]) p.catch(() => {});

@@ -1,6 +1,6 @@
 // texlume viewer: a PTM-textured model relit per fragment (docs/viewer.md).
 // The page is served by `texlume view`, which prepares /model/scene.json,
-// /model/geometry.bin and the 8-bit coefficient planes of every atlas.
+// /model/geometry.bin and the PTM of every atlas as 8-bit RGBA PNGs.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
@@ -38,10 +38,9 @@ void main() {
 
 const fragmentShader = /* glsl */ `
 precision highp float;
-uniform sampler2D coefficients0, coefficients1, coefficients2, coefficients3, coefficients4,
-    coefficients5, colourTexture, bakedTexture;
-uniform vec3 coefficientScale[6];
-uniform vec3 coefficientBias[6];
+uniform sampler2D ptm0, ptm1, ptm2, ptm3, ptm4, bakedTexture;
+uniform vec4 ptmScale[5];
+uniform vec4 ptmBias[5];
 uniform bool lrgb;
 uniform int mode;            // 0 PTM, 1 baked 2D texture, 2 flat
 uniform bool showSeams, showCharts;
@@ -58,9 +57,24 @@ float linearToSrgb(float v) {
 }
 vec3 linearToSrgb(vec3 v) { return vec3(linearToSrgb(v.r), linearToSrgb(v.g), linearToSrgb(v.b)); }
 
-// Plane k of the atlas: 8-bit values times scale plus bias (docs/viewer.md).
-vec3 plane(sampler2D t, int k) {
-  return texture2D(t, vUv).rgb * coefficientScale[k] + coefficientBias[k];
+// Texture k of the atlas: four 8-bit values times scale plus bias (docs/viewer.md).
+vec4 ptmTexel(sampler2D t, int k) { return texture2D(t, vUv) * ptmScale[k] + ptmBias[k]; }
+
+// The PTM's values at this fragment: LRGB, the luminance coefficients a0..a5 in
+// c[0].x, c[1].x, ..., and the colour in colour; RGB, coefficient k of the R, G,
+// B polynomials in c[k].
+void ptmValues(out vec3 c[6], out vec3 colour) {
+  vec4 t0 = ptmTexel(ptm0, 0), t1 = ptmTexel(ptm1, 1);
+  if (lrgb) {
+    c[0] = vec3(t0.x); c[1] = vec3(t0.y); c[2] = vec3(t0.z);
+    c[3] = vec3(t0.w); c[4] = vec3(t1.x); c[5] = vec3(t1.y);
+    colour = vec3(t1.z, t1.w, 3.0 - t1.z - t1.w);  // the colour sums to 3
+    return;
+  }
+  vec4 t2 = ptmTexel(ptm2, 2), t3 = ptmTexel(ptm3, 3), t4 = ptmTexel(ptm4, 4);
+  c[0] = t0.xyz; c[1] = vec3(t0.w, t1.xy); c[2] = vec3(t1.zw, t2.x);
+  c[3] = t2.yzw; c[4] = t3.xyz; c[5] = vec3(t3.w, t4.xy);
+  colour = vec3(1.0);
 }
 
 // Paper 003 eq. 1: L = a0 lu^2 + a1 lv^2 + a2 lu lv + a3 lu + a4 lv + a5.
@@ -69,29 +83,23 @@ float biquadratic(vec3 a012, vec3 a345, vec2 l) {
          a345.y * l.y + a345.z;
 }
 
-// The luminance coefficients (LRGB: its own; RGB: the channels' mean).
+// The luminance coefficients (LRGB: its own, up to the colour's scale, which
+// does not move the maximum; RGB: the channels' mean).
 void luminance(out vec3 a012, out vec3 a345) {
-  if (lrgb) {
-    a012 = plane(coefficients0, 0);
-    a345 = plane(coefficients1, 1);
-  } else {
-    vec3 c0 = plane(coefficients0, 0), c1 = plane(coefficients1, 1), c2 = plane(coefficients2, 2);
-    vec3 c3 = plane(coefficients3, 3), c4 = plane(coefficients4, 4), c5 = plane(coefficients5, 5);
-    const vec3 third = vec3(1.0 / 3.0);
-    a012 = vec3(dot(c0, third), dot(c1, third), dot(c2, third));
-    a345 = vec3(dot(c3, third), dot(c4, third), dot(c5, third));
-  }
+  vec3 c[6], colour;
+  ptmValues(c, colour);
+  const vec3 third = vec3(1.0 / 3.0);
+  a012 = vec3(dot(c[0], third), dot(c[1], third), dot(c[2], third));
+  a345 = vec3(dot(c[3], third), dot(c[4], third), dot(c[5], third));
 }
 
-// The PTM's RGB (display domain) for a light l in the texel frame (eqs. 1-2).
+// The PTM's RGB (display domain) for a light l in the texel frame (eqs. 1-2;
+// LRGB: the luminance times the colour).
 vec3 evaluate(vec2 l) {
-  if (lrgb) {
-    return biquadratic(plane(coefficients0, 0), plane(coefficients1, 1), l) *
-           texture2D(colourTexture, vUv).rgb;
-  }
-  vec3 c0 = plane(coefficients0, 0), c1 = plane(coefficients1, 1), c2 = plane(coefficients2, 2);
-  vec3 c3 = plane(coefficients3, 3), c4 = plane(coefficients4, 4), c5 = plane(coefficients5, 5);
-  return c0 * l.x * l.x + c1 * l.y * l.y + c2 * l.x * l.y + c3 * l.x + c4 * l.y + c5;
+  vec3 c[6], colour;
+  ptmValues(c, colour);
+  return (c[0] * l.x * l.x + c[1] * l.y * l.y + c[2] * l.x * l.y + c[3] * l.x + c[4] * l.y + c[5]) *
+         colour;
 }
 
 // As texlume's renderer: lights below the horizon elevation are evaluated at it
@@ -182,9 +190,8 @@ async function main() {
   if (!prefetch) throw new Error('/viewer/prefetch.js did not run');
   api.marks.prefetchStart = prefetch.started;
   const scene = await prefetch.scene;
-  if (scene.format !== 'texlume-web-1') throw new Error('scene.json: unknown format ' + scene.format);
+  if (scene.format !== 'texlume-web-2') throw new Error('scene.json: unknown format ' + scene.format);
   api.marks.scene = performance.now();
-  const texturesOfAtlas = await prefetch.ptmTextures;
   const bytes = await prefetch.geometry;
   api.marks.geometry = performance.now();
   const g = scene.geometry;
@@ -202,7 +209,9 @@ async function main() {
   renderer.outputColorSpace = THREE.LinearSRGBColorSpace;  // shaders write display values as they are
   const world = new THREE.Scene();
   world.background = new THREE.Color().setRGB(32 / 255, 33 / 255, 36 / 255, THREE.LinearSRGBColorSpace);
+  // Stands in for the textures until they are in: RGBA8 and filtered as they are.
   const placeholder = new THREE.DataTexture(new Uint8Array([128, 128, 128, 255]), 1, 1);
+  placeholder.minFilter = placeholder.magFilter = THREE.LinearFilter;
   placeholder.needsUpdate = true;
   const uniformsShared = {
     lightWorld: { value: new THREE.Vector3(0, 0, 1) },
@@ -216,20 +225,16 @@ async function main() {
   const materials = [];
   for (const range of g.ranges) {
     const atlas = scene.atlases[range.atlas];
-    const [planeBitmaps, colourBitmap] = await texturesOfAtlas[range.atlas];
-    const planes = planeBitmaps.map(textureOf);
-    const colour = colourBitmap ? textureOf(colourBitmap) : placeholder;
     const scale = [], bias = [];
-    for (let k = 0; k < 6; ++k) {
-      const p = atlas.coefficients[Math.min(k, atlas.coefficients.length - 1)];
-      scale.push(new THREE.Vector3(...p.scale));
-      bias.push(new THREE.Vector3(...p.bias));
+    for (let k = 0; k < 5; ++k) {
+      const t = atlas.textures[Math.min(k, atlas.textures.length - 1)];
+      const four = (v, fill) => new THREE.Vector4(...[0, 1, 2, 3].map((i) => (i < v.length ? v[i] : fill)));
+      scale.push(four(t.scale, 0));
+      bias.push(four(t.bias, 0));
     }
     const uniforms = { ...uniformsShared, lrgb: { value: atlas.format === 'LRGB' },
-      coefficientScale: { value: scale }, coefficientBias: { value: bias },
-      colourTexture: { value: colour }, bakedTexture: { value: placeholder } };
-    for (let k = 0; k < 6; ++k)
-      uniforms['coefficients' + k] = { value: planes[Math.min(k, planes.length - 1)] };
+      ptmScale: { value: scale }, ptmBias: { value: bias }, bakedTexture: { value: placeholder } };
+    for (let k = 0; k < 5; ++k) uniforms['ptm' + k] = { value: placeholder };  // until they are in
     const material = new THREE.ShaderMaterial({ uniforms, vertexShader, fragmentShader });
     materials.push(material);
     const geometry = new THREE.BufferGeometry();
@@ -335,14 +340,20 @@ async function main() {
   toggle('charts', 'showCharts', true);
   toggle('specular', 'specular', 0.6);
 
+  const texturesOfAtlas = await prefetch.ptmTextures;
+  const ptmTextures = [];  // per atlas
+  await Promise.all(g.ranges.map(async (range, i) => {
+    const bitmaps = await texturesOfAtlas[range.atlas];
+    const u = materials[i].uniforms;
+    ptmTextures[range.atlas] = ptmTextures[range.atlas] || bitmaps.map(textureOf);
+    for (let k = 0; k < bitmaps.length; ++k) u['ptm' + k].value = ptmTextures[range.atlas][k];
+  }));
   api.marks.textures = performance.now();
   renderer.compile(world, camera);
   api.marks.compiled = performance.now();
-  world.traverse((o) => {
-    if (!o.material) return;
-    for (const u of Object.values(o.material.uniforms))
+  for (const material of materials)
+    for (const u of Object.values(material.uniforms))
       if (u.value && u.value.isTexture) renderer.initTexture(u.value);
-  });
   api.marks.uploaded = performance.now();
   drawLightSphere();
   render();
@@ -359,6 +370,21 @@ async function main() {
       gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));
     },
     faces: scene.faces,
+    // The bytes of PTM texture k of an atlas as WebGL holds them, w x h texels
+    // from (x, y), rows from v = 0 up (for the tests: nothing may be lost on the
+    // way, the alpha channel included).
+    ptmTextureBytes: (atlas, k, x, y, w, h) => {
+      const gl = renderer.getContext();
+      const framebuffer = gl.createFramebuffer();
+      gl.bindFramebuffer(gl.FRAMEBUFFER, framebuffer);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D,
+          renderer.properties.get(ptmTextures[atlas][k]).__webglTexture, 0);
+      const bytes = new Uint8Array(w * h * 4);
+      gl.readPixels(x, y, w, h, gl.RGBA, gl.UNSIGNED_BYTE, bytes);
+      gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+      gl.deleteFramebuffer(framebuffer);
+      return Array.from(bytes);
+    },
   });
   // The baked 2D textures are only needed for the baked mode: loaded after the
   // first frame; `ready` once they are in.
