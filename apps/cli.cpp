@@ -14,6 +14,7 @@
 
 #include "apps/http_server.h"
 #include "apps/progress_bar.h"
+#include "btf/btf.h"
 #include "datasets_synthetic/object_scene.h"
 #include "datasets_synthetic/scene.h"
 #include "ptm/fit.h"
@@ -218,6 +219,46 @@ int RunFitCommand(const std::vector<std::string>& args, std::ostream& out, std::
   record_path += ".json";
   WriteFileAtomically(
       record_path, [&](std::ostream& o) { o << record.dump(2) << "\n"; }, false);
+  return kExitOk;
+}
+
+int RunBtfCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& /*err*/) {
+  const Arguments a(args, {"capture", "out", "components"}, {});
+  const std::filesystem::path capture_dir = a.Require("capture");
+  const std::filesystem::path out_dir = a.Require("out");
+  const int components = a.GetInt("components", 40);
+  if (components < 1) throw UsageError("--components must be at least 1");
+  ProgressBar bar;
+  const auto t0 = std::chrono::steady_clock::now();
+  const btf::BtfCapture capture = btf::ReadBtfCapture(capture_dir);
+  const auto t1 = std::chrono::steady_clock::now();
+  const btf::BtfFactorisation f = btf::FactoriseBtf(capture, components, bar.Callback());
+  const auto t2 = std::chrono::steady_clock::now();
+  // The error table: powers of two up to the rank, the chosen n included.
+  std::vector<int> counts;
+  for (int n = 1; n < static_cast<int>(f.singular_values.size()); n *= 2) counts.push_back(n);
+  counts.push_back(static_cast<int>(f.singular_values.size()));
+  counts.push_back(components);
+  std::sort(counts.begin(), counts.end());
+  counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
+  const std::vector<btf::SvdError> errors = btf::SvdErrorTable(f, counts);
+  btf::WriteBtfFactorisation(f, errors, out_dir);
+  const auto t3 = std::chrono::steady_clock::now();
+  auto seconds = [](auto a0, auto a1) { return std::chrono::duration<double>(a1 - a0).count(); };
+  out << "Factorised a " << capture.width << "x" << capture.height << " BTF of "
+      << capture.views.size() << " views x " << capture.lights.size() << " lights into "
+      << components << " components in " << seconds(t1, t2) << " s. Wrote " << out_dir.string()
+      << "\n components | RMS error (linear) | relative\n";
+  for (const btf::SvdError& e : errors)
+    out << " " << e.components << (e.components == components ? " (kept)" : "") << " | " << e.rms
+        << " | " << e.relative << "\n";
+  nlohmann::json record;
+  record["command"] = "btf";
+  record["settings"] = {{"capture", capture_dir.string()}, {"components", components}};
+  record["timings_s"] = {
+      {"read", seconds(t0, t1)}, {"factorise", seconds(t1, t2)}, {"write", seconds(t2, t3)}};
+  WriteFileAtomically(
+      out_dir / "run.json", [&](std::ostream& o) { o << record.dump(2) << "\n"; }, false);
   return kExitOk;
 }
 

@@ -47,6 +47,8 @@ int RunInspectCommand(const std::vector<std::string>& args, std::ostream& out, s
 int RunSceneCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 /// `texlume fit`: fits a PTM to an RTI capture. Returns the exit code.
 int RunFitCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+/// `texlume btf`: SVD-factorises a BTF capture (paper 004 §III). Returns the exit code.
+int RunBtfCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 /// `texlume relight`: renders a PTM under a light. Returns the exit code.
 int RunRelightCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 /// `texlume lights-from-sphere`: light directions from a reflective sphere.

@@ -92,9 +92,9 @@ void Answer(int fd, const HttpHandler& handler) {
     }
   }
   if (!response.body || (response.status != 200 && response.body->empty())) {
-    const std::string text = response.status == 200 ? std::string()
-                                                    : std::to_string(response.status) + " " +
-                                                          Reason(response.status);
+    const std::string text = response.status == 200
+                                 ? std::string()
+                                 : std::to_string(response.status) + " " + Reason(response.status);
     response.body = std::make_shared<const std::vector<unsigned char>>(text.begin(), text.end());
     if (response.status != 200) response.content_type = "text/plain";
   }

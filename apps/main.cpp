@@ -22,6 +22,9 @@ constexpr const char* kUsage =
     "  fit --images DIR --lights FILE.lp --out sample.ptm [--format lrgb|rgb] [--robust]\n"
     "      [--exr FILE] [--web DIR] [--band-rows N]\n"
     "      Fit a PTM to an RTI capture (writes sample.ptm.json with settings and timings).\n"
+    "  btf --capture DIR --out DIR [--components N]\n"
+    "      SVD-factorise a BTF capture (btf.json + one image per view and light) into N\n"
+    "      geometry maps and appearance functions (default 40); prints the error table.\n"
     "  relight --ptm FILE(.ptm|.exr) --light lx,ly,lz --out image.png [--normals FILE]\n"
     "      [--gain G] [--specular KS]\n"
     "      Render a PTM under a light (texture frame: x right, y up, z out).\n"
@@ -81,6 +84,7 @@ int main(int argc, char** argv) {
     }
     if (command == "inspect") return RunInspectCommand(args, std::cout, std::cerr);
     if (command == "fit") return RunFitCommand(args, std::cout, std::cerr);
+    if (command == "btf") return RunBtfCommand(args, std::cout, std::cerr);
     if (command == "relight") return RunRelightCommand(args, std::cout, std::cerr);
     if (command == "lights-from-sphere")
       return RunLightsFromSphereCommand(args, std::cout, std::cerr);

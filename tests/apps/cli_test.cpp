@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "datasets_synthetic/object_scene.h"
 #include "datasets_synthetic/scene.h"
@@ -301,6 +302,59 @@ TEST_F(FitCliTest, Synth2dBuildsAPtmFromPhotosAndRefusesBadPhotos) {
   EXPECT_EQ(Texlume(base + (tmp_ / "bad").string(), &out), 1);
   EXPECT_NE(out.find("photo_01.png"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(tmp_ / "bad"));
+}
+
+}  // namespace
+}  // namespace texlume
+
+namespace texlume {
+namespace {
+
+// `texlume btf` on the synthetic scene's BTF capture: writes the factorisation
+// and the error table, falling with n; refuses bad command lines and captures.
+TEST(Cli, BtfFactorisesTheSceneCaptureAndRefusesBadInput) {
+  TempDir tmp;
+  datasets::SceneOptions options;
+  options.num_images = 3;
+  options.image_width = 64;
+  options.image_height = 64;
+  options.num_held_out_views = 0;
+  options.capture_size = 16;
+  options.num_capture_lights = 6;
+  options.num_held_out_capture_lights = 0;
+  options.write_surface = false;
+  options.btf_size = 32;
+  datasets::GenerateScene(options, tmp.path() / "scene");
+  const std::string capture = (tmp / "scene").string() + "/material/btf";
+  std::string out;
+  ASSERT_EQ(
+      Texlume("btf --capture " + capture + " --out " + (tmp / "svd").string() + " --components 8",
+              &out),
+      0)
+      << out;
+  const nlohmann::json j = nlohmann::json::parse(testing::ReadText(tmp / "svd/btf_svd.json"));
+  EXPECT_EQ(j["components"].get<int>(), 8);
+  EXPECT_TRUE(std::filesystem::exists(tmp / "svd/geometry_maps.exr"));
+  EXPECT_TRUE(std::filesystem::exists(tmp / "svd/run.json"));
+  double previous = 1e9;
+  for (const auto& row : j["errors"]) {
+    EXPECT_LE(row["rms"].get<double>(), previous);
+    previous = row["rms"].get<double>();
+  }
+  EXPECT_NE(out.find("8 (kept)"), std::string::npos) << out;
+  // 6 views x 12 lights x 3 channels = 216 columns at most.
+  EXPECT_EQ(
+      Texlume("btf --capture " + capture + " --out " + (tmp / "x").string() + " --components 217",
+              &out),
+      2);
+  EXPECT_NE(out.find("[1, 216]"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("btf --out " + (tmp / "x").string(), &out), 2);
+  EXPECT_EQ(
+      Texlume("btf --capture " + (tmp / "nothing").string() + " --out " + (tmp / "x").string(),
+              &out),
+      1);
+  EXPECT_NE(out.find("btf.json"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "x"));
 }
 
 }  // namespace

@@ -454,7 +454,8 @@ TEST_F(MeshPipelineTest, WebModelKeepsChartsAndThePtmWithinQuantisation) {
     ASSERT_EQ(bgra.back().type(), CV_8UC4);
     ASSERT_EQ(bgra.back().cols, atlas.width);
     ASSERT_EQ(bgra.back().rows, atlas.height);
-    for (const auto& scale : t["scale"]) half_step = std::max(half_step, scale.get<double>() / 510.0);
+    for (const auto& scale : t["scale"])
+      half_step = std::max(half_step, scale.get<double>() / 510.0);
   }
   auto channel = [&](std::size_t i, int x, int y) {
     const nlohmann::json& t = textures[i / 4];
@@ -471,8 +472,10 @@ TEST_F(MeshPipelineTest, WebModelKeepsChartsAndThePtmWithinQuantisation) {
       // What each channel holds (docs/viewer.md).
       std::array<double, 18> expected{};
       if (lrgb) {
-        const double s = (atlas.colour[t * 3] + atlas.colour[t * 3 + 1] + atlas.colour[t * 3 + 2]) / 3.0;
-        for (int i = 0; i < 6; ++i) expected[static_cast<std::size_t>(i)] = atlas.Coefficients(t)[i] * s;
+        const double s =
+            (atlas.colour[t * 3] + atlas.colour[t * 3 + 1] + atlas.colour[t * 3 + 2]) / 3.0;
+        for (int i = 0; i < 6; ++i)
+          expected[static_cast<std::size_t>(i)] = atlas.Coefficients(t)[i] * s;
         expected[6] = s > 1e-6 ? atlas.colour[t * 3] / s : 1.0;
         expected[7] = s > 1e-6 ? atlas.colour[t * 3 + 1] / s : 1.0;
       } else {
@@ -496,7 +499,8 @@ TEST_F(MeshPipelineTest, WebModelKeepsChartsAndThePtmWithinQuantisation) {
           for (std::size_t i = 0; i < 6; ++i)
             rgb[c] += basis[i] * channel(3 * i + static_cast<std::size_t>(c), x, y);
       }
-      worst_rgb = std::max(worst_rgb, (rgb - atlas.Evaluate(t, lu, lv).cast<double>()).cwiseAbs().maxCoeff());
+      worst_rgb = std::max(worst_rgb,
+                           (rgb - atlas.Evaluate(t, lu, lv).cast<double>()).cwiseAbs().maxCoeff());
     }
   EXPECT_LE(worst_channel, half_step + 1e-6);
   EXPECT_LT(worst_rgb, 0.03);  // display values in [0, 1]: 8 bits per channel
