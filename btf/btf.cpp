@@ -13,6 +13,7 @@
 #include "sfm/errors.h"
 #include "sfm/file_util.h"
 #include "synth/mesh_synthesis.h"
+#include "synth/model_io.h"
 #include "synth/pipeline.h"
 
 namespace texlume::btf {
@@ -66,15 +67,7 @@ nlohmann::json DirectionsJson(const std::vector<Eigen::Vector3d>& directions) {
 BtfCapture ReadBtfCapture(const fs::path& dir) {
   const fs::path json_path = dir / "btf.json";
   const std::string label = json_path.string();
-  nlohmann::json j;
-  {
-    std::ifstream in = OpenForReading(json_path, false);
-    try {
-      j = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::exception& e) {
-      throw InputError(label, std::string("is not valid JSON: ") + e.what());
-    }
-  }
+  const nlohmann::json j = synth::ReadJsonFile(json_path);
   BtfCapture capture;
   auto integer = [&](const char* key) {
     if (!j.contains(key) || !j[key].is_number_integer())
@@ -308,15 +301,7 @@ void WriteBtfFactorisation(const BtfFactorisation& factorisation,
 BtfFactorisation ReadBtfFactorisation(const fs::path& dir) {
   const fs::path json_path = dir / "btf_svd.json";
   const std::string label = json_path.string();
-  nlohmann::json j;
-  {
-    std::ifstream in = OpenForReading(json_path, false);
-    try {
-      j = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::exception& e) {
-      throw InputError(label, std::string("is not valid JSON: ") + e.what());
-    }
-  }
+  const nlohmann::json j = synth::ReadJsonFile(json_path);
   if (j.value("format", "") != "texlume-btf-svd-1")
     throw InputError(label, "is not a texlume BTF factorisation (format texlume-btf-svd-1)");
   BtfFactorisation out;

@@ -321,15 +321,18 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
   }
 }
 
+nlohmann::json ReadJsonFile(const fs::path& path) {
+  std::ifstream in = OpenForReading(path, false);
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path.string(), std::string("is not valid JSON: ") + e.what());
+  }
+}
+
 nlohmann::json ReadModelManifest(const fs::path& dir) {
   const fs::path manifest_path = dir / "manifest.json";
-  std::ifstream in = OpenForReading(manifest_path, false);
-  nlohmann::json manifest;
-  try {
-    manifest = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(manifest_path.string(), std::string("is not valid JSON: ") + e.what());
-  }
+  const nlohmann::json manifest = ReadJsonFile(manifest_path);
   if (!manifest.is_object() || manifest.value("format", "") != kManifestFormat ||
       !manifest.contains("atlases") || !manifest["atlases"].is_array())
     throw InputError(manifest_path.string(), "is not a texlume model manifest");

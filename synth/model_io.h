@@ -45,6 +45,10 @@ void WriteModelFolder(const std::filesystem::path& dir, const TexturedModel& mod
 /// "atlases" array). Throws InputError naming the file otherwise.
 nlohmann::json ReadModelManifest(const std::filesystem::path& dir);
 
+/// Parses a JSON file. Throws InputError naming it when it cannot be opened or
+/// is not valid JSON.
+nlohmann::json ReadJsonFile(const std::filesystem::path& path);
+
 /// The frame face f's atlas coefficients are in, as columns in world
 /// coordinates: x = dP/du made orthogonal to the normal, y = n x x (dP/dv
 /// direction, v up), z = the face normal (x = the first edge without texture

@@ -85,9 +85,7 @@ float biquadratic(vec3 a012, vec3 a345, vec2 l) {
 
 // The luminance coefficients (LRGB: its own, up to the colour's scale, which
 // does not move the maximum; RGB: the channels' mean).
-void luminance(out vec3 a012, out vec3 a345) {
-  vec3 c[6], colour;
-  ptmValues(c, colour);
+void luminance(vec3 c[6], out vec3 a012, out vec3 a345) {
   const vec3 third = vec3(1.0 / 3.0);
   a012 = vec3(dot(c[0], third), dot(c[1], third), dot(c[2], third));
   a345 = vec3(dot(c[3], third), dot(c[4], third), dot(c[5], third));
@@ -95,16 +93,14 @@ void luminance(out vec3 a012, out vec3 a345) {
 
 // The PTM's RGB (display domain) for a light l in the texel frame (eqs. 1-2;
 // LRGB: the luminance times the colour).
-vec3 evaluate(vec2 l) {
-  vec3 c[6], colour;
-  ptmValues(c, colour);
+vec3 evaluate(vec3 c[6], vec3 colour, vec2 l) {
   return (c[0] * l.x * l.x + c[1] * l.y * l.y + c[2] * l.x * l.y + c[3] * l.x + c[4] * l.y + c[5]) *
          colour;
 }
 
 // As texlume's renderer: lights below the horizon elevation are evaluated at it
 // (same azimuth), fading linearly with l_z to 0 at the horizon.
-vec3 relight(vec3 l) {
+vec3 relight(vec3 c[6], vec3 colour, vec3 l) {
   if (l.z <= 0.0) return vec3(0.0);
   float fall = 1.0;
   if (l.z < horizonZ) {
@@ -112,13 +108,13 @@ vec3 relight(vec3 l) {
     float r = max(length(l.xy), 1e-6);
     l = vec3(l.xy * sqrt(1.0 - horizonZ * horizonZ) / r, horizonZ);
   }
-  return linearToSrgb(srgbToLinear(max(evaluate(l.xy), vec3(0.0))) * fall);
+  return linearToSrgb(srgbToLinear(max(evaluate(c, colour, l.xy), vec3(0.0))) * fall);
 }
 
 // The direction of the biquadratic's maximum (Malzbender et al. 2001, eq. 16).
-vec3 ptmNormal() {
+vec3 ptmNormal(vec3 c[6]) {
   vec3 a012, a345;
-  luminance(a012, a345);
+  luminance(c, a012, a345);
   float det = 4.0 * a012.x * a012.y - a012.z * a012.z;
   vec2 n;
   if (abs(det) < 1e-12 || !(a012.x < 0.0 && det > 0.0)) {
@@ -144,12 +140,14 @@ void main() {
   vec3 l = vec3(dot(lightWorld, t), dot(lightWorld, b), dot(lightWorld, n));
   vec3 colour;
   if (mode == 0) {
-    colour = relight(l);
+    vec3 c[6], tint;
+    ptmValues(c, tint);  // sampled once per fragment
+    colour = relight(c, tint, l);
     if (specular > 0.0 && l.z > 0.0) {
       vec3 toEye = normalize(cameraPosition - vWorldPosition);
       vec3 v = vec3(dot(toEye, t), dot(toEye, b), dot(toEye, n));
       vec3 h = normalize(l + v);
-      colour += specular * pow(max(dot(ptmNormal(), h), 0.0), 40.0);
+      colour += specular * pow(max(dot(ptmNormal(c), h), 0.0), 40.0);
     }
   } else if (mode == 1) {
     colour = texture2D(bakedTexture, vUv).rgb;
