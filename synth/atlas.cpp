@@ -311,12 +311,16 @@ std::vector<std::array<int, 3>> PackSkyline(const std::vector<std::pair<int, int
   return out;
 }
 
-Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthesis,
-                     const AtlasOptions& options, const ProgressCallback& progress) {
+AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
+                          const std::vector<std::array<Unfolding, 3>>& unfoldings,
+                          double texel_size, const AtlasOptions& options,
+                          const ProgressCallback& progress) {
   options.Check();
-  const auto start = std::chrono::steady_clock::now();
+  if (!(texel_size > 0.0)) throw OptionError("atlas texel size must be > 0");
   const std::size_t num_faces = mesh.faces.size();
-  const double t = synthesis.texel_size;
+  if (patches.size() != num_faces || unfoldings.size() != num_faces)
+    throw OptionError("atlas layout: patches and unfoldings must have one entry per face");
+  const double t = texel_size;
   const int gutter = options.gutter;
 
   // 1. Charts: faces with their rigid placement in the chart plane.
@@ -324,7 +328,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
   if (options.mode == AtlasMode::kPerTriangle) {
     for (std::size_t f = 0; f < num_faces; ++f) {
       // The minimal bounding box of a triangle has a side along one of its edges.
-      const auto& c = synthesis.patches[f].corners_in_frame;
+      const auto& c = patches[f].corners_in_frame;
       double best_area = std::numeric_limits<double>::max();
       Eigen::Matrix2d best = Eigen::Matrix2d::Identity();
       for (int k = 0; k < 3; ++k) {
@@ -370,7 +374,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
           const int f = bfs.front();
           bfs.pop_front();
           seed_order.push_back(f);
-          for (const Unfolding& u : synthesis.unfoldings[static_cast<std::size_t>(f)])
+          for (const Unfolding& u : unfoldings[static_cast<std::size_t>(f)])
             if (u.face >= 0 && !seen[static_cast<std::size_t>(u.face)]) {
               seen[static_cast<std::size_t>(u.face)] = 1;
               bfs.push_back(u.face);
@@ -390,7 +394,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
         std::array<Eigen::Vector2d, 3> c;
         for (int k = 0; k < 3; ++k)
           c[static_cast<std::size_t>(k)] =
-              cf.rotation * synthesis.patches[static_cast<std::size_t>(cf.face)]
+              cf.rotation * patches[static_cast<std::size_t>(cf.face)]
                                 .corners_in_frame[static_cast<std::size_t>(k)] +
               cf.translation;
         return c;
@@ -440,11 +444,10 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
         queue.pop_front();
         for (int k = 0; k < 3; ++k) {
           const Unfolding& u =
-              synthesis
-                  .unfoldings[static_cast<std::size_t>(from.face)][static_cast<std::size_t>(k)];
+              unfoldings[static_cast<std::size_t>(from.face)][static_cast<std::size_t>(k)];
           if (u.face < 0 || chart_of[static_cast<std::size_t>(u.face)] >= 0) continue;
-          if (synthesis.patches[static_cast<std::size_t>(u.face)].frame.z_axis.dot(
-                  synthesis.patches[seed].frame.z_axis) < min_cos)
+          if (patches[static_cast<std::size_t>(u.face)].frame.z_axis.dot(
+                  patches[seed].frame.z_axis) < min_cos)
             continue;
           // p_from = R_u^T (p_nb - t_u), so chart = R_from R_u^T p_nb + ...
           ChartFace cf;
@@ -464,7 +467,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
   std::vector<std::array<int, 3>> packed;
   if (options.mode == AtlasMode::kPerTriangle) {
     for (const auto& chart : charts) {
-      const ChartOutline outline = Box(chart, 0.0, synthesis.patches, t, gutter, nullptr);
+      const ChartOutline outline = Box(chart, 0.0, patches, t, gutter, nullptr);
       chart_lo.push_back(outline.lo);
       chart_hi.push_back(outline.hi);
       sizes.emplace_back(outline.Width(), outline.Height());
@@ -481,7 +484,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     for (std::size_t c = 0; c < charts.size(); ++c) {
       for (int r = 0; r < kPackingRotations; ++r)
         outlines[c].push_back(
-            Outline(charts[c], 2.0 * kPi * r / kPackingRotations, synthesis.patches, t, gutter));
+            Outline(charts[c], 2.0 * kPi * r / kPackingRotations, patches, t, gutter));
       for (const auto& o : outlines[c]) area[c] = std::max(area[c], o.area);
 #pragma omp critical(texlume_chart_outlines)
       {
@@ -538,9 +541,9 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     }
   }
 
-  Atlases atlases;
-  atlases.num_charts = static_cast<int>(charts.size());
-  atlases.faces.resize(num_faces);
+  AtlasLayout layout;
+  layout.num_charts = static_cast<int>(charts.size());
+  layout.faces.resize(num_faces);
   int num_atlases = 0;
   std::vector<int> used_height;
   for (std::size_t c = 0; c < charts.size(); ++c) {
@@ -550,45 +553,40 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     used_height[static_cast<std::size_t>(bin)] =
         std::max(used_height[static_cast<std::size_t>(bin)], y0 + sizes[c].second);
     for (const ChartFace& cf : charts[c]) {
-      FacePlacement& fp = atlases.faces[static_cast<std::size_t>(cf.face)];
+      FacePlacement& fp = layout.faces[static_cast<std::size_t>(cf.face)];
       fp.atlas = bin;
       fp.chart = static_cast<int>(c);
       fp.rotation = cf.rotation;
       fp.offset = Eigen::Vector2d(x0 + cf.translation.x() / t - chart_lo[c].x(),
                                   y0 + chart_hi[c].y() - cf.translation.y() / t);
       for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector2d q = cf.rotation * synthesis.patches[static_cast<std::size_t>(cf.face)]
+        const Eigen::Vector2d q = cf.rotation * patches[static_cast<std::size_t>(cf.face)]
                                                     .corners_in_frame[static_cast<std::size_t>(k)];
         fp.corners_px[static_cast<std::size_t>(k)] =
             Eigen::Vector2d(fp.offset.x() + q.x() / t, fp.offset.y() - q.y() / t);
       }
     }
   }
+  for (int a = 0; a < num_atlases; ++a)
+    layout.atlas_sizes.emplace_back(options.atlas_size,
+                                    std::max(1, used_height[static_cast<std::size_t>(a)]));
+  return layout;
+}
 
-  // 3. Bake: every texel inside a face (and its gutter ring) from the blended
-  // synthesis, coefficients rotated into the atlas frame.
-  const std::size_t num_planes = synthesis.sample_planes.size();
-  const int coefficient_planes = synthesis.CoefficientPlanes();
-  std::vector<std::vector<cv::Mat>> planes(static_cast<std::size_t>(num_atlases));
-  std::vector<cv::Mat> claim(static_cast<std::size_t>(num_atlases));  // distance of the claim
-  for (int a = 0; a < num_atlases; ++a) {
-    const int h = std::max(1, used_height[static_cast<std::size_t>(a)]);
-    const int w = options.atlas_size;
-    for (std::size_t c = 0; c < num_planes; ++c)
-      planes[static_cast<std::size_t>(a)].push_back(cv::Mat::zeros(h, w, CV_32FC1));
-    claim[static_cast<std::size_t>(a)] =
-        cv::Mat(h, w, CV_32FC1, cv::Scalar(std::numeric_limits<float>::max()));
-    atlases.coverage.push_back(cv::Mat::zeros(h, w, CV_8UC1));
+AtlasCoverage VisitAtlasTexels(const AtlasLayout& layout, double texel_size, int gutter,
+                               const AtlasTexelVisitor& visit, const ProgressCallback& progress) {
+  const double t = texel_size;
+  AtlasCoverage out;
+  std::vector<cv::Mat> claim;  // distance of the claim, per atlas
+  for (const cv::Size& size : layout.atlas_sizes) {
+    claim.emplace_back(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::max()));
+    out.coverage.push_back(cv::Mat::zeros(size, CV_8UC1));
   }
-  std::size_t inside_texels = 0;
-  std::vector<float> value(num_planes);
+  const std::size_t num_faces = layout.faces.size();
   for (std::size_t f = 0; f < num_faces; ++f) {
-    const FacePlacement& fp = atlases.faces[f];
-    auto& atlas_planes = planes[static_cast<std::size_t>(fp.atlas)];
+    const FacePlacement& fp = layout.faces[f];
     cv::Mat& claims = claim[static_cast<std::size_t>(fp.atlas)];
-    cv::Mat& coverage = atlases.coverage[static_cast<std::size_t>(fp.atlas)];
-    const Eigen::Matrix<double, 6, 6> to_atlas =
-        ptm::OrthonormalFrameRotation(-RotationAngle(fp.rotation));
+    cv::Mat& coverage = out.coverage[static_cast<std::size_t>(fp.atlas)];
     Eigen::Vector2d lo = fp.corners_px[0], hi = lo;
     for (const auto& p : fp.corners_px) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     const int x0 = std::max(0, static_cast<int>(std::floor(lo.x())) - gutter);
@@ -607,20 +605,11 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
           continue;
         }
         const Eigen::Vector2d r((q.x() - fp.offset.x()) * t, (fp.offset.y() - q.y()) * t);
-        const Eigen::Vector2d p_frame = fp.rotation.transpose() * r;
-        synthesis.SampleBlended(static_cast<int>(f), p_frame, options.blend_strip, value.data());
-        for (int poly = 0; poly < coefficient_planes / 6; ++poly) {
-          Eigen::Matrix<double, 6, 1> v;
-          for (int i = 0; i < 6; ++i) v[i] = value[static_cast<std::size_t>(poly * 6 + i)];
-          v = to_atlas * v;
-          for (int i = 0; i < 6; ++i)
-            value[static_cast<std::size_t>(poly * 6 + i)] = static_cast<float>(v[i]);
-        }
-        for (std::size_t c = 0; c < num_planes; ++c) atlas_planes[c].at<float>(y, x) = value[c];
+        visit(fp.atlas, x, y, static_cast<int>(f), fp.rotation.transpose() * r);
         claims.at<float>(y, x) = key;
         if (d <= 0.0) {
           coverage.at<std::uint8_t>(y, x) = 255;
-          ++inside_texels;
+          ++out.inside_texels;
         } else {
           coverage.at<std::uint8_t>(y, x) = 128;
         }
@@ -628,41 +617,83 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     }
     if (progress && ((f + 1) % 256 == 0 || f + 1 == num_faces)) progress("atlas", f + 1, num_faces);
   }
-  // Dilate into the few gutter texels no face reached (one ring per gutter texel).
-  std::size_t total_texels = 0;
-  for (int a = 0; a < num_atlases; ++a) {
-    cv::Mat& coverage = atlases.coverage[static_cast<std::size_t>(a)];
-    auto& atlas_planes = planes[static_cast<std::size_t>(a)];
-    std::vector<double> sum(num_planes);
-    for (int ring = 0; ring < gutter; ++ring) {
-      const cv::Mat before = coverage.clone();
-      for (int y = 0; y < coverage.rows; ++y) {
-        for (int x = 0; x < coverage.cols; ++x) {
-          if (before.at<std::uint8_t>(y, x)) continue;
-          int n = 0;
-          std::fill(sum.begin(), sum.end(), 0.0);
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int yy = y + dy, xx = x + dx;
-              if (yy < 0 || xx < 0 || yy >= coverage.rows || xx >= coverage.cols ||
-                  !before.at<std::uint8_t>(yy, xx))
-                continue;
-              for (std::size_t c = 0; c < num_planes; ++c)
-                sum[c] += atlas_planes[c].at<float>(yy, xx);
-              ++n;
-            }
-          if (n == 0) continue;
-          for (std::size_t c = 0; c < num_planes; ++c)
-            atlas_planes[c].at<float>(y, x) = static_cast<float>(sum[c] / n);
-          coverage.at<std::uint8_t>(y, x) = 64;
-        }
+  return out;
+}
+
+void DilateGutters(std::vector<cv::Mat>& planes, cv::Mat& coverage, int rings) {
+  const std::size_t num_planes = planes.size();
+  std::vector<double> sum(num_planes);
+  for (int ring = 0; ring < rings; ++ring) {
+    const cv::Mat before = coverage.clone();
+    for (int y = 0; y < coverage.rows; ++y) {
+      for (int x = 0; x < coverage.cols; ++x) {
+        if (before.at<std::uint8_t>(y, x)) continue;
+        int n = 0;
+        std::fill(sum.begin(), sum.end(), 0.0);
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int yy = y + dy, xx = x + dx;
+            if (yy < 0 || xx < 0 || yy >= coverage.rows || xx >= coverage.cols ||
+                !before.at<std::uint8_t>(yy, xx))
+              continue;
+            for (std::size_t c = 0; c < num_planes; ++c) sum[c] += planes[c].at<float>(yy, xx);
+            ++n;
+          }
+        if (n == 0) continue;
+        for (std::size_t c = 0; c < num_planes; ++c)
+          planes[c].at<float>(y, x) = static_cast<float>(sum[c] / n);
+        coverage.at<std::uint8_t>(y, x) = 64;
       }
     }
-    total_texels += coverage.total();
-    atlases.ptms.push_back(FromOrthonormalPlanes(atlas_planes, synthesis.format));
   }
-  atlases.occupancy =
-      total_texels ? static_cast<double>(inside_texels) / static_cast<double>(total_texels) : 0.0;
+}
+
+Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthesis,
+                     const AtlasOptions& options, const ProgressCallback& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  const AtlasLayout layout = LayoutAtlases(mesh, synthesis.patches, synthesis.unfoldings,
+                                           synthesis.texel_size, options, progress);
+  // Bake: every texel inside a face (and its gutter ring) from the blended
+  // synthesis, coefficients rotated into the atlas frame.
+  const std::size_t num_planes = synthesis.sample_planes.size();
+  const int coefficient_planes = synthesis.CoefficientPlanes();
+  std::vector<std::vector<cv::Mat>> planes(layout.atlas_sizes.size());
+  for (std::size_t a = 0; a < layout.atlas_sizes.size(); ++a)
+    for (std::size_t c = 0; c < num_planes; ++c)
+      planes[a].push_back(cv::Mat::zeros(layout.atlas_sizes[a], CV_32FC1));
+  std::vector<Eigen::Matrix<double, 6, 6>> to_atlas;
+  for (const FacePlacement& fp : layout.faces)
+    to_atlas.push_back(ptm::OrthonormalFrameRotation(-RotationAngle(fp.rotation)));
+  std::vector<float> value(num_planes);
+  AtlasCoverage coverage = VisitAtlasTexels(
+      layout, synthesis.texel_size, options.gutter,
+      [&](int atlas, int x, int y, int face, const Eigen::Vector2d& p_frame) {
+        synthesis.SampleBlended(face, p_frame, options.blend_strip, value.data());
+        for (int poly = 0; poly < coefficient_planes / 6; ++poly) {
+          Eigen::Matrix<double, 6, 1> v;
+          for (int i = 0; i < 6; ++i) v[i] = value[static_cast<std::size_t>(poly * 6 + i)];
+          v = to_atlas[static_cast<std::size_t>(face)] * v;
+          for (int i = 0; i < 6; ++i)
+            value[static_cast<std::size_t>(poly * 6 + i)] = static_cast<float>(v[i]);
+        }
+        auto& atlas_planes = planes[static_cast<std::size_t>(atlas)];
+        for (std::size_t c = 0; c < num_planes; ++c) atlas_planes[c].at<float>(y, x) = value[c];
+      },
+      progress);
+  Atlases atlases;
+  atlases.num_charts = layout.num_charts;
+  atlases.faces = layout.faces;
+  std::size_t total_texels = 0;
+  for (std::size_t a = 0; a < planes.size(); ++a) {
+    // Dilate into the few gutter texels no face reached (one ring per gutter texel).
+    DilateGutters(planes[a], coverage.coverage[a], options.gutter);
+    total_texels += coverage.coverage[a].total();
+    atlases.ptms.push_back(FromOrthonormalPlanes(planes[a], synthesis.format));
+  }
+  atlases.coverage = std::move(coverage.coverage);
+  atlases.occupancy = total_texels ? static_cast<double>(coverage.inside_texels) /
+                                         static_cast<double>(total_texels)
+                                   : 0.0;
   atlases.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return atlases;
 }

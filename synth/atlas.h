@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -49,6 +50,45 @@ struct FacePlacement {
   /// The triangle's corners in atlas pixel coordinates.
   std::array<Eigen::Vector2d, 3> corners_px;
 };
+
+/// Where every face goes, without values: placements and atlas sizes.
+struct AtlasLayout {
+  std::vector<FacePlacement> faces;
+  std::vector<cv::Size> atlas_sizes;  ///< texels; the last atlas cropped to the rows it uses
+  int num_charts = 0;
+};
+
+/// Lays out the faces (per triangle or in charts) and packs them into atlases
+/// (per-triangle boxes: skyline, tallest first; charts: by their outlines at 16
+/// rotations on a per-column skyline, largest first). `patches` give each face's
+/// frame and corners, `unfoldings` its neighbours across edges; `texel_size` in
+/// world units. Throws OptionError when a chart does not fit an atlas.
+AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
+                          const std::vector<std::array<Unfolding, 3>>& unfoldings,
+                          double texel_size, const AtlasOptions& options,
+                          const ProgressCallback& progress = {});
+
+/// Called for an atlas texel (x, y) of `atlas` that face `face` fills;
+/// `p_in_frame` is the texel centre in the face's triangle frame (world units).
+using AtlasTexelVisitor =
+    std::function<void(int atlas, int x, int y, int face, const Eigen::Vector2d& p_in_frame)>;
+
+/// Texels a layout fills, per atlas (CV_8UC1: 255 inside a triangle, 128
+/// gutter, 64 dilated), and the count inside triangles.
+struct AtlasCoverage {
+  std::vector<cv::Mat> coverage;
+  std::size_t inside_texels = 0;
+};
+
+/// Visits every texel inside a face (once; the first face wins on a shared edge)
+/// and every texel within `gutter` texels of one (possibly again, by a nearer face).
+AtlasCoverage VisitAtlasTexels(const AtlasLayout& layout, double texel_size, int gutter,
+                               const AtlasTexelVisitor& visit,
+                               const ProgressCallback& progress = {});
+
+/// Fills texels that `coverage` marks 0 next to filled ones with the mean of
+/// their filled 8-neighbours, `rings` times (marking them 64), in every plane.
+void DilateGutters(std::vector<cv::Mat>& planes, cv::Mat& coverage, int rings);
 
 /// Packed, baked, blended PTM atlases and the texture coordinates into them.
 /// Each atlas texel's coefficients are in the frame x = atlas +x (right), y =
