@@ -100,43 +100,33 @@ sfm::TriangleMesh SubdivideMidpoint(const sfm::TriangleMesh& mesh) {
   return out;
 }
 
-SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress) {
-  options.synthesis.Check();
-  options.atlas.Check();
-  options.visibility.Check();
-  if (options.max_subdivisions < 0 || options.max_subdivisions > 6)
-    throw OptionError("max subdivisions must be in [0, 6]");
+SynthInputs LoadSynthInputs(const SynthJobOptions& options, int sample_side,
+                            double sample_texel_size, int strip,
+                            const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
-  SynthJobSummary summary;
-  if (fs::exists(options.out_dir) &&
-      (!fs::is_directory(options.out_dir) ||
-       (!fs::exists(options.out_dir / "manifest.json") && !fs::is_empty(options.out_dir)))) {
-    throw InputError(options.out_dir.string(),
-                     "exists and is not a texlume model folder; not replacing it");
-  }
-
+  SynthInputs inputs;
   // Inputs.
-  const sfm::LoadedModel loaded = sfm::ReadModel(options.model_dir);
-  const sfm::Reconstruction& reconstruction = loaded.reconstruction;
+  inputs.reconstruction = sfm::ReadModel(options.model_dir).reconstruction;
+  const sfm::Reconstruction& reconstruction = inputs.reconstruction;
   const sfm::ObjectLights lights = sfm::ReadObjectLightsFile(options.lights_file);
   const std::vector<std::string> unlit =
       sfm::CheckLightsAgainstModel(lights, reconstruction, options.lights_file.string());
   for (const std::string& name : unlit)
-    summary.warnings.push_back("skipping " + name + ": no light for it in " +
+    inputs.warnings.push_back("skipping " + name + ": no light for it in " +
                                options.lights_file.string());
   sfm::LoadedMesh loaded_mesh = sfm::LoadMesh(options.mesh_file);
   for (const std::string& problem : loaded_mesh.report.Problems())
-    summary.warnings.push_back(options.mesh_file.string() + ": " + problem);
-  sfm::TriangleMesh mesh = std::move(loaded_mesh.mesh);
-  const ptm::Ptm sample = ptm::ReadPtmAnyFormat(options.sample_file);
+    inputs.warnings.push_back(options.mesh_file.string() + ": " + problem);
+  sfm::TriangleMesh& mesh = inputs.mesh;
+  mesh = std::move(loaded_mesh.mesh);
 
-  std::vector<MeshPhoto> photos;
+  std::vector<MeshPhoto>& photos = inputs.photos;
   for (const auto& [id, image] : reconstruction.images) {
     const auto it = lights.find(image.name);
     if (it == lights.end()) continue;
     const fs::path file = options.images_dir / image.name;
     if (!fs::exists(file)) {
-      summary.warnings.push_back("skipping " + image.name + ": no file " + file.string());
+      inputs.warnings.push_back("skipping " + image.name + ": no file " + file.string());
       continue;
     }
     MeshPhoto photo;
@@ -158,8 +148,7 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
     throw InputError(options.images_dir.string(),
                      "no usable photo: every image of the model lacks a light or a file");
   }
-  summary.photos_used = photos.size();
-  summary.seconds_load = Since(start);
+  inputs.seconds_load = Since(start);
 
   // Visibility (and subdivision while the largest triangle does not fit the sample).
   auto t = std::chrono::steady_clock::now();
@@ -171,26 +160,25 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
         longest = std::max(longest, (m.Corner(f, (k + 1) % 3) - m.Corner(f, k)).norm());
       widest = std::max(widest, longest);
     }
-    return widest / options.synthesis.sample_texel_size + 2 * options.synthesis.strip + 2;
+    return widest / sample_texel_size + 2 * strip + 2;
   };
-  while (largest_patch(mesh) > std::min(sample.width, sample.height) &&
-         summary.subdivisions < static_cast<std::size_t>(options.max_subdivisions)) {
+  while (largest_patch(mesh) > sample_side &&
+         inputs.subdivisions < static_cast<std::size_t>(options.max_subdivisions)) {
     mesh = SubdivideMidpoint(mesh);
-    ++summary.subdivisions;
+    ++inputs.subdivisions;
   }
-  if (summary.subdivisions) {
-    summary.warnings.push_back("subdivided the mesh " + std::to_string(summary.subdivisions) +
+  if (inputs.subdivisions) {
+    inputs.warnings.push_back("subdivided the mesh " + std::to_string(inputs.subdivisions) +
                                " time(s) so that every triangle's patch fits the sample");
   }
-  summary.faces = mesh.faces.size();
-  const sfm::VisibilityResult visibility =
+  inputs.visibility =
       sfm::ComputeVisibility(mesh, reconstruction, options.visibility, progress);
   // Photos used here only (visibility saw every image of the model).
   std::size_t seen_by_usable = 0;
   {
     std::map<sfm::ImageId, bool> usable;
     for (const MeshPhoto& p : photos) usable[p.image_id] = true;
-    for (const auto& tv : visibility.triangles) {
+    for (const auto& tv : inputs.visibility.triangles) {
       bool seen = false;
       for (const auto& v : tv.views)
         seen = seen || (usable.count(v.image_id) && v.visible_fraction > 0);
@@ -206,10 +194,43 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
                          "frame of the COLMAP model " +
                          options.model_dir.string() + "?");
   }
-  summary.seconds_visibility = Since(t);
+  inputs.seconds_visibility = Since(t);
+
+  return inputs;
+}
+
+SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress) {
+  options.synthesis.Check();
+  options.atlas.Check();
+  options.visibility.Check();
+  if (options.max_subdivisions < 0 || options.max_subdivisions > 6)
+    throw OptionError("max subdivisions must be in [0, 6]");
+  const auto start = std::chrono::steady_clock::now();
+  SynthJobSummary summary;
+  if (fs::exists(options.out_dir) &&
+      (!fs::is_directory(options.out_dir) ||
+       (!fs::exists(options.out_dir / "manifest.json") && !fs::is_empty(options.out_dir)))) {
+    throw InputError(options.out_dir.string(),
+                     "exists and is not a texlume model folder; not replacing it");
+  }
+
+  const ptm::Ptm sample = ptm::ReadPtmAnyFormat(options.sample_file);
+  SynthInputs inputs = LoadSynthInputs(options, std::min(sample.width, sample.height),
+                                       options.synthesis.sample_texel_size,
+                                       options.synthesis.strip, progress);
+  const sfm::Reconstruction& reconstruction = inputs.reconstruction;
+  const sfm::TriangleMesh& mesh = inputs.mesh;
+  const std::vector<MeshPhoto>& photos = inputs.photos;
+  const sfm::VisibilityResult& visibility = inputs.visibility;
+  summary.warnings = inputs.warnings;
+  summary.photos_used = photos.size();
+  summary.subdivisions = inputs.subdivisions;
+  summary.faces = mesh.faces.size();
+  summary.seconds_load = inputs.seconds_load;
+  summary.seconds_visibility = inputs.seconds_visibility;
 
   // Synthesis (Algorithm 2), blending and atlases.
-  t = std::chrono::steady_clock::now();
+  auto t = std::chrono::steady_clock::now();
   const MeshSynthesis synthesis = SynthesizeMeshPtm(mesh, reconstruction, visibility, photos,
                                                     sample, options.synthesis, progress);
   summary.seconds_synthesis = Since(t);
@@ -387,7 +408,7 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
   RenderJobSummary summary;
   const TexturedModel model = ReadModelFolder(options.model_folder);
   ModelRenderer renderer(model);
-  if (options.mode != RenderMode::kPtm) {
+  if (options.mode != RenderMode::kPtm && !options.renderer) {
     ModelBaselines baselines = ReadModelBaselines(options.model_folder, model);
     renderer.flat_albedo = baselines.flat_albedo;
     renderer.baked = std::move(baselines.baked);
@@ -405,8 +426,10 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
     const auto it = lights.find(image.name);
     if (it == lights.end()) continue;
     const sfm::Camera& camera = cameras.reconstruction.cameras.at(image.camera_id);
-    const RenderedView view = renderer.Render(camera, image.cam_from_world, it->second,
-                                              options.mode, options.samples_per_axis);
+    const RenderedView view =
+        options.renderer ? options.renderer(model, camera, image.cam_from_world, it->second)
+                         : renderer.Render(camera, image.cam_from_world, it->second,
+                                           options.mode, options.samples_per_axis);
     const fs::path name = PngName(image.name);
     fs::create_directories((options.out_dir / name).parent_path());
     fs::create_directories((options.out_dir / "masks" / name).parent_path());
@@ -465,7 +488,8 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
   record["settings"] = {{"model", options.model_folder.string()},
                         {"cameras", options.cameras_dir.string()},
                         {"lights", options.lights_file.string()},
-                        {"mode", options.mode == RenderMode::kPtm    ? "ptm"
+                        {"mode", options.renderer              ? options.renderer_name
+                                 : options.mode == RenderMode::kPtm  ? "ptm"
                                  : options.mode == RenderMode::kFlat ? "flat"
                                                                      : "baked"},
                         {"samples_per_axis", options.samples_per_axis}};

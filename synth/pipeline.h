@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,26 @@ struct SynthJobSummary {
          seconds_baselines = 0, seconds_report = 0, seconds_export = 0, seconds_total = 0;
 };
 
+/// The main job's inputs, read and checked (shared with the BTF job, btf/).
+struct SynthInputs {
+  sfm::Reconstruction reconstruction;
+  sfm::TriangleMesh mesh;          ///< subdivided as needed
+  std::vector<MeshPhoto> photos;   ///< those with a light and a file
+  sfm::VisibilityResult visibility;
+  std::vector<std::string> warnings;
+  std::size_t subdivisions = 0;
+  double seconds_load = 0, seconds_visibility = 0;
+};
+
+/// Reads the COLMAP model, object lights, mesh and photos named in `options`
+/// (sample and out_dir are not touched), splits the mesh while its largest
+/// patch (longest edge / sample_texel_size + 2 strip texels) exceeds
+/// `sample_side` texels (up to options.max_subdivisions times) and computes
+/// visibility. Throws InputError as RunSynthJob describes.
+SynthInputs LoadSynthInputs(const SynthJobOptions& options, int sample_side,
+                            double sample_texel_size, int strip,
+                            const ProgressCallback& progress = {});
+
 /// Runs the whole job: reads and checks the inputs, visibility and best views,
 /// per-triangle synthesis (Algorithm 2), blending, atlases, and the model folder
 /// (WriteModelFolder, plus the baselines `texlume render` draws: baked_K.png
@@ -62,6 +83,14 @@ struct RenderJobOptions {
   std::filesystem::path out_dir;
   RenderMode mode = RenderMode::kPtm;
   int samples_per_axis = 2;
+  /// When set, draws every view instead of `mode` (the BTF renderer of btf/
+  /// goes here); given the model folder's model as ReadModelFolder reads it.
+  std::function<RenderedView(const TexturedModel& model, const sfm::Camera& camera,
+                             const sfm::Rigid3d& cam_from_world,
+                             const std::vector<sfm::ObjectLight>& lights)>
+      renderer;
+  /// Written into render.json's settings as the mode (with `renderer`).
+  std::string renderer_name;
   /// Optional ground truth: images (and masks) with the same names; PSNR and
   /// SSIM inside the masks go into render.json.
   std::filesystem::path truth_images_dir, truth_masks_dir;
