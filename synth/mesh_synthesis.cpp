@@ -211,39 +211,22 @@ void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip,
   for (std::size_t c = 0; c < n; ++c) out[c] = static_cast<float>(own_weight * own[c] + sum[c]);
 }
 
-MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
-                                const sfm::Reconstruction& reconstruction,
-                                const sfm::VisibilityResult& visibility,
-                                const std::vector<MeshPhoto>& photos, const ptm::Ptm& sample,
-                                const MeshSynthesisOptions& options,
-                                const ProgressCallback& progress) {
-  options.Check();
-  const auto start = std::chrono::steady_clock::now();
+PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int strip,
+                                TangentFrame tangent_frame,
+                                const Eigen::Vector3d& field_direction_in_world) {
   const std::size_t num_faces = mesh.faces.size();
-  if (visibility.triangles.size() != num_faces)
-    throw InputError("visibility", "does not match the mesh's face count");
-  const double t = options.sample_texel_size;
-  MeshSynthesis result;
-  result.format = sample.format;
-  result.texel_size = t;
-  result.sample_planes = ToOrthonormalPlanes(sample);
-  const int coefficient_planes = result.CoefficientPlanes();
-  const std::vector<cv::Mat> sample_coefficients(result.sample_planes.begin(),
-                                                 result.sample_planes.begin() + coefficient_planes);
-  const cv::Mat sample_energy = PlaneEnergy(sample_coefficients);
-  const std::vector<cv::Mat> sample_raw = RawPlanes(sample);
-
-  // 1. Frames, patch rectangles, and the memory they need (refused up front).
+  PatchGeometry result;
+  std::int64_t& total_texels = result.total_texels;
+  int& widest = result.widest;
+  int& tallest = result.tallest;
   result.patches.resize(num_faces);
-  std::int64_t total_texels = 0;
-  int widest = 0, tallest = 0;
   for (std::size_t f = 0; f < num_faces; ++f) {
     TrianglePatch& patch = result.patches[f];
-    if (options.tangent_frame == TangentFrame::kSmoothField) {
+    if (tangent_frame == TangentFrame::kSmoothField) {
       const Eigen::Vector3d n = (mesh.Corner(f, 1) - mesh.Corner(f, 0))
                                     .cross(mesh.Corner(f, 2) - mesh.Corner(f, 0))
                                     .normalized();
-      Eigen::Vector3d d = options.field_direction_in_world.normalized();
+      Eigen::Vector3d d = field_direction_in_world.normalized();
       if ((d - n * n.dot(d)).norm() < 0.3) {
         // Near the field's poles: the world axis least aligned with the normal.
         Eigen::Index axis;
@@ -262,10 +245,10 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       lo = lo.cwiseMin(p.head<2>());
       hi = hi.cwiseMax(p.head<2>());
     }
-    patch.x_min = lo.x() - options.strip * t;
-    patch.y_max = hi.y() + options.strip * t;
-    const double w = std::ceil((hi.x() - lo.x()) / t) + 2.0 * options.strip;
-    const double h = std::ceil((hi.y() - lo.y()) / t) + 2.0 * options.strip;
+    patch.x_min = lo.x() - strip * t;
+    patch.y_max = hi.y() + strip * t;
+    const double w = std::ceil((hi.x() - lo.x()) / t) + 2.0 * strip;
+    const double h = std::ceil((hi.y() - lo.y()) / t) + 2.0 * strip;
     if (!(w < 1e7 && h < 1e7)) {
       throw InputError("mesh", "face " + std::to_string(f) + " needs a patch of " +
                                    std::to_string(w) + " x " + std::to_string(h) +
@@ -277,25 +260,6 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     tallest = std::max(tallest, patch.height);
     total_texels += static_cast<std::int64_t>(patch.width) * patch.height;
   }
-  if (total_texels > options.max_texels) {
-    throw InputError(
-        "mesh",
-        "at a texel size of " + std::to_string(t) + " world units the " +
-            std::to_string(num_faces) + " patches need " + std::to_string(total_texels) +
-            " texels (about " +
-            std::to_string(
-                total_texels * 4 * static_cast<std::int64_t>(result.sample_planes.size()) >> 20) +
-            " MiB per copy), more than the limit of " + std::to_string(options.max_texels) +
-            "; use a larger texel size or a finer mesh");
-  }
-  if (widest > sample.width || tallest > sample.height) {
-    throw InputError(
-        "mesh", "the largest triangle needs a patch of " + std::to_string(widest) + " x " +
-                    std::to_string(tallest) + " texels (strip included) but the sample is " +
-                    std::to_string(sample.width) + " x " + std::to_string(sample.height) +
-                    "; subdivide the mesh (texlume synth --subdivide) or capture a larger sample");
-  }
-
   // Unfoldings across every shared edge.
   const std::vector<std::array<int, 3>> neighbours = sfm::FaceNeighbours(mesh);
   result.unfoldings.resize(num_faces);
@@ -323,6 +287,62 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       // This frame's x axis is (cos angle, sin angle) in the neighbour's frame.
       u.coefficients_to_this = ptm::OrthonormalFrameRotation(angle);
     }
+  }
+
+  return result;
+}
+
+MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
+                                const sfm::Reconstruction& reconstruction,
+                                const sfm::VisibilityResult& visibility,
+                                const std::vector<MeshPhoto>& photos, const ptm::Ptm& sample,
+                                const MeshSynthesisOptions& options,
+                                const ProgressCallback& progress) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t num_faces = mesh.faces.size();
+  if (visibility.triangles.size() != num_faces)
+    throw InputError("visibility", "does not match the mesh's face count");
+  const double t = options.sample_texel_size;
+  MeshSynthesis result;
+  result.format = sample.format;
+  result.texel_size = t;
+  result.sample_planes = ToOrthonormalPlanes(sample);
+  const int coefficient_planes = result.CoefficientPlanes();
+  const std::vector<cv::Mat> sample_coefficients(result.sample_planes.begin(),
+                                                 result.sample_planes.begin() + coefficient_planes);
+  const cv::Mat sample_energy = PlaneEnergy(sample_coefficients);
+  const std::vector<cv::Mat> sample_raw = RawPlanes(sample);
+
+  std::int64_t total_texels = 0;
+  int widest = 0, tallest = 0;
+  // 1. Frames, patch rectangles, and the memory they need (refused up front).
+  {
+    PatchGeometry geometry = MakePatchGeometry(mesh, t, options.strip, options.tangent_frame,
+                                               options.field_direction_in_world);
+    result.patches = std::move(geometry.patches);
+    result.unfoldings = std::move(geometry.unfoldings);
+    total_texels = geometry.total_texels;
+    widest = geometry.widest;
+    tallest = geometry.tallest;
+  }
+  if (total_texels > options.max_texels) {
+    throw InputError(
+        "mesh",
+        "at a texel size of " + std::to_string(t) + " world units the " +
+            std::to_string(num_faces) + " patches need " + std::to_string(total_texels) +
+            " texels (about " +
+            std::to_string(
+                total_texels * 4 * static_cast<std::int64_t>(result.sample_planes.size()) >> 20) +
+            " MiB per copy), more than the limit of " + std::to_string(options.max_texels) +
+            "; use a larger texel size or a finer mesh");
+  }
+  if (widest > sample.width || tallest > sample.height) {
+    throw InputError(
+        "mesh", "the largest triangle needs a patch of " + std::to_string(widest) + " x " +
+                    std::to_string(tallest) + " texels (strip included) but the sample is " +
+                    std::to_string(sample.width) + " x " + std::to_string(sample.height) +
+                    "; subdivide the mesh (texlume synth --subdivide) or capture a larger sample");
   }
 
   // Photos by image id, and the reduced samples by density level.
@@ -771,7 +791,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     }
   };
 
-  const std::vector<int> order = sfm::BreadthFirstFaceOrder(mesh, neighbours, seed_face);
+  const std::vector<int> order =
+      sfm::BreadthFirstFaceOrder(mesh, sfm::FaceNeighbours(mesh), seed_face);
   std::vector<char> done(num_faces, 0);
   std::mt19937_64 rng(options.seed);
   std::size_t processed = 0;

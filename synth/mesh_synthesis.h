@@ -146,6 +146,21 @@ struct MeshSynthesis {
                      float* planes_out) const;
 };
 
+/// Per-face frames, corners and patch rectangles (the bounding box plus `strip`
+/// texels of size `texel_size` world units on every side; sample_x/y left 0),
+/// and the unfoldings across every shared edge (Algorithm 2's set-up, shared by
+/// the PTM and BTF synthesis). Throws InputError when a patch would be absurdly
+/// large (a texel size in other units than the mesh).
+struct PatchGeometry {
+  std::vector<TrianglePatch> patches;
+  std::vector<std::array<Unfolding, 3>> unfoldings;
+  std::int64_t total_texels = 0;
+  int widest = 0, tallest = 0;  ///< largest patch sides, texels
+};
+PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double texel_size, int strip,
+                                TangentFrame tangent_frame,
+                                const Eigen::Vector3d& field_direction_in_world);
+
 /// Per-triangle image-constrained PTM synthesis on a mesh (paper 003 Algorithm 2).
 /// `visibility` from sfm::ComputeVisibility for this mesh and reconstruction;
 /// `photos` the usable photos (each image_id in the reconstruction). Throws
