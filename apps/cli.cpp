@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <memory>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -15,6 +16,7 @@
 #include "apps/http_server.h"
 #include "apps/progress_bar.h"
 #include "btf/btf.h"
+#include "btf/btf_model.h"
 #include "datasets_synthetic/object_scene.h"
 #include "datasets_synthetic/scene.h"
 #include "ptm/fit.h"
@@ -435,6 +437,9 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
        "lights",
        "mesh",
        "sample",
+       "btf",
+       "components",
+       "seam-band",
        "sample-texel-size",
        "out",
        "strip",
@@ -458,10 +463,12 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
   o.images_dir = a.Require("images");
   o.lights_file = a.Require("lights");
   o.mesh_file = a.Require("mesh");
-  o.sample_file = a.Require("sample");
+  const auto btf_dir = a.Get("btf");
+  if (btf_dir && a.Has("sample")) throw UsageError("give --sample (a PTM) or --btf, not both");
+  if (!btf_dir) o.sample_file = a.Require("sample");
   o.out_dir = a.Require("out");
   o.synthesis.sample_texel_size = a.GetDouble("sample-texel-size", 0.0);
-  if (!(o.synthesis.sample_texel_size > 0.0)) {
+  if (!btf_dir && !(o.synthesis.sample_texel_size > 0.0)) {
     throw UsageError(
         "--sample-texel-size: give the sample's texel size in world units of the model");
   }
@@ -496,6 +503,30 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
   o.visibility.max_buffer_dimension = a.GetInt("max-buffer-size", 0);
   o.write_report = !a.Has("no-report");
   ProgressBar bar;
+  if (btf_dir) {
+    btf::BtfSynthJobOptions b;
+    b.btf = *btf_dir;
+    b.components = a.GetInt("components", b.components);
+    b.synthesis.sample_texel_size = o.synthesis.sample_texel_size;
+    b.synthesis.strip = o.synthesis.strip;
+    b.synthesis.seam_band = a.GetInt("seam-band", std::min(b.synthesis.seam_band, o.synthesis.strip));
+    b.synthesis.top_k = o.synthesis.top_k;
+    b.synthesis.max_views = o.synthesis.all_views ? o.synthesis.max_views : 1;
+    b.synthesis.seed = o.synthesis.seed;
+    b.synthesis.tangent_frame = o.synthesis.tangent_frame;
+    b.synthesis.field_direction_in_world = o.synthesis.field_direction_in_world;
+    b.job = std::move(o);
+    const btf::BtfSynthJobSummary s = btf::RunBtfSynthJob(b, bar.Callback());
+    for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
+    out << "Synthesised a BTF over " << s.faces << " triangles (" << s.from_photos
+        << " from photos, " << s.from_neighbours << " from neighbours only, " << s.random
+        << " seeds) from " << s.photos_used << " photos; graph-cut seams on " << s.seam_edges
+        << " edges (cost per cut pair " << s.seam_cost_per_link << ", straight edge "
+        << s.edge_cost_per_link << "); " << s.atlases << " atlas(es), " << s.charts
+        << " charts, occupancy " << s.occupancy << ", in " << s.seconds_total
+        << " s: " << b.job.out_dir.string() << " (see manifest.json)\n";
+    return kExitOk;
+  }
   const synth::SynthJobSummary s = synth::RunSynthJob(o, bar.Callback());
   for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
   out << "Synthesised " << s.faces << " triangles (" << s.from_photos << " from photos, "
@@ -522,9 +553,28 @@ int RunRenderCommand(const std::vector<std::string>& args, std::ostream& out, st
       o.mode = synth::RenderMode::kFlat;
     } else if (*b == "baked") {
       o.mode = synth::RenderMode::kBaked;
+    } else if (*b == "ptm") {
+      o.mode = synth::RenderMode::kPtm;
     } else {
-      throw UsageError("--baseline: flat or baked, not '" + *b + "'");
+      throw UsageError("--baseline: flat, baked or ptm, not '" + *b + "'");
     }
+  }
+  // A BTF model (texlume synth --btf) is drawn as a BTF unless a baseline is asked for.
+  std::shared_ptr<btf::BtfModel> btf_model;
+  if (!a.Has("baseline") && synth::ReadModelManifest(o.model_folder).contains("btf")) {
+    o.renderer_name = "btf";
+    o.renderer = [&btf_model, &o](
+                     const synth::TexturedModel& model, const sfm::Camera& camera,
+                     const sfm::Rigid3d& cam_from_world,
+                     const std::vector<sfm::ObjectLight>& lights) {
+      if (!btf_model)
+        btf_model = std::make_shared<btf::BtfModel>(btf::ReadBtfModel(o.model_folder, model));
+      synth::ModelRenderer renderer(model);
+      return renderer.RenderWith(camera, cam_from_world, o.samples_per_axis,
+                                 [&](const synth::ModelRenderer::SurfaceSample& s) {
+                                   return btf::ShadeBtf(*btf_model, s, lights);
+                                 });
+    };
   }
   o.samples_per_axis = a.GetInt("samples", o.samples_per_axis);
   if (const auto t = a.Get("truth")) o.truth_images_dir = *t;

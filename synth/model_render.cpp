@@ -56,13 +56,11 @@ ModelRenderer::ModelRenderer(const TexturedModel& model) : model_(model), impl_(
 
 ModelRenderer::~ModelRenderer() = default;
 
-RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
-                                   const std::vector<sfm::ObjectLight>& lights, RenderMode mode,
-                                   int samples_per_axis) const {
+RenderedView ModelRenderer::RenderWith(const sfm::Camera& camera,
+                                       const sfm::Rigid3d& cam_from_world, int samples_per_axis,
+                                       const Shader& shade) const {
   if (samples_per_axis < 1 || samples_per_axis > 8)
     throw OptionError("samples per axis must be in [1, 8]");
-  if (mode == RenderMode::kBaked && baked.size() != model_.atlases.size())
-    throw OptionError("the baked baseline needs one baked texture per atlas");
   const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
   RenderedView out;
   out.rgb = cv::Mat(height, width, CV_32FC3, cv::Scalar::all(0));
@@ -71,13 +69,9 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
   const Eigen::Vector3d origin = world_from_cam.translation;
   const int n = samples_per_axis;
   const sfm::TriangleMesh& mesh = model_.mesh;
-  const Eigen::Vector3f flat_linear(SrgbToLinear(flat_albedo.x()), SrgbToLinear(flat_albedo.y()),
-                                    SrgbToLinear(flat_albedo.z()));
 
 #pragma omp parallel for schedule(dynamic, 4)
   for (int y = 0; y < height; ++y) {
-    std::vector<float> texel(21);
-    std::vector<std::pair<Eigen::Vector3d, double>> local;  // lights in the face frame
     for (int x = 0; x < width; ++x) {
       Eigen::Vector3f sum = Eigen::Vector3f::Zero();
       int hits = 0;
@@ -88,67 +82,29 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
           const std::optional<RayCaster::Hit> hit = impl_->caster->Intersect(origin, direction);
           if (!hit) continue;
           ++hits;
-          const std::size_t f = hit->triangle;
+          SurfaceSample s;
+          s.face = hit->triangle;
           const double b1 = hit->b1, b2 = hit->b2, b0 = 1.0 - b1 - b2;
-          const Eigen::Vector3d point = origin + hit->distance * direction;
-          Eigen::Vector3f value = Eigen::Vector3f::Zero();
-          if (mode == RenderMode::kFlat) {
-            const auto& v = mesh.faces[f];
-            const Eigen::Vector3d normal = (b0 * vertex_normals_[static_cast<std::size_t>(v[0])] +
-                                            b1 * vertex_normals_[static_cast<std::size_t>(v[1])] +
-                                            b2 * vertex_normals_[static_cast<std::size_t>(v[2])])
-                                               .normalized();
-            double shading = 0.0;
-            for (const sfm::ObjectLight& l : lights)
-              shading += l.intensity * std::max(0.0, normal.dot(l.DirectionFrom(point)));
-            for (int c = 0; c < 3; ++c)
-              value[c] = LinearToSrgb(static_cast<float>(shading) * flat_linear[c]);
-          } else {
-            const auto& c = model_.corner_px[f];
-            const Eigen::Vector2d px =
+          s.point = origin + hit->distance * direction;
+          s.to_viewer = (origin - s.point).normalized();
+          const auto& v = mesh.faces[s.face];
+          s.smooth_normal = (b0 * vertex_normals_[static_cast<std::size_t>(v[0])] +
+                             b1 * vertex_normals_[static_cast<std::size_t>(v[1])] +
+                             b2 * vertex_normals_[static_cast<std::size_t>(v[2])])
+                                .normalized();
+          if (!model_.corner_px.empty()) {
+            const auto& c = model_.corner_px[s.face];
+            s.atlas = model_.face_atlas[s.face];
+            s.atlas_px =
                 b0 * c[0].cast<double>() + b1 * c[1].cast<double>() + b2 * c[2].cast<double>();
-            const int atlas_index = model_.face_atlas[f];
-            if (mode == RenderMode::kBaked) {
-              const cv::Mat& tex = baked[static_cast<std::size_t>(atlas_index)];
-              Bilinear(
-                  tex.cols, tex.rows, px.x(), px.y(), 3,
-                  [&](int xx, int yy, int ch) { return tex.at<cv::Vec3f>(yy, xx)[ch]; },
-                  texel.data());
-              value = Eigen::Vector3f(texel[0], texel[1], texel[2]);
-            } else {
-              const ptm::Ptm& atlas = model_.atlases[static_cast<std::size_t>(atlas_index)];
-              const int coefficient_count = atlas.NumPolynomials() * 6;
-              const bool lrgb = atlas.format == ptm::PtmFormat::kLrgb;
-              Bilinear(
-                  atlas.width, atlas.height, px.x(), px.y(), coefficient_count + (lrgb ? 3 : 0),
-                  [&](int xx, int yy, int ch) {
-                    const std::size_t t = static_cast<std::size_t>(yy) * atlas.width + xx;
-                    return ch < coefficient_count
-                               ? atlas.Coefficients(t)[ch]
-                               : atlas.colour[t * 3 +
-                                              static_cast<std::size_t>(ch - coefficient_count)];
-                  },
-                  texel.data());
-              // The face frame turned by the smallest rotation that takes the face
-              // normal to the interpolated vertex normal, so shading varies smoothly
-              // across faces of the coarse mesh, as on the surface it approximates.
-              const auto& v = mesh.faces[f];
-              const Eigen::Vector3d smooth = (b0 * vertex_normals_[static_cast<std::size_t>(v[0])] +
-                                              b1 * vertex_normals_[static_cast<std::size_t>(v[1])] +
-                                              b2 * vertex_normals_[static_cast<std::size_t>(v[2])])
-                                                 .normalized();
-              const Eigen::Matrix3d frame =
-                  Eigen::Quaterniond::FromTwoVectors(face_frames_[f].col(2), smooth)
-                      .toRotationMatrix() *
-                  face_frames_[f];
-              local.clear();
-              for (const sfm::ObjectLight& l : lights)
-                local.emplace_back(frame.transpose() * l.DirectionFrom(point), l.intensity);
-              value = RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format,
-                                     local, 1.0);
-            }
           }
-          sum += value;
+          // The face frame turned by the smallest rotation that takes the face
+          // normal to the interpolated vertex normal, so shading varies smoothly
+          // across faces of the coarse mesh, as on the surface it approximates.
+          s.frame = Eigen::Quaterniond::FromTwoVectors(face_frames_[s.face].col(2), s.smooth_normal)
+                        .toRotationMatrix() *
+                    face_frames_[s.face];
+          sum += shade(s);
         }
       }
       if (hits == 0) continue;
@@ -159,6 +115,52 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
     }
   }
   return out;
+}
+
+RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
+                                   const std::vector<sfm::ObjectLight>& lights, RenderMode mode,
+                                   int samples_per_axis) const {
+  if (mode == RenderMode::kBaked && baked.size() != model_.atlases.size())
+    throw OptionError("the baked baseline needs one baked texture per atlas");
+  const Eigen::Vector3f flat_linear(SrgbToLinear(flat_albedo.x()), SrgbToLinear(flat_albedo.y()),
+                                    SrgbToLinear(flat_albedo.z()));
+  return RenderWith(camera, cam_from_world, samples_per_axis, [&](const SurfaceSample& s) {
+    Eigen::Vector3f value = Eigen::Vector3f::Zero();
+    std::array<float, 21> texel{};
+    if (mode == RenderMode::kFlat) {
+      double shading = 0.0;
+      for (const sfm::ObjectLight& l : lights)
+        shading += l.intensity * std::max(0.0, s.smooth_normal.dot(l.DirectionFrom(s.point)));
+      for (int c = 0; c < 3; ++c)
+        value[c] = LinearToSrgb(static_cast<float>(shading) * flat_linear[c]);
+    } else if (mode == RenderMode::kBaked) {
+      const cv::Mat& tex = baked[static_cast<std::size_t>(s.atlas)];
+      Bilinear(
+          tex.cols, tex.rows, s.atlas_px.x(), s.atlas_px.y(), 3,
+          [&](int xx, int yy, int ch) { return tex.at<cv::Vec3f>(yy, xx)[ch]; }, texel.data());
+      value = Eigen::Vector3f(texel[0], texel[1], texel[2]);
+    } else {
+      const ptm::Ptm& atlas = model_.atlases[static_cast<std::size_t>(s.atlas)];
+      const int coefficient_count = atlas.NumPolynomials() * 6;
+      const bool lrgb = atlas.format == ptm::PtmFormat::kLrgb;
+      Bilinear(
+          atlas.width, atlas.height, s.atlas_px.x(), s.atlas_px.y(),
+          coefficient_count + (lrgb ? 3 : 0),
+          [&](int xx, int yy, int ch) {
+            const std::size_t t = static_cast<std::size_t>(yy) * atlas.width + xx;
+            return ch < coefficient_count
+                       ? atlas.Coefficients(t)[ch]
+                       : atlas.colour[t * 3 + static_cast<std::size_t>(ch - coefficient_count)];
+          },
+          texel.data());
+      std::vector<std::pair<Eigen::Vector3d, double>> local;  // lights in the face frame
+      for (const sfm::ObjectLight& l : lights)
+        local.emplace_back(s.frame.transpose() * l.DirectionFrom(s.point), l.intensity);
+      value = RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format, local,
+                             1.0);
+    }
+    return value;
+  });
 }
 
 std::vector<cv::Mat> BakePhotoTextures(const TexturedModel& model,

@@ -49,6 +49,24 @@ class ModelRenderer {
   Eigen::Vector3f flat_albedo = Eigen::Vector3f::Constant(0.5f);
   std::vector<cv::Mat> baked;
 
+  /// One ray's hit, for a shader.
+  struct SurfaceSample {
+    std::size_t face = 0;
+    int atlas = 0;
+    Eigen::Vector2d atlas_px = Eigen::Vector2d::Zero();  ///< texture coordinates, atlas pixels
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();     ///< world
+    Eigen::Vector3d to_viewer = Eigen::Vector3d::Zero();  ///< unit, world
+    Eigen::Vector3d smooth_normal = Eigen::Vector3d::Zero();
+    /// Columns in world coordinates: the atlas frame of the face (AtlasFaceFrame)
+    /// turned so that z is the smooth normal.
+    Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();
+  };
+  /// Display RGB of one ray's hit. Called concurrently.
+  using Shader = std::function<Eigen::Vector3f(const SurfaceSample&)>;
+  /// Ray-casts the model as Render does, colouring each hit with `shade`.
+  RenderedView RenderWith(const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
+                          int samples_per_axis, const Shader& shade) const;
+
  private:
   struct Impl;
   const TexturedModel& model_;

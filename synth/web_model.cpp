@@ -30,22 +30,6 @@ std::vector<unsigned char> ReadBytes(const fs::path& path) {
   return std::vector<unsigned char>(std::istreambuf_iterator<char>(in), {});
 }
 
-/// 8-bit RGBA PNG of up to four planes of `width` x `height` bytes (R, G, B, A;
-/// missing planes are 0).
-std::vector<unsigned char> PlanesPng(const std::vector<const QuantisedPlane*>& planes, int width,
-                                     int height, const std::string& label) {
-  cv::Mat bgra(height, width, CV_8UC4, cv::Scalar::all(0));
-  constexpr int kBgraOfRgba[4] = {2, 1, 0, 3};
-  for (std::size_t c = 0; c < planes.size(); ++c)
-    for (int y = 0; y < height; ++y) {
-      const unsigned char* in =
-          planes[c]->bytes.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
-      unsigned char* out = bgra.ptr<unsigned char>(y) + kBgraOfRgba[c];
-      for (int x = 0; x < width; ++x) out[4 * x] = in[x];
-    }
-  return EncodePng(bgra, label);
-}
-
 }  // namespace
 
 std::vector<int> ChartsOfModel(const TexturedModel& model) {
@@ -84,6 +68,20 @@ std::vector<int> ChartsOfModel(const TexturedModel& model) {
     chart[f] = it->second;
   }
   return chart;
+}
+
+std::vector<unsigned char> PlanesPng(const std::vector<const QuantisedPlane*>& planes, int width,
+                                     int height, const std::string& label) {
+  cv::Mat bgra(height, width, CV_8UC4, cv::Scalar::all(0));
+  constexpr int kBgraOfRgba[4] = {2, 1, 0, 3};
+  for (std::size_t c = 0; c < planes.size(); ++c)
+    for (int y = 0; y < height; ++y) {
+      const unsigned char* in =
+          planes[c]->bytes.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
+      unsigned char* out = bgra.ptr<unsigned char>(y) + kBgraOfRgba[c];
+      for (int x = 0; x < width; ++x) out[4 * x] = in[x];
+    }
+  return EncodePng(bgra, label);
 }
 
 QuantisedPlane QuantisePlane(const std::vector<float>& values) {

@@ -30,6 +30,10 @@ struct QuantisedPlane {
   double scale = 1.0, bias = 0.0;
 };
 QuantisedPlane QuantisePlane(const std::vector<float>& values);
+/// PNG bytes (8-bit RGBA) of up to four quantised planes of `width` x `height`
+/// (R, G, B, A; missing planes are 0). Throws InputError(label) on failure.
+std::vector<unsigned char> PlanesPng(const std::vector<const QuantisedPlane*>& planes, int width,
+                                     int height, const std::string& label);
 
 /// Builds the web model of a model folder written by WriteModelFolder (reads
 /// its manifest, OBJ, EXR atlases and baked textures). Throws InputError naming

@@ -1,0 +1,637 @@
+#include "btf/mesh_btf.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/imgproc/detail/gcgraph.hpp>
+#include <random>
+
+#include "sfm/errors.h"
+#include "synth/template_match.h"
+#include "synth/triangle_frame.h"
+
+namespace texlume::btf {
+namespace {
+
+double Since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+double AngleOf(const Eigen::Matrix2d& r) { return std::atan2(r(1, 0), r(0, 0)); }
+
+// The minimum cut of a small graph (paper 004 Fig. 8), behind an interface of
+// our own: nodes, n-links, t-links, then which side each node ends on. OpenCV's
+// GCGraph (BSD/Apache) does the work.
+class MinCut {
+ public:
+  MinCut(int nodes, int links) : graph_(static_cast<unsigned>(nodes), 2u * links) {
+    for (int i = 0; i < nodes; ++i) graph_.addVtx();
+  }
+  void Link(int a, int b, double weight) { graph_.addEdges(a, b, weight, weight); }
+  /// Costs of labelling node a with A (source) and with B (sink).
+  void Terminals(int a, double cost_a, double cost_b) {
+    // GCGraph's t-link to the source is cut when the node ends on the sink side.
+    graph_.addTermWeights(a, cost_b, cost_a);
+  }
+  void Solve() { graph_.maxFlow(); }
+  bool IsA(int a) { return graph_.inSourceSegment(a); }
+
+ private:
+  cv::detail::GCGraph<double> graph_;
+};
+
+// Geometry maps as CV_32FC1 planes (for reductions and FFT matching).
+std::vector<cv::Mat> GeometryPlanes(const BtfFactorisation& s) {
+  std::vector<cv::Mat> planes(static_cast<std::size_t>(s.Components()));
+  for (int i = 0; i < s.Components(); ++i) {
+    cv::Mat& m = planes[static_cast<std::size_t>(i)];
+    m = cv::Mat(s.height, s.width, CV_32FC1);
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x)
+        m.at<float>(y, x) = s.geometry(static_cast<Eigen::Index>(y) * s.width + x, i);
+  }
+  return planes;
+}
+
+}  // namespace
+
+void BtfMeshSynthesisOptions::Check() const {
+  if (!(sample_texel_size > 0.0) || !std::isfinite(sample_texel_size))
+    throw OptionError("sample texel size must be a positive number of world units");
+  if (strip < 2 || strip > 32) throw OptionError("strip (W_e) must be in [2, 32] texels");
+  if (seam_band < 1 || seam_band > strip)
+    throw OptionError("seam band must be in [1, strip] texels");
+  if (top_k < 1) throw OptionError("top_k must be >= 1");
+  if (max_views < 1) throw OptionError("max_views must be >= 1");
+  if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
+  if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
+  if (max_texels < 1) throw OptionError("max_texels must be >= 1");
+  if (!(field_direction_in_world.norm() > 0.0))
+    throw OptionError("field direction must be nonzero");
+}
+
+void SampleGeometry(const BtfFactorisation& s, const Eigen::Vector2d& sample_px, float* out) {
+  const double u = std::clamp(sample_px.x() - 0.5, 0.0, s.width - 1.0);
+  const double v = std::clamp(sample_px.y() - 0.5, 0.0, s.height - 1.0);
+  const int x0 = std::min(static_cast<int>(u), std::max(0, s.width - 2));
+  const int y0 = std::min(static_cast<int>(v), std::max(0, s.height - 2));
+  const int x1 = std::min(x0 + 1, s.width - 1), y1 = std::min(y0 + 1, s.height - 1);
+  const float fx = static_cast<float>(u - x0), fy = static_cast<float>(v - y0);
+  const Eigen::Index w = s.width;
+  const auto r00 = s.geometry.row(y0 * w + x0), r01 = s.geometry.row(y0 * w + x1);
+  const auto r10 = s.geometry.row(y1 * w + x0), r11 = s.geometry.row(y1 * w + x1);
+  for (int i = 0; i < s.Components(); ++i)
+    out[i] = (1 - fy) * ((1 - fx) * r00[i] + fx * r01[i]) + fy * ((1 - fx) * r10[i] + fx * r11[i]);
+}
+
+BtfSampleLookup BtfMeshSynthesis::Lookup(int face, const Eigen::Vector2d& p) const {
+  auto own = [&](int f, const Eigen::Vector2d& q, double angle) {
+    const synth::TrianglePatch& patch = patches[static_cast<std::size_t>(f)];
+    BtfSampleLookup out;
+    out.source_face = f;
+    out.sample_px = Eigen::Vector2d(patch.sample_x + (q.x() - patch.x_min) / texel_size,
+                                    patch.sample_y + (patch.y_max - q.y()) / texel_size);
+    out.angle_rad = angle;
+    return out;
+  };
+  const synth::TrianglePatch& patch = patches[static_cast<std::size_t>(face)];
+  const cv::Mat& label = labels[static_cast<std::size_t>(face)];
+  const int i = static_cast<int>(std::floor((p.x() - patch.x_min) / texel_size));
+  const int j = static_cast<int>(std::floor((patch.y_max - p.y()) / texel_size));
+  if (label.empty() || i < 0 || j < 0 || i >= label.cols || j >= label.rows) return own(face, p, 0);
+  const int l = label.at<std::uint8_t>(j, i);
+  if (l == 0) return own(face, p, 0);
+  const synth::Unfolding& u =
+      unfoldings[static_cast<std::size_t>(face)][static_cast<std::size_t>(l - 1)];
+  if (u.face < 0) return own(face, p, 0);
+  return own(u.face, u.rotation * p + u.translation, AngleOf(u.rotation));
+}
+
+BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
+                                   const sfm::Reconstruction& reconstruction,
+                                   const sfm::VisibilityResult& visibility,
+                                   const std::vector<synth::MeshPhoto>& photos,
+                                   const BtfFactorisation& sample,
+                                   const BtfMeshSynthesisOptions& options,
+                                   const ProgressCallback& progress) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t num_faces = mesh.faces.size();
+  if (visibility.triangles.size() != num_faces)
+    throw InputError("visibility", "does not match the mesh's face count");
+  const double t = options.sample_texel_size;
+  const int n = sample.Components();
+  BtfMeshSynthesis result;
+  result.texel_size = t;
+  result.sample_width = sample.width;
+  result.sample_height = sample.height;
+
+  // 1. Frames, patch rectangles, unfoldings (Algorithm 2's set-up).
+  {
+    synth::PatchGeometry geometry = synth::MakePatchGeometry(
+        mesh, t, options.strip, options.tangent_frame, options.field_direction_in_world);
+    if (geometry.total_texels > options.max_texels) {
+      throw InputError("mesh", "at a texel size of " + std::to_string(t) + " world units the " +
+                                   std::to_string(num_faces) + " patches need " +
+                                   std::to_string(geometry.total_texels) +
+                                   " texels, more than the limit of " +
+                                   std::to_string(options.max_texels));
+    }
+    if (geometry.widest > sample.width || geometry.tallest > sample.height) {
+      throw InputError("mesh", "the largest triangle needs a patch of " +
+                                   std::to_string(geometry.widest) + " x " +
+                                   std::to_string(geometry.tallest) +
+                                   " texels (strip included) but the BTF sample is " +
+                                   std::to_string(sample.width) + " x " +
+                                   std::to_string(sample.height) +
+                                   "; subdivide the mesh or capture a larger sample");
+    }
+    result.patches = std::move(geometry.patches);
+    result.unfoldings = std::move(geometry.unfoldings);
+  }
+  const std::vector<cv::Mat> planes = GeometryPlanes(sample);
+  const cv::Mat planes_energy = synth::PlaneEnergy(planes);
+  Eigen::VectorXf mean_g = sample.geometry.colwise().mean().transpose();
+
+  // Geometry maps reduced to a photo density r = 2^(-level/4) photo pixels per
+  // texel. The BTF is linear in g, so reducing g equals reducing the relit image.
+  struct Reduced {
+    std::vector<cv::Mat> g;
+    double rx = 1.0, ry = 1.0;
+  };
+  std::map<int, Reduced> reduced;
+  auto reduced_at = [&](int level) -> const Reduced& {
+    auto it = reduced.find(level);
+    if (it != reduced.end()) return it->second;
+    Reduced r;
+    const double density = std::pow(2.0, -level / 4.0);
+    const int rw = std::max(1, static_cast<int>(std::lround(sample.width * density)));
+    const int rh = std::max(1, static_cast<int>(std::lround(sample.height * density)));
+    for (const cv::Mat& m : planes) {
+      cv::Mat small;
+      cv::resize(m, small, cv::Size(rw, rh), 0, 0, cv::INTER_AREA);
+      r.g.push_back(small);
+    }
+    r.rx = static_cast<double>(rw) / sample.width;
+    r.ry = static_cast<double>(rh) / sample.height;
+    return reduced.emplace(level, std::move(r)).first->second;
+  };
+
+  // A triangle in one photo: the photo rectified into the triangle frame at the
+  // photo's density (linear RGB), the mask, and A = sum_lights I p(v, l)
+  // (n x 3): the relit sample is then sum_i g_i A_i.
+  std::map<sfm::ImageId, std::size_t> photo_index;
+  for (std::size_t k = 0; k < photos.size(); ++k) photo_index[photos[k].image_id] = k;
+  struct Rectified {
+    std::size_t photo = 0;
+    int level = 0;
+    std::vector<cv::Mat> linear;  // RGB
+    cv::Mat mask;                 // CV_32FC1
+    int count = 0;
+    Eigen::MatrixX3f appearance;  // n x 3
+    bool steep = true;            // every light and the view above 60 degrees
+  };
+  auto rectify = [&](std::size_t f, const sfm::TriangleView& view, Rectified& out) -> bool {
+    const auto it = photo_index.find(view.image_id);
+    if (it == photo_index.end()) return false;
+    const synth::MeshPhoto& photo = photos[it->second];
+    const sfm::Image& image = reconstruction.images.at(view.image_id);
+    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
+    const synth::TrianglePatch& patch = result.patches[f];
+    const auto& c = patch.corners_in_frame;
+    const double area = 0.5 * std::abs((c[1] - c[0]).x() * (c[2] - c[0]).y() -
+                                       (c[1] - c[0]).y() * (c[2] - c[0]).x());
+    const double density = std::sqrt(std::max(view.projected_area_px, 1e-6f) / (area / (t * t)));
+    const int level = std::clamp(static_cast<int>(std::lround(-4.0 * std::log2(density))), 0, 40);
+    const Reduced& r = reduced_at(level);
+    const int tw = std::max(1, static_cast<int>(std::lround(patch.width * r.rx)));
+    const int th = std::max(1, static_cast<int>(std::lround(patch.height * r.ry)));
+    if (tw > r.g[0].cols || th > r.g[0].rows) return false;
+    cv::Mat map_x(th, tw, CV_32FC1), map_y(th, tw, CV_32FC1);
+    out.mask = cv::Mat::zeros(th, tw, CV_32FC1);
+    out.count = 0;
+    for (int j = 0; j < th; ++j) {
+      for (int i = 0; i < tw; ++i) {
+        const Eigen::Vector2d p(patch.x_min + (i + 0.5) / r.rx * t,
+                                patch.y_max - (j + 0.5) / r.ry * t);
+        const Eigen::Vector3d world =
+            patch.frame.origin_in_world + p.x() * patch.frame.x_axis + p.y() * patch.frame.y_axis;
+        const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(
+            image.cam_from_world.rotation * world + image.cam_from_world.translation);
+        map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
+        map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
+        if (px && synth::SignedDistanceToTriangle(c, p) <= 0.0 && px->x() >= 0.5 &&
+            px->y() >= 0.5 && px->x() <= photo.image.cols - 0.5 &&
+            px->y() <= photo.image.rows - 0.5) {
+          out.mask.at<float>(j, i) = 1.0f;
+          ++out.count;
+        }
+      }
+    }
+    if (out.count < options.min_photo_pixels) return false;
+    cv::Mat rectified;
+    cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
+    std::vector<cv::Mat> display;
+    cv::split(rectified, display);
+    out.linear.assign(3, cv::Mat());
+    for (int ch = 0; ch < 3; ++ch) {
+      cv::Mat& m = out.linear[static_cast<std::size_t>(ch)];
+      m = cv::Mat(th, tw, CV_32FC1);
+      for (int j = 0; j < th; ++j)
+        for (int i = 0; i < tw; ++i)
+          m.at<float>(j, i) =
+              synth::SrgbToLinear(display[static_cast<std::size_t>(ch)].at<float>(j, i));
+    }
+    const Eigen::Vector3d v = patch.frame.DirectionInFrame(
+        (image.ProjectionCenter() - patch.frame.origin_in_world).normalized());
+    out.steep = v.z() > 0.5;
+    out.appearance = Eigen::MatrixX3f::Zero(n, 3);
+    for (const sfm::ObjectLight& light : photo.lights) {
+      const Eigen::Vector3d l =
+          patch.frame.DirectionInFrame(light.DirectionFrom(patch.frame.origin_in_world));
+      out.steep = out.steep && l.z() > 0.5;
+      if (l.z() <= 0.0 || v.z() <= 0.0) continue;
+      out.appearance += static_cast<float>(light.intensity) * InterpolateAppearance(sample, v, l);
+    }
+    out.photo = it->second;
+    out.level = level;
+    return true;
+  };
+  auto relit = [&](const Reduced& r, const Eigen::MatrixX3f& a, double gain) {
+    std::vector<cv::Mat> out(3);
+    for (int ch = 0; ch < 3; ++ch) {
+      cv::Mat& m = out[static_cast<std::size_t>(ch)];
+      m = cv::Mat::zeros(r.g[0].size(), CV_32FC1);
+      for (int i = 0; i < n; ++i)
+        cv::scaleAdd(r.g[static_cast<std::size_t>(i)], static_cast<double>(a(i, ch)) * gain, m, m);
+    }
+    return out;
+  };
+  auto views_of = [&](std::size_t f) {
+    std::vector<sfm::TriangleView> v;
+    const sfm::TriangleVisibility& tv = visibility.triangles[f];
+    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) return v;
+    std::vector<sfm::TriangleView> others;
+    for (const sfm::TriangleView& view : tv.views) {
+      if (!view.fully_visible) continue;
+      (view.image_id == tv.best_view ? v : others).push_back(view);
+    }
+    std::sort(others.begin(), others.end(),
+              [](const auto& a, const auto& b) { return a.angle_rad < b.angle_rad; });
+    for (const auto& view : others)
+      if (static_cast<int>(v.size()) < options.max_views) v.push_back(view);
+    return v;
+  };
+
+  // 2a. Gain per photo, as in the PTM synthesis: photo mean over the sample's
+  // mean relit under the triangle's view and lights, m = a_T g_n, solved for
+  // log g_n by alternating least squares with the mean log a_T at 0.
+  struct Ratio {
+    std::size_t face, photo;
+    double log_m, weight;
+  };
+  std::vector<Ratio> ratios;
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    int used = 0;
+    for (const sfm::TriangleView& view : visibility.triangles[f].views) {
+      if (!view.fully_visible || used >= 8) continue;
+      Rectified rect;
+      if (!rectify(f, view, rect) || !rect.steep) continue;
+      double photo_linear = 0.0;
+      for (int ch = 0; ch < 3; ++ch)
+        photo_linear += cv::sum(rect.linear[static_cast<std::size_t>(ch)].mul(rect.mask))[0];
+      const double model_linear = (mean_g.transpose() * rect.appearance).sum() * rect.count;
+      if (!(model_linear > 0.02 * 3 * rect.count) || !(photo_linear > 1e-6)) continue;
+      ratios.push_back({f, rect.photo, std::log(photo_linear / model_linear), model_linear});
+      ++used;
+    }
+  }
+  std::vector<double> log_gain(photos.size(), 0.0), log_albedo(num_faces, 0.0);
+  for (int it = 0; it < 20; ++it) {
+    std::vector<double> sum(num_faces, 0.0), weight(num_faces, 0.0);
+    for (const Ratio& r : ratios) {
+      sum[r.face] += r.weight * (r.log_m - log_gain[r.photo]);
+      weight[r.face] += r.weight;
+    }
+    double mean = 0.0, total = 0.0;
+    for (std::size_t f = 0; f < num_faces; ++f)
+      if (weight[f] > 0)
+        log_albedo[f] = sum[f] / weight[f], mean += weight[f] * log_albedo[f], total += weight[f];
+    if (total > 0) mean /= total;
+    for (double& v : log_albedo) v -= mean;
+    std::vector<double> gsum(photos.size(), 0.0), gweight(photos.size(), 0.0);
+    for (const Ratio& r : ratios) {
+      gsum[r.photo] += r.weight * (r.log_m - log_albedo[r.face]);
+      gweight[r.photo] += r.weight;
+    }
+    for (std::size_t k = 0; k < photos.size(); ++k)
+      if (gweight[k] > 0) log_gain[k] = gsum[k] / gweight[k];
+  }
+  result.photo_gains.resize(photos.size());
+  for (std::size_t k = 0; k < photos.size(); ++k) result.photo_gains[k] = std::exp(log_gain[k]);
+
+  // 2b. Breadth-first synthesis from the best-seen triangle.
+  int seed_face = 0;
+  float best_area = -1.0f;
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const auto& tv = visibility.triangles[f];
+    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) continue;
+    for (const auto& v : tv.views)
+      if (v.image_id == tv.best_view && v.projected_area_px > best_area)
+        best_area = v.projected_area_px, seed_face = static_cast<int>(f);
+  }
+  const std::vector<int> order =
+      sfm::BreadthFirstFaceOrder(mesh, sfm::FaceNeighbours(mesh), seed_face);
+  std::vector<char> done(num_faces, 0);
+  std::mt19937_64 rng(options.seed);
+  std::vector<float> value(static_cast<std::size_t>(n));
+  std::size_t processed = 0;
+  for (const int face : order) {
+    const std::size_t f = static_cast<std::size_t>(face);
+    synth::TrianglePatch& patch = result.patches[f];
+    const int w = patch.width, h = patch.height;
+    // Overlap targets: synthesised neighbours' geometry maps, unfolded into this
+    // frame, on the texels within W_e of the shared edge.
+    std::vector<int> target_texels;
+    std::vector<float> targets;  // n per target texel
+    for (int j = 0; j < h; ++j) {
+      for (int i = 0; i < w; ++i) {
+        const Eigen::Vector2d p(patch.x_min + (i + 0.5) * t, patch.y_max - (j + 0.5) * t);
+        for (int k = 0; k < 3; ++k) {
+          const synth::Unfolding& u = result.unfoldings[f][static_cast<std::size_t>(k)];
+          if (u.face < 0 || !done[static_cast<std::size_t>(u.face)]) continue;
+          const double d = synth::DistanceToSegment(
+              patch.corners_in_frame[static_cast<std::size_t>(k)],
+              patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)], p);
+          if (d > options.strip * t) continue;
+          const synth::TrianglePatch& other = result.patches[static_cast<std::size_t>(u.face)];
+          const Eigen::Vector2d q = u.rotation * p + u.translation;
+          const double sx = other.sample_x + (q.x() - other.x_min) / t;
+          const double sy = other.sample_y + (other.y_max - q.y()) / t;
+          if (sx < other.sample_x || sy < other.sample_y || sx > other.sample_x + other.width ||
+              sy > other.sample_y + other.height)
+            continue;
+          SampleGeometry(sample, Eigen::Vector2d(sx, sy), value.data());
+          target_texels.push_back(j * w + i);
+          targets.insert(targets.end(), value.begin(), value.end());
+          break;
+        }
+      }
+    }
+    auto overlap_error = [&](int sx, int sy) {
+      if (target_texels.empty()) return 0.0;
+      double e = 0.0;
+      for (std::size_t m = 0; m < target_texels.size(); ++m) {
+        const int i = target_texels[m] % w, j = target_texels[m] / w;
+        const auto row = sample.geometry.row(static_cast<Eigen::Index>(sy + j) * sample.width +
+                                             sx + i);
+        for (int c = 0; c < n; ++c) {
+          const double d = row[c] - targets[m * static_cast<std::size_t>(n) + c];
+          e += d * d;
+        }
+      }
+      return e / static_cast<double>(target_texels.size());
+    };
+
+    std::vector<Rectified> rects;
+    for (const sfm::TriangleView& view : views_of(f)) {
+      Rectified r;
+      if (rectify(f, view, r)) rects.push_back(std::move(r));
+    }
+    const int max_sx = sample.width - w, max_sy = sample.height - h;
+    if (!rects.empty()) {
+      // Eq. 3 of paper 003 per photo (RMS, linear RGB), summed over the photos.
+      cv::Mat total = cv::Mat::zeros(max_sy + 1, max_sx + 1, CV_32FC1);
+      for (const Rectified& r : rects) {
+        const Reduced& red = reduced_at(r.level);
+        const std::vector<cv::Mat> model = relit(red, r.appearance, result.photo_gains[r.photo]);
+        const cv::Mat ssd = synth::MaskedSsd(model, synth::PlaneEnergy(model), r.linear, r.mask);
+        for (int sy = 0; sy <= max_sy; ++sy) {
+          const int py = std::min(static_cast<int>(std::lround(sy * red.ry)), ssd.rows - 1);
+          for (int sx = 0; sx <= max_sx; ++sx) {
+            const int px = std::min(static_cast<int>(std::lround(sx * red.rx)), ssd.cols - 1);
+            total.at<float>(sy, sx) += std::sqrt(ssd.at<float>(py, px) / (3.0f * r.count));
+          }
+        }
+      }
+      std::vector<std::pair<float, cv::Point>> all;
+      const int stride =
+          std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx)));
+      for (int sy = 0; sy <= max_sy; sy += stride)
+        for (int sx = 0; sx <= max_sx; sx += stride)
+          all.emplace_back(total.at<float>(sy, sx), cv::Point(sx, sy));
+      const std::size_t k =
+          std::min<std::size_t>(static_cast<std::size_t>(options.top_k), all.size());
+      std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k), all.end(),
+                        [](const auto& a, const auto& b) { return a.first < b.first; });
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t c = 0; c < k; ++c) {
+        const double e = overlap_error(all[c].second.x, all[c].second.y);
+        if (e < best) {
+          best = e;
+          patch.sample_x = all[c].second.x;
+          patch.sample_y = all[c].second.y;
+          patch.image_score = all[c].first;
+          patch.overlap_error = e;
+        }
+      }
+      patch.source = synth::PatchSource::kPhotos;
+      patch.views_used = static_cast<int>(rects.size());
+      ++result.num_from_photos;
+    } else if (!target_texels.empty()) {
+      std::vector<cv::Mat> target_planes(static_cast<std::size_t>(n));
+      for (cv::Mat& m : target_planes) m = cv::Mat::zeros(h, w, CV_32FC1);
+      cv::Mat mask = cv::Mat::zeros(h, w, CV_32FC1);
+      for (std::size_t m = 0; m < target_texels.size(); ++m) {
+        const int i = target_texels[m] % w, j = target_texels[m] / w;
+        mask.at<float>(j, i) = 1.0f;
+        for (int c = 0; c < n; ++c)
+          target_planes[static_cast<std::size_t>(c)].at<float>(j, i) =
+              targets[m * static_cast<std::size_t>(n) + c];
+      }
+      const cv::Mat errors = synth::MaskedSsd(planes, planes_energy, target_planes, mask);
+      const cv::Point p = synth::PickWithinTolerance(errors, options.tolerance, rng);
+      patch.sample_x = p.x;
+      patch.sample_y = p.y;
+      patch.overlap_error = errors.at<float>(p.y, p.x) / static_cast<double>(target_texels.size());
+      patch.source = synth::PatchSource::kNeighbours;
+      ++result.num_from_neighbours;
+    } else {
+      patch.sample_x = std::uniform_int_distribution<int>(0, max_sx)(rng);
+      patch.sample_y = std::uniform_int_distribution<int>(0, max_sy)(rng);
+      patch.source = synth::PatchSource::kRandom;
+      ++result.num_random;
+    }
+    done[f] = 1;
+    ++processed;
+    if (progress && (processed % 64 == 0 || processed == num_faces))
+      progress("btf synthesis", processed, num_faces);
+  }
+  result.seconds_synthesis = Since(start);
+
+  // 3. Graph-cut seams across every shared edge (paper 004 §V, Fig. 8).
+  const auto seams_start = std::chrono::steady_clock::now();
+  result.labels.resize(num_faces);
+  for (std::size_t f = 0; f < num_faces; ++f)
+    result.labels[f] =
+        cv::Mat::zeros(result.patches[f].height, result.patches[f].width, CV_8UC1);
+  const double band = options.seam_band * t;
+  double cut_cost = 0.0, edge_cost = 0.0;
+  std::size_t edge_links = 0;
+  std::vector<float> a_value(static_cast<std::size_t>(n)), b_value(static_cast<std::size_t>(n));
+  // The distance between the two patches' geometry-map vectors at a point of
+  // face f's frame (the |f_A(p) - f_B(p)| of E_smooth).
+  auto difference = [&](std::size_t f, const synth::Unfolding& u, const Eigen::Vector2d& p) {
+    const synth::TrianglePatch& own = result.patches[f];
+    SampleGeometry(sample,
+                   Eigen::Vector2d(own.sample_x + (p.x() - own.x_min) / t,
+                                   own.sample_y + (own.y_max - p.y()) / t),
+                   a_value.data());
+    const synth::TrianglePatch& other = result.patches[static_cast<std::size_t>(u.face)];
+    const Eigen::Vector2d q = u.rotation * p + u.translation;
+    SampleGeometry(sample,
+                   Eigen::Vector2d(other.sample_x + (q.x() - other.x_min) / t,
+                                   other.sample_y + (other.y_max - q.y()) / t),
+                   b_value.data());
+    double d = 0.0;
+    for (int c = 0; c < n; ++c) d += (a_value[c] - b_value[c]) * (a_value[c] - b_value[c]);
+    return std::sqrt(d);
+  };
+  auto nearest_edge = [](const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
+    int best = 0;
+    double best_d = std::numeric_limits<double>::max();
+    for (int k = 0; k < 3; ++k) {
+      const double d = synth::DistanceToSegment(c[static_cast<std::size_t>(k)],
+                                                c[static_cast<std::size_t>((k + 1) % 3)], p);
+      if (d < best_d) best_d = d, best = k;
+    }
+    return best;
+  };
+  std::size_t edges_done = 0;
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const synth::TrianglePatch& patch = result.patches[f];
+    for (int k = 0; k < 3; ++k) {
+      const synth::Unfolding& u = result.unfoldings[f][static_cast<std::size_t>(k)];
+      if (u.face < 0 || static_cast<std::size_t>(u.face) < f) continue;  // each edge once
+      const std::size_t h = static_cast<std::size_t>(u.face);
+      const synth::TrianglePatch& other = result.patches[h];
+      int kh = -1;  // the shared edge's index in the neighbour
+      for (int m = 0; m < 3; ++m)
+        if (result.unfoldings[h][static_cast<std::size_t>(m)].face == static_cast<int>(f)) kh = m;
+      if (kh < 0) continue;
+      const Eigen::Vector2d a = patch.corners_in_frame[static_cast<std::size_t>(k)];
+      const Eigen::Vector2d b = patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)];
+      // Side of the edge a point is on: +1 towards f's third corner.
+      const Eigen::Vector2d third = patch.corners_in_frame[static_cast<std::size_t>((k + 2) % 3)];
+      auto cross = [&](const Eigen::Vector2d& p) {
+        return (b - a).x() * (p - a).y() - (b - a).y() * (p - a).x();
+      };
+      const double own_sign = cross(third) >= 0 ? 1.0 : -1.0;
+      // Nodes: f's patch texels within the band whose nearest edge (of their own
+      // triangle) is this one, on f's side or the neighbour's.
+      const int w = patch.width, hgt = patch.height;
+      std::vector<int> node(static_cast<std::size_t>(w * hgt), -1);
+      std::vector<signed char> side(static_cast<std::size_t>(w * hgt), 0);  // +1 f, -1 h
+      std::vector<std::pair<int, int>> cells;
+      auto centre = [&](int i, int j) {
+        return Eigen::Vector2d(patch.x_min + (i + 0.5) * t, patch.y_max - (j + 0.5) * t);
+      };
+      for (int j = 0; j < hgt; ++j) {
+        for (int i = 0; i < w; ++i) {
+          const Eigen::Vector2d p = centre(i, j);
+          const bool on_f = cross(p) * own_sign >= 0;
+          side[static_cast<std::size_t>(j * w + i)] = on_f ? 1 : -1;
+          if (synth::DistanceToSegment(a, b, p) > band) continue;
+          const Eigen::Vector2d q = u.rotation * p + u.translation;
+          if (on_f ? nearest_edge(patch.corners_in_frame, p) != k
+                   : nearest_edge(other.corners_in_frame, q) != kh)
+            continue;
+          const double sx = (q.x() - other.x_min) / t, sy = (other.y_max - q.y()) / t;
+          if (sx < 0 || sy < 0 || sx > other.width || sy > other.height) continue;
+          node[static_cast<std::size_t>(j * w + i)] = static_cast<int>(cells.size());
+          cells.emplace_back(i, j);
+        }
+      }
+      if (cells.empty()) continue;
+      std::vector<double> diff(cells.size());
+      for (std::size_t c = 0; c < cells.size(); ++c)
+        diff[c] = difference(f, u, centre(cells[c].first, cells[c].second));
+      MinCut cut(static_cast<int>(cells.size()), static_cast<int>(2 * cells.size()));
+      constexpr double kHard = 1e9;
+      constexpr int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        const auto [i, j] = cells[c];
+        const int s = side[static_cast<std::size_t>(j * w + i)];
+        bool hard = false;
+        for (int m = 0; m < 4; ++m) {
+          const int ii = i + di[m], jj = j + dj[m];
+          const bool inside = ii >= 0 && jj >= 0 && ii < w && jj < hgt;
+          const int other_node = inside ? node[static_cast<std::size_t>(jj * w + ii)] : -1;
+          if (other_node < 0) {
+            // Next to a texel outside the band on this side: it keeps its own patch.
+            if (!inside || side[static_cast<std::size_t>(jj * w + ii)] == s) hard = true;
+          } else if (m % 2 == 0) {  // each pair once (right and down)
+            // E_smooth's V(p, q), plus a little per link so seams stay short.
+            cut.Link(static_cast<int>(c), other_node,
+                     diff[c] + diff[static_cast<std::size_t>(other_node)] + 1e-6);
+          }
+          if (other_node >= 0 && m % 2 == 0 &&
+              side[static_cast<std::size_t>(jj * w + ii)] != s) {
+            edge_cost += diff[c] + diff[static_cast<std::size_t>(other_node)];
+            ++edge_links;
+          }
+        }
+        if (hard) cut.Terminals(static_cast<int>(c), s > 0 ? 0.0 : kHard, s > 0 ? kHard : 0.0);
+      }
+      cut.Solve();
+      std::vector<char> is_a(cells.size());
+      for (std::size_t c = 0; c < cells.size(); ++c) is_a[c] = cut.IsA(static_cast<int>(c));
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        const auto [i, j] = cells[c];
+        if (!is_a[c]) result.labels[f].at<std::uint8_t>(j, i) = static_cast<std::uint8_t>(1 + k);
+        for (int m = 0; m < 4; m += 2) {
+          const int ii = i + di[m], jj = j + dj[m];
+          if (ii >= w || jj >= hgt) continue;
+          const int o = node[static_cast<std::size_t>(jj * w + ii)];
+          if (o >= 0 && is_a[c] != is_a[static_cast<std::size_t>(o)]) {
+            cut_cost += diff[c] + diff[static_cast<std::size_t>(o)];
+            ++result.seam_links;
+          }
+        }
+      }
+      // The neighbour's texels near the edge take the cut's label at the nearest
+      // cell of this grid: where it chose A, they show this face's patch.
+      cv::Mat& nb_labels = result.labels[h];
+      const Eigen::Matrix2d back = u.rotation.transpose();
+      for (int j = 0; j < other.height; ++j) {
+        for (int i = 0; i < other.width; ++i) {
+          const Eigen::Vector2d q(other.x_min + (i + 0.5) * t, other.y_max - (j + 0.5) * t);
+          const Eigen::Vector2d p = back * (q - u.translation);
+          if (synth::DistanceToSegment(a, b, p) > band + t) continue;
+          const int ci = static_cast<int>(std::floor((p.x() - patch.x_min) / t));
+          const int cj = static_cast<int>(std::floor((patch.y_max - p.y()) / t));
+          if (ci < 0 || cj < 0 || ci >= w || cj >= hgt) continue;
+          const int c = node[static_cast<std::size_t>(cj * w + ci)];
+          if (c >= 0 && is_a[static_cast<std::size_t>(c)] &&
+              side[static_cast<std::size_t>(cj * w + ci)] < 0)
+            nb_labels.at<std::uint8_t>(j, i) = static_cast<std::uint8_t>(1 + kh);
+        }
+      }
+      ++result.seam_edges;
+    }
+    ++edges_done;
+    if (progress && (edges_done % 256 == 0 || edges_done == num_faces))
+      progress("graph-cut seams", edges_done, num_faces);
+  }
+  result.seam_cost_per_link =
+      result.seam_links ? cut_cost / static_cast<double>(result.seam_links) : 0.0;
+  result.edge_cost_per_link = edge_links ? edge_cost / static_cast<double>(edge_links) : 0.0;
+  result.seconds_seams = Since(seams_start);
+  return result;
+}
+
+}  // namespace texlume::btf
