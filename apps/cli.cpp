@@ -6,8 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
-#include <memory>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -509,7 +509,8 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
     b.components = a.GetInt("components", b.components);
     b.synthesis.sample_texel_size = o.synthesis.sample_texel_size;
     b.synthesis.strip = o.synthesis.strip;
-    b.synthesis.seam_band = a.GetInt("seam-band", std::min(b.synthesis.seam_band, o.synthesis.strip));
+    b.synthesis.seam_band =
+        a.GetInt("seam-band", std::min(b.synthesis.seam_band, o.synthesis.strip));
     b.synthesis.top_k = o.synthesis.top_k;
     b.synthesis.max_views = o.synthesis.all_views ? o.synthesis.max_views : 1;
     b.synthesis.seed = o.synthesis.seed;
@@ -563,10 +564,9 @@ int RunRenderCommand(const std::vector<std::string>& args, std::ostream& out, st
   std::shared_ptr<btf::BtfModel> btf_model;
   if (!a.Has("baseline") && synth::ReadModelManifest(o.model_folder).contains("btf")) {
     o.renderer_name = "btf";
-    o.renderer = [&btf_model, &o](
-                     const synth::TexturedModel& model, const sfm::Camera& camera,
-                     const sfm::Rigid3d& cam_from_world,
-                     const std::vector<sfm::ObjectLight>& lights) {
+    o.renderer = [&btf_model, &o](const synth::TexturedModel& model, const sfm::Camera& camera,
+                                  const sfm::Rigid3d& cam_from_world,
+                                  const std::vector<sfm::ObjectLight>& lights) {
       if (!btf_model)
         btf_model = std::make_shared<btf::BtfModel>(btf::ReadBtfModel(o.model_folder, model));
       synth::ModelRenderer renderer(model);
@@ -597,10 +597,13 @@ int RunRenderCommand(const std::vector<std::string>& args, std::ostream& out, st
 
 int RunSceneCommand(const std::vector<std::string>& args, std::ostream& out,
                     std::ostream& /*err*/) {
-  const Arguments a(args,
-                    {"kind", "material", "out", "seed", "images", "camera-model", "width", "height",
-                     "capture-size", "capture-lights", "held-out-lights", "texel-size", "relief",
-                     "specular", "held-out-views", "held-out-scale", "samples", "mesh-resolution"},
+  const Arguments a(args, {"kind",           "material",        "out",
+                           "seed",           "images",          "camera-model",
+                           "width",          "height",          "capture-size",
+                           "capture-lights", "held-out-lights", "texel-size",
+                           "relief",         "specular",        "held-out-views",
+                           "held-out-scale", "samples",         "mesh-resolution",
+                           "btf-size",       "btf-views",       "btf-lights"},
                     {"no-btf", "fixed-exposure"});
   datasets::SceneOptions options;
   const std::string kind = a.Get("kind").value_or("sphere");
@@ -638,6 +641,9 @@ int RunSceneCommand(const std::vector<std::string>& args, std::ostream& out,
   options.mesh_resolution = a.GetInt("mesh-resolution", options.mesh_resolution);
   options.shading.samples_per_axis = a.GetInt("samples", options.shading.samples_per_axis);
   options.write_btf = !a.Has("no-btf");
+  options.btf_size = a.GetInt("btf-size", options.btf_size);
+  options.btf_view_count = a.GetInt("btf-views", options.btf_view_count);
+  options.btf_light_count = a.GetInt("btf-lights", options.btf_light_count);
   options.vary_exposure = !a.Has("fixed-exposure");
   const std::filesystem::path dir = a.Require("out");
   ProgressBar bar;

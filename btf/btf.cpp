@@ -222,14 +222,31 @@ Eigen::MatrixX3f InterpolateAppearance(const BtfFactorisation& factorisation,
   const int n = factorisation.Components();
   Eigen::MatrixX3f p = Eigen::MatrixX3f::Zero(n, 3);
   const std::size_t num_lights = factorisation.lights.size();
-  for (const auto& [a, wa] : DirectionWeights(factorisation.views, view))
-    for (const auto& [b, wb] : DirectionWeights(factorisation.lights, light))
+  // Below the lowest direction of a grid, the direction at that elevation (same
+  // azimuth); a light there also fades linearly in l_z to 0 at the horizon, as
+  // irradiance does (cos of the angle to the normal), instead of extrapolating.
+  auto lift = [](const std::vector<Eigen::Vector3d>& grid, Eigen::Vector3d d) {
+    double z_low = 1.0;
+    for (const Eigen::Vector3d& g : grid) z_low = std::min(z_low, g.z());
+    const double r = std::hypot(d.x(), d.y());
+    if (d.z() >= z_low || z_low >= 1.0 || r < 1e-12) return std::make_pair(d, 1.0);
+    const double fade = std::max(d.z(), 0.0) / z_low;
+    const double s = std::sqrt(1.0 - z_low * z_low) / r;
+    return std::make_pair(Eigen::Vector3d(d.x() * s, d.y() * s, z_low), fade);
+  };
+  const auto [view_used, view_fade] = lift(factorisation.views, view);
+  const auto [light_used, light_fade] = lift(factorisation.lights, light);
+  (void)view_fade;  // radiance does not vanish towards a grazing view
+  for (const auto& [a, wa] : DirectionWeights(factorisation.views, view_used))
+    for (const auto& [b, wb_grid] : DirectionWeights(factorisation.lights, light_used)) {
+      const double wb = wb_grid * light_fade;
       for (int c = 0; c < 3; ++c)
         p.col(c) += static_cast<float>(wa * wb) *
                     factorisation.appearance
                         .row(static_cast<Eigen::Index>((a * num_lights + b) * 3 +
                                                        static_cast<std::size_t>(c)))
                         .transpose();
+    }
   return p;
 }
 

@@ -135,8 +135,8 @@ std::vector<ptm::Ptm> PreviewPtms(const BtfAtlases& atlases, const BtfFactorisat
         Eigen::Matrix<double, 6, 1> coefficients = fit * lum;
         // Eq. 2: colour = L (R, G, B), the colour's largest channel 1.
         const double total = lum.sum();
-        Eigen::Vector3d colour = total > 1e-9 ? Eigen::Vector3d(channel_sum / total)
-                                              : Eigen::Vector3d::Ones();
+        Eigen::Vector3d colour =
+            total > 1e-9 ? Eigen::Vector3d(channel_sum / total) : Eigen::Vector3d::Ones();
         const double top = std::max(colour.maxCoeff(), 1e-6);
         colour /= top;
         coefficients *= top;
@@ -157,7 +157,8 @@ BtfModel ReadBtfModel(const fs::path& dir, const synth::TexturedModel& model) {
   const nlohmann::json manifest = synth::ReadModelManifest(dir);
   const fs::path manifest_path = dir / "manifest.json";
   if (!manifest.contains("btf") || !manifest["btf"].is_object())
-    throw InputError(manifest_path.string(), "describes no BTF model (made by texlume synth --btf)");
+    throw InputError(manifest_path.string(),
+                     "describes no BTF model (made by texlume synth --btf)");
   BtfModel out;
   out.sample = ReadBtfFactorisation(dir / "btf");
   for (std::size_t k = 0; k < model.atlases.size(); ++k) {
@@ -169,8 +170,8 @@ BtfModel ReadBtfModel(const fs::path& dir, const synth::TexturedModel& model) {
     for (const std::string& want : kCoordinateChannels) {
       const auto it = std::find(names.begin(), names.end(), want);
       if (it == names.end())
-        throw InputError(file.string(), "has no channel " + want +
-                                            " (expected sample_x, sample_y, angle)");
+        throw InputError(file.string(),
+                         "has no channel " + want + " (expected sample_x, sample_y, angle)");
       ordered.push_back(planes[static_cast<std::size_t>(it - names.begin())]);
     }
     if (ordered[0].cols != model.atlases[k].width || ordered[0].rows != model.atlases[k].height)
@@ -256,8 +257,8 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
   if (so.sample_texel_size == 0.0) so.sample_texel_size = sample.texel_size;
   so.Check();
 
-  synth::SynthInputs inputs = synth::LoadSynthInputs(
-      job, std::min(sample.width, sample.height), so.sample_texel_size, so.strip, progress);
+  synth::SynthInputs inputs = synth::LoadSynthInputs(job, std::min(sample.width, sample.height),
+                                                     so.sample_texel_size, so.strip, progress);
   summary.warnings = inputs.warnings;
   summary.photos_used = inputs.photos.size();
   summary.subdivisions = inputs.subdivisions;
@@ -294,14 +295,15 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
   // The baselines `texlume render` draws, as for PTM models.
   const std::vector<cv::Mat> baked = synth::BakePhotoTextures(
       model, inputs.reconstruction, inputs.visibility, inputs.photos, synthesis.photo_gains);
-  const Eigen::Vector3f flat_albedo =
-      synth::MeanAlbedoFromPhotos(inputs.mesh, inputs.reconstruction, inputs.visibility,
-                                  inputs.photos, synthesis.photo_gains);
+  const Eigen::Vector3f flat_albedo = synth::MeanAlbedoFromPhotos(
+      inputs.mesh, inputs.reconstruction, inputs.visibility, inputs.photos, synthesis.photo_gains);
 
   nlohmann::json record;
   record["command"] = "synth --btf";
-  record["inputs"] = {{"model", job.model_dir.string()},   {"images", job.images_dir.string()},
-                      {"lights", job.lights_file.string()}, {"mesh", job.mesh_file.string()},
+  record["inputs"] = {{"model", job.model_dir.string()},
+                      {"images", job.images_dir.string()},
+                      {"lights", job.lights_file.string()},
+                      {"mesh", job.mesh_file.string()},
                       {"btf", options.btf.string()}};
   record["settings"] = {
       {"sample_texel_size", so.sample_texel_size},
@@ -347,16 +349,16 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
                    {"atlases", btf_files},
                    {"atlas_channels", "sample_x, sample_y, angle (docs/btf.md)"},
                    {"ptm_atlases", "a preview: the BTF seen head-on, fitted per texel"}};
-  record["timings_s"] = {{"load", inputs.seconds_load},
-                         {"visibility", inputs.seconds_visibility},
-                         {"factorise", summary.seconds_factorise},
-                         {"synthesis", summary.seconds_synthesis},
-                         {"seams", summary.seconds_seams},
-                         {"atlas", summary.seconds_atlas},
-                         {"ptm_preview", summary.seconds_preview},
-                         {"synthesis_per_triangle",
-                          (summary.seconds_synthesis + summary.seconds_seams) /
-                              static_cast<double>(std::max<std::size_t>(1, summary.faces))}};
+  record["timings_s"] = {
+      {"load", inputs.seconds_load},
+      {"visibility", inputs.seconds_visibility},
+      {"factorise", summary.seconds_factorise},
+      {"synthesis", summary.seconds_synthesis},
+      {"seams", summary.seconds_seams},
+      {"atlas", summary.seconds_atlas},
+      {"ptm_preview", summary.seconds_preview},
+      {"synthesis_per_triangle", (summary.seconds_synthesis + summary.seconds_seams) /
+                                     static_cast<double>(std::max<std::size_t>(1, summary.faces))}};
   // The geometry maps baked per atlas texel, for export: 8 bits per component
   // with a scale and bias each, four components per RGBA PNG (docs/btf.md).
   t = std::chrono::steady_clock::now();
@@ -369,7 +371,8 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::size_t i = 0; i < planes.size(); ++i) {
       const cv::Mat flat = planes[i].reshape(1, 1);
-      quantised[i] = synth::QuantisePlane(std::vector<float>(flat.begin<float>(), flat.end<float>()));
+      quantised[i] =
+          synth::QuantisePlane(std::vector<float>(flat.begin<float>(), flat.end<float>()));
     }
     nlohmann::json files = nlohmann::json::array();
     geometry_png.resize(geometry_png.size() + (planes.size() + 3) / 4);
@@ -400,7 +403,8 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
       cv::split(atlases.sample_coords[a], planes);
       ptm::WriteExr(folder / AtlasFileName(a), planes, kCoordinateChannels);
     }
-    for (const auto& [name, bytes] : geometry_png) synth::WriteBytesAtomically(folder / name, bytes);
+    for (const auto& [name, bytes] : geometry_png)
+      synth::WriteBytesAtomically(folder / name, bytes);
   });
   summary.seconds_total = Since(start);
   return summary;

@@ -142,13 +142,12 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
                                    std::to_string(options.max_texels));
     }
     if (geometry.widest > sample.width || geometry.tallest > sample.height) {
-      throw InputError("mesh", "the largest triangle needs a patch of " +
-                                   std::to_string(geometry.widest) + " x " +
-                                   std::to_string(geometry.tallest) +
-                                   " texels (strip included) but the BTF sample is " +
-                                   std::to_string(sample.width) + " x " +
-                                   std::to_string(sample.height) +
-                                   "; subdivide the mesh or capture a larger sample");
+      throw InputError("mesh",
+                       "the largest triangle needs a patch of " + std::to_string(geometry.widest) +
+                           " x " + std::to_string(geometry.tallest) +
+                           " texels (strip included) but the BTF sample is " +
+                           std::to_string(sample.width) + " x " + std::to_string(sample.height) +
+                           "; subdivide the mesh or capture a larger sample");
     }
     result.patches = std::move(geometry.patches);
     result.unfoldings = std::move(geometry.unfoldings);
@@ -387,8 +386,8 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
       double e = 0.0;
       for (std::size_t m = 0; m < target_texels.size(); ++m) {
         const int i = target_texels[m] % w, j = target_texels[m] / w;
-        const auto row = sample.geometry.row(static_cast<Eigen::Index>(sy + j) * sample.width +
-                                             sx + i);
+        const auto row =
+            sample.geometry.row(static_cast<Eigen::Index>(sy + j) * sample.width + sx + i);
         for (int c = 0; c < n; ++c) {
           const double d = row[c] - targets[m * static_cast<std::size_t>(n) + c];
           e += d * d;
@@ -477,8 +476,7 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
   const auto seams_start = std::chrono::steady_clock::now();
   result.labels.resize(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f)
-    result.labels[f] =
-        cv::Mat::zeros(result.patches[f].height, result.patches[f].width, CV_8UC1);
+    result.labels[f] = cv::Mat::zeros(result.patches[f].height, result.patches[f].width, CV_8UC1);
   const double band = options.seam_band * t;
   double cut_cost = 0.0, edge_cost = 0.0;
   std::size_t edge_links = 0;
@@ -579,8 +577,7 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
             cut.Link(static_cast<int>(c), other_node,
                      diff[c] + diff[static_cast<std::size_t>(other_node)] + 1e-6);
           }
-          if (other_node >= 0 && m % 2 == 0 &&
-              side[static_cast<std::size_t>(jj * w + ii)] != s) {
+          if (other_node >= 0 && m % 2 == 0 && side[static_cast<std::size_t>(jj * w + ii)] != s) {
             edge_cost += diff[c] + diff[static_cast<std::size_t>(other_node)];
             ++edge_links;
           }
@@ -627,6 +624,8 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     if (progress && (edges_done % 256 == 0 || edges_done == num_faces))
       progress("graph-cut seams", edges_done, num_faces);
   }
+  result.seam_cost = cut_cost;
+  result.edge_cost = edge_cost;
   result.seam_cost_per_link =
       result.seam_links ? cut_cost / static_cast<double>(result.seam_links) : 0.0;
   result.edge_cost_per_link = edge_links ? edge_cost / static_cast<double>(edge_links) : 0.0;

@@ -49,7 +49,7 @@ struct BtfMeshSynthesisOptions {
 /// the rotation from the frame the point was asked in to the sample's frame
 /// (a tangent direction d becomes R(angle_rad) d in the sample frame).
 struct BtfSampleLookup {
-  int source_face = 0;  ///< the face whose patch supplies it
+  int source_face = 0;                                  ///< the face whose patch supplies it
   Eigen::Vector2d sample_px = Eigen::Vector2d::Zero();  ///< x right, y down, centres at +0.5
   double angle_rad = 0.0;
 };
@@ -68,9 +68,10 @@ struct BtfMeshSynthesis {
   std::vector<cv::Mat> labels;
   std::vector<double> photo_gains;  ///< per photo (linear exposure x intensity)
   std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
-  std::size_t seam_edges = 0;      ///< mesh edges with a graph cut
-  std::size_t seam_links = 0;      ///< texel pairs the seams cut
-  double seam_cost_per_link = 0;  ///< mean E_smooth term of a cut pair (geometry-map units)
+  std::size_t seam_edges = 0;           ///< mesh edges with a graph cut
+  std::size_t seam_links = 0;           ///< texel pairs the seams cut
+  double seam_cost = 0, edge_cost = 0;  ///< totals of the two below
+  double seam_cost_per_link = 0;        ///< mean E_smooth term of a cut pair (geometry-map units)
   double edge_cost_per_link = 0;  ///< the same for a straight seam along the mesh edge (no cut)
   double seconds_synthesis = 0, seconds_seams = 0;
 

@@ -691,9 +691,9 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
     atlases.ptms.push_back(FromOrthonormalPlanes(planes[a], synthesis.format));
   }
   atlases.coverage = std::move(coverage.coverage);
-  atlases.occupancy = total_texels ? static_cast<double>(coverage.inside_texels) /
-                                         static_cast<double>(total_texels)
-                                   : 0.0;
+  atlases.occupancy =
+      total_texels ? static_cast<double>(coverage.inside_texels) / static_cast<double>(total_texels)
+                   : 0.0;
   atlases.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return atlases;
 }

@@ -156,8 +156,8 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
       std::vector<std::pair<Eigen::Vector3d, double>> local;  // lights in the face frame
       for (const sfm::ObjectLight& l : lights)
         local.emplace_back(s.frame.transpose() * l.DirectionFrom(s.point), l.intensity);
-      value = RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format, local,
-                             1.0);
+      value =
+          RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format, local, 1.0);
     }
     return value;
   });

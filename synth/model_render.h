@@ -53,8 +53,8 @@ class ModelRenderer {
   struct SurfaceSample {
     std::size_t face = 0;
     int atlas = 0;
-    Eigen::Vector2d atlas_px = Eigen::Vector2d::Zero();  ///< texture coordinates, atlas pixels
-    Eigen::Vector3d point = Eigen::Vector3d::Zero();     ///< world
+    Eigen::Vector2d atlas_px = Eigen::Vector2d::Zero();   ///< texture coordinates, atlas pixels
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();      ///< world
     Eigen::Vector3d to_viewer = Eigen::Vector3d::Zero();  ///< unit, world
     Eigen::Vector3d smooth_normal = Eigen::Vector3d::Zero();
     /// Columns in world coordinates: the atlas frame of the face (AtlasFaceFrame)

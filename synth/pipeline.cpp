@@ -101,8 +101,7 @@ sfm::TriangleMesh SubdivideMidpoint(const sfm::TriangleMesh& mesh) {
 }
 
 SynthInputs LoadSynthInputs(const SynthJobOptions& options, int sample_side,
-                            double sample_texel_size, int strip,
-                            const ProgressCallback& progress) {
+                            double sample_texel_size, int strip, const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
   SynthInputs inputs;
   // Inputs.
@@ -113,7 +112,7 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options, int sample_side,
       sfm::CheckLightsAgainstModel(lights, reconstruction, options.lights_file.string());
   for (const std::string& name : unlit)
     inputs.warnings.push_back("skipping " + name + ": no light for it in " +
-                               options.lights_file.string());
+                              options.lights_file.string());
   sfm::LoadedMesh loaded_mesh = sfm::LoadMesh(options.mesh_file);
   for (const std::string& problem : loaded_mesh.report.Problems())
     inputs.warnings.push_back(options.mesh_file.string() + ": " + problem);
@@ -169,10 +168,9 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options, int sample_side,
   }
   if (inputs.subdivisions) {
     inputs.warnings.push_back("subdivided the mesh " + std::to_string(inputs.subdivisions) +
-                               " time(s) so that every triangle's patch fits the sample");
+                              " time(s) so that every triangle's patch fits the sample");
   }
-  inputs.visibility =
-      sfm::ComputeVisibility(mesh, reconstruction, options.visibility, progress);
+  inputs.visibility = sfm::ComputeVisibility(mesh, reconstruction, options.visibility, progress);
   // Photos used here only (visibility saw every image of the model).
   std::size_t seen_by_usable = 0;
   {
@@ -215,9 +213,9 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
   }
 
   const ptm::Ptm sample = ptm::ReadPtmAnyFormat(options.sample_file);
-  SynthInputs inputs = LoadSynthInputs(options, std::min(sample.width, sample.height),
-                                       options.synthesis.sample_texel_size,
-                                       options.synthesis.strip, progress);
+  SynthInputs inputs =
+      LoadSynthInputs(options, std::min(sample.width, sample.height),
+                      options.synthesis.sample_texel_size, options.synthesis.strip, progress);
   const sfm::Reconstruction& reconstruction = inputs.reconstruction;
   const sfm::TriangleMesh& mesh = inputs.mesh;
   const std::vector<MeshPhoto>& photos = inputs.photos;
@@ -428,8 +426,8 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
     const sfm::Camera& camera = cameras.reconstruction.cameras.at(image.camera_id);
     const RenderedView view =
         options.renderer ? options.renderer(model, camera, image.cam_from_world, it->second)
-                         : renderer.Render(camera, image.cam_from_world, it->second,
-                                           options.mode, options.samples_per_axis);
+                         : renderer.Render(camera, image.cam_from_world, it->second, options.mode,
+                                           options.samples_per_axis);
     const fs::path name = PngName(image.name);
     fs::create_directories((options.out_dir / name).parent_path());
     fs::create_directories((options.out_dir / "masks" / name).parent_path());
@@ -488,7 +486,7 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
   record["settings"] = {{"model", options.model_folder.string()},
                         {"cameras", options.cameras_dir.string()},
                         {"lights", options.lights_file.string()},
-                        {"mode", options.renderer              ? options.renderer_name
+                        {"mode", options.renderer                    ? options.renderer_name
                                  : options.mode == RenderMode::kPtm  ? "ptm"
                                  : options.mode == RenderMode::kFlat ? "flat"
                                                                      : "baked"},

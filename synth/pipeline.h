@@ -48,8 +48,8 @@ struct SynthJobSummary {
 /// The main job's inputs, read and checked (shared with the BTF job, btf/).
 struct SynthInputs {
   sfm::Reconstruction reconstruction;
-  sfm::TriangleMesh mesh;          ///< subdivided as needed
-  std::vector<MeshPhoto> photos;   ///< those with a light and a file
+  sfm::TriangleMesh mesh;         ///< subdivided as needed
+  std::vector<MeshPhoto> photos;  ///< those with a light and a file
   sfm::VisibilityResult visibility;
   std::vector<std::string> warnings;
   std::size_t subdivisions = 0;
