@@ -358,4 +358,64 @@ TEST(Cli, BtfFactorisesTheSceneCaptureAndRefusesBadInput) {
 }
 
 }  // namespace
+TEST(Cli, SynthWithABtfSampleRendersAsABtfAndRefusesBadInput) {
+  TempDir tmp;
+  datasets::SceneOptions options;
+  options.num_images = 8;
+  options.image_width = 96;
+  options.image_height = 96;
+  options.focal_px = 90;
+  options.num_held_out_views = 1;
+  options.held_out_lights_per_view = 1;
+  options.capture_size = 16;
+  options.num_capture_lights = 6;
+  options.num_held_out_capture_lights = 0;
+  options.write_surface = false;
+  options.material.texel_size = 0.01;
+  options.btf_size = 40;
+  datasets::GenerateScene(options, tmp.path() / "scene");
+  const std::string scene = (tmp / "scene").string();
+  const std::string inputs = " --model " + scene + "/object/sparse --images " + scene +
+                             "/object/images --lights " + scene + "/object/lights.json --mesh " +
+                             scene + "/object/mesh.ply --atlas-size 512 --no-report";
+  const std::string model = (tmp / "model").string();
+  std::string out;
+  ASSERT_EQ(
+      Texlume("synth" + inputs + " --btf " + scene + "/material/btf --components 8 --out " + model,
+              &out),
+      0)
+      << out;
+  EXPECT_NE(out.find("graph-cut seams"), std::string::npos) << out;
+  const nlohmann::json manifest =
+      nlohmann::json::parse(testing::ReadText(tmp / "model/manifest.json"));
+  EXPECT_EQ(manifest["btf"]["format"], "texlume-btf-model-1");
+  EXPECT_EQ(manifest["settings"]["components"].get<int>(), 8);
+  const std::string held = scene + "/object/held_out";
+  const std::string render = "render --model " + model + " --cameras " + held +
+                             "/sparse --lights " + held + "/lights.json --truth " + held +
+                             "/images --truth-masks " + held + "/masks --out ";
+  ASSERT_EQ(Texlume(render + (tmp / "r").string(), &out), 0) << out;
+  EXPECT_EQ(nlohmann::json::parse(testing::ReadText(tmp / "r/render.json"))["settings"]["mode"],
+            "btf");
+  ASSERT_EQ(Texlume(render + (tmp / "f").string() + " --baseline flat", &out), 0) << out;
+  EXPECT_EQ(nlohmann::json::parse(testing::ReadText(tmp / "f/render.json"))["settings"]["mode"],
+            "flat");
+  // Bad input: both samples, a missing capture, more components than the data.
+  EXPECT_EQ(Texlume("synth" + inputs + " --btf " + scene + "/material/btf --sample x.ptm --out " +
+                        (tmp / "x").string(),
+                    &out),
+            2);
+  EXPECT_EQ(Texlume("synth" + inputs + " --btf " + (tmp / "nothing").string() + " --out " +
+                        (tmp / "x").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("btf.json"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth" + inputs + " --btf " + scene + "/material/btf --components 999 --out " +
+                        (tmp / "x").string(),
+                    &out),
+            2);
+  EXPECT_NE(out.find("[1, 216]"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "x"));
+}
+
 }  // namespace texlume

@@ -1,5 +1,7 @@
 // Issue 8: per-triangle image-constrained BTF quilting with graph-cut seams,
 // the BTF model folder and its rendering, on a small glossy sphere.
+#include "btf/mesh_btf.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -9,7 +11,6 @@
 
 #include "btf/btf.h"
 #include "btf/btf_model.h"
-#include "btf/mesh_btf.h"
 #include "datasets_synthetic/scene.h"
 #include "ptm/fit.h"
 #include "ptm/ptm_io.h"
@@ -46,8 +47,8 @@ class MeshBtfTest : public ::testing::Test {
     o.num_held_out_views = 2;
     o.held_out_lights_per_view = 2;
     datasets::GenerateScene(o, tmp_->path() / "scene");
-    sample_ = new BtfFactorisation(
-        FactoriseBtf(ReadBtfCapture(tmp_->path() / "scene/material/btf"), 24));
+    sample_ =
+        new BtfFactorisation(FactoriseBtf(ReadBtfCapture(tmp_->path() / "scene/material/btf"), 24));
     job_ = new synth::SynthJobOptions(Job(tmp_->path() / "btf_model"));
     inputs_ = new synth::SynthInputs(synth::LoadSynthInputs(*job_, 96, 0.004, 8));
     synthesis_ = new BtfMeshSynthesis(SynthesizeMeshBtf(inputs_->mesh, inputs_->reconstruction,
@@ -174,8 +175,10 @@ TEST_F(MeshBtfTest, BothSidesOfAnEdgeSeeTheSameSampleTexelAndFrame) {
         ++compared;
         EXPECT_NEAR((lf.sample_px - lh.sample_px).norm(), 0.0, 1e-6) << f << " " << k;
         const Eigen::Vector3d d = (b - a).normalized();
-        const Eigen::Vector2d df = Eigen::Rotation2Dd(lf.angle_rad) * ff.DirectionInFrame(d).head<2>();
-        const Eigen::Vector2d dh = Eigen::Rotation2Dd(lh.angle_rad) * fh.DirectionInFrame(d).head<2>();
+        const Eigen::Vector2d df =
+            Eigen::Rotation2Dd(lf.angle_rad) * ff.DirectionInFrame(d).head<2>();
+        const Eigen::Vector2d dh =
+            Eigen::Rotation2Dd(lh.angle_rad) * fh.DirectionInFrame(d).head<2>();
         EXPECT_NEAR((df - dh).norm(), 0.0, 1e-6) << f << " " << k;
       }
     }
@@ -210,7 +213,8 @@ TEST_F(MeshBtfTest, ModelFolderHoldsCoordinatesGeometryAtlasesAndAPtmPreview) {
       if (model.face_atlas[f] != static_cast<int>(a)) continue;
       const auto& px = model.corner_px[f];
       const Eigen::Vector2f centroid = (px[0] + px[1] + px[2]) / 3.0f;
-      const cv::Vec3f v = c.at<cv::Vec3f>(static_cast<int>(centroid.y()), static_cast<int>(centroid.x()));
+      const cv::Vec3f v =
+          c.at<cv::Vec3f>(static_cast<int>(centroid.y()), static_cast<int>(centroid.x()));
       EXPECT_GE(v[0], 0.0f);
       EXPECT_GE(v[1], 0.0f);
       EXPECT_LE(v[0], sample_->width);
@@ -245,7 +249,8 @@ TEST_F(MeshBtfTest, OnAGlossyMaterialTheBtfModelBeatsThePtmModelAtHeldOutViews) 
   synth::RunSynthJob(p);
   const auto btf = Render(btf_dir, "r_btf", synth::RenderMode::kPtm, true);
   const auto preview = Render(btf_dir, "r_preview", synth::RenderMode::kPtm, false);
-  const auto ptm_model = Render(tmp_->path() / "ptm_model", "r_ptm", synth::RenderMode::kPtm, false);
+  const auto ptm_model =
+      Render(tmp_->path() / "ptm_model", "r_ptm", synth::RenderMode::kPtm, false);
   ASSERT_EQ(btf.metrics.size(), 4u);
   RecordProperty("psnr_btf", std::to_string(btf.mean_psnr));
   RecordProperty("psnr_ptm", std::to_string(ptm_model.mean_psnr));
