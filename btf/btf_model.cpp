@@ -236,6 +236,7 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
   }
   BtfSynthJobSummary summary;
 
+  synth::SynthInputs inputs = synth::LoadSynthInputs(job);
   // The sample: a factorisation as it is, or a capture factorised here.
   auto t = std::chrono::steady_clock::now();
   BtfFactorisation sample;
@@ -257,8 +258,8 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
   if (so.sample_texel_size == 0.0) so.sample_texel_size = sample.texel_size;
   so.Check();
 
-  synth::SynthInputs inputs = synth::LoadSynthInputs(job, std::min(sample.width, sample.height),
-                                                     so.sample_texel_size, so.strip, progress);
+  synth::PrepareSynthMesh(inputs, job, std::min(sample.width, sample.height), so.sample_texel_size,
+                          so.strip, progress);
   summary.warnings = inputs.warnings;
   summary.photos_used = inputs.photos.size();
   summary.subdivisions = inputs.subdivisions;

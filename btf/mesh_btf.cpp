@@ -582,7 +582,10 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
             ++edge_links;
           }
         }
-        if (hard) cut.Terminals(static_cast<int>(c), s > 0 ? 0.0 : kHard, s > 0 ? kHard : 0.0);
+        // Hard: next to the band's outside. Otherwise a vanishing preference for
+        // its own side, so texels the cut leaves free keep their own patch.
+        const double keep = hard ? kHard : 1e-9;
+        cut.Terminals(static_cast<int>(c), s > 0 ? 0.0 : keep, s > 0 ? keep : 0.0);
       }
       cut.Solve();
       std::vector<char> is_a(cells.size());

@@ -100,8 +100,7 @@ sfm::TriangleMesh SubdivideMidpoint(const sfm::TriangleMesh& mesh) {
   return out;
 }
 
-SynthInputs LoadSynthInputs(const SynthJobOptions& options, int sample_side,
-                            double sample_texel_size, int strip, const ProgressCallback& progress) {
+SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   SynthInputs inputs;
   // Inputs.
@@ -148,7 +147,14 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options, int sample_side,
                      "no usable photo: every image of the model lacks a light or a file");
   }
   inputs.seconds_load = Since(start);
+  return inputs;
+}
 
+void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int sample_side,
+                      double sample_texel_size, int strip, const ProgressCallback& progress) {
+  const sfm::Reconstruction& reconstruction = inputs.reconstruction;
+  const std::vector<MeshPhoto>& photos = inputs.photos;
+  sfm::TriangleMesh& mesh = inputs.mesh;
   // Visibility (and subdivision while the largest triangle does not fit the sample).
   auto t = std::chrono::steady_clock::now();
   auto largest_patch = [&](const sfm::TriangleMesh& m) {
@@ -193,8 +199,6 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options, int sample_side,
                          options.model_dir.string() + "?");
   }
   inputs.seconds_visibility = Since(t);
-
-  return inputs;
 }
 
 SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress) {
@@ -212,10 +216,10 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
                      "exists and is not a texlume model folder; not replacing it");
   }
 
+  SynthInputs inputs = LoadSynthInputs(options);
   const ptm::Ptm sample = ptm::ReadPtmAnyFormat(options.sample_file);
-  SynthInputs inputs =
-      LoadSynthInputs(options, std::min(sample.width, sample.height),
-                      options.synthesis.sample_texel_size, options.synthesis.strip, progress);
+  PrepareSynthMesh(inputs, options, std::min(sample.width, sample.height),
+                   options.synthesis.sample_texel_size, options.synthesis.strip, progress);
   const sfm::Reconstruction& reconstruction = inputs.reconstruction;
   const sfm::TriangleMesh& mesh = inputs.mesh;
   const std::vector<MeshPhoto>& photos = inputs.photos;

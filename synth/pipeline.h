@@ -57,13 +57,15 @@ struct SynthInputs {
 };
 
 /// Reads the COLMAP model, object lights, mesh and photos named in `options`
-/// (sample and out_dir are not touched), splits the mesh while its largest
-/// patch (longest edge / sample_texel_size + 2 strip texels) exceeds
-/// `sample_side` texels (up to options.max_subdivisions times) and computes
-/// visibility. Throws InputError as RunSynthJob describes.
-SynthInputs LoadSynthInputs(const SynthJobOptions& options, int sample_side,
-                            double sample_texel_size, int strip,
-                            const ProgressCallback& progress = {});
+/// (sample and out_dir are not touched). Throws InputError as RunSynthJob describes.
+SynthInputs LoadSynthInputs(const SynthJobOptions& options);
+
+/// Splits the mesh while its largest patch (longest edge / sample_texel_size +
+/// 2 strip texels) exceeds `sample_side` texels (up to options.max_subdivisions
+/// times) and computes visibility. Throws InputError when most triangles are
+/// seen by no usable photo (a mesh in another frame).
+void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int sample_side,
+                      double sample_texel_size, int strip, const ProgressCallback& progress = {});
 
 /// Runs the whole job: reads and checks the inputs, visibility and best views,
 /// per-triangle synthesis (Algorithm 2), blending, atlases, and the model folder

@@ -50,7 +50,8 @@ class MeshBtfTest : public ::testing::Test {
     sample_ =
         new BtfFactorisation(FactoriseBtf(ReadBtfCapture(tmp_->path() / "scene/material/btf"), 24));
     job_ = new synth::SynthJobOptions(Job(tmp_->path() / "btf_model"));
-    inputs_ = new synth::SynthInputs(synth::LoadSynthInputs(*job_, 96, 0.004, 8));
+    inputs_ = new synth::SynthInputs(synth::LoadSynthInputs(*job_));
+    synth::PrepareSynthMesh(*inputs_, *job_, 96, 0.004, 8);
     synthesis_ = new BtfMeshSynthesis(SynthesizeMeshBtf(inputs_->mesh, inputs_->reconstruction,
                                                         inputs_->visibility, inputs_->photos,
                                                         *sample_, Options()));
