@@ -564,12 +564,12 @@ int RunRenderCommand(const std::vector<std::string>& args, std::ostream& out, st
   std::shared_ptr<btf::BtfModel> btf_model;
   if (!a.Has("baseline") && synth::ReadModelManifest(o.model_folder).contains("btf")) {
     o.renderer_name = "btf";
-    o.renderer = [&btf_model, &o](const synth::TexturedModel& model, const sfm::Camera& camera,
+    o.renderer = [&btf_model, &o](const synth::ModelRenderer& renderer,
+                                  const synth::TexturedModel& model, const sfm::Camera& camera,
                                   const sfm::Rigid3d& cam_from_world,
                                   const std::vector<sfm::ObjectLight>& lights) {
       if (!btf_model)
         btf_model = std::make_shared<btf::BtfModel>(btf::ReadBtfModel(o.model_folder, model));
-      synth::ModelRenderer renderer(model);
       return renderer.RenderWith(camera, cam_from_world, o.samples_per_axis,
                                  [&](const synth::ModelRenderer::SurfaceSample& s) {
                                    return btf::ShadeBtf(*btf_model, s, lights);

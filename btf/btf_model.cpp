@@ -335,14 +335,8 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
                        {"straight_edge_cost_per_link", summary.edge_cost_per_link},
                        {"photo_gains", synthesis.photo_gains}};
   record["warnings"] = summary.warnings;
-  record["baselines"] = {{"flat_albedo", {flat_albedo.x(), flat_albedo.y(), flat_albedo.z()}},
-                         {"baked", nlohmann::json::array()}};
-  std::vector<std::pair<std::string, cv::Mat>> extra;
-  for (std::size_t a = 0; a < baked.size(); ++a) {
-    const std::string name = "baked_" + std::to_string(a) + ".png";
-    record["baselines"]["baked"].push_back(name);
-    extra.emplace_back(name, synth::ToBgr8(baked[a]));
-  }
+  std::vector<std::pair<std::string, cv::Mat>> extra =
+      synth::RecordBaselines(flat_albedo, baked, record);
   nlohmann::json btf_files = nlohmann::json::array();
   for (std::size_t a = 0; a < atlases.geometry.size(); ++a) btf_files.push_back(AtlasFileName(a));
   record["btf"] = {{"format", "texlume-btf-model-1"},

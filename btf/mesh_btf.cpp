@@ -201,36 +201,15 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     const sfm::Image& image = reconstruction.images.at(view.image_id);
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
     const synth::TrianglePatch& patch = result.patches[f];
-    const auto& c = patch.corners_in_frame;
-    const double area = 0.5 * std::abs((c[1] - c[0]).x() * (c[2] - c[0]).y() -
-                                       (c[1] - c[0]).y() * (c[2] - c[0]).x());
-    const double density = std::sqrt(std::max(view.projected_area_px, 1e-6f) / (area / (t * t)));
-    const int level = std::clamp(static_cast<int>(std::lround(-4.0 * std::log2(density))), 0, 40);
+    const int level = synth::PhotoDensityLevel(patch, view, t);
     const Reduced& r = reduced_at(level);
     const int tw = std::max(1, static_cast<int>(std::lround(patch.width * r.rx)));
     const int th = std::max(1, static_cast<int>(std::lround(patch.height * r.ry)));
     if (tw > r.g[0].cols || th > r.g[0].rows) return false;
-    cv::Mat map_x(th, tw, CV_32FC1), map_y(th, tw, CV_32FC1);
-    out.mask = cv::Mat::zeros(th, tw, CV_32FC1);
-    out.count = 0;
-    for (int j = 0; j < th; ++j) {
-      for (int i = 0; i < tw; ++i) {
-        const Eigen::Vector2d p(patch.x_min + (i + 0.5) / r.rx * t,
-                                patch.y_max - (j + 0.5) / r.ry * t);
-        const Eigen::Vector3d world =
-            patch.frame.origin_in_world + p.x() * patch.frame.x_axis + p.y() * patch.frame.y_axis;
-        const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(
-            image.cam_from_world.rotation * world + image.cam_from_world.translation);
-        map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
-        map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
-        if (px && synth::SignedDistanceToTriangle(c, p) <= 0.0 && px->x() >= 0.5 &&
-            px->y() >= 0.5 && px->x() <= photo.image.cols - 0.5 &&
-            px->y() <= photo.image.rows - 0.5) {
-          out.mask.at<float>(j, i) = 1.0f;
-          ++out.count;
-        }
-      }
-    }
+    cv::Mat map_x, map_y;
+    out.count = synth::RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera,
+                                         image.cam_from_world, photo.image.size(), 0.0, map_x,
+                                         map_y, out.mask);
     if (out.count < options.min_photo_pixels) return false;
     cv::Mat rectified;
     cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
@@ -270,30 +249,11 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     }
     return out;
   };
-  auto views_of = [&](std::size_t f) {
-    std::vector<sfm::TriangleView> v;
-    const sfm::TriangleVisibility& tv = visibility.triangles[f];
-    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) return v;
-    std::vector<sfm::TriangleView> others;
-    for (const sfm::TriangleView& view : tv.views) {
-      if (!view.fully_visible) continue;
-      (view.image_id == tv.best_view ? v : others).push_back(view);
-    }
-    std::sort(others.begin(), others.end(),
-              [](const auto& a, const auto& b) { return a.angle_rad < b.angle_rad; });
-    for (const auto& view : others)
-      if (static_cast<int>(v.size()) < options.max_views) v.push_back(view);
-    return v;
-  };
 
   // 2a. Gain per photo, as in the PTM synthesis: photo mean over the sample's
   // mean relit under the triangle's view and lights, m = a_T g_n, solved for
   // log g_n by alternating least squares with the mean log a_T at 0.
-  struct Ratio {
-    std::size_t face, photo;
-    double log_m, weight;
-  };
-  std::vector<Ratio> ratios;
+  std::vector<synth::GainObservation> ratios;
   for (std::size_t f = 0; f < num_faces; ++f) {
     int used = 0;
     for (const sfm::TriangleView& view : visibility.triangles[f].views) {
@@ -309,40 +269,10 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
       ++used;
     }
   }
-  std::vector<double> log_gain(photos.size(), 0.0), log_albedo(num_faces, 0.0);
-  for (int it = 0; it < 20; ++it) {
-    std::vector<double> sum(num_faces, 0.0), weight(num_faces, 0.0);
-    for (const Ratio& r : ratios) {
-      sum[r.face] += r.weight * (r.log_m - log_gain[r.photo]);
-      weight[r.face] += r.weight;
-    }
-    double mean = 0.0, total = 0.0;
-    for (std::size_t f = 0; f < num_faces; ++f)
-      if (weight[f] > 0)
-        log_albedo[f] = sum[f] / weight[f], mean += weight[f] * log_albedo[f], total += weight[f];
-    if (total > 0) mean /= total;
-    for (double& v : log_albedo) v -= mean;
-    std::vector<double> gsum(photos.size(), 0.0), gweight(photos.size(), 0.0);
-    for (const Ratio& r : ratios) {
-      gsum[r.photo] += r.weight * (r.log_m - log_albedo[r.face]);
-      gweight[r.photo] += r.weight;
-    }
-    for (std::size_t k = 0; k < photos.size(); ++k)
-      if (gweight[k] > 0) log_gain[k] = gsum[k] / gweight[k];
-  }
-  result.photo_gains.resize(photos.size());
-  for (std::size_t k = 0; k < photos.size(); ++k) result.photo_gains[k] = std::exp(log_gain[k]);
+  result.photo_gains = synth::SolvePhotoGains(ratios, num_faces, photos.size());
 
   // 2b. Breadth-first synthesis from the best-seen triangle.
-  int seed_face = 0;
-  float best_area = -1.0f;
-  for (std::size_t f = 0; f < num_faces; ++f) {
-    const auto& tv = visibility.triangles[f];
-    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) continue;
-    for (const auto& v : tv.views)
-      if (v.image_id == tv.best_view && v.projected_area_px > best_area)
-        best_area = v.projected_area_px, seed_face = static_cast<int>(f);
-  }
+  const int seed_face = synth::BestSeenFace(visibility);
   const std::vector<int> order =
       sfm::BreadthFirstFaceOrder(mesh, sfm::FaceNeighbours(mesh), seed_face);
   std::vector<char> done(num_faces, 0);
@@ -397,7 +327,8 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     };
 
     std::vector<Rectified> rects;
-    for (const sfm::TriangleView& view : views_of(f)) {
+    for (const sfm::TriangleView& view :
+         synth::ConstrainingViews(visibility.triangles[f], true, options.max_views)) {
       Rectified r;
       if (rectify(f, view, r)) rects.push_back(std::move(r));
     }
@@ -408,25 +339,13 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
       for (const Rectified& r : rects) {
         const Reduced& red = reduced_at(r.level);
         const std::vector<cv::Mat> model = relit(red, r.appearance, result.photo_gains[r.photo]);
-        const cv::Mat ssd = synth::MaskedSsd(model, synth::PlaneEnergy(model), r.linear, r.mask);
-        for (int sy = 0; sy <= max_sy; ++sy) {
-          const int py = std::min(static_cast<int>(std::lround(sy * red.ry)), ssd.rows - 1);
-          for (int sx = 0; sx <= max_sx; ++sx) {
-            const int px = std::min(static_cast<int>(std::lround(sx * red.rx)), ssd.cols - 1);
-            total.at<float>(sy, sx) += std::sqrt(ssd.at<float>(py, px) / (3.0f * r.count));
-          }
-        }
+        synth::AddImageScore(synth::MaskedSsd(model, synth::PlaneEnergy(model), r.linear, r.mask),
+                             r.count, red.rx, red.ry, total);
       }
-      std::vector<std::pair<float, cv::Point>> all;
-      const int stride =
-          std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx)));
-      for (int sy = 0; sy <= max_sy; sy += stride)
-        for (int sx = 0; sx <= max_sx; sx += stride)
-          all.emplace_back(total.at<float>(sy, sx), cv::Point(sx, sy));
-      const std::size_t k =
-          std::min<std::size_t>(static_cast<std::size_t>(options.top_k), all.size());
-      std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k), all.end(),
-                        [](const auto& a, const auto& b) { return a.first < b.first; });
+      const std::vector<std::pair<float, cv::Point>> all = synth::BestPlacements(
+          total, std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx))),
+          options.top_k);
+      const std::size_t k = all.size();
       double best = std::numeric_limits<double>::infinity();
       for (std::size_t c = 0; c < k; ++c) {
         const double e = overlap_error(all[c].second.x, all[c].second.y);

@@ -211,6 +211,125 @@ void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip,
   for (std::size_t c = 0; c < n; ++c) out[c] = static_cast<float>(own_weight * own[c] + sum[c]);
 }
 
+int PhotoDensityLevel(const TrianglePatch& patch, const sfm::TriangleView& view, double t) {
+  const auto& c = patch.corners_in_frame;
+  const double area =
+      0.5 * std::abs((c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x());
+  const double density = std::sqrt(std::max(view.projected_area_px, 1e-6f) / (area / (t * t)));
+  return std::clamp(static_cast<int>(std::lround(-4.0 * std::log2(density))), 0, 40);
+}
+
+int RectificationMaps(const TrianglePatch& patch, double t, double rx, double ry, cv::Size grid,
+                      const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
+                      cv::Size image_size, double mask_margin, cv::Mat& map_x, cv::Mat& map_y,
+                      cv::Mat& mask) {
+  map_x.create(grid, CV_32FC1);
+  map_y.create(grid, CV_32FC1);
+  mask = cv::Mat::zeros(grid, CV_32FC1);
+  int count = 0;
+  for (int j = 0; j < grid.height; ++j) {
+    for (int i = 0; i < grid.width; ++i) {
+      const Eigen::Vector2d p(patch.x_min + (i + 0.5) / rx * t, patch.y_max - (j + 0.5) / ry * t);
+      const Eigen::Vector3d world =
+          patch.frame.origin_in_world + p.x() * patch.frame.x_axis + p.y() * patch.frame.y_axis;
+      const Eigen::Vector3d cam = cam_from_world.rotation * world + cam_from_world.translation;
+      const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(cam);
+      map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
+      map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
+      if (px && SignedDistanceToTriangle(patch.corners_in_frame, p) <= mask_margin &&
+          px->x() >= 0.5 && px->y() >= 0.5 && px->x() <= image_size.width - 0.5 &&
+          px->y() <= image_size.height - 0.5) {
+        mask.at<float>(j, i) = 1.0f;
+        ++count;
+      }
+    }
+  }
+  return count;
+}
+
+std::vector<sfm::TriangleView> ConstrainingViews(const sfm::TriangleVisibility& tv, bool all_views,
+                                                 int max_views) {
+  std::vector<sfm::TriangleView> v;
+  if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) return v;
+  for (const sfm::TriangleView& view : tv.views)
+    if (view.fully_visible && view.image_id == tv.best_view) v.push_back(view);
+  if (all_views) {
+    std::vector<sfm::TriangleView> others;
+    for (const sfm::TriangleView& view : tv.views)
+      if (view.fully_visible && view.image_id != tv.best_view) others.push_back(view);
+    std::sort(others.begin(), others.end(),
+              [](const auto& a, const auto& b) { return a.angle_rad < b.angle_rad; });
+    for (const auto& view : others)
+      if (static_cast<int>(v.size()) < max_views) v.push_back(view);
+  }
+  return v;
+}
+
+std::vector<double> SolvePhotoGains(const std::vector<GainObservation>& ratios,
+                                    std::size_t num_faces, std::size_t num_photos) {
+  std::vector<double> log_gain(num_photos, 0.0), log_albedo(num_faces, 0.0);
+  for (int it = 0; it < 20; ++it) {
+    std::vector<double> sum(num_faces, 0.0), weight(num_faces, 0.0);
+    for (const GainObservation& r : ratios) {
+      sum[r.face] += r.weight * (r.log_m - log_gain[r.photo]);
+      weight[r.face] += r.weight;
+    }
+    double mean = 0.0, total = 0.0;
+    for (std::size_t f = 0; f < num_faces; ++f)
+      if (weight[f] > 0)
+        log_albedo[f] = sum[f] / weight[f], mean += weight[f] * log_albedo[f], total += weight[f];
+    if (total > 0) mean /= total;
+    for (double& v : log_albedo) v -= mean;
+    std::vector<double> gsum(num_photos, 0.0), gweight(num_photos, 0.0);
+    for (const GainObservation& r : ratios) {
+      gsum[r.photo] += r.weight * (r.log_m - log_albedo[r.face]);
+      gweight[r.photo] += r.weight;
+    }
+    for (std::size_t n = 0; n < num_photos; ++n)
+      if (gweight[n] > 0) log_gain[n] = gsum[n] / gweight[n];
+  }
+  std::vector<double> gains(num_photos, 1.0);
+  for (std::size_t n = 0; n < num_photos; ++n) gains[n] = std::exp(log_gain[n]);
+  return gains;
+}
+
+int BestSeenFace(const sfm::VisibilityResult& visibility) {
+  int seed_face = 0;
+  float best_area = -1.0f;
+  for (std::size_t f = 0; f < visibility.triangles.size(); ++f) {
+    const auto& tv = visibility.triangles[f];
+    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) continue;
+    for (const auto& v : tv.views)
+      if (v.image_id == tv.best_view && v.projected_area_px > best_area) {
+        best_area = v.projected_area_px;
+        seed_face = static_cast<int>(f);
+      }
+  }
+  return seed_face;
+}
+
+void AddImageScore(const cv::Mat& ssd, int count, double rx, double ry, cv::Mat& total) {
+  for (int sy = 0; sy < total.rows; ++sy) {
+    const int py = std::min(static_cast<int>(std::lround(sy * ry)), ssd.rows - 1);
+    for (int sx = 0; sx < total.cols; ++sx) {
+      const int px = std::min(static_cast<int>(std::lround(sx * rx)), ssd.cols - 1);
+      total.at<float>(sy, sx) += std::sqrt(ssd.at<float>(py, px) / (3.0f * count));
+    }
+  }
+}
+
+std::vector<std::pair<float, cv::Point>> BestPlacements(const cv::Mat& score, int stride, int k) {
+  std::vector<std::pair<float, cv::Point>> all;
+  for (int sy = 0; sy < score.rows; sy += stride)
+    for (int sx = 0; sx < score.cols; sx += stride)
+      all.emplace_back(score.at<float>(sy, sx), cv::Point(sx, sy));
+  const std::size_t kept = std::min<std::size_t>(static_cast<std::size_t>(k), all.size());
+  std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(kept), all.end(),
+                    [](const auto& a, const auto& b) { return a.first < b.first; });
+  all.resize(kept);
+  return all;
+}
+
 PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int strip,
                                 TangentFrame tangent_frame,
                                 const Eigen::Vector3d& field_direction_in_world) {
@@ -406,39 +525,15 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     const sfm::Image& image = reconstruction.images.at(view.image_id);
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
     const TrianglePatch& patch = result.patches[f];
-    const double area =
-        0.5 * std::abs((patch.corners_in_frame[1] - patch.corners_in_frame[0]).x() *
-                           (patch.corners_in_frame[2] - patch.corners_in_frame[0]).y() -
-                       (patch.corners_in_frame[1] - patch.corners_in_frame[0]).y() *
-                           (patch.corners_in_frame[2] - patch.corners_in_frame[0]).x());
-    const double density = std::sqrt(std::max(view.projected_area_px, 1e-6f) / (area / (t * t)));
-    const int level = std::clamp(static_cast<int>(std::lround(-4.0 * std::log2(density))), 0, 40);
+    const int level = PhotoDensityLevel(patch, view, t);
     const ReducedSample& r = reduced_at(level);
     const int tw = std::max(1, static_cast<int>(std::lround(patch.width * r.rx)));
     const int th = std::max(1, static_cast<int>(std::lround(patch.height * r.ry)));
     if (tw > r.raw[0].cols || th > r.raw[0].rows) return false;
-    cv::Mat map_x(th, tw, CV_32FC1), map_y(th, tw, CV_32FC1);
-    out.mask = cv::Mat::zeros(th, tw, CV_32FC1);
-    out.count = 0;
-    for (int j = 0; j < th; ++j) {
-      for (int i = 0; i < tw; ++i) {
-        const Eigen::Vector2d p(patch.x_min + (i + 0.5) / r.rx * t,
-                                patch.y_max - (j + 0.5) / r.ry * t);
-        const Eigen::Vector3d world =
-            patch.frame.origin_in_world + p.x() * patch.frame.x_axis + p.y() * patch.frame.y_axis;
-        const Eigen::Vector3d cam =
-            image.cam_from_world.rotation * world + image.cam_from_world.translation;
-        const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(cam);
-        map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
-        map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
-        if (px && SignedDistanceToTriangle(patch.corners_in_frame, p) <= mask_margin &&
-            px->x() >= 0.5 && px->y() >= 0.5 && px->x() <= photo.image.cols - 0.5 &&
-            px->y() <= photo.image.rows - 0.5) {
-          out.mask.at<float>(j, i) = 1.0f;
-          ++out.count;
-        }
-      }
-    }
+    cv::Mat map_x, map_y;
+    out.count =
+        RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera, image.cam_from_world,
+                          photo.image.size(), mask_margin, map_x, map_y, out.mask);
     if (out.count < options.min_photo_pixels) return false;
     cv::Mat rectified;
     cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
@@ -456,21 +551,7 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
 
   // Views used per face: the best fully visible view, or every fully visible one.
   auto views_of = [&](std::size_t f) {
-    std::vector<sfm::TriangleView> v;
-    const sfm::TriangleVisibility& tv = visibility.triangles[f];
-    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) return v;
-    for (const sfm::TriangleView& view : tv.views)
-      if (view.fully_visible && view.image_id == tv.best_view) v.push_back(view);
-    if (options.all_views) {
-      std::vector<sfm::TriangleView> others;
-      for (const sfm::TriangleView& view : tv.views)
-        if (view.fully_visible && view.image_id != tv.best_view) others.push_back(view);
-      std::sort(others.begin(), others.end(),
-                [](const auto& a, const auto& b) { return a.angle_rad < b.angle_rad; });
-      for (const auto& view : others)
-        if (static_cast<int>(v.size()) < options.max_views) v.push_back(view);
-    }
-    return v;
+    return ConstrainingViews(visibility.triangles[f], options.all_views, options.max_views);
   };
 
   // 2a. Per-photo gain (exposure x light intensity, linear domain). For every
@@ -479,11 +560,7 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   // sample's). log m = log a_T + log g_n is solved by alternating least squares
   // over all such pairs, with the mean log a_T fixed at 0 (the object's mean
   // albedo is the sample's), so stains and colour do not leak into the gains.
-  struct Ratio {
-    std::size_t face, photo;
-    double log_m, weight;
-  };
-  std::vector<Ratio> ratios;
+  std::vector<GainObservation> ratios;
   {
     const int coarse_level = std::max(
         0,
@@ -521,42 +598,10 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       }
     }
   }
-  std::vector<double> log_gain(photos.size(), 0.0), log_albedo(num_faces, 0.0);
-  for (int it = 0; it < 20; ++it) {
-    std::vector<double> sum(num_faces, 0.0), weight(num_faces, 0.0);
-    for (const Ratio& r : ratios) {
-      sum[r.face] += r.weight * (r.log_m - log_gain[r.photo]);
-      weight[r.face] += r.weight;
-    }
-    double mean = 0.0, total = 0.0;
-    for (std::size_t f = 0; f < num_faces; ++f)
-      if (weight[f] > 0)
-        log_albedo[f] = sum[f] / weight[f], mean += weight[f] * log_albedo[f], total += weight[f];
-    if (total > 0) mean /= total;
-    for (double& v : log_albedo) v -= mean;
-    std::vector<double> gsum(photos.size(), 0.0), gweight(photos.size(), 0.0);
-    for (const Ratio& r : ratios) {
-      gsum[r.photo] += r.weight * (r.log_m - log_albedo[r.face]);
-      gweight[r.photo] += r.weight;
-    }
-    for (std::size_t n = 0; n < photos.size(); ++n)
-      if (gweight[n] > 0) log_gain[n] = gsum[n] / gweight[n];
-  }
-  result.photo_gains.assign(photos.size(), 1.0);
-  for (std::size_t n = 0; n < photos.size(); ++n) result.photo_gains[n] = std::exp(log_gain[n]);
+  result.photo_gains = SolvePhotoGains(ratios, num_faces, photos.size());
 
   // 2b. Breadth-first synthesis from a seed (the best-seen triangle).
-  int seed_face = 0;
-  float best_area = -1.0f;
-  for (std::size_t f = 0; f < num_faces; ++f) {
-    const auto& tv = visibility.triangles[f];
-    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) continue;
-    for (const auto& v : tv.views)
-      if (v.image_id == tv.best_view && v.projected_area_px > best_area) {
-        best_area = v.projected_area_px;
-        seed_face = static_cast<int>(f);
-      }
-  }
+  const int seed_face = BestSeenFace(visibility);
   // Photo-consistency pass of one patch (LRGB): per cell of the primary view's
   // grid, dq = J^T (J J^T + lambda I)^-1 r over the views, J_n the derivative of
   // the displayed luminance under photo n's lights (sRGB, gain and light mixture
@@ -857,27 +902,15 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       for (const Rectified& r : rects) {
         const ReducedSample& red = reduced_at(r.level);
         const std::vector<cv::Mat> relit = relit_planes(red, r.lights, result.photo_gains[r.photo]);
-        const cv::Mat ssd = MaskedSsd(relit, PlaneEnergy(relit), r.planes, r.mask);
-        for (int sy = 0; sy <= max_sy; ++sy) {
-          const int py = std::min(static_cast<int>(std::lround(sy * red.ry)), ssd.rows - 1);
-          for (int sx = 0; sx <= max_sx; ++sx) {
-            const int px = std::min(static_cast<int>(std::lround(sx * red.rx)), ssd.cols - 1);
-            total.at<float>(sy, sx) += std::sqrt(ssd.at<float>(py, px) / (3.0f * r.count));
-          }
-        }
+        AddImageScore(MaskedSsd(relit, PlaneEnergy(relit), r.planes, r.mask), r.count, red.rx,
+                      red.ry, total);
       }
       // Top-k distinct positions at the coarsest density used (neighbouring texel
       // positions share one photo-density cell and score alike).
-      std::vector<std::pair<float, cv::Point>> all;
-      const int stride =
-          std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx)));
-      for (int sy = 0; sy <= max_sy; sy += stride)
-        for (int sx = 0; sx <= max_sx; sx += stride)
-          all.emplace_back(total.at<float>(sy, sx), cv::Point(sx, sy));
-      const std::size_t k =
-          std::min<std::size_t>(static_cast<std::size_t>(options.top_k), all.size());
-      std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(k), all.end(),
-                        [](const auto& a, const auto& b) { return a.first < b.first; });
+      const std::vector<std::pair<float, cv::Point>> all = BestPlacements(
+          total, std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx))),
+          options.top_k);
+      const std::size_t k = all.size();
       double best = std::numeric_limits<double>::infinity();
       for (std::size_t c = 0; c < k; ++c) {
         const double e = overlap_error(all[c].second.x, all[c].second.y);

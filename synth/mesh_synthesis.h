@@ -161,6 +161,45 @@ PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double texel_size
                                 TangentFrame tangent_frame,
                                 const Eigen::Vector3d& field_direction_in_world);
 
+/// Helpers of Algorithm 2 shared by the PTM and BTF synthesis.
+///
+/// The photo density level of a face in a view: r = 2^(-level/4) photo pixels
+/// per texel of `texel_size` world units, level in [0, 40].
+int PhotoDensityLevel(const TrianglePatch& patch, const sfm::TriangleView& view, double texel_size);
+/// cv::remap maps that rectify a photo into the patch grid of `grid` cells at
+/// density (rx, ry) cells per texel, and the mask (CV_32FC1) of cells within
+/// `mask_margin` world units of the triangle whose photo pixel lies in the
+/// image. Returns the number of masked cells.
+int RectificationMaps(const TrianglePatch& patch, double texel_size, double rx, double ry,
+                      cv::Size grid, const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
+                      cv::Size image_size, double mask_margin, cv::Mat& map_x, cv::Mat& map_y,
+                      cv::Mat& mask);
+/// The views that constrain a face: its best fully visible view, then (all_views)
+/// the other fully visible ones by angle, up to max_views; none when the face
+/// is fully visible nowhere.
+std::vector<sfm::TriangleView> ConstrainingViews(const sfm::TriangleVisibility& visibility,
+                                                 bool all_views, int max_views);
+/// One face seen fully in one photo: log of the photo's mean over the sample's
+/// mean relit there (m = a_T g_n), and its weight.
+struct GainObservation {
+  std::size_t face = 0, photo = 0;
+  double log_m = 0.0, weight = 0.0;
+};
+/// Gains g_n per photo: log m = log a_T + log g_n solved by alternating least
+/// squares (20 rounds) with the mean log a_T at 0, so the object's mean albedo is
+/// the sample's and stains do not leak into the gains. 1 for unobserved photos.
+std::vector<double> SolvePhotoGains(const std::vector<GainObservation>& observations,
+                                    std::size_t num_faces, std::size_t num_photos);
+/// The face with the largest projected area in its best fully visible view (0
+/// when there is none): where breadth-first synthesis starts.
+int BestSeenFace(const sfm::VisibilityResult& visibility);
+/// Adds eq. 3's RMS score of one photo (`ssd` from MaskedSsd at the photo's
+/// density (rx, ry), over `count` masked cells and 3 channels) to `total`, a map
+/// over sample placements in texels.
+void AddImageScore(const cv::Mat& ssd, int count, double rx, double ry, cv::Mat& total);
+/// The k lowest placements of a score map, looking every `stride` texels, best first.
+std::vector<std::pair<float, cv::Point>> BestPlacements(const cv::Mat& score, int stride, int k);
+
 /// Per-triangle image-constrained PTM synthesis on a mesh (paper 003 Algorithm 2).
 /// `visibility` from sfm::ComputeVisibility for this mesh and reconstruction;
 /// `photos` the usable photos (each image_id in the reconstruction). Throws

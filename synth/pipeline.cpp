@@ -302,14 +302,7 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
                        {"occupancy", summary.occupancy},
                        {"photo_gains", synthesis.photo_gains}};
   record["warnings"] = summary.warnings;
-  record["baselines"] = {{"flat_albedo", {flat_albedo.x(), flat_albedo.y(), flat_albedo.z()}},
-                         {"baked", nlohmann::json::array()}};
-  std::vector<std::pair<std::string, cv::Mat>> extra;
-  for (std::size_t a = 0; a < baked.size(); ++a) {
-    const std::string name = "baked_" + std::to_string(a) + ".png";
-    record["baselines"]["baked"].push_back(name);
-    extra.emplace_back(name, ToBgr8(baked[a]));
-  }
+  std::vector<std::pair<std::string, cv::Mat>> extra = RecordBaselines(flat_albedo, baked, record);
   record["timings_s"] = {{"load", summary.seconds_load},
                          {"visibility", summary.seconds_visibility},
                          {"synthesis", summary.seconds_synthesis},
@@ -376,6 +369,20 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
   return summary;
 }
 
+std::vector<std::pair<std::string, cv::Mat>> RecordBaselines(const Eigen::Vector3f& flat_albedo,
+                                                             const std::vector<cv::Mat>& baked,
+                                                             nlohmann::json& record) {
+  record["baselines"] = {{"flat_albedo", {flat_albedo.x(), flat_albedo.y(), flat_albedo.z()}},
+                         {"baked", nlohmann::json::array()}};
+  std::vector<std::pair<std::string, cv::Mat>> extra;
+  for (std::size_t a = 0; a < baked.size(); ++a) {
+    const std::string name = "baked_" + std::to_string(a) + ".png";
+    record["baselines"]["baked"].push_back(name);
+    extra.emplace_back(name, ToBgr8(baked[a]));
+  }
+  return extra;
+}
+
 ModelBaselines ReadModelBaselines(const fs::path& model_folder, const TexturedModel& model) {
   const fs::path manifest_path = model_folder / "manifest.json";
   const nlohmann::json manifest = ReadModelManifest(model_folder);
@@ -429,9 +436,10 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
     if (it == lights.end()) continue;
     const sfm::Camera& camera = cameras.reconstruction.cameras.at(image.camera_id);
     const RenderedView view =
-        options.renderer ? options.renderer(model, camera, image.cam_from_world, it->second)
-                         : renderer.Render(camera, image.cam_from_world, it->second, options.mode,
-                                           options.samples_per_axis);
+        options.renderer
+            ? options.renderer(renderer, model, camera, image.cam_from_world, it->second)
+            : renderer.Render(camera, image.cam_from_world, it->second, options.mode,
+                              options.samples_per_axis);
     const fs::path name = PngName(image.name);
     fs::create_directories((options.out_dir / name).parent_path());
     fs::create_directories((options.out_dir / "masks" / name).parent_path());

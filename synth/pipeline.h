@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -86,9 +87,10 @@ struct RenderJobOptions {
   RenderMode mode = RenderMode::kPtm;
   int samples_per_axis = 2;
   /// When set, draws every view instead of `mode` (the BTF renderer of btf/
-  /// goes here); given the model folder's model as ReadModelFolder reads it.
-  std::function<RenderedView(const TexturedModel& model, const sfm::Camera& camera,
-                             const sfm::Rigid3d& cam_from_world,
+  /// goes here), given the job's ray caster for the model folder's model
+  /// (ModelRenderer::RenderWith) and that model as ReadModelFolder reads it.
+  std::function<RenderedView(const ModelRenderer& renderer, const TexturedModel& model,
+                             const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
                              const std::vector<sfm::ObjectLight>& lights)>
       renderer;
   /// Written into render.json's settings as the mode (with `renderer`).
@@ -123,6 +125,12 @@ struct ModelBaselines {
   Eigen::Vector3f flat_albedo = Eigen::Vector3f::Constant(0.5f);
   std::vector<cv::Mat> baked;  ///< CV_32FC3 display RGB, per atlas
 };
+/// Records the baselines in a manifest `record` ("baselines": the flat albedo
+/// and baked_K.png per atlas) and returns those PNGs (8-bit BGR) for
+/// WriteModelFolder's extra images.
+std::vector<std::pair<std::string, cv::Mat>> RecordBaselines(const Eigen::Vector3f& flat_albedo,
+                                                             const std::vector<cv::Mat>& baked,
+                                                             nlohmann::json& record);
 /// Throws InputError naming the manifest or texture when missing or malformed.
 ModelBaselines ReadModelBaselines(const std::filesystem::path& model_folder,
                                   const TexturedModel& model);

@@ -81,6 +81,14 @@ class MeshBtfTest : public ::testing::Test {
     j.write_report = false;
     return j;
   }
+  static BtfSynthJobOptions BtfJob(const fs::path& out) {
+    BtfSynthJobOptions o;
+    o.job = Job(out);
+    o.btf = tmp_->path() / "scene/material/btf";
+    o.components = 24;
+    o.synthesis = Options();
+    return o;
+  }
   static synth::RenderJobSummary Render(const fs::path& model, const std::string& out,
                                         synth::RenderMode mode, bool as_btf) {
     synth::RenderJobOptions r;
@@ -95,13 +103,14 @@ class MeshBtfTest : public ::testing::Test {
     std::shared_ptr<BtfModel> btf;
     if (as_btf) {
       r.renderer_name = "btf";
-      r.renderer = [&](const synth::TexturedModel& m, const sfm::Camera& camera,
-                       const sfm::Rigid3d& pose, const std::vector<sfm::ObjectLight>& lights) {
+      r.renderer = [&](const synth::ModelRenderer& renderer, const synth::TexturedModel& m,
+                       const sfm::Camera& camera, const sfm::Rigid3d& pose,
+                       const std::vector<sfm::ObjectLight>& lights) {
         if (!btf) btf = std::make_shared<BtfModel>(ReadBtfModel(model, m));
-        return synth::ModelRenderer(m).RenderWith(
-            camera, pose, 2, [&](const synth::ModelRenderer::SurfaceSample& s) {
-              return ShadeBtf(*btf, s, lights);
-            });
+        return renderer.RenderWith(camera, pose, 2,
+                                   [&](const synth::ModelRenderer::SurfaceSample& s) {
+                                     return ShadeBtf(*btf, s, lights);
+                                   });
       };
     }
     return synth::RunRenderJob(r);
@@ -190,12 +199,7 @@ TEST_F(MeshBtfTest, BothSidesOfAnEdgeSeeTheSameSampleTexelAndFrame) {
 
 TEST_F(MeshBtfTest, ModelFolderHoldsCoordinatesGeometryAtlasesAndAPtmPreview) {
   const fs::path dir = tmp_->path() / "btf_model";
-  BtfSynthJobOptions o;
-  o.job = Job(dir);
-  o.btf = tmp_->path() / "scene/material/btf";
-  o.components = 24;
-  o.synthesis = Options();
-  const BtfSynthJobSummary summary = RunBtfSynthJob(o);
+  const BtfSynthJobSummary summary = RunBtfSynthJob(BtfJob(dir));
   EXPECT_EQ(summary.faces, 1280u);
   const synth::TexturedModel model = synth::ReadModelFolder(dir);
   const BtfModel btf = ReadBtfModel(dir, model);
@@ -232,12 +236,7 @@ TEST_F(MeshBtfTest, ModelFolderHoldsCoordinatesGeometryAtlasesAndAPtmPreview) {
 
 TEST_F(MeshBtfTest, OnAGlossyMaterialTheBtfModelBeatsThePtmModelAtHeldOutViews) {
   const fs::path btf_dir = tmp_->path() / "btf_model_render";
-  BtfSynthJobOptions o;
-  o.job = Job(btf_dir);
-  o.btf = tmp_->path() / "scene/material/btf";
-  o.components = 24;
-  o.synthesis = Options();
-  RunBtfSynthJob(o);
+  RunBtfSynthJob(BtfJob(btf_dir));
   // The PTM model of the same material from its RTI capture, same settings
   // (no photo-consistency pass: that is the PTM pipeline's own addition).
   const fs::path capture = tmp_->path() / "scene/material/capture";
