@@ -154,30 +154,15 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
   }
   const std::vector<cv::Mat> planes = GeometryPlanes(sample);
   const cv::Mat planes_energy = synth::PlaneEnergy(planes);
-  Eigen::VectorXf mean_g = sample.geometry.colwise().mean().transpose();
+  const Eigen::VectorXf mean_g = sample.geometry.colwise().mean().transpose();
 
   // Geometry maps reduced to a photo density r = 2^(-level/4) photo pixels per
   // texel. The BTF is linear in g, so reducing g equals reducing the relit image.
-  struct Reduced {
-    std::vector<cv::Mat> g;
-    double rx = 1.0, ry = 1.0;
-  };
-  std::map<int, Reduced> reduced;
-  auto reduced_at = [&](int level) -> const Reduced& {
+  std::map<int, synth::ReducedPlanes> reduced;
+  auto reduced_at = [&](int level) -> const synth::ReducedPlanes& {
     auto it = reduced.find(level);
     if (it != reduced.end()) return it->second;
-    Reduced r;
-    const double density = std::pow(2.0, -level / 4.0);
-    const int rw = std::max(1, static_cast<int>(std::lround(sample.width * density)));
-    const int rh = std::max(1, static_cast<int>(std::lround(sample.height * density)));
-    for (const cv::Mat& m : planes) {
-      cv::Mat small;
-      cv::resize(m, small, cv::Size(rw, rh), 0, 0, cv::INTER_AREA);
-      r.g.push_back(small);
-    }
-    r.rx = static_cast<double>(rw) / sample.width;
-    r.ry = static_cast<double>(rh) / sample.height;
-    return reduced.emplace(level, std::move(r)).first->second;
+    return reduced.emplace(level, synth::ReduceToDensityLevel(planes, level)).first->second;
   };
 
   // A triangle in one photo: the photo rectified into the triangle frame at the
@@ -202,10 +187,10 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
     const synth::TrianglePatch& patch = result.patches[f];
     const int level = synth::PhotoDensityLevel(patch, view, t);
-    const Reduced& r = reduced_at(level);
+    const synth::ReducedPlanes& r = reduced_at(level);
     const int tw = std::max(1, static_cast<int>(std::lround(patch.width * r.rx)));
     const int th = std::max(1, static_cast<int>(std::lround(patch.height * r.ry)));
-    if (tw > r.g[0].cols || th > r.g[0].rows) return false;
+    if (tw > r.planes[0].cols || th > r.planes[0].rows) return false;
     cv::Mat map_x, map_y;
     out.count = synth::RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera,
                                          image.cam_from_world, photo.image.size(), 0.0, map_x,
@@ -239,13 +224,14 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     out.level = level;
     return true;
   };
-  auto relit = [&](const Reduced& r, const Eigen::MatrixX3f& a, double gain) {
+  auto relit = [&](const synth::ReducedPlanes& r, const Eigen::MatrixX3f& a, double gain) {
     std::vector<cv::Mat> out(3);
     for (int ch = 0; ch < 3; ++ch) {
       cv::Mat& m = out[static_cast<std::size_t>(ch)];
-      m = cv::Mat::zeros(r.g[0].size(), CV_32FC1);
+      m = cv::Mat::zeros(r.planes[0].size(), CV_32FC1);
       for (int i = 0; i < n; ++i)
-        cv::scaleAdd(r.g[static_cast<std::size_t>(i)], static_cast<double>(a(i, ch)) * gain, m, m);
+        cv::scaleAdd(r.planes[static_cast<std::size_t>(i)], static_cast<double>(a(i, ch)) * gain, m,
+                     m);
     }
     return out;
   };
@@ -337,7 +323,7 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
       // Eq. 3 of paper 003 per photo (RMS, linear RGB), summed over the photos.
       cv::Mat total = cv::Mat::zeros(max_sy + 1, max_sx + 1, CV_32FC1);
       for (const Rectified& r : rects) {
-        const Reduced& red = reduced_at(r.level);
+        const synth::ReducedPlanes& red = reduced_at(r.level);
         const std::vector<cv::Mat> model = relit(red, r.appearance, result.photo_gains[r.photo]);
         synth::AddImageScore(synth::MaskedSsd(model, synth::PlaneEnergy(model), r.linear, r.mask),
                              r.count, red.rx, red.ry, total);

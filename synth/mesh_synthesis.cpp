@@ -211,6 +211,22 @@ void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip,
   for (std::size_t c = 0; c < n; ++c) out[c] = static_cast<float>(own_weight * own[c] + sum[c]);
 }
 
+ReducedPlanes ReduceToDensityLevel(const std::vector<cv::Mat>& planes, int level) {
+  ReducedPlanes r;
+  const int width = planes[0].cols, height = planes[0].rows;
+  const double density = std::pow(2.0, -level / 4.0);
+  const int rw = std::max(1, static_cast<int>(std::lround(width * density)));
+  const int rh = std::max(1, static_cast<int>(std::lround(height * density)));
+  for (const cv::Mat& m : planes) {
+    cv::Mat small;
+    cv::resize(m, small, cv::Size(rw, rh), 0, 0, cv::INTER_AREA);
+    r.planes.push_back(small);
+  }
+  r.rx = static_cast<double>(rw) / width;
+  r.ry = static_cast<double>(rh) / height;
+  return r;
+}
+
 int PhotoDensityLevel(const TrianglePatch& patch, const sfm::TriangleView& view, double t) {
   const auto& c = patch.corners_in_frame;
   const double area =
@@ -471,18 +487,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   auto reduced_at = [&](int level) -> const ReducedSample& {
     auto it = reduced.find(level);
     if (it != reduced.end()) return it->second;
-    ReducedSample r;
-    const double density = std::pow(2.0, -level / 4.0);
-    const int rw = std::max(1, static_cast<int>(std::lround(sample.width * density)));
-    const int rh = std::max(1, static_cast<int>(std::lround(sample.height * density)));
-    for (const cv::Mat& m : sample_raw) {
-      cv::Mat small;
-      cv::resize(m, small, cv::Size(rw, rh), 0, 0, cv::INTER_AREA);
-      r.raw.push_back(small);
-    }
-    r.rx = static_cast<double>(rw) / sample.width;
-    r.ry = static_cast<double>(rh) / sample.height;
-    return reduced.emplace(level, std::move(r)).first->second;
+    ReducedPlanes r = ReduceToDensityLevel(sample_raw, level);
+    return reduced.emplace(level, ReducedSample{std::move(r.planes), r.rx, r.ry}).first->second;
   };
   const int polys = sample.NumPolynomials();
   auto relit_planes = [&](const ReducedSample& r, const LightList& lights, double gain) {

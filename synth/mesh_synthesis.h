@@ -166,6 +166,13 @@ PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double texel_size
 /// The photo density level of a face in a view: r = 2^(-level/4) photo pixels
 /// per texel of `texel_size` world units, level in [0, 40].
 int PhotoDensityLevel(const TrianglePatch& patch, const sfm::TriangleView& view, double texel_size);
+/// Planes (one size, CV_32FC1) reduced by area to that density level, and the
+/// effective density (reduced size over full size) along x and y.
+struct ReducedPlanes {
+  std::vector<cv::Mat> planes;
+  double rx = 1.0, ry = 1.0;
+};
+ReducedPlanes ReduceToDensityLevel(const std::vector<cv::Mat>& planes, int level);
 /// cv::remap maps that rectify a photo into the patch grid of `grid` cells at
 /// density (rx, ry) cells per texel, and the mask (CV_32FC1) of cells within
 /// `mask_margin` world units of the triangle whose photo pixel lies in the
