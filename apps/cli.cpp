@@ -697,12 +697,22 @@ int RunViewCommand(const std::vector<std::string>& args, std::ostream& out, std:
   if (port < 0 || port > 65535) throw UsageError("--port must be in [0, 65535]");
   const std::string host = a.Get("host").value_or("127.0.0.1");
   const std::filesystem::path web = WebDir();
-  const std::filesystem::path three = web / "node_modules/three";
-  if (!std::filesystem::exists(web / "viewer/index.html") ||
-      !std::filesystem::exists(three / "build/three.module.js"))
+  // The page loads web/viewer/viewer.js bundled with three.js by esbuild
+  // (`npm run build` in web/, run by ./scripts/install_deps.sh).
+  const std::filesystem::path bundle = web / "dist/viewer.js";
+  if (!std::filesystem::exists(web / "viewer/index.html") || !std::filesystem::exists(bundle))
     throw InputError(web.string(),
-                     "has no viewer or no three.js; run ./scripts/install_deps.sh "
-                     "(it runs npm ci in web/), or set TEXLUME_WEB_DIR");
+                     "has no viewer or no viewer bundle (dist/viewer.js); run "
+                     "./scripts/install_deps.sh (it runs npm ci and npm run build in web/), or "
+                     "set TEXLUME_WEB_DIR");
+  for (const char* source : {"viewer/viewer.js", "package-lock.json"}) {
+    std::error_code ec;
+    const auto source_time = std::filesystem::last_write_time(web / source, ec);
+    if (!ec && source_time > std::filesystem::last_write_time(bundle))
+      throw InputError(bundle.string(), std::string("is older than ") + source +
+                                            "; run `npm run build` in " + web.string() +
+                                            " (or ./scripts/install_deps.sh)");
+  }
   const auto t0 = std::chrono::steady_clock::now();
   synth::WebModel model = synth::BuildWebModel(model_dir);
   const double prepare_s =
@@ -724,8 +734,8 @@ int RunViewCommand(const std::vector<std::string>& args, std::ostream& out, std:
     if (path == "/" || path == "/index.html") return file_response(web / "viewer/index.html");
     if (path.rfind("/viewer/", 0) == 0)
       if (const auto f = FileBelow(web / "viewer", path.substr(8))) return file_response(*f);
-    if (path.rfind("/three/", 0) == 0)
-      if (const auto f = FileBelow(three, path.substr(7))) return file_response(*f);
+    if (path.rfind("/dist/", 0) == 0)
+      if (const auto f = FileBelow(web / "dist", path.substr(6))) return file_response(*f);
     if (path.rfind("/model/", 0) == 0) {
       const auto it = model_files.find(path.substr(7));
       if (it != model_files.end()) return {200, ContentTypeOf(it->first), it->second};

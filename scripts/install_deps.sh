@@ -39,8 +39,8 @@ else
   $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-# The viewer's web packages (three.js; playwright-core and gltf-validator for the
-# tests), exactly as pinned in web/package-lock.json.
+# The viewer's web packages (three.js and esbuild to bundle it; playwright-core
+# and gltf-validator for the tests), exactly as pinned in web/package-lock.json.
 web="$(cd "$(dirname "$0")/../web" && pwd)"
 if [ ! -f "$web/node_modules/.package-lock.json" ] ||
    [ "$web/package-lock.json" -nt "$web/node_modules/.package-lock.json" ]; then
@@ -48,4 +48,11 @@ if [ ! -f "$web/node_modules/.package-lock.json" ] ||
   (cd "$web" && npm ci --no-audit --no-fund)
 else
   echo "install_deps: web packages already installed"
+fi
+# The viewer's page loads one bundle: web/viewer/viewer.js with the parts of
+# three.js it uses, minified by esbuild (web/dist/viewer.js).
+if [ ! -f "$web/dist/viewer.js" ] || [ "$web/viewer/viewer.js" -nt "$web/dist/viewer.js" ] ||
+   [ "$web/package-lock.json" -nt "$web/dist/viewer.js" ]; then
+  echo "install_deps: npm run build in $web"
+  (cd "$web" && npm run build --silent)
 fi

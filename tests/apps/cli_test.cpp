@@ -2,6 +2,7 @@
 // bad input, as a user sees them.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -165,6 +166,34 @@ TEST(Cli, ViewRefusesBadCommandLinesAndFoldersThatAreNotModels) {
   EXPECT_EQ(Texlume("view a b", &out), 2);
   EXPECT_EQ(Texlume("view " + tmp.path().string() + " --port 70000", &out), 2);
   EXPECT_EQ(Texlume("view " + (tmp / "nomodel").string() + " --port 0", &out), 1);
+  EXPECT_NE(out.find("manifest.json"), std::string::npos) << out;
+}
+
+TEST(Cli, ViewRefusesAMissingOrStaleViewerBundle) {
+  TempDir tmp;
+  const std::filesystem::path web = tmp / "web";
+  std::filesystem::create_directories(web / "viewer");
+  std::filesystem::create_directories(web / "dist");
+  WriteText(web / "viewer/index.html", "<!doctype html>");
+  WriteText(web / "viewer/viewer.js", "// source");
+  const std::string view = "env TEXLUME_WEB_DIR=" + web.string() + " " +
+                           std::string(TEXLUME_BINARY) + " view " + (tmp / "nomodel").string() +
+                           " --port 0";
+  std::string out;
+  EXPECT_EQ(testing::RunCommand(view, &out), 1);
+  EXPECT_NE(out.find("dist/viewer.js"), std::string::npos) << out;
+  // A bundle older than the viewer's source is not served.
+  WriteText(web / "dist/viewer.js", "// bundle");
+  std::filesystem::last_write_time(web / "dist/viewer.js",
+                                   std::filesystem::last_write_time(web / "viewer/viewer.js") -
+                                       std::chrono::hours(1));
+  EXPECT_EQ(testing::RunCommand(view, &out), 1);
+  EXPECT_NE(out.find("is older than viewer/viewer.js"), std::string::npos) << out;
+  // A fresh one is: the model folder is what is wrong now.
+  std::filesystem::last_write_time(web / "dist/viewer.js",
+                                   std::filesystem::last_write_time(web / "viewer/viewer.js") +
+                                       std::chrono::hours(1));
+  EXPECT_EQ(testing::RunCommand(view, &out), 1);
   EXPECT_NE(out.find("manifest.json"), std::string::npos) << out;
 }
 
