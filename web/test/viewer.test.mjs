@@ -107,9 +107,14 @@ async function dragLight(fx, fy) {
 }
 
 test('the page loads the model with no console errors', async () => {
-  const state = await page.evaluate(() => ({ ready: window.texlumeViewer.ready, errors: window.texlumeViewer.errors }));
+  const state = await page.evaluate(() => ({ ready: window.texlumeViewer.ready, errors: window.texlumeViewer.errors,
+                                             software: window.texlumeViewer.softwareRenderer,
+                                             status: document.getElementById('status').textContent }));
   assert.deepEqual(state.errors, []);
   assert.equal(state.ready, true);
+  // SwiftShader is recognised as a software rasteriser (drawn without multisampling).
+  assert.equal(state.software, true);
+  assert.match(state.status, /software WebGL/);
   const image = await shot();
   assert.ok(halves(image, objectMask(image)).pixels > 0.05 * image.width * image.height,
             'the model covers the view');

@@ -5,7 +5,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
 const statusEl = document.getElementById('status');
-const canvas = document.getElementById('view');
+let canvas = document.getElementById('view');  // replaced by makeRenderer on a GPU
 // Times (ms since the page was opened) at each step of loading, for the bench.
 const api = { ready: false, errors: [], firstFrameMs: null, marks: { moduleStart: performance.now() } };
 window.texlumeViewer = api;
@@ -182,6 +182,28 @@ function textureOf(bitmap) {
   return texture;
 }
 
+// The page's WebGL renderer. Multisampling costs a CPU rasteriser (SwiftShader,
+// llvmpipe) about half its frame rate and a GPU next to nothing: the canvas's
+// first context, made without it, is kept on a software rasteriser; on a GPU the
+// page draws on a fresh canvas (a canvas keeps its first context's settings)
+// with multisampling.
+function makeRenderer() {
+  const settings = { alpha: false, depth: true, stencil: false, premultipliedAlpha: true, preserveDrawingBuffer: true };
+  const gl = canvas.getContext('webgl2', { ...settings, antialias: false });
+  if (gl) {
+    const info = gl.getExtension('WEBGL_debug_renderer_info');
+    const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+    if (/swiftshader|llvmpipe|softpipe|software/i.test(name))
+      return { renderer: new THREE.WebGLRenderer({ canvas, context: gl, ...settings, antialias: false }), software: true };
+    const lose = gl.getExtension('WEBGL_lose_context');
+    if (lose) lose.loseContext();
+    const fresh = canvas.cloneNode(false);
+    canvas.replaceWith(fresh);
+    canvas = fresh;
+  }
+  return { renderer: new THREE.WebGLRenderer({ canvas, ...settings, antialias: true }), software: false };
+}
+
 async function main() {
   // prefetch.js started fetching the model and decoding its PTM textures.
   const prefetch = window.texlumePrefetch;
@@ -202,7 +224,8 @@ async function main() {
   const barycentric = new Float32Array(g.vertices * 3);
   for (let v = 0; v < g.vertices; ++v) barycentric[v * 3 + (v % 3)] = 1;
 
-  const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+  const { renderer, software } = makeRenderer();
+  api.softwareRenderer = software;
   renderer.setPixelRatio(window.devicePixelRatio);
   renderer.outputColorSpace = THREE.LinearSRGBColorSpace;  // shaders write display values as they are
   const world = new THREE.Scene();
@@ -358,7 +381,8 @@ async function main() {
   // Since the page was opened (navigation start): HTML, scripts, model, first frame.
   api.firstFrameMs = performance.now();
   statusEl.textContent = `${scene.faces} triangles, ${scene.atlases.length} atlas(es), ` +
-      `${scene.charts} charts; first frame after ${(api.firstFrameMs / 1000).toFixed(2)} s`;
+      `${scene.charts} charts; first frame after ${(api.firstFrameMs / 1000).toFixed(2)} s` +
+      (api.softwareRenderer ? ' (software WebGL: no multisampling)' : '');
   Object.assign(api, {
     setLight,
     renderNow: render,
