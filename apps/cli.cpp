@@ -514,6 +514,10 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
     b.synthesis.top_k = o.synthesis.top_k;
     b.synthesis.max_views = o.synthesis.all_views ? o.synthesis.max_views : 1;
     b.synthesis.seed = o.synthesis.seed;
+    // The photo-consistency pass: --correction-iterations 0 turns it off, as for PTMs.
+    b.synthesis.photo_correction = o.synthesis.correction_iterations > 0;
+    b.synthesis.correction_noise = a.GetDouble("correction-noise", b.synthesis.correction_noise);
+    b.synthesis.correction_sigma = a.GetDouble("correction-sigma", b.synthesis.correction_sigma);
     b.synthesis.tangent_frame = o.synthesis.tangent_frame;
     b.synthesis.field_direction_in_world = o.synthesis.field_direction_in_world;
     b.job = std::move(o);

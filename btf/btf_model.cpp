@@ -26,6 +26,7 @@ double WrapAngle(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
 std::string AtlasFileName(std::size_t k) { return "btf_atlas_" + std::to_string(k) + ".exr"; }
 
 const std::vector<std::string> kCoordinateChannels = {"sample_x", "sample_y", "angle"};
+const std::vector<std::string> kGainChannels = {"gain_r", "gain_g", "gain_b"};
 
 std::string GeometryFileName(std::size_t atlas, std::size_t part) {
   return "btf_geometry_" + std::to_string(atlas) + "_" + std::to_string(part) + ".png";
@@ -54,10 +55,10 @@ BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const BtfMeshSynthesis
   out.layout = synth::LayoutAtlases(mesh, synthesis.patches, synthesis.unfoldings,
                                     synthesis.texel_size, options, progress);
   const int n = sample.Components();
-  // Planes: sample x, sample y, angle, then g_0 .. g_{n-1}.
+  // Planes: sample x, sample y, angle, the factors r, g, b, then g_0 .. g_{n-1}.
   std::vector<std::vector<cv::Mat>> planes(out.layout.atlas_sizes.size());
   for (std::size_t a = 0; a < planes.size(); ++a)
-    for (int c = 0; c < 3 + n; ++c)
+    for (int c = 0; c < 6 + n; ++c)
       planes[a].push_back(cv::Mat::zeros(out.layout.atlas_sizes[a], CV_32FC1));
   std::vector<double> face_angle;
   for (const synth::FacePlacement& fp : out.layout.faces)
@@ -73,8 +74,10 @@ BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const BtfMeshSynthesis
         // d_sample = R(look) d_face and d_face = R(-face) d_atlas.
         p[2].at<float>(y, x) = static_cast<float>(
             WrapAngle(look.angle_rad - face_angle[static_cast<std::size_t>(face)]));
+        for (int c = 0; c < 3; ++c)
+          p[static_cast<std::size_t>(3 + c)].at<float>(y, x) = look.colour_gain[c];
         SampleGeometry(sample, look.sample_px, g.data());
-        for (int i = 0; i < n; ++i) p[static_cast<std::size_t>(3 + i)].at<float>(y, x) = g[i];
+        for (int i = 0; i < n; ++i) p[static_cast<std::size_t>(6 + i)].at<float>(y, x) = g[i];
       },
       progress);
   std::size_t total = 0;
@@ -84,7 +87,10 @@ BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const BtfMeshSynthesis
     cv::Mat coords;
     cv::merge(std::vector<cv::Mat>(planes[a].begin(), planes[a].begin() + 3), coords);
     out.sample_coords.push_back(coords);
-    out.geometry.emplace_back(planes[a].begin() + 3, planes[a].end());
+    cv::Mat gain;
+    cv::merge(std::vector<cv::Mat>(planes[a].begin() + 3, planes[a].begin() + 6), gain);
+    out.colour_gain.push_back(gain);
+    out.geometry.emplace_back(planes[a].begin() + 6, planes[a].end());
   }
   out.coverage = std::move(coverage.coverage);
   out.occupancy = total ? static_cast<double>(coverage.inside_texels) / total : 0.0;
@@ -121,7 +127,10 @@ std::vector<ptm::Ptm> PreviewPtms(const BtfAtlases& atlases, const BtfFactorisat
       for (int x = 0; x < coords.cols; ++x) {
         const std::size_t t = static_cast<std::size_t>(y) * coords.cols + x;
         for (int i = 0; i < n; ++i) g[i] = planes[static_cast<std::size_t>(i)].at<float>(y, x);
-        const Eigen::VectorXf linear = appearance * g;
+        Eigen::VectorXf linear = appearance * g;
+        const cv::Vec3f k = atlases.colour_gain[a].at<cv::Vec3f>(y, x);
+        for (int j = 0; j < count; ++j)
+          for (int c = 0; c < 3; ++c) linear[j * 3 + c] *= k[c];
         Eigen::Vector3d channel_sum = Eigen::Vector3d::Zero();
         for (int j = 0; j < count; ++j) {
           double s = 0.0;
@@ -179,6 +188,17 @@ BtfModel ReadBtfModel(const fs::path& dir, const synth::TexturedModel& model) {
     cv::Mat coords;
     cv::merge(ordered, coords);
     out.sample_coords.push_back(coords);
+    // The photo-consistency factors (absent from models made without them: 1).
+    std::vector<cv::Mat> gain;
+    for (const std::string& want : kGainChannels) {
+      const auto it = std::find(names.begin(), names.end(), want);
+      if (it != names.end()) gain.push_back(planes[static_cast<std::size_t>(it - names.begin())]);
+    }
+    if (!gain.empty() && gain.size() != 3)
+      throw InputError(file.string(), "has some but not all of gain_r, gain_g, gain_b");
+    cv::Mat factors(coords.size(), CV_32FC3, cv::Scalar::all(1.0));
+    if (!gain.empty()) cv::merge(gain, factors);
+    out.colour_gain.push_back(factors);
   }
   return out;
 }
@@ -216,8 +236,9 @@ Eigen::Vector3f ShadeBtf(const BtfModel& model, const synth::ModelRenderer::Surf
     linear += static_cast<float>(light.intensity) *
               (InterpolateAppearance(model.sample, view, l).transpose() * g);
   }
-  return {synth::LinearToSrgb(linear[0]), synth::LinearToSrgb(linear[1]),
-          synth::LinearToSrgb(linear[2])};
+  const cv::Vec3f k = model.colour_gain[static_cast<std::size_t>(s.atlas)].at<cv::Vec3f>(ny, nx);
+  return {synth::LinearToSrgb(linear[0] * k[0]), synth::LinearToSrgb(linear[1] * k[1]),
+          synth::LinearToSrgb(linear[2] * k[2])};
 }
 
 BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
@@ -316,6 +337,9 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
       {"tangent_frame",
        so.tangent_frame == synth::TangentFrame::kSmoothField ? "smooth_field" : "first_edge"},
       {"tolerance", so.tolerance},
+      {"photo_correction", so.photo_correction},
+      {"correction_noise", so.correction_noise},
+      {"correction_sigma", so.correction_sigma},
       {"seed", so.seed},
       {"atlas_mode", job.atlas.mode == synth::AtlasMode::kCharts ? "charts" : "per_triangle"},
       {"atlas_size", job.atlas.atlas_size},
@@ -333,6 +357,8 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
                        {"seam_edges", summary.seam_edges},
                        {"seam_cost_per_link", summary.seam_cost_per_link},
                        {"straight_edge_cost_per_link", summary.edge_cost_per_link},
+                       {"photo_rms_quilted", synthesis.photo_rms_quilted},
+                       {"photo_rms_corrected", synthesis.photo_rms_corrected},
                        {"photo_gains", synthesis.photo_gains}};
   record["warnings"] = summary.warnings;
   std::vector<std::pair<std::string, cv::Mat>> extra =
@@ -342,7 +368,7 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
   record["btf"] = {{"format", "texlume-btf-model-1"},
                    {"factorisation", "btf/btf_svd.json"},
                    {"atlases", btf_files},
-                   {"atlas_channels", "sample_x, sample_y, angle (docs/btf.md)"},
+                   {"atlas_channels", "sample_x, sample_y, angle, gain_r, gain_g, gain_b (docs/btf.md)"},
                    {"ptm_atlases", "a preview: the BTF seen head-on, fitted per texel"}};
   record["timings_s"] = {
       {"load", inputs.seconds_load},
@@ -394,9 +420,13 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
   synth::WriteModelFolder(job.out_dir, model, record, extra, [&](const fs::path& folder) {
     WriteBtfFactorisation(sample, errors, folder / "btf");
     for (std::size_t a = 0; a < atlases.sample_coords.size(); ++a) {
-      std::vector<cv::Mat> planes;
+      std::vector<cv::Mat> planes, gain;
       cv::split(atlases.sample_coords[a], planes);
-      ptm::WriteExr(folder / AtlasFileName(a), planes, kCoordinateChannels);
+      cv::split(atlases.colour_gain[a], gain);
+      planes.insert(planes.end(), gain.begin(), gain.end());
+      std::vector<std::string> names = kCoordinateChannels;
+      names.insert(names.end(), kGainChannels.begin(), kGainChannels.end());
+      ptm::WriteExr(folder / AtlasFileName(a), planes, names);
     }
     for (const auto& [name, bytes] : geometry_png)
       synth::WriteBytesAtomically(folder / name, bytes);

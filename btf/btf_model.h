@@ -27,6 +27,9 @@ struct BtfAtlases {
   /// +0.5), angle (radians): a tangent direction d in the atlas frame (x = atlas
   /// right, y = atlas up, z = normal) is R(angle) d in the sample's frame.
   std::vector<cv::Mat> sample_coords;
+  /// CV_32FC3 per atlas: the photo-consistency factors (linear R, G, B) the
+  /// BTF is multiplied by at each texel (BtfMeshSynthesis::colour_gain).
+  std::vector<cv::Mat> colour_gain;
   /// Per atlas, n CV_32FC1 planes: g_i at each texel's sample position.
   std::vector<std::vector<cv::Mat>> geometry;
   double occupancy = 0.0;
@@ -41,7 +44,8 @@ BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const BtfMeshSynthesis
 /// A PTM preview of BTF atlases for PTM viewers and exports (the web viewer,
 /// glTF extras, .ptm): per texel an RGB PTM in the display domain, in the atlas
 /// frame, fitted by least squares to the BTF seen head-on (v = normal) under 25
-/// lights between 15 and 90 degrees of elevation. View dependence is lost.
+/// lights between 15 and 90 degrees of elevation, with the photo-consistency
+/// factors. View dependence is lost.
 std::vector<ptm::Ptm> PreviewPtms(const BtfAtlases& atlases, const BtfFactorisation& sample,
                                   const ProgressCallback& progress = {});
 
@@ -49,9 +53,11 @@ std::vector<ptm::Ptm> PreviewPtms(const BtfAtlases& atlases, const BtfFactorisat
 struct BtfModel {
   BtfFactorisation sample;
   std::vector<cv::Mat> sample_coords;  ///< as BtfAtlases
+  std::vector<cv::Mat> colour_gain;    ///< as BtfAtlases (all 1 when the file has none)
 };
 
-/// Reads `btf/` (the factorisation) and `btf_atlas_K.exr` (sample coordinates) of a model folder.
+/// Reads `btf/` (the factorisation) and `btf_atlas_K.exr` (sample coordinates
+/// and photo-consistency factors) of a model folder.
 /// Throws InputError naming the file when one is missing, malformed, or its
 /// size differs from the model's atlas.
 BtfModel ReadBtfModel(const std::filesystem::path& dir, const synth::TexturedModel& model);
@@ -60,7 +66,8 @@ BtfModel ReadBtfModel(const std::filesystem::path& dir, const synth::TexturedMod
 /// position moved by the hit's offset from it, view and light directions in the
 /// atlas frame (the renderer's smooth frame) turned into the sample frame by the
 /// texel's angle, f = sum_lights I sum_i g_i(x) p_i(v, l) (g bilinear in the
-/// sample; p interpolated over the direction grid), then sRGB.
+/// sample; p interpolated over the direction grid), times the texel's
+/// photo-consistency factors, then sRGB.
 Eigen::Vector3f ShadeBtf(const BtfModel& model, const synth::ModelRenderer::SurfaceSample& sample,
                          const std::vector<sfm::ObjectLight>& lights);
 

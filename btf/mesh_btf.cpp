@@ -70,6 +70,10 @@ void BtfMeshSynthesisOptions::Check() const {
   if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
   if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
   if (max_texels < 1) throw OptionError("max_texels must be >= 1");
+  if (!(correction_noise > 0.0) || !std::isfinite(correction_noise))
+    throw OptionError("correction noise must be > 0");
+  if (!(correction_sigma > 0.0) || !std::isfinite(correction_sigma))
+    throw OptionError("correction sigma must be > 0 photo pixels");
   if (!(field_direction_in_world.norm() > 0.0))
     throw OptionError("field direction must be nonzero");
 }
@@ -93,9 +97,27 @@ BtfSampleLookup BtfMeshSynthesis::Lookup(int face, const Eigen::Vector2d& p) con
     const synth::TrianglePatch& patch = patches[static_cast<std::size_t>(f)];
     BtfSampleLookup out;
     out.source_face = f;
-    out.sample_px = Eigen::Vector2d(patch.sample_x + (q.x() - patch.x_min) / texel_size,
-                                    patch.sample_y + (patch.y_max - q.y()) / texel_size);
+    const Eigen::Vector2d in_patch((q.x() - patch.x_min) / texel_size,
+                                   (patch.y_max - q.y()) / texel_size);  // texels, y down
+    out.sample_px = Eigen::Vector2d(patch.sample_x, patch.sample_y) + in_patch;
     out.angle_rad = angle;
+    if (static_cast<std::size_t>(f) < colour_gain.size() &&
+        !colour_gain[static_cast<std::size_t>(f)].empty()) {
+      // Bilinear on the factor grid (cell centres at (c + 0.5) / density texels).
+      const cv::Mat& k = colour_gain[static_cast<std::size_t>(f)];
+      const Eigen::Vector2d& density = gain_density[static_cast<std::size_t>(f)];
+      const double u = std::clamp(in_patch.x() * density.x() - 0.5, 0.0, k.cols - 1.0);
+      const double v = std::clamp(in_patch.y() * density.y() - 0.5, 0.0, k.rows - 1.0);
+      const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
+      const int x1 = std::min(x0 + 1, k.cols - 1), y1 = std::min(y0 + 1, k.rows - 1);
+      const float fx = static_cast<float>(u - x0), fy = static_cast<float>(v - y0);
+      const auto at = [&](int x, int y) {
+        const cv::Vec3f& c = k.at<cv::Vec3f>(y, x);
+        return Eigen::Vector3f(c[0], c[1], c[2]);
+      };
+      out.colour_gain = (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) +
+                        fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+    }
     return out;
   };
   const synth::TrianglePatch& patch = patches[static_cast<std::size_t>(face)];
@@ -175,6 +197,7 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     int level = 0;
     std::vector<cv::Mat> linear;  // RGB
     cv::Mat mask;                 // CV_32FC1
+    cv::Mat wide_mask;            // the same over the seam band too (photo correction)
     int count = 0;
     Eigen::MatrixX3f appearance;  // n x 3
     bool steep = true;            // every light and the view above 60 degrees
@@ -196,6 +219,12 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
                                          image.cam_from_world, photo.image.size(), 0.0, map_x,
                                          map_y, out.mask);
     if (out.count < options.min_photo_pixels) return false;
+    if (options.photo_correction) {
+      cv::Mat wide_x, wide_y;
+      synth::RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera,
+                               image.cam_from_world, photo.image.size(),
+                               (options.seam_band + 1) * t, wide_x, wide_y, out.wide_mask);
+    }
     cv::Mat rectified;
     cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
     std::vector<cv::Mat> display;
@@ -256,6 +285,98 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     }
   }
   result.photo_gains = synth::SolvePhotoGains(ratios, num_faces, photos.size());
+
+  // Photo-consistency factors (per face in 2b, after its placement): k per channel
+  // on a grid at the first (best) photo's density over the whole patch:
+  // k = (sum_r m_r p_r + lambda mu) / (sum_r m_r^2 + lambda mu), smoothed by a
+  // Gaussian normalised over the observed cells (which carries k into the strip
+  // the graph cuts may show), 1 where nothing is observed nearby.
+  result.colour_gain.resize(num_faces);
+  result.gain_density.assign(num_faces, Eigen::Vector2d::Ones());
+  double residual_quilted = 0.0, residual_corrected = 0.0, residual_count = 0.0;
+  auto correct = [&](std::size_t f, const std::vector<Rectified>& scored,
+                     const std::vector<std::vector<cv::Mat>>& models) {
+    const synth::TrianglePatch& patch = result.patches[f];
+    const cv::Size grid = scored[0].mask.size();
+    std::array<cv::Mat, 3> num, den;
+    for (int ch = 0; ch < 3; ++ch) {
+      num[static_cast<std::size_t>(ch)] = cv::Mat::zeros(grid, CV_32FC1);
+      den[static_cast<std::size_t>(ch)] = cv::Mat::zeros(grid, CV_32FC1);
+    }
+    cv::Mat observed = cv::Mat::zeros(grid, CV_32FC1);
+    struct OnGrid {
+      std::array<cv::Mat, 3> model, photo;
+      cv::Mat inside;  // the triangle's cells (for the residuals)
+    };
+    std::vector<OnGrid> on_grid(scored.size());
+    for (std::size_t r = 0; r < scored.size(); ++r) {
+      const synth::ReducedPlanes& red = reduced_at(scored[r].level);
+      const cv::Size size = scored[r].mask.size();
+      OnGrid& g = on_grid[r];
+      // The chosen patch relit under photo r: its cell i is at reduced-sample
+      // position sample_x rx + i (pixel centres at integers).
+      const cv::Point2f centre(static_cast<float>(patch.sample_x * red.rx + (size.width - 1) * 0.5),
+                               static_cast<float>(patch.sample_y * red.ry + (size.height - 1) * 0.5));
+      cv::Mat wide = scored[r].wide_mask;
+      g.inside = scored[r].mask;
+      for (std::size_t ch = 0; ch < 3; ++ch) {
+        cv::getRectSubPix(models[r][ch], size, centre, g.model[ch]);
+        g.photo[ch] = scored[r].linear[ch];
+      }
+      if (size != grid) {
+        for (std::size_t ch = 0; ch < 3; ++ch) {
+          cv::resize(g.model[ch], g.model[ch], grid, 0, 0, cv::INTER_AREA);
+          cv::resize(g.photo[ch], g.photo[ch], grid, 0, 0, cv::INTER_AREA);
+        }
+        cv::resize(wide, wide, grid, 0, 0, cv::INTER_AREA);
+        cv::resize(g.inside, g.inside, grid, 0, 0, cv::INTER_AREA);
+      }
+      for (std::size_t ch = 0; ch < 3; ++ch) {
+        num[ch] += g.model[ch].mul(g.photo[ch]).mul(wide);
+        den[ch] += g.model[ch].mul(g.model[ch]).mul(wide);
+      }
+      observed += wide;
+    }
+    const double observed_sum = cv::sum(observed)[0];
+    if (!(observed_sum > 0.0)) return;
+    const double sigma = options.correction_sigma;
+    cv::Mat weight, wide_weight;
+    cv::GaussianBlur(observed, weight, cv::Size(), sigma);
+    cv::GaussianBlur(observed, wide_weight, cv::Size(), 4.0 * sigma);
+    std::vector<cv::Mat> k(3);
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+      const double mu = cv::sum(den[ch])[0] / observed_sum;  // mean m^2 per observation
+      const double prior = options.correction_noise * std::max(mu, 1e-12);
+      cv::Mat raw;
+      cv::divide(num[ch] + prior * observed, den[ch] + prior * observed + 1e-30, raw);
+      // raw * observed is 0 where nothing is observed: normalised smoothing.
+      const cv::Mat weighted = raw.mul(observed);
+      cv::Mat smooth, wide;
+      cv::GaussianBlur(weighted, smooth, cv::Size(), sigma);
+      cv::GaussianBlur(weighted, wide, cv::Size(), 4.0 * sigma);
+      k[ch] = cv::Mat(grid, CV_32FC1);
+      for (int j = 0; j < grid.height; ++j)
+        for (int i = 0; i < grid.width; ++i) {
+          float v = 1.0f;
+          if (weight.at<float>(j, i) > 0.05f)
+            v = smooth.at<float>(j, i) / weight.at<float>(j, i);
+          else if (wide_weight.at<float>(j, i) > 0.01f)
+            v = wide.at<float>(j, i) / wide_weight.at<float>(j, i);
+          k[ch].at<float>(j, i) = std::clamp(v, 0.2f, 5.0f);
+        }
+    }
+    for (const OnGrid& g : on_grid)
+      for (std::size_t ch = 0; ch < 3; ++ch) {
+        const cv::Mat before = g.model[ch] - g.photo[ch];
+        const cv::Mat after = g.model[ch].mul(k[ch]) - g.photo[ch];
+        residual_quilted += cv::sum(before.mul(before).mul(g.inside))[0];
+        residual_corrected += cv::sum(after.mul(after).mul(g.inside))[0];
+        residual_count += cv::sum(g.inside)[0];
+      }
+    cv::merge(k, result.colour_gain[f]);
+    const synth::ReducedPlanes& grid_level = reduced_at(scored[0].level);
+    result.gain_density[f] = Eigen::Vector2d(grid_level.rx, grid_level.ry);
+  };
 
   // 2b. Breadth-first synthesis from the best-seen triangle.
   const int seed_face = synth::BestSeenFace(visibility);
@@ -322,9 +443,11 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     if (!rects.empty()) {
       // Eq. 3 of paper 003 per photo (RMS, linear RGB), summed over the photos.
       cv::Mat total = cv::Mat::zeros(max_sy + 1, max_sx + 1, CV_32FC1);
+      std::vector<std::vector<cv::Mat>> models;  // per photo: the relit sample at its density
       for (const Rectified& r : rects) {
         const synth::ReducedPlanes& red = reduced_at(r.level);
-        const std::vector<cv::Mat> model = relit(red, r.appearance, result.photo_gains[r.photo]);
+        const std::vector<cv::Mat>& model =
+            models.emplace_back(relit(red, r.appearance, result.photo_gains[r.photo]));
         synth::AddImageScore(synth::MaskedSsd(model, synth::PlaneEnergy(model), r.linear, r.mask),
                              r.count, red.rx, red.ry, total);
       }
@@ -346,6 +469,7 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
       patch.source = synth::PatchSource::kPhotos;
       patch.views_used = static_cast<int>(rects.size());
       ++result.num_from_photos;
+      if (options.photo_correction) correct(f, rects, models);
     } else if (!target_texels.empty()) {
       std::vector<cv::Mat> target_planes(static_cast<std::size_t>(n));
       for (cv::Mat& m : target_planes) m = cv::Mat::zeros(h, w, CV_32FC1);
@@ -374,6 +498,10 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     ++processed;
     if (progress && (processed % 64 == 0 || processed == num_faces))
       progress("btf synthesis", processed, num_faces);
+  }
+  if (residual_count > 0) {
+    result.photo_rms_quilted = std::sqrt(residual_quilted / residual_count);
+    result.photo_rms_corrected = std::sqrt(residual_corrected / residual_count);
   }
   result.seconds_synthesis = Since(start);
 

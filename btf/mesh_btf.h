@@ -38,6 +38,21 @@ struct BtfMeshSynthesisOptions {
   double tolerance = 0.1;
   /// Fewest rectified photo pixels inside a triangle for the photo to constrain it. >= 1.
   int min_photo_pixels = 6;
+  /// Photo-consistency pass (beyond paper 004, as the PTM synthesis's): per
+  /// triangle seen in photos, a per-channel factor k on a grid at the best
+  /// photo's density, the most probable under a prior k = 1 given every
+  /// constraint photo, k = (sum_r m_r p_r + lambda mu) / (sum_r m_r^2 + lambda mu)
+  /// with m_r the chosen patch relit under photo r (times its gain), p_r the
+  /// photo, mu the mean m^2: the photos' low frequencies (stains, colour, the
+  /// exact light and dark spots) on the sample's fine detail.
+  bool photo_correction = true;
+  /// lambda above: photo noise as a share of the model's mean power; small
+  /// trusts the photos, large keeps the sample. > 0.
+  double correction_noise = 0.05;
+  /// Smoothing of the factors (Gaussian sigma, photo pixels; normalised over the
+  /// observed cells, which also carries them into the strip, with 4 sigma where
+  /// no observed cell is near). > 0.
+  double correction_sigma = 0.35;
   /// Refuse up front when the patches would take more texels than this.
   std::int64_t max_texels = std::int64_t{1} << 30;
   std::uint32_t seed = 1;
@@ -52,6 +67,8 @@ struct BtfSampleLookup {
   int source_face = 0;                                  ///< the face whose patch supplies it
   Eigen::Vector2d sample_px = Eigen::Vector2d::Zero();  ///< x right, y down, centres at +0.5
   double angle_rad = 0.0;
+  /// The photo-consistency factor per linear RGB channel (1 without one).
+  Eigen::Vector3f colour_gain = Eigen::Vector3f::Ones();
 };
 
 /// The per-triangle BTF synthesis: each face's patch of the sample (rectangle
@@ -67,6 +84,14 @@ struct BtfMeshSynthesis {
   /// 0 = the face's own patch, 1 + k = the patch of the neighbour across edge k.
   std::vector<cv::Mat> labels;
   std::vector<double> photo_gains;  ///< per photo (linear exposure x intensity)
+  /// Per face, the photo-consistency factors (CV_32FC3, linear R, G, B) on a
+  /// grid over its patch rectangle at `gain_density` cells per texel (x, y);
+  /// empty: none (unseen faces, or the pass is off).
+  std::vector<cv::Mat> colour_gain;
+  std::vector<Eigen::Vector2d> gain_density;
+  /// RMS linear difference to the constraint photos at their density (masked
+  /// photo pixels of every constraint photo), before and after the factors.
+  double photo_rms_quilted = 0, photo_rms_corrected = 0;
   std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
   std::size_t seam_edges = 0;           ///< mesh edges with a graph cut
   std::size_t seam_links = 0;           ///< texel pairs the seams cut
