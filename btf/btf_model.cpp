@@ -365,11 +365,12 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
       synth::RecordBaselines(flat_albedo, baked, record);
   nlohmann::json btf_files = nlohmann::json::array();
   for (std::size_t a = 0; a < atlases.geometry.size(); ++a) btf_files.push_back(AtlasFileName(a));
-  record["btf"] = {{"format", "texlume-btf-model-1"},
-                   {"factorisation", "btf/btf_svd.json"},
-                   {"atlases", btf_files},
-                   {"atlas_channels", "sample_x, sample_y, angle, gain_r, gain_g, gain_b (docs/btf.md)"},
-                   {"ptm_atlases", "a preview: the BTF seen head-on, fitted per texel"}};
+  record["btf"] = {
+      {"format", "texlume-btf-model-1"},
+      {"factorisation", "btf/btf_svd.json"},
+      {"atlases", btf_files},
+      {"atlas_channels", "sample_x, sample_y, angle, gain_r, gain_g, gain_b (docs/btf.md)"},
+      {"ptm_atlases", "a preview: the BTF seen head-on, fitted per texel"}};
   record["timings_s"] = {
       {"load", inputs.seconds_load},
       {"visibility", inputs.seconds_visibility},

@@ -221,9 +221,9 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     if (out.count < options.min_photo_pixels) return false;
     if (options.photo_correction) {
       cv::Mat wide_x, wide_y;
-      synth::RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera,
-                               image.cam_from_world, photo.image.size(),
-                               (options.seam_band + 1) * t, wide_x, wide_y, out.wide_mask);
+      synth::RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera, image.cam_from_world,
+                               photo.image.size(), (options.seam_band + 1) * t, wide_x, wide_y,
+                               out.wide_mask);
     }
     cv::Mat rectified;
     cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
@@ -315,8 +315,9 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
       OnGrid& g = on_grid[r];
       // The chosen patch relit under photo r: its cell i is at reduced-sample
       // position sample_x rx + i (pixel centres at integers).
-      const cv::Point2f centre(static_cast<float>(patch.sample_x * red.rx + (size.width - 1) * 0.5),
-                               static_cast<float>(patch.sample_y * red.ry + (size.height - 1) * 0.5));
+      const cv::Point2f centre(
+          static_cast<float>(patch.sample_x * red.rx + (size.width - 1) * 0.5),
+          static_cast<float>(patch.sample_y * red.ry + (size.height - 1) * 0.5));
       cv::Mat wide = scored[r].wide_mask;
       g.inside = scored[r].mask;
       for (std::size_t ch = 0; ch < 3; ++ch) {

@@ -184,15 +184,15 @@ TEST(Cli, ViewRefusesAMissingOrStaleViewerBundle) {
   EXPECT_NE(out.find("dist/viewer.js"), std::string::npos) << out;
   // A bundle older than the viewer's source is not served.
   WriteText(web / "dist/viewer.js", "// bundle");
-  std::filesystem::last_write_time(web / "dist/viewer.js",
-                                   std::filesystem::last_write_time(web / "viewer/viewer.js") -
-                                       std::chrono::hours(1));
+  std::filesystem::last_write_time(
+      web / "dist/viewer.js",
+      std::filesystem::last_write_time(web / "viewer/viewer.js") - std::chrono::hours(1));
   EXPECT_EQ(testing::RunCommand(view, &out), 1);
   EXPECT_NE(out.find("is older than viewer/viewer.js"), std::string::npos) << out;
   // A fresh one is: the model folder is what is wrong now.
-  std::filesystem::last_write_time(web / "dist/viewer.js",
-                                   std::filesystem::last_write_time(web / "viewer/viewer.js") +
-                                       std::chrono::hours(1));
+  std::filesystem::last_write_time(
+      web / "dist/viewer.js",
+      std::filesystem::last_write_time(web / "viewer/viewer.js") + std::chrono::hours(1));
   EXPECT_EQ(testing::RunCommand(view, &out), 1);
   EXPECT_NE(out.find("manifest.json"), std::string::npos) << out;
 }

@@ -308,9 +308,8 @@ TEST_F(MeshBtfTest, PhotoCorrectionBringsThePatchesCloserToThePhotos) {
   // Without the pass, every factor is 1 and the residual is the quilted one.
   BtfMeshSynthesisOptions off = Options();
   off.photo_correction = false;
-  const BtfMeshSynthesis plain = SynthesizeMeshBtf(inputs_->mesh, inputs_->reconstruction,
-                                                   inputs_->visibility, inputs_->photos, *sample_,
-                                                   off);
+  const BtfMeshSynthesis plain = SynthesizeMeshBtf(
+      inputs_->mesh, inputs_->reconstruction, inputs_->visibility, inputs_->photos, *sample_, off);
   const Eigen::Vector2d p = plain.patches[0].corners_in_frame[0] * 0.5;
   EXPECT_EQ(plain.Lookup(0, p).colour_gain, Eigen::Vector3f::Ones());
   EXPECT_EQ(plain.photo_rms_corrected, 0.0);
