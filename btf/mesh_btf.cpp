@@ -452,21 +452,11 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
         synth::AddImageScore(synth::MaskedSsd(model, synth::PlaneEnergy(model), r.linear, r.mask),
                              r.count, red.rx, red.ry, total);
       }
-      const std::vector<std::pair<float, cv::Point>> all = synth::BestPlacements(
-          total, std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx))),
-          options.top_k);
-      const std::size_t k = all.size();
-      double best = std::numeric_limits<double>::infinity();
-      for (std::size_t c = 0; c < k; ++c) {
-        const double e = overlap_error(all[c].second.x, all[c].second.y);
-        if (e < best) {
-          best = e;
-          patch.sample_x = all[c].second.x;
-          patch.sample_y = all[c].second.y;
-          patch.image_score = all[c].first;
-          patch.overlap_error = e;
-        }
-      }
+      synth::KeepClosestToNeighbours(
+          synth::BestPlacements(
+              total, std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx))),
+              options.top_k),
+          overlap_error, patch);
       patch.source = synth::PatchSource::kPhotos;
       patch.views_used = static_cast<int>(rects.size());
       ++result.num_from_photos;

@@ -346,6 +346,22 @@ std::vector<std::pair<float, cv::Point>> BestPlacements(const cv::Mat& score, in
   return all;
 }
 
+void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& candidates,
+                             const std::function<double(int, int)>& overlap_error,
+                             TrianglePatch& patch) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& [score, at] : candidates) {
+    const double e = overlap_error(at.x, at.y);
+    if (e < best) {
+      best = e;
+      patch.sample_x = at.x;
+      patch.sample_y = at.y;
+      patch.image_score = score;
+      patch.overlap_error = e;
+    }
+  }
+}
+
 PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int strip,
                                 TangentFrame tangent_frame,
                                 const Eigen::Vector3d& field_direction_in_world) {
@@ -913,21 +929,11 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       }
       // Top-k distinct positions at the coarsest density used (neighbouring texel
       // positions share one photo-density cell and score alike).
-      const std::vector<std::pair<float, cv::Point>> all = BestPlacements(
-          total, std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx))),
-          options.top_k);
-      const std::size_t k = all.size();
-      double best = std::numeric_limits<double>::infinity();
-      for (std::size_t c = 0; c < k; ++c) {
-        const double e = overlap_error(all[c].second.x, all[c].second.y);
-        if (e < best) {
-          best = e;
-          patch.sample_x = all[c].second.x;
-          patch.sample_y = all[c].second.y;
-          patch.image_score = all[c].first;
-          patch.overlap_error = e;
-        }
-      }
+      KeepClosestToNeighbours(
+          BestPlacements(
+              total, std::max(1, static_cast<int>(std::floor(1.0 / reduced_at(rects[0].level).rx))),
+              options.top_k),
+          overlap_error, patch);
       patch.source = PatchSource::kPhotos;
       patch.views_used = static_cast<int>(rects.size());
       ++result.num_from_photos;

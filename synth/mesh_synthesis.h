@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -206,6 +207,12 @@ int BestSeenFace(const sfm::VisibilityResult& visibility);
 void AddImageScore(const cv::Mat& ssd, int count, double rx, double ry, cv::Mat& total);
 /// The k lowest placements of a score map, looking every `stride` texels, best first.
 std::vector<std::pair<float, cv::Point>> BestPlacements(const cv::Mat& score, int stride, int k);
+/// Algorithm 2's second constraint: of the image score's candidates (BestPlacements),
+/// the one with the least `overlap_error(sample_x, sample_y)` (the first on a tie)
+/// becomes the patch's placement, with its image score and overlap error.
+void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& candidates,
+                             const std::function<double(int, int)>& overlap_error,
+                             TrianglePatch& patch);
 
 /// Per-triangle image-constrained PTM synthesis on a mesh (paper 003 Algorithm 2).
 /// `visibility` from sfm::ComputeVisibility for this mesh and reconstruction;
