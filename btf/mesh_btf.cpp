@@ -202,7 +202,9 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     Eigen::MatrixX3f appearance;  // n x 3
     bool steep = true;            // every light and the view above 60 degrees
   };
-  auto rectify = [&](std::size_t f, const sfm::TriangleView& view, Rectified& out) -> bool {
+  // `seam_band_mask`: also the mask over the seam band (the photo correction's).
+  auto rectify = [&](std::size_t f, const sfm::TriangleView& view, Rectified& out,
+                     bool seam_band_mask) -> bool {
     const auto it = photo_index.find(view.image_id);
     if (it == photo_index.end()) return false;
     const synth::MeshPhoto& photo = photos[it->second];
@@ -219,7 +221,7 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
                                          image.cam_from_world, photo.image.size(), 0.0, map_x,
                                          map_y, out.mask);
     if (out.count < options.min_photo_pixels) return false;
-    if (options.photo_correction) {
+    if (seam_band_mask) {
       cv::Mat wide_x, wide_y;
       synth::RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera, image.cam_from_world,
                                photo.image.size(), (options.seam_band + 1) * t, wide_x, wide_y,
@@ -274,7 +276,7 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     for (const sfm::TriangleView& view : visibility.triangles[f].views) {
       if (!view.fully_visible || used >= 8) continue;
       Rectified rect;
-      if (!rectify(f, view, rect) || !rect.steep) continue;
+      if (!rectify(f, view, rect, false) || !rect.steep) continue;
       double photo_linear = 0.0;
       for (int ch = 0; ch < 3; ++ch)
         photo_linear += cv::sum(rect.linear[static_cast<std::size_t>(ch)].mul(rect.mask))[0];
@@ -438,7 +440,7 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     for (const sfm::TriangleView& view :
          synth::ConstrainingViews(visibility.triangles[f], true, options.max_views)) {
       Rectified r;
-      if (rectify(f, view, r)) rects.push_back(std::move(r));
+      if (rectify(f, view, r, options.photo_correction)) rects.push_back(std::move(r));
     }
     const int max_sx = sample.width - w, max_sy = sample.height - h;
     if (!rects.empty()) {
