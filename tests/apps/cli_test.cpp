@@ -333,27 +333,27 @@ TEST_F(FitCliTest, Synth2dBuildsAPtmFromPhotosAndRefusesBadPhotos) {
   EXPECT_FALSE(std::filesystem::exists(tmp_ / "bad"));
 }
 
-}  // namespace
-}  // namespace texlume
-
-namespace texlume {
-namespace {
-
-// `texlume btf` on the synthetic scene's BTF capture: writes the factorisation
-// and the error table, falling with n; refuses bad command lines and captures.
-TEST(Cli, BtfFactorisesTheSceneCaptureAndRefusesBadInput) {
-  TempDir tmp;
+// A small synthetic scene with a BTF capture of the material (6 views x 12
+// lights) and an object seen in `num_images` photos of `size` pixels.
+datasets::SceneOptions SmallBtfScene(int num_images, int size, int btf_size) {
   datasets::SceneOptions options;
-  options.num_images = 3;
-  options.image_width = 64;
-  options.image_height = 64;
+  options.num_images = num_images;
+  options.image_width = size;
+  options.image_height = size;
   options.num_held_out_views = 0;
   options.capture_size = 16;
   options.num_capture_lights = 6;
   options.num_held_out_capture_lights = 0;
   options.write_surface = false;
-  options.btf_size = 32;
-  datasets::GenerateScene(options, tmp.path() / "scene");
+  options.btf_size = btf_size;
+  return options;
+}
+
+// `texlume btf` on the synthetic scene's BTF capture: writes the factorisation
+// and the error table, falling with n; refuses bad command lines and captures.
+TEST(Cli, BtfFactorisesTheSceneCaptureAndRefusesBadInput) {
+  TempDir tmp;
+  datasets::GenerateScene(SmallBtfScene(3, 64, 32), tmp.path() / "scene");
   const std::string capture = (tmp / "scene").string() + "/material/btf";
   std::string out;
   ASSERT_EQ(
@@ -386,22 +386,13 @@ TEST(Cli, BtfFactorisesTheSceneCaptureAndRefusesBadInput) {
   EXPECT_FALSE(std::filesystem::exists(tmp / "x"));
 }
 
-}  // namespace
 TEST(Cli, SynthWithABtfSampleRendersAsABtfAndRefusesBadInput) {
   TempDir tmp;
-  datasets::SceneOptions options;
-  options.num_images = 8;
-  options.image_width = 96;
-  options.image_height = 96;
+  datasets::SceneOptions options = SmallBtfScene(8, 96, 40);
   options.focal_px = 90;
   options.num_held_out_views = 1;
   options.held_out_lights_per_view = 1;
-  options.capture_size = 16;
-  options.num_capture_lights = 6;
-  options.num_held_out_capture_lights = 0;
-  options.write_surface = false;
   options.material.texel_size = 0.01;
-  options.btf_size = 40;
   datasets::GenerateScene(options, tmp.path() / "scene");
   const std::string scene = (tmp / "scene").string();
   const std::string inputs = " --model " + scene + "/object/sparse --images " + scene +
@@ -447,4 +438,5 @@ TEST(Cli, SynthWithABtfSampleRendersAsABtfAndRefusesBadInput) {
   EXPECT_FALSE(std::filesystem::exists(tmp / "x"));
 }
 
+}  // namespace
 }  // namespace texlume
