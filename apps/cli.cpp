@@ -456,7 +456,9 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
        "correction-sigma",
        "correction-noise",
        "chart-angle",
-       "chart-size"},
+       "chart-size",
+       "chart-flattening",
+       "chart-stretch"},
       {"best-view-only", "no-additive-correction", "no-channel-correction", "no-report"});
   synth::SynthJobOptions o;
   o.model_dir = a.Require("model");
@@ -498,6 +500,12 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
   o.atlas.max_chart_normal_angle_deg =
       a.GetDouble("chart-angle", o.atlas.max_chart_normal_angle_deg);
   o.atlas.max_chart_size = a.GetInt("chart-size", o.atlas.max_chart_size);
+  const std::string flattening = a.Get("chart-flattening").value_or("rigid");
+  if (flattening != "rigid" && flattening != "conformal")
+    throw UsageError("--chart-flattening: rigid or conformal, not '" + flattening + "'");
+  o.atlas.flattening =
+      flattening == "rigid" ? synth::ChartFlattening::kRigid : synth::ChartFlattening::kConformal;
+  o.atlas.max_chart_stretch = a.GetDouble("chart-stretch", o.atlas.max_chart_stretch);
   o.atlas.blend_strip = o.synthesis.strip;
   o.max_subdivisions = a.GetInt("max-subdivisions", o.max_subdivisions);
   o.visibility.max_buffer_dimension = a.GetInt("max-buffer-size", 0);

@@ -62,7 +62,7 @@ BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const BtfMeshSynthesis
       planes[a].push_back(cv::Mat::zeros(out.layout.atlas_sizes[a], CV_32FC1));
   std::vector<double> face_angle;
   for (const synth::FacePlacement& fp : out.layout.faces)
-    face_angle.push_back(std::atan2(fp.rotation(1, 0), fp.rotation(0, 0)));
+    face_angle.push_back(-fp.AtlasFrameAngle());  // the atlas frame's turn from the face frame
   std::vector<float> g(static_cast<std::size_t>(n));
   synth::AtlasCoverage coverage = synth::VisitAtlasTexels(
       out.layout, synthesis.texel_size, options.gutter,
@@ -344,6 +344,10 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
       {"atlas_mode", job.atlas.mode == synth::AtlasMode::kCharts ? "charts" : "per_triangle"},
       {"atlas_size", job.atlas.atlas_size},
       {"gutter", job.atlas.gutter},
+      {"chart_flattening", synth::ChartFlatteningName(job.atlas.flattening)},
+      {"chart_size", job.atlas.max_chart_size},
+      {"chart_angle_deg", job.atlas.max_chart_normal_angle_deg},
+      {"chart_stretch", job.atlas.max_chart_stretch},
       {"horizon_elevation_deg", synth::kHorizonElevationDeg}};
   record["summary"] = {{"photos_used", summary.photos_used},
                        {"faces", summary.faces},

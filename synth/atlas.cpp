@@ -11,22 +11,11 @@
 
 #include "ptm/coefficient_space.h"
 #include "sfm/errors.h"
+#include "synth/charts.h"
 #include "synth/planar_synthesis.h"
 
 namespace texlume::synth {
 namespace {
-
-double RotationAngle(const Eigen::Matrix2d& r) { return std::atan2(r(1, 0), r(0, 0)); }
-
-struct ChartFace {
-  int face;
-  Eigen::Matrix2d rotation;  // chart = rotation * frame + translation (world units)
-  Eigen::Vector2d translation;
-};
-
-std::int64_t Key(int x, int y) {
-  return (static_cast<std::int64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
-}
 
 constexpr double kPi = 3.14159265358979323846;
 /// Turns tried for every chart when packing (every 360/16 = 22.5 degrees).
@@ -61,7 +50,7 @@ ChartOutline Box(const std::vector<ChartFace>& chart, double angle,
     std::array<Eigen::Vector2d, 3> c;
     for (std::size_t k = 0; k < 3; ++k) {
       c[k] = turn *
-             (cf.rotation * patches[static_cast<std::size_t>(cf.face)].corners_in_frame[k] +
+             (cf.linear * patches[static_cast<std::size_t>(cf.face)].corners_in_frame[k] +
               cf.translation) /
              t;
       lo = lo.cwiseMin(c[k]);
@@ -237,6 +226,40 @@ OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlin
 }
 }  // namespace
 
+Eigen::Vector2d FacePlacement::FrameFromAtlas(const Eigen::Vector2d& px, double texel_size) const {
+  const Eigen::Vector2d r((px.x() - offset.x()) * texel_size, (offset.y() - px.y()) * texel_size);
+  return linear.inverse() * r;
+}
+
+double FacePlacement::AtlasFrameAngle() const {
+  const Eigen::Vector2d x_in_frame = linear.inverse().col(0);
+  return std::atan2(x_in_frame.y(), x_in_frame.x());
+}
+
+const char* ChartFlatteningName(ChartFlattening flattening) {
+  return flattening == ChartFlattening::kRigid ? "rigid" : "conformal";
+}
+
+AtlasStretch MeasureStretch(const std::vector<TrianglePatch>& patches, const AtlasLayout& layout) {
+  AtlasStretch s;
+  double weighted = 0, area = 0;
+  s.min = std::numeric_limits<double>::max();
+  s.max = 0;
+  for (std::size_t f = 0; f < layout.faces.size() && f < patches.size(); ++f) {
+    const auto& c = patches[f].corners_in_frame;
+    const double a = 0.5 * std::abs((c[1] - c[0]).x() * (c[2] - c[0]).y() -
+                                    (c[1] - c[0]).y() * (c[2] - c[0]).x());
+    const Eigen::Vector2d sigma = SingularValues2(layout.faces[f].linear);
+    weighted += a * std::sqrt(sigma.x() * sigma.y());
+    area += a;
+    s.min = std::min(s.min, sigma.y());
+    s.max = std::max(s.max, sigma.x());
+  }
+  if (area > 0) s.mean = weighted / area;
+  if (s.max == 0) s.min = s.max = 1.0;
+  return s;
+}
+
 void AtlasOptions::Check() const {
   if (atlas_size < 64 || atlas_size > 16384) throw OptionError("atlas size must be in [64, 16384]");
   if (gutter < 1 || gutter > 16) throw OptionError("gutter must be in [1, 16] texels");
@@ -245,6 +268,8 @@ void AtlasOptions::Check() const {
     throw OptionError("max chart size must be in [0, atlas size]");
   if (!(max_chart_normal_angle_deg > 0.0 && max_chart_normal_angle_deg <= 180.0))
     throw OptionError("max chart normal angle must be in (0, 180] degrees");
+  if (!(max_chart_stretch >= 1.01 && max_chart_stretch <= 4.0))
+    throw OptionError("max chart stretch must be in [1.01, 4]");
 }
 
 std::vector<std::array<int, 3>> PackSkyline(const std::vector<std::pair<int, int>>& sizes,
@@ -343,122 +368,24 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
       }
       charts.push_back({{static_cast<int>(f), best, Eigen::Vector2d::Zero()}});
     }
+  } else if (options.flattening == ChartFlattening::kRigid) {
+    RigidChartOptions ro;
+    ro.texel_size = t;
+    ro.max_extent_texels =
+        (options.max_chart_size > 0 ? std::min(options.max_chart_size, options.atlas_size)
+                                    : options.atlas_size) -
+        2 * gutter - 2;
+    ro.max_normal_angle_deg = options.max_chart_normal_angle_deg;
+    ro.gutter = gutter;
+    charts = MakeRigidCharts(mesh, patches, unfoldings, ro);
   } else {
-    std::vector<std::vector<int>> faces_of_vertex(mesh.vertices.size());
-    for (std::size_t f = 0; f < num_faces; ++f)
-      for (int v : mesh.faces[f])
-        faces_of_vertex[static_cast<std::size_t>(v)].push_back(static_cast<int>(f));
-    auto shares_vertex = [&](int a, int b) {
-      for (int v : mesh.faces[static_cast<std::size_t>(a)])
-        for (int g : faces_of_vertex[static_cast<std::size_t>(v)])
-          if (g == b) return true;
-      return false;
-    };
-    std::vector<int> chart_of(num_faces, -1);
-    const double max_extent =
-        ((options.max_chart_size > 0 ? std::min(options.max_chart_size, options.atlas_size)
-                                     : options.atlas_size) -
-         2 * gutter - 2) *
-        t;
-    const double min_cos = std::cos(options.max_chart_normal_angle_deg * kPi / 180.0);
-    // Seeds in breadth-first order over face adjacency, so each new chart starts
-    // at the border of the charted region and few fragments are left between.
-    std::vector<int> seed_order;
-    {
-      std::vector<char> seen(num_faces, 0);
-      for (std::size_t root = 0; root < num_faces; ++root) {
-        if (seen[root]) continue;
-        std::deque<int> bfs = {static_cast<int>(root)};
-        seen[root] = 1;
-        while (!bfs.empty()) {
-          const int f = bfs.front();
-          bfs.pop_front();
-          seed_order.push_back(f);
-          for (const Unfolding& u : unfoldings[static_cast<std::size_t>(f)])
-            if (u.face >= 0 && !seen[static_cast<std::size_t>(u.face)]) {
-              seen[static_cast<std::size_t>(u.face)] = 1;
-              bfs.push_back(u.face);
-            }
-        }
-      }
-    }
-    for (const int seed_face : seed_order) {
-      const auto seed = static_cast<std::size_t>(seed_face);
-      if (chart_of[seed] >= 0) continue;
-      const int chart_id = static_cast<int>(charts.size());
-      std::vector<ChartFace> chart;
-      std::unordered_map<std::int64_t, int> texels;  // chart texel -> face
-      Eigen::Vector2d lo(0, 0), hi(0, 0);
-      bool first = true;
-      auto corners_of = [&](const ChartFace& cf) {
-        std::array<Eigen::Vector2d, 3> c;
-        for (int k = 0; k < 3; ++k)
-          c[static_cast<std::size_t>(k)] =
-              cf.rotation * patches[static_cast<std::size_t>(cf.face)]
-                                .corners_in_frame[static_cast<std::size_t>(k)] +
-              cf.translation;
-        return c;
-      };
-      // Accepts a placement when it overlaps nothing, keeps clear of faces it does
-      // not touch on the mesh, and the chart still fits an atlas.
-      auto try_add = [&](const ChartFace& cf) {
-        const auto c = corners_of(cf);
-        Eigen::Vector2d clo = c[0], chi = c[0];
-        for (const auto& p : c) clo = clo.cwiseMin(p), chi = chi.cwiseMax(p);
-        if (!first) {
-          const Eigen::Vector2d nlo = lo.cwiseMin(clo), nhi = hi.cwiseMax(chi);
-          if ((nhi - nlo).maxCoeff() > max_extent) return false;
-        }
-        const double clearance = (2 * gutter + 1) * t;
-        const int x0 = static_cast<int>(std::floor((clo.x() - clearance) / t));
-        const int x1 = static_cast<int>(std::ceil((chi.x() + clearance) / t));
-        const int y0 = static_cast<int>(std::floor((clo.y() - clearance) / t));
-        const int y1 = static_cast<int>(std::ceil((chi.y() + clearance) / t));
-        std::vector<std::int64_t> mine;
-        for (int y = y0; y <= y1; ++y) {
-          for (int x = x0; x <= x1; ++x) {
-            const Eigen::Vector2d p((x + 0.5) * t, (y + 0.5) * t);
-            const double d = SignedDistanceToTriangle(c, p);
-            if (d > clearance) continue;
-            const auto it = texels.find(Key(x, y));
-            if (it != texels.end()) {
-              if (d < -0.5 * t) return false;                         // overlap
-              if (!shares_vertex(cf.face, it->second)) return false;  // too close
-            }
-            if (d <= 0.0) mine.push_back(Key(x, y));
-          }
-        }
-        for (const std::int64_t k : mine) texels.emplace(k, cf.face);
-        lo = first ? clo : lo.cwiseMin(clo);
-        hi = first ? chi : hi.cwiseMax(chi);
-        first = false;
-        chart.push_back(cf);
-        chart_of[static_cast<std::size_t>(cf.face)] = chart_id;
-        return true;
-      };
-      try_add({static_cast<int>(seed), Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero()});
-      // Breadth-first over the mesh edges, each neighbour unfolded across the edge.
-      std::deque<std::size_t> queue = {0};
-      while (!queue.empty()) {
-        const ChartFace from = chart[queue.front()];
-        queue.pop_front();
-        for (int k = 0; k < 3; ++k) {
-          const Unfolding& u =
-              unfoldings[static_cast<std::size_t>(from.face)][static_cast<std::size_t>(k)];
-          if (u.face < 0 || chart_of[static_cast<std::size_t>(u.face)] >= 0) continue;
-          if (patches[static_cast<std::size_t>(u.face)].frame.z_axis.dot(
-                  patches[seed].frame.z_axis) < min_cos)
-            continue;
-          // p_from = R_u^T (p_nb - t_u), so chart = R_from R_u^T p_nb + ...
-          ChartFace cf;
-          cf.face = u.face;
-          cf.rotation = from.rotation * u.rotation.transpose();
-          cf.translation = from.translation - cf.rotation * u.translation;
-          if (try_add(cf)) queue.push_back(chart.size() - 1);
-        }
-      }
-      charts.push_back(std::move(chart));
-    }
+    ConformalChartOptions co;
+    co.texel_size = t;
+    co.max_side_texels = options.max_chart_size > 0 ? options.max_chart_size : options.atlas_size;
+    co.max_normal_angle_deg = options.max_chart_normal_angle_deg;
+    co.max_stretch = options.max_chart_stretch;
+    co.max_extent_texels = options.atlas_size - 2 * gutter - 2;
+    charts = MakeConformalCharts(mesh, patches, unfoldings, co);
   }
 
   // 2. Chart boxes in texels (with gutters), packed.
@@ -531,7 +458,7 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
       // Turn the chart to the chosen rotation.
       const Eigen::Matrix2d turn = Eigen::Rotation2Dd(o.angle).toRotationMatrix();
       for (ChartFace& cf : charts[c]) {
-        cf.rotation = turn * cf.rotation;
+        cf.linear = turn * cf.linear;
         cf.translation = turn * cf.translation;
       }
       chart_lo[c] = o.lo;
@@ -556,12 +483,12 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
       FacePlacement& fp = layout.faces[static_cast<std::size_t>(cf.face)];
       fp.atlas = bin;
       fp.chart = static_cast<int>(c);
-      fp.rotation = cf.rotation;
+      fp.linear = cf.linear;
       fp.offset = Eigen::Vector2d(x0 + cf.translation.x() / t - chart_lo[c].x(),
                                   y0 + chart_hi[c].y() - cf.translation.y() / t);
       for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector2d q = cf.rotation * patches[static_cast<std::size_t>(cf.face)]
-                                                    .corners_in_frame[static_cast<std::size_t>(k)];
+        const Eigen::Vector2d q = cf.linear * patches[static_cast<std::size_t>(cf.face)]
+                                                  .corners_in_frame[static_cast<std::size_t>(k)];
         fp.corners_px[static_cast<std::size_t>(k)] =
             Eigen::Vector2d(fp.offset.x() + q.x() / t, fp.offset.y() - q.y() / t);
       }
@@ -605,7 +532,7 @@ AtlasCoverage VisitAtlasTexels(const AtlasLayout& layout, double texel_size, int
           continue;
         }
         const Eigen::Vector2d r((q.x() - fp.offset.x()) * t, (fp.offset.y() - q.y()) * t);
-        visit(fp.atlas, x, y, static_cast<int>(f), fp.rotation.transpose() * r);
+        visit(fp.atlas, x, y, static_cast<int>(f), fp.linear.inverse() * r);
         claims.at<float>(y, x) = key;
         if (d <= 0.0) {
           coverage.at<std::uint8_t>(y, x) = 255;
@@ -663,7 +590,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
       planes[a].push_back(cv::Mat::zeros(layout.atlas_sizes[a], CV_32FC1));
   std::vector<Eigen::Matrix<double, 6, 6>> to_atlas;
   for (const FacePlacement& fp : layout.faces)
-    to_atlas.push_back(ptm::OrthonormalFrameRotation(-RotationAngle(fp.rotation)));
+    to_atlas.push_back(ptm::OrthonormalFrameRotation(fp.AtlasFrameAngle()));
   std::vector<float> value(num_planes);
   AtlasCoverage coverage = VisitAtlasTexels(
       layout, synthesis.texel_size, options.gutter,
@@ -683,6 +610,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
   Atlases atlases;
   atlases.num_charts = layout.num_charts;
   atlases.faces = layout.faces;
+  atlases.stretch = MeasureStretch(synthesis.patches, layout);
   std::size_t total_texels = 0;
   for (std::size_t a = 0; a < planes.size(); ++a) {
     // Dilate into the few gutter texels no face reached (one ring per gutter texel).

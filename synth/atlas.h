@@ -16,12 +16,19 @@ namespace texlume::synth {
 /// How triangles are laid out in the atlases (paper 003 §3: per-triangle boxes).
 enum class AtlasMode {
   kPerTriangle,  ///< each triangle's minimal bounding box, bin-packed (the paper)
-  kCharts,       ///< connected triangles unfolded edge to edge into charts, packed
+  kCharts,       ///< connected triangles flattened into charts (rigid or conformal), packed
+};
+
+/// How kCharts flattens a chart (synth/charts.h).
+enum class ChartFlattening {
+  kRigid,      ///< faces unfolded edge to edge: no distortion, cracks around vertices
+  kConformal,  ///< least-squares conformal map: no cracks, texel stretch within a bound
 };
 
 /// Settings of BuildAtlases.
 struct AtlasOptions {
   AtlasMode mode = AtlasMode::kCharts;
+  ChartFlattening flattening = ChartFlattening::kRigid;
   /// Width of every atlas and the most height (texels); the last atlas is cropped
   /// to the rows it uses. [64, 16384].
   int atlas_size = 2048;
@@ -31,26 +38,46 @@ struct AtlasOptions {
   /// Blend width across mesh edges (W_e, texels; the synthesis strip). [2, 32].
   int blend_strip = 8;
   /// kCharts: a face joins a chart only while its normal is within this angle of
-  /// the chart's first face (compact charts pack with less waste). (0, 180].
+  /// the chart's seed face. (0, 180].
   double max_chart_normal_angle_deg = 180.0;
-  /// kCharts: largest chart side in texels (0 = the atlas size); smaller charts
-  /// nest better. [0, atlas_size].
+  /// kCharts: largest chart side in texels (0 = the atlas size); kConformal
+  /// grows charts around their seed face within a square of this side on the
+  /// seed's tangent plane. Smaller charts nest better. [0, atlas_size].
   int max_chart_size = 192;
+  /// kConformal: most texel stretch of a face in a chart (the singular values of
+  /// the chart map, texels per texel of the synthesis, stay in [1/s, s]); a
+  /// chart beyond it is split. [1.01, 4].
+  double max_chart_stretch = 1.25;
   void Check() const;
 };
 
 /// Where one face went: atlas pixel coordinates of a point p of its triangle
-/// frame (world units) are x = offset.x + (R p).x / t, y = offset.y - (R p).y / t
-/// (x right, y down, pixel centres at +0.5), R = rotation.
+/// frame (world units) are x = offset.x + (L p).x / t, y = offset.y - (L p).y / t
+/// (x right, y down, pixel centres at +0.5), L = linear: a rotation for a rigid
+/// placement, near a rotation (conformal, texel stretch near 1) in a chart.
 struct FacePlacement {
   int atlas = 0;
   int chart = 0;
-  Eigen::Matrix2d rotation = Eigen::Matrix2d::Identity();
+  Eigen::Matrix2d linear = Eigen::Matrix2d::Identity();
   Eigen::Vector2d offset = Eigen::Vector2d::Zero();
   /// The triangle's corners in atlas pixel coordinates.
   std::array<Eigen::Vector2d, 3> corners_px;
+
+  /// The point of the triangle frame (world units) at atlas pixel coordinates `px`.
+  Eigen::Vector2d FrameFromAtlas(const Eigen::Vector2d& px, double texel_size) const;
+  /// The angle (radians) of the atlas +x direction (dP/du) in the triangle
+  /// frame: the atlas frame is the triangle frame turned by it (about the normal).
+  double AtlasFrameAngle() const;
 };
 
+/// Texel stretch of a layout: per face the singular values of its map from
+/// the triangle frame to the atlas, in texels per texel of the synthesis (1:
+/// the synthesis density; below 1 the atlas holds less detail than synthesised).
+struct AtlasStretch {
+  double mean = 1.0;  ///< area-weighted mean of sqrt(s1 s2) (the density's scale)
+  double min = 1.0;   ///< smallest singular value over the faces
+  double max = 1.0;   ///< largest singular value over the faces
+};
 /// Where every face goes, without values: placements and atlas sizes.
 struct AtlasLayout {
   std::vector<FacePlacement> faces;
@@ -58,9 +85,9 @@ struct AtlasLayout {
   int num_charts = 0;
 };
 
-/// Lays out the faces (per triangle or in charts) and packs them into atlases
-/// (per-triangle boxes: skyline, tallest first; charts: by their outlines at 16
-/// rotations on a per-column skyline, largest first). `patches` give each face's
+/// Lays out the faces (per triangle or in conformal charts, synth/charts.h) and
+/// packs them into atlases (per-triangle boxes: skyline, tallest first; charts:
+/// by their outlines at 16 rotations, bottom-left, largest first). `patches` give each face's
 /// frame and corners, `unfoldings` its neighbours across edges; `texel_size` in
 /// world units. Throws OptionError when a chart does not fit an atlas.
 AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
@@ -103,7 +130,13 @@ struct Atlases {
   /// Texels whose centre lies inside a triangle / all atlas texels.
   double occupancy = 0.0;
   double seconds = 0.0;
+  AtlasStretch stretch;  ///< of the faces' maps (1 for rigid placements)
 };
+
+AtlasStretch MeasureStretch(const std::vector<TrianglePatch>& patches, const AtlasLayout& layout);
+
+/// "rigid" or "conformal" (the manifest's and the CLI's names).
+const char* ChartFlatteningName(ChartFlattening flattening);
 
 /// Lays out the faces (per triangle or in charts), packs them into atlases
 /// (per-triangle boxes: skyline, tallest first; charts: by their outlines at 16

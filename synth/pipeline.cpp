@@ -245,6 +245,7 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
   summary.atlases = atlases.ptms.size();
   summary.charts = static_cast<std::size_t>(atlases.num_charts);
   summary.occupancy = atlases.occupancy;
+  summary.stretch = atlases.stretch;
 
   TexturedModel model;
   model.mesh = mesh;
@@ -290,7 +291,11 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
       {"seed", so.seed},
       {"atlas_mode", options.atlas.mode == AtlasMode::kCharts ? "charts" : "per_triangle"},
       {"atlas_size", options.atlas.atlas_size},
-      {"gutter", options.atlas.gutter}};
+      {"gutter", options.atlas.gutter},
+      {"chart_flattening", ChartFlatteningName(options.atlas.flattening)},
+      {"chart_size", options.atlas.max_chart_size},
+      {"chart_angle_deg", options.atlas.max_chart_normal_angle_deg},
+      {"chart_stretch", options.atlas.max_chart_stretch}};
   record["summary"] = {{"photos_used", summary.photos_used},
                        {"faces", summary.faces},
                        {"subdivisions", summary.subdivisions},
@@ -300,6 +305,10 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
                        {"atlases", summary.atlases},
                        {"charts", summary.charts},
                        {"occupancy", summary.occupancy},
+                       {"texel_stretch",
+                        {{"mean", summary.stretch.mean},
+                         {"min", summary.stretch.min},
+                         {"max", summary.stretch.max}}},
                        {"photo_gains", synthesis.photo_gains}};
   record["warnings"] = summary.warnings;
   std::vector<std::pair<std::string, cv::Mat>> extra = RecordBaselines(flat_albedo, baked, record);

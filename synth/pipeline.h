@@ -42,6 +42,7 @@ struct SynthJobSummary {
   std::size_t from_photos = 0, from_neighbours = 0, random = 0;
   std::size_t atlases = 0, charts = 0;
   double occupancy = 0.0;
+  AtlasStretch stretch;
   double seconds_load = 0, seconds_visibility = 0, seconds_synthesis = 0, seconds_atlas = 0,
          seconds_baselines = 0, seconds_report = 0, seconds_export = 0, seconds_total = 0;
 };

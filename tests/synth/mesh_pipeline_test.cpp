@@ -152,10 +152,8 @@ TEST_F(MeshPipelineTest, AtlasFramesAgreeWithTriangleFrames) {
                                 static_cast<std::size_t>(std::floor(px.x()));
       const Eigen::Vector2d centre(std::floor(px.x()) + 0.5, std::floor(px.y()) + 0.5);
       // Recompute the frame value at that texel centre.
-      const Eigen::Vector2d r((centre.x() - fp.offset.x()) * synthesis.texel_size,
-                              (fp.offset.y() - centre.y()) * synthesis.texel_size);
-      synthesis.SampleBlended(static_cast<int>(f), fp.rotation.transpose() * r, ao.blend_strip,
-                              value.data());
+      synthesis.SampleBlended(static_cast<int>(f), fp.FrameFromAtlas(centre, synthesis.texel_size),
+                              ao.blend_strip, value.data());
       for (int i = 0; i < 6; ++i) q[i] = value[static_cast<std::size_t>(i)];
       const Eigen::Matrix<double, 6, 1> a_at_texel = from * q;
       // Tangent frame from the texture coordinates (v up), as the renderer does.

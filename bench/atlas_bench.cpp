@@ -1,0 +1,91 @@
+// Atlas layout alone (issue 6): the coarse meshes of the synthetic shapes at the
+// default material's texel size (and split 1-to-4 once), laid out in charts and
+// in per-triangle boxes, without synthesis.
+// Run: build/bench/atlas_bench [--gutter G] [--chart-size N]
+// Prints per mesh and mode: occupancy (texels inside triangles / atlas texels),
+// charts, atlases, layout seconds, and the charts' texel stretch (area-weighted
+// mean and extremes of the per-face singular values of texels per texel size).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "datasets_synthetic/material.h"
+#include "datasets_synthetic/shapes.h"
+#include "synth/atlas.h"
+#include "synth/mesh_synthesis.h"
+#include "synth/pipeline.h"
+
+using namespace texlume;
+
+namespace {
+cv::Mat Thumbnail(const cv::Mat& coverage) {
+  cv::Mat small;
+  cv::resize(coverage, small, cv::Size(), 0.25, 0.25, cv::INTER_AREA);
+  return small;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  synth::AtlasOptions charts;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--gutter")) charts.gutter = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--chart-size")) charts.max_chart_size = std::atoi(argv[i + 1]);
+  }
+  synth::AtlasOptions boxes = charts, conformal = charts;
+  boxes.mode = synth::AtlasMode::kPerTriangle;
+  conformal.flattening = synth::ChartFlattening::kConformal;
+  const double texel_size = datasets::MaterialOptions{}.texel_size;
+  for (const datasets::SceneShape shape : {datasets::SceneShape::kSphere,
+                                           datasets::SceneShape::kCylinder,
+                                           datasets::SceneShape::kTorus}) {
+    sfm::TriangleMesh mesh = datasets::CoarseMesh(shape);
+    for (int level = 0; level < 2; ++level) {
+      if (level > 0) mesh = synth::SubdivideMidpoint(mesh);
+      const synth::PatchGeometry geometry = synth::MakePatchGeometry(
+          mesh, texel_size, 8, synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
+      for (const synth::AtlasOptions& options : {charts, conformal, boxes}) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const synth::AtlasLayout layout = synth::LayoutAtlases(
+            mesh, geometry.patches, geometry.unfoldings, texel_size, options);
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const synth::AtlasCoverage coverage = synth::VisitAtlasTexels(
+            layout, texel_size, options.gutter,
+            [](int, int, int, int, const Eigen::Vector2d&) {});
+        if (const char* dump = std::getenv("ATLAS_BENCH_DUMP"))
+          for (std::size_t a = 0; a < coverage.coverage.size(); ++a)
+            cv::imwrite(std::string(dump) + "/" + std::string(datasets::SceneShapeName(shape)) +
+                            std::to_string(mesh.faces.size()) + "_" +
+                            (options.mode == synth::AtlasMode::kPerTriangle ? "boxes"
+                             : options.flattening == synth::ChartFlattening::kRigid ? "rigid"
+                                                                                  : "conformal") +
+                            std::to_string(a) + ".png",
+                        Thumbnail(coverage.coverage[a]));
+        double texels = 0, written = 0;
+        for (const cv::Mat& c : coverage.coverage) written += cv::countNonZero(c);
+        for (const cv::Size& s : layout.atlas_sizes) texels += static_cast<double>(s.area());
+        const synth::AtlasStretch stretch = synth::MeasureStretch(geometry.patches, layout);
+        std::printf(
+            "%-8s %6zu faces %-12s occupancy %.3f  charts %4d  atlases %zu (last %dx%d)  "
+            "%.2f s  inside/outline %.3f  packing %.3f  stretch mean %.3f  min %.3f  max %.3f\n",
+            std::string(datasets::SceneShapeName(shape)).c_str(), mesh.faces.size(),
+            options.mode == synth::AtlasMode::kPerTriangle ? "per-triangle"
+            : options.flattening == synth::ChartFlattening::kRigid ? "rigid"
+                                                                   : "conformal",
+            static_cast<double>(coverage.inside_texels) / texels, layout.num_charts,
+            layout.atlas_sizes.size(), layout.atlas_sizes.back().width,
+            layout.atlas_sizes.back().height, seconds,
+            static_cast<double>(coverage.inside_texels) / written, written / texels, stretch.mean, stretch.min, stretch.max);
+        std::fflush(stdout);
+      }
+    }
+  }
+  return 0;
+}
