@@ -11,7 +11,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -42,9 +41,9 @@ int main(int argc, char** argv) {
   boxes.mode = synth::AtlasMode::kPerTriangle;
   conformal.flattening = synth::ChartFlattening::kConformal;
   const double texel_size = datasets::MaterialOptions{}.texel_size;
-  for (const datasets::SceneShape shape : {datasets::SceneShape::kSphere,
-                                           datasets::SceneShape::kCylinder,
-                                           datasets::SceneShape::kTorus}) {
+  for (const datasets::SceneShape shape :
+       {datasets::SceneShape::kSphere, datasets::SceneShape::kCylinder,
+        datasets::SceneShape::kTorus}) {
     sfm::TriangleMesh mesh = datasets::CoarseMesh(shape);
     for (int level = 0; level < 2; ++level) {
       if (level > 0) mesh = synth::SubdivideMidpoint(mesh);
@@ -52,20 +51,19 @@ int main(int argc, char** argv) {
           mesh, texel_size, 8, synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
       for (const synth::AtlasOptions& options : {charts, conformal, boxes}) {
         const auto t0 = std::chrono::steady_clock::now();
-        const synth::AtlasLayout layout = synth::LayoutAtlases(
-            mesh, geometry.patches, geometry.unfoldings, texel_size, options);
+        const synth::AtlasLayout layout =
+            synth::LayoutAtlases(mesh, geometry.patches, geometry.unfoldings, texel_size, options);
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const synth::AtlasCoverage coverage = synth::VisitAtlasTexels(
-            layout, texel_size, options.gutter,
-            [](int, int, int, int, const Eigen::Vector2d&) {});
+            layout, texel_size, options.gutter, [](int, int, int, int, const Eigen::Vector2d&) {});
         if (const char* dump = std::getenv("ATLAS_BENCH_DUMP"))
           for (std::size_t a = 0; a < coverage.coverage.size(); ++a)
             cv::imwrite(std::string(dump) + "/" + std::string(datasets::SceneShapeName(shape)) +
                             std::to_string(mesh.faces.size()) + "_" +
-                            (options.mode == synth::AtlasMode::kPerTriangle ? "boxes"
+                            (options.mode == synth::AtlasMode::kPerTriangle         ? "boxes"
                              : options.flattening == synth::ChartFlattening::kRigid ? "rigid"
-                                                                                  : "conformal") +
+                                                                                    : "conformal") +
                             std::to_string(a) + ".png",
                         Thumbnail(coverage.coverage[a]));
         double texels = 0, written = 0;
@@ -76,13 +74,14 @@ int main(int argc, char** argv) {
             "%-8s %6zu faces %-12s occupancy %.3f  charts %4d  atlases %zu (last %dx%d)  "
             "%.2f s  inside/outline %.3f  packing %.3f  stretch mean %.3f  min %.3f  max %.3f\n",
             std::string(datasets::SceneShapeName(shape)).c_str(), mesh.faces.size(),
-            options.mode == synth::AtlasMode::kPerTriangle ? "per-triangle"
+            options.mode == synth::AtlasMode::kPerTriangle         ? "per-triangle"
             : options.flattening == synth::ChartFlattening::kRigid ? "rigid"
                                                                    : "conformal",
             static_cast<double>(coverage.inside_texels) / texels, layout.num_charts,
             layout.atlas_sizes.size(), layout.atlas_sizes.back().width,
             layout.atlas_sizes.back().height, seconds,
-            static_cast<double>(coverage.inside_texels) / written, written / texels, stretch.mean, stretch.min, stretch.max);
+            static_cast<double>(coverage.inside_texels) / written, written / texels, stretch.mean,
+            stretch.min, stretch.max);
         std::fflush(stdout);
       }
     }

@@ -62,7 +62,9 @@ bool Lscm(const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patch
         vertex_of_local.push_back(v);
   const int n = static_cast<int>(vertex_of_local.size());
   // Pins: the vertex farthest from the first, and the one farthest from it.
-  auto point = [&](int l) { return mesh.vertices[static_cast<std::size_t>(vertex_of_local[static_cast<std::size_t>(l)])]; };
+  auto point = [&](int l) {
+    return mesh.vertices[static_cast<std::size_t>(vertex_of_local[static_cast<std::size_t>(l)])];
+  };
   auto farthest_from = [&](int l0) {
     int best = l0;
     double d_best = -1;
@@ -173,8 +175,10 @@ bool ScaleAndCheck(const std::vector<TrianglePatch>& patches, const std::vector<
     for (std::size_t k = 0; k < 3; ++k) q[k] = q0[k] - lo;
     Eigen::Vector2d qlo = q[0].cwiseMin(q[1]).cwiseMin(q[2]);
     Eigen::Vector2d qhi = q[0].cwiseMax(q[1]).cwiseMax(q[2]);
-    for (int y = std::max(0, static_cast<int>(qlo.y())); y <= std::min(h - 1, static_cast<int>(qhi.y())); ++y)
-      for (int x = std::max(0, static_cast<int>(qlo.x())); x <= std::min(w - 1, static_cast<int>(qhi.x())); ++x) {
+    for (int y = std::max(0, static_cast<int>(qlo.y()));
+         y <= std::min(h - 1, static_cast<int>(qhi.y())); ++y)
+      for (int x = std::max(0, static_cast<int>(qlo.x()));
+           x <= std::min(w - 1, static_cast<int>(qhi.x())); ++x) {
         if (SignedDistanceToTriangle(q, Eigen::Vector2d(x + 0.5, y + 0.5)) >= -0.5) continue;
         char& cell = inside[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
                             static_cast<std::size_t>(x)];
@@ -186,9 +190,9 @@ bool ScaleAndCheck(const std::vector<TrianglePatch>& patches, const std::vector<
 }
 
 /// Connected parts of `faces` over shared mesh edges.
-std::vector<std::vector<int>> ConnectedParts(const std::vector<int>& faces,
-                                             const std::vector<std::array<Unfolding, 3>>& unfoldings,
-                                             std::vector<int>& mark, int& stamp) {
+std::vector<std::vector<int>> ConnectedParts(
+    const std::vector<int>& faces, const std::vector<std::array<Unfolding, 3>>& unfoldings,
+    std::vector<int>& mark, int& stamp) {
   ++stamp;
   const int in_set = stamp;
   for (const int f : faces) mark[static_cast<std::size_t>(f)] = in_set;
@@ -268,7 +272,7 @@ std::vector<std::vector<ChartFace>> MakeRigidCharts(
       for (int k = 0; k < 3; ++k)
         c[static_cast<std::size_t>(k)] =
             cf.linear * patches[static_cast<std::size_t>(cf.face)]
-                              .corners_in_frame[static_cast<std::size_t>(k)] +
+                            .corners_in_frame[static_cast<std::size_t>(k)] +
             cf.translation;
       return c;
     };
@@ -319,8 +323,8 @@ std::vector<std::vector<ChartFace>> MakeRigidCharts(
         const Unfolding& u =
             unfoldings[static_cast<std::size_t>(from.face)][static_cast<std::size_t>(k)];
         if (u.face < 0 || chart_of[static_cast<std::size_t>(u.face)] >= 0) continue;
-        if (patches[static_cast<std::size_t>(u.face)].frame.z_axis.dot(
-                patches[seed].frame.z_axis) < min_cos)
+        if (patches[static_cast<std::size_t>(u.face)].frame.z_axis.dot(patches[seed].frame.z_axis) <
+            min_cos)
           continue;
         // p_from = R_u^T (p_nb - t_u), so chart = R_from R_u^T p_nb + ...
         ChartFace cf;
@@ -425,8 +429,8 @@ std::vector<std::vector<ChartFace>> MakeConformalCharts(
     std::vector<int> faces = std::move(work.front());
     work.pop_front();
     std::vector<Corners> uv;
-    if (faces.size() == 1 || (Lscm(mesh, patches, faces, t, &uv) &&
-                              ScaleAndCheck(patches, faces, t, options, uv))) {
+    if (faces.size() == 1 ||
+        (Lscm(mesh, patches, faces, t, &uv) && ScaleAndCheck(patches, faces, t, options, uv))) {
       std::vector<ChartFace> chart;
       for (std::size_t i = 0; i < faces.size(); ++i) {
         const Corners c = FrameCornersTexels(patches[static_cast<std::size_t>(faces[i])], t);
@@ -471,7 +475,8 @@ std::vector<std::vector<ChartFace>> MakeConformalCharts(
     for (std::size_t i = 0; i < order.size(); ++i)
       (i < order.size() / 2 ? low : high).push_back(faces[order[i]]);
     for (const auto* half : {&low, &high})
-      for (auto& part : ConnectedParts(*half, unfoldings, mark, stamp)) work.push_back(std::move(part));
+      for (auto& part : ConnectedParts(*half, unfoldings, mark, stamp))
+        work.push_back(std::move(part));
   }
   return charts;
 }

@@ -149,6 +149,18 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
                     "--sample-texel-size 0.01 --out f --atlas boxes",
                     &out),
             2);
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --chart-flattening curved",
+                    &out),
+            2);
+  EXPECT_NE(out.find("chart-flattening"), std::string::npos) << out;
+  // A stretch bound out of range is refused before anything is read.
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --chart-flattening conformal "
+                    "--chart-stretch 0.5",
+                    &out),
+            2);
+  EXPECT_NE(out.find("stretch"), std::string::npos) << out;
   EXPECT_EQ(Texlume("render --model " + (tmp / "nomodel").string() +
                         " --cameras c --lights l "
                         "--out " +

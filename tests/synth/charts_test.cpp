@@ -22,8 +22,9 @@ PatchGeometry Geometry(const sfm::TriangleMesh& mesh) {
 TEST(Charts, SingularValuesOfKnownMaps) {
   const Eigen::Matrix2d rotation = Eigen::Rotation2Dd(0.7).toRotationMatrix();
   EXPECT_TRUE(SingularValues2(rotation).isApprox(Eigen::Vector2d(1, 1)));
-  EXPECT_TRUE(SingularValues2(rotation * Eigen::Vector2d(3, 0.5).asDiagonal() * rotation.transpose())
-                  .isApprox(Eigen::Vector2d(3, 0.5)));
+  EXPECT_TRUE(
+      SingularValues2(rotation * Eigen::Vector2d(3, 0.5).asDiagonal() * rotation.transpose())
+          .isApprox(Eigen::Vector2d(3, 0.5)));
   Eigen::Matrix2d shear;
   shear << 1, 1, 0, 1;  // singular values: golden ratio and its inverse
   const double phi = 0.5 * (1 + std::sqrt(5.0));
