@@ -189,6 +189,17 @@ bool ScaleAndCheck(const std::vector<TrianglePatch>& patches, const std::vector<
   return true;
 }
 
+/// Seeds in breadth-first order over the faces (sfm::BreadthFirstFaceOrder from
+/// face 0), so each new chart starts at the border of the charted region.
+std::vector<int> SeedOrder(const sfm::TriangleMesh& mesh,
+                           const std::vector<std::array<Unfolding, 3>>& unfoldings) {
+  if (mesh.faces.empty()) return {};
+  std::vector<std::array<int, 3>> neighbours(unfoldings.size());
+  for (std::size_t f = 0; f < unfoldings.size(); ++f)
+    for (std::size_t k = 0; k < 3; ++k) neighbours[f][k] = unfoldings[f][k].face;
+  return sfm::BreadthFirstFaceOrder(mesh, neighbours, 0);
+}
+
 /// Connected parts of `faces` over shared mesh edges.
 std::vector<std::vector<int>> ConnectedParts(
     const std::vector<int>& faces, const std::vector<std::array<Unfolding, 3>>& unfoldings,
@@ -240,25 +251,7 @@ std::vector<std::vector<ChartFace>> MakeRigidCharts(
   const double min_cos = std::cos(options.max_normal_angle_deg * kPi / 180.0);
   // Seeds in breadth-first order over face adjacency, so each new chart starts
   // at the border of the charted region and few fragments are left between.
-  std::vector<int> seed_order;
-  {
-    std::vector<char> seen(num_faces, 0);
-    for (std::size_t root = 0; root < num_faces; ++root) {
-      if (seen[root]) continue;
-      std::deque<int> bfs = {static_cast<int>(root)};
-      seen[root] = 1;
-      while (!bfs.empty()) {
-        const int f = bfs.front();
-        bfs.pop_front();
-        seed_order.push_back(f);
-        for (const Unfolding& u : unfoldings[static_cast<std::size_t>(f)])
-          if (u.face >= 0 && !seen[static_cast<std::size_t>(u.face)]) {
-            seen[static_cast<std::size_t>(u.face)] = 1;
-            bfs.push_back(u.face);
-          }
-      }
-    }
-  }
+  const std::vector<int> seed_order = SeedOrder(mesh, unfoldings);
   for (const int seed_face : seed_order) {
     const auto seed = static_cast<std::size_t>(seed_face);
     if (chart_of[seed] >= 0) continue;
@@ -367,25 +360,7 @@ std::vector<std::vector<ChartFace>> MakeConformalCharts(
   std::vector<Eigen::Vector3d> centroid(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f)
     centroid[f] = (mesh.Corner(f, 0) + mesh.Corner(f, 1) + mesh.Corner(f, 2)) / 3.0;
-  std::vector<int> seed_order;
-  {
-    std::vector<char> seen(num_faces, 0);
-    for (std::size_t root = 0; root < num_faces; ++root) {
-      if (seen[root]) continue;
-      std::deque<int> bfs = {static_cast<int>(root)};
-      seen[root] = 1;
-      while (!bfs.empty()) {
-        const int f = bfs.front();
-        bfs.pop_front();
-        seed_order.push_back(f);
-        for (const Unfolding& u : unfoldings[static_cast<std::size_t>(f)])
-          if (u.face >= 0 && !seen[static_cast<std::size_t>(u.face)]) {
-            seen[static_cast<std::size_t>(u.face)] = 1;
-            bfs.push_back(u.face);
-          }
-      }
-    }
-  }
+  const std::vector<int> seed_order = SeedOrder(mesh, unfoldings);
   const double half_side = 0.5 * options.max_side_texels * t;
   const double min_cos = std::cos(options.max_normal_angle_deg * kPi / 180.0);
   std::vector<int> chart_of(num_faces, -1);

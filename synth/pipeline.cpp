@@ -150,6 +150,16 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
   return inputs;
 }
 
+nlohmann::json AtlasSettingsJson(const AtlasOptions& atlas) {
+  return {{"atlas_mode", atlas.mode == AtlasMode::kCharts ? "charts" : "per_triangle"},
+          {"atlas_size", atlas.atlas_size},
+          {"gutter", atlas.gutter},
+          {"chart_flattening", ChartFlatteningName(atlas.flattening)},
+          {"chart_size", atlas.max_chart_size},
+          {"chart_angle_deg", atlas.max_chart_normal_angle_deg},
+          {"chart_stretch", atlas.max_chart_stretch}};
+}
+
 void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int sample_side,
                       double sample_texel_size, int strip, const ProgressCallback& progress) {
   const sfm::Reconstruction& reconstruction = inputs.reconstruction;
@@ -288,14 +298,8 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
       {"channel_correction", so.channel_correction},
       {"correction_sigma", so.correction_sigma},
       {"horizon_elevation_deg", kHorizonElevationDeg},
-      {"seed", so.seed},
-      {"atlas_mode", options.atlas.mode == AtlasMode::kCharts ? "charts" : "per_triangle"},
-      {"atlas_size", options.atlas.atlas_size},
-      {"gutter", options.atlas.gutter},
-      {"chart_flattening", ChartFlatteningName(options.atlas.flattening)},
-      {"chart_size", options.atlas.max_chart_size},
-      {"chart_angle_deg", options.atlas.max_chart_normal_angle_deg},
-      {"chart_stretch", options.atlas.max_chart_stretch}};
+      {"seed", so.seed}};
+  record["settings"].update(AtlasSettingsJson(options.atlas));
   record["summary"] = {{"photos_used", summary.photos_used},
                        {"faces", summary.faces},
                        {"subdivisions", summary.subdivisions},

@@ -144,6 +144,9 @@ cv::Mat ReadPhotoRgb(const std::filesystem::path& path);
 cv::Mat ToBgr8(const cv::Mat& display_rgb);
 
 /// 1-to-4 midpoint subdivision (shared edge midpoints welded).
+/// The atlas settings as the manifests record them (shared by the PTM and BTF jobs).
+nlohmann::json AtlasSettingsJson(const AtlasOptions& atlas);
+
 sfm::TriangleMesh SubdivideMidpoint(const sfm::TriangleMesh& mesh);
 
 }  // namespace texlume::synth
