@@ -500,11 +500,17 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
   o.atlas.max_chart_normal_angle_deg =
       a.GetDouble("chart-angle", o.atlas.max_chart_normal_angle_deg);
   o.atlas.max_chart_size = a.GetInt("chart-size", o.atlas.max_chart_size);
-  const std::string flattening = a.Get("chart-flattening").value_or("rigid");
-  if (flattening != "rigid" && flattening != "conformal")
-    throw UsageError("--chart-flattening: rigid or conformal, not '" + flattening + "'");
-  o.atlas.flattening =
-      flattening == "rigid" ? synth::ChartFlattening::kRigid : synth::ChartFlattening::kConformal;
+  const std::string flattening =
+      a.Get("chart-flattening").value_or(synth::ChartFlatteningName(o.atlas.flattening));
+  bool known_flattening = false;
+  for (const synth::ChartFlattening f :
+       {synth::ChartFlattening::kRigid, synth::ChartFlattening::kConformal,
+        synth::ChartFlattening::kStrips, synth::ChartFlattening::kAuto})
+    if (flattening == synth::ChartFlatteningName(f))
+      o.atlas.flattening = f, known_flattening = true;
+  if (!known_flattening)
+    throw UsageError("--chart-flattening: auto, strips, rigid or conformal, not '" + flattening +
+                     "'");
   o.atlas.max_chart_stretch = a.GetDouble("chart-stretch", o.atlas.max_chart_stretch);
   o.atlas.blend_strip = o.synthesis.strip;
   o.max_subdivisions = a.GetInt("max-subdivisions", o.max_subdivisions);

@@ -1,7 +1,7 @@
 // Atlas layout alone (issue 6): the coarse meshes of the synthetic shapes at the
 // default material's texel size (and split 1-to-4 once), laid out in charts and
 // in per-triangle boxes, without synthesis.
-// Run: build/bench/atlas_bench [--gutter G] [--chart-size N]
+// Run: build/bench/atlas_bench [--gutter G] [--chart-size N]  (rigid, conformal, strips, boxes)
 // Prints per mesh and mode: occupancy (texels inside triangles / atlas texels),
 // charts, atlases, layout seconds, and the charts' texel stretch (area-weighted
 // mean and extremes of the per-face singular values of texels per texel size).
@@ -13,7 +13,10 @@
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "datasets_synthetic/material.h"
 #include "datasets_synthetic/shapes.h"
@@ -29,6 +32,27 @@ cv::Mat Thumbnail(const cv::Mat& coverage) {
   cv::resize(coverage, small, cv::Size(), 0.25, 0.25, cv::INTER_AREA);
   return small;
 }
+sfm::TriangleMesh Jittered(sfm::TriangleMesh mesh) {
+  double edge = 0;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    edge += (mesh.Corner(f, 1) - mesh.Corner(f, 0)).norm();
+  edge /= static_cast<double>(std::max<std::size_t>(1, mesh.faces.size()));
+  std::vector<Eigen::Vector3d> normal(mesh.vertices.size(), Eigen::Vector3d::Zero());
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const Eigen::Vector3d n =
+        (mesh.Corner(f, 1) - mesh.Corner(f, 0)).cross(mesh.Corner(f, 2) - mesh.Corner(f, 0));
+    for (const int v : mesh.faces[f]) normal[static_cast<std::size_t>(v)] += n;
+  }
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const Eigen::Vector3d n = normal[v].normalized();
+    Eigen::Vector3d d(u(rng), u(rng), u(rng));
+    d -= d.dot(n) * n;  // along the surface
+    mesh.vertices[v] += (edge / 3.0) * d;
+  }
+  return mesh;
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -37,19 +61,27 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--gutter")) charts.gutter = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--chart-size")) charts.max_chart_size = std::atoi(argv[i + 1]);
   }
-  synth::AtlasOptions boxes = charts, conformal = charts;
+  synth::AtlasOptions boxes = charts, conformal = charts, strips = charts;
+  charts.flattening = synth::ChartFlattening::kRigid;
   boxes.mode = synth::AtlasMode::kPerTriangle;
   conformal.flattening = synth::ChartFlattening::kConformal;
+  strips.flattening = synth::ChartFlattening::kStrips;
+  // Strips are as long as an atlas row allows, whatever --chart-size says.
+  strips.max_chart_size = 0;
   const double texel_size = datasets::MaterialOptions{}.texel_size;
   for (const datasets::SceneShape shape :
        {datasets::SceneShape::kSphere, datasets::SceneShape::kCylinder,
         datasets::SceneShape::kTorus}) {
-    sfm::TriangleMesh mesh = datasets::CoarseMesh(shape);
-    for (int level = 0; level < 2; ++level) {
-      if (level > 0) mesh = synth::SubdivideMidpoint(mesh);
+    // The coarse mesh, split 1-to-4, and the coarse mesh with every vertex moved
+    // along the surface by up to a third of the mean edge (irregular triangles,
+    // as decimated photogrammetry meshes have), normals kept.
+    const sfm::TriangleMesh coarse = datasets::CoarseMesh(shape);
+    std::vector<std::pair<std::string, sfm::TriangleMesh>> meshes = {
+        {"", coarse}, {"", synth::SubdivideMidpoint(coarse)}, {" jittered", Jittered(coarse)}};
+    for (const auto& [label, mesh] : meshes) {
       const synth::PatchGeometry geometry = synth::MakePatchGeometry(
           mesh, texel_size, 8, synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
-      for (const synth::AtlasOptions& options : {charts, conformal, boxes}) {
+      for (const synth::AtlasOptions& options : {charts, conformal, strips, boxes}) {
         const auto t0 = std::chrono::steady_clock::now();
         const synth::AtlasLayout layout =
             synth::LayoutAtlases(mesh, geometry.patches, geometry.unfoldings, texel_size, options);
@@ -60,10 +92,10 @@ int main(int argc, char** argv) {
         if (const char* dump = std::getenv("ATLAS_BENCH_DUMP"))
           for (std::size_t a = 0; a < coverage.coverage.size(); ++a)
             cv::imwrite(std::string(dump) + "/" + std::string(datasets::SceneShapeName(shape)) +
-                            std::to_string(mesh.faces.size()) + "_" +
-                            (options.mode == synth::AtlasMode::kPerTriangle         ? "boxes"
-                             : options.flattening == synth::ChartFlattening::kRigid ? "rigid"
-                                                                                    : "conformal") +
+                            std::to_string(mesh.faces.size()) + (label.empty() ? "" : "j") + "_" +
+                            (options.mode == synth::AtlasMode::kPerTriangle
+                                 ? std::string("boxes")
+                                 : std::string(synth::ChartFlatteningName(options.flattening))) +
                             std::to_string(a) + ".png",
                         Thumbnail(coverage.coverage[a]));
         double texels = 0, written = 0;
@@ -71,12 +103,12 @@ int main(int argc, char** argv) {
         for (const cv::Size& s : layout.atlas_sizes) texels += static_cast<double>(s.area());
         const synth::AtlasStretch stretch = synth::MeasureStretch(geometry.patches, layout);
         std::printf(
-            "%-8s %6zu faces %-12s occupancy %.3f  charts %4d  atlases %zu (last %dx%d)  "
+            "%-17s %6zu faces %-12s occupancy %.3f  charts %4d  atlases %zu (last %dx%d)  "
             "%.2f s  inside/outline %.3f  packing %.3f  stretch mean %.3f  min %.3f  max %.3f\n",
-            std::string(datasets::SceneShapeName(shape)).c_str(), mesh.faces.size(),
-            options.mode == synth::AtlasMode::kPerTriangle         ? "per-triangle"
-            : options.flattening == synth::ChartFlattening::kRigid ? "rigid"
-                                                                   : "conformal",
+            (std::string(datasets::SceneShapeName(shape)) + label).c_str(), mesh.faces.size(),
+            options.mode == synth::AtlasMode::kPerTriangle
+                ? "per-triangle"
+                : synth::ChartFlatteningName(options.flattening),
             static_cast<double>(coverage.inside_texels) / texels, layout.num_charts,
             layout.atlas_sizes.size(), layout.atlas_sizes.back().width,
             layout.atlas_sizes.back().height, seconds,

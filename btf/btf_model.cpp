@@ -302,6 +302,9 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
   summary.seconds_atlas = Since(t);
   summary.atlases = atlases.geometry.size();
   summary.charts = static_cast<std::size_t>(atlases.layout.num_charts);
+  summary.chart_flattening = job.atlas.mode == synth::AtlasMode::kCharts
+                                 ? synth::ChartFlatteningName(atlases.layout.flattening)
+                                 : "none";
   summary.occupancy = atlases.occupancy;
   t = std::chrono::steady_clock::now();
   synth::TexturedModel model;
@@ -351,6 +354,7 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
                        {"random", summary.random},
                        {"atlases", summary.atlases},
                        {"charts", summary.charts},
+                       {"chart_flattening", summary.chart_flattening},
                        {"occupancy", summary.occupancy},
                        {"seam_edges", summary.seam_edges},
                        {"seam_cost_per_link", summary.seam_cost_per_link},

@@ -58,10 +58,12 @@ ChartOutline Box(const std::vector<ChartFace>& chart, double angle,
     }
     if (corners) corners->push_back(c);
   }
-  o.lo = Eigen::Vector2i(static_cast<int>(std::floor(lo.x())) - gutter,
-                         static_cast<int>(std::floor(lo.y())) - gutter);
-  o.hi = Eigen::Vector2i(static_cast<int>(std::ceil(hi.x())) + gutter,
-                         static_cast<int>(std::ceil(hi.y())) + gutter);
+  // Texels i whose centre i + 0.5 is within gutter + 0.5 (and a hair) of the corners' box.
+  constexpr double kHair = 1e-6;
+  o.lo = Eigen::Vector2i(static_cast<int>(std::ceil(lo.x() - gutter - 1 - kHair)),
+                         static_cast<int>(std::ceil(lo.y() - gutter - 1 - kHair)));
+  o.hi = Eigen::Vector2i(static_cast<int>(std::floor(hi.x() + gutter + kHair)) + 1,
+                         static_cast<int>(std::floor(hi.y() + gutter + kHair)) + 1);
   return o;
 }
 
@@ -75,12 +77,13 @@ ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
     for (auto& p : c) p = Eigen::Vector2d(p.x() - o.lo.x(), o.hi.y() - p.y());  // box, y down
     Eigen::Vector2d clo = c[0], chi = clo;
     for (const auto& p : c) clo = clo.cwiseMin(p), chi = chi.cwiseMax(p);
-    // Texels the bake writes for this face: centre within gutter + 0.5 of it.
+    // Texels the bake writes for this face: centre within gutter + 0.5 of it
+    // (and a hair more, so rounding in the bake cannot write beyond the outline).
     for (int y = std::max(0, static_cast<int>(clo.y()) - gutter - 1);
          y <= std::min(h - 1, static_cast<int>(chi.y()) + gutter + 1); ++y)
       for (int x = std::max(0, static_cast<int>(clo.x()) - gutter - 1);
            x <= std::min(w - 1, static_cast<int>(chi.x()) + gutter + 1); ++x)
-        if (SignedDistanceToTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5)) <= gutter + 0.5)
+        if (SignedDistanceToTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5)) <= gutter + 0.5 + 1e-6)
           mask.at<std::uint8_t>(y, x) = 1;
   }
   for (int y = 0; y < h; ++y)
@@ -224,6 +227,139 @@ OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlin
                       (bin + 1 < bins.size() ? bin_size : bins[bin].used_rows);
   return packing;
 }
+
+/// Strip charts (bands of equal height, synth/charts.h) packed in rows: pieces
+/// go tallest first, left to right, each turned by 0 or 180 degrees to slide
+/// furthest left against the row's texel-exact right edge (so slanted ends
+/// nest); a band that overruns the row is cut at a rung, and its rest starts
+/// the next row, so rows end within a triangle of the atlas edge.
+struct RowPacking {
+  std::vector<std::vector<ChartFace>> pieces;
+  std::vector<ChartOutline> outlines;     ///< per piece, at its turn
+  std::vector<std::array<int, 3>> drops;  ///< per piece: atlas, x, y of the outline box
+  std::int64_t texels = 0;                ///< atlas texels used (the last atlas cropped)
+};
+
+RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
+                            const std::vector<TrianglePatch>& patches, double t, int gutter,
+                            int atlas_size, const ProgressCallback& progress) {
+  // Band x of a face (texels): the centroid of its corners in the chart frame.
+  auto band_x = [&](const ChartFace& cf) {
+    double x = 0;
+    for (const auto& c : patches[static_cast<std::size_t>(cf.face)].corners_in_frame)
+      x += (cf.linear * c + cf.translation).x();
+    return x / (3.0 * t);
+  };
+  std::vector<std::vector<ChartFace>> queue;
+  std::vector<double> height;
+  for (const auto& chart : charts) {
+    std::vector<ChartFace> sorted = chart;
+    std::stable_sort(sorted.begin(), sorted.end(),
+                     [&](const ChartFace& a, const ChartFace& b) { return band_x(a) < band_x(b); });
+    queue.push_back(std::move(sorted));
+    height.push_back(Box(chart, 0.0, patches, t, gutter, nullptr).Height());
+  }
+  std::vector<std::size_t> order(queue.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return height[a] != height[b] ? height[a] > height[b] : queue[a].size() > queue[b].size();
+  });
+
+  RowPacking out;
+  int atlas = 0, row_y = 0, row_height = 0;
+  std::vector<int> right_edge;  // per row of the current band row: first free x
+  auto new_row = [&](int h) {
+    row_y += row_height;
+    if (row_y + h > atlas_size) ++atlas, row_y = 0;
+    row_height = h;
+    right_edge.assign(static_cast<std::size_t>(h), 0);
+  };
+  // Where `o` slides to in the current row: the smallest x where no run
+  // overlaps the row's used texels.
+  auto slide = [&](const ChartOutline& o, int dy) {
+    int x = 0;
+    for (const ChartOutline::Run& r : o.runs)
+      x = std::max(x, right_edge[static_cast<std::size_t>(r.row + dy)] - r.x);
+    return x;
+  };
+  std::size_t done = 0;
+  for (const std::size_t c : order) {
+    if (height[c] > atlas_size)
+      throw OptionError("a strip chart of " + std::to_string(static_cast<int>(height[c])) +
+                        " texels' height does not fit an atlas of " + std::to_string(atlas_size));
+    std::vector<ChartFace> rest = queue[c];
+    while (!rest.empty()) {
+      if (row_height == 0) new_row(static_cast<int>(height[c]));
+      // The longest prefix of `rest` (in the turned order) that fits this row.
+      bool placed = false;
+      if (static_cast<int>(height[c]) <= row_height) {
+        std::size_t count = rest.size();
+        while (count > 0 && !placed) {
+          int best_turn = -1, best_x = 0, best_dy = 0;
+          ChartOutline best;
+          for (int turn = 0; turn < 2; ++turn) {
+            std::vector<ChartFace> piece;
+            if (turn == 0)
+              piece.assign(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(count));
+            else
+              piece.assign(rest.end() - static_cast<std::ptrdiff_t>(count), rest.end());
+            ChartOutline o = Outline(piece, turn * kPi, patches, t, gutter);
+            // Shorter pieces may sit lower in the row, under others.
+            for (int dy = 0; dy + o.Height() <= row_height; ++dy) {
+              const int x = slide(o, dy);
+              if (x + o.Width() > atlas_size) continue;
+              if (best_turn < 0 || x + o.Width() < best_x + best.Width())
+                best_turn = turn, best_x = x, best_dy = dy, best = o;
+            }
+          }
+          if (best_turn < 0) {
+            // Fewer faces: those whose band x lies within the row's free width.
+            const int free_width =
+                atlas_size - *std::min_element(right_edge.begin(), right_edge.end());
+            const double x0 = band_x(rest.front());
+            std::size_t fit = 0;
+            while (fit + 1 < count && band_x(rest[fit]) - x0 < free_width) ++fit;
+            count = fit;
+            continue;
+          }
+          std::vector<ChartFace> piece;
+          if (best_turn == 0) {
+            piece.assign(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(count));
+            rest.erase(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(count));
+          } else {
+            piece.assign(rest.end() - static_cast<std::ptrdiff_t>(count), rest.end());
+            rest.erase(rest.end() - static_cast<std::ptrdiff_t>(count), rest.end());
+          }
+          for (const ChartOutline::Run& r : best.runs) {
+            int& edge = right_edge[static_cast<std::size_t>(r.row + best_dy)];
+            edge = std::max(edge, best_x + r.x + r.length);
+          }
+          out.pieces.push_back(std::move(piece));
+          out.outlines.push_back(std::move(best));
+          out.drops.push_back({atlas, best_x, row_y + best_dy});
+          placed = true;
+        }
+      }
+      if (!placed) {
+        if (std::all_of(right_edge.begin(), right_edge.end(), [](int e) { return e == 0; }))
+          throw OptionError("a strip chart does not fit an atlas of " + std::to_string(atlas_size));
+        new_row(static_cast<int>(height[c]));
+      }
+    }
+    ++done;
+    if (progress && (done % 8 == 0 || done == order.size()))
+      progress("packing", done, order.size());
+  }
+  std::vector<int> used_rows(static_cast<std::size_t>(atlas) + 1, 0);
+  for (std::size_t p = 0; p < out.pieces.size(); ++p) {
+    int& rows = used_rows[static_cast<std::size_t>(out.drops[p][0])];
+    rows = std::max(rows, out.drops[p][2] + out.outlines[p].Height());
+  }
+  for (std::size_t a = 0; a < used_rows.size(); ++a)
+    out.texels += static_cast<std::int64_t>(atlas_size) *
+                  (a + 1 < used_rows.size() ? atlas_size : used_rows[a]);
+  return out;
+}
 }  // namespace
 
 Eigen::Vector2d FacePlacement::FrameFromAtlas(const Eigen::Vector2d& px, double texel_size) const {
@@ -237,7 +373,23 @@ double FacePlacement::AtlasFrameAngle() const {
 }
 
 const char* ChartFlatteningName(ChartFlattening flattening) {
-  return flattening == ChartFlattening::kRigid ? "rigid" : "conformal";
+  switch (flattening) {
+    case ChartFlattening::kRigid:
+      return "rigid";
+    case ChartFlattening::kConformal:
+      return "conformal";
+    case ChartFlattening::kStrips:
+      return "strips";
+    case ChartFlattening::kAuto:
+      return "auto";
+  }
+  return "rigid";
+}
+
+std::int64_t AtlasLayout::Texels() const {
+  std::int64_t texels = 0;
+  for (const cv::Size& size : atlas_sizes) texels += static_cast<std::int64_t>(size.area());
+  return texels;
 }
 
 AtlasStretch MeasureStretch(const std::vector<TrianglePatch>& patches, const AtlasLayout& layout) {
@@ -345,6 +497,17 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
   const std::size_t num_faces = mesh.faces.size();
   if (patches.size() != num_faces || unfoldings.size() != num_faces)
     throw OptionError("atlas layout: patches and unfoldings must have one entry per face");
+  if (options.mode == AtlasMode::kCharts && options.flattening == ChartFlattening::kAuto) {
+    // Strips fill atlases best on regular meshes; on irregular ones (decimated
+    // photogrammetry) they fragment and rigid charts do better. Both are laid
+    // out and the one with fewer atlas texels is kept (strips on a tie).
+    AtlasOptions strips = options, rigid = options;
+    strips.flattening = ChartFlattening::kStrips;
+    rigid.flattening = ChartFlattening::kRigid;
+    AtlasLayout best = LayoutAtlases(mesh, patches, unfoldings, texel_size, strips, progress);
+    AtlasLayout other = LayoutAtlases(mesh, patches, unfoldings, texel_size, rigid, progress);
+    return other.Texels() < best.Texels() ? other : best;
+  }
   const double t = texel_size;
   const int gutter = options.gutter;
 
@@ -378,6 +541,8 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
     ro.max_normal_angle_deg = options.max_chart_normal_angle_deg;
     ro.gutter = gutter;
     charts = MakeRigidCharts(mesh, patches, unfoldings, ro);
+  } else if (options.flattening == ChartFlattening::kStrips) {
+    // Laid out below, with the packing.
   } else {
     ConformalChartOptions co;
     co.texel_size = t;
@@ -400,6 +565,40 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
       sizes.emplace_back(outline.Width(), outline.Height());
     }
     packed = PackSkyline(sizes, options.atlas_size, options.atlas_size);
+  } else if (options.flattening == ChartFlattening::kStrips) {
+    // Strips from each seed-side rule, with and without dissolving strips of
+    // one or two faces (fans such as cylinder caps chart better conformally),
+    // each packed in rows; the layout with the fewest atlas texels wins.
+    StripChartOptions so;
+    so.texel_size = t;
+    so.max_stretch = options.max_chart_stretch;
+    so.max_length_texels = options.atlas_size - 2 * gutter - 2;  // a whole row (rows cut them)
+    so.max_normal_angle_deg = options.max_chart_normal_angle_deg;
+    RowPacking best;
+    std::int64_t best_texels = 0;
+    for (const StripSide side : {StripSide::kTallest, StripSide::kNearestPreferred}) {
+      for (const int min_strip_faces : {1, 3}) {
+        so.side = side;
+        so.min_strip_faces = min_strip_faces;
+        RowPacking rows = PackStripsInRows(MakeStripCharts(mesh, patches, unfoldings, so), patches,
+                                           t, gutter, options.atlas_size, progress);
+        if (best.pieces.empty() || rows.texels < best_texels)
+          best_texels = rows.texels, best = std::move(rows);
+      }
+    }
+    charts = std::move(best.pieces);
+    for (std::size_t c = 0; c < charts.size(); ++c) {
+      const ChartOutline& o = best.outlines[c];
+      const Eigen::Matrix2d turn = Eigen::Rotation2Dd(o.angle).toRotationMatrix();
+      for (ChartFace& cf : charts[c]) {
+        cf.linear = turn * cf.linear;
+        cf.translation = turn * cf.translation;
+      }
+      chart_lo.push_back(o.lo);
+      chart_hi.push_back(o.hi);
+      sizes.emplace_back(o.Width(), o.Height());
+      packed.push_back(best.drops[c]);
+    }
   } else {
     // Charts are packed by their outlines (the texels the bake writes), largest
     // first, each at the best of kPackingRotations turns and the first position
@@ -470,6 +669,7 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
 
   AtlasLayout layout;
   layout.num_charts = static_cast<int>(charts.size());
+  layout.flattening = options.flattening;
   layout.faces.resize(num_faces);
   int num_atlases = 0;
   std::vector<int> used_height;
@@ -609,6 +809,7 @@ Atlases BuildAtlases(const sfm::TriangleMesh& mesh, const MeshSynthesis& synthes
       progress);
   Atlases atlases;
   atlases.num_charts = layout.num_charts;
+  atlases.flattening = layout.flattening;
   atlases.faces = layout.faces;
   atlases.stretch = MeasureStretch(synthesis.patches, layout);
   std::size_t total_texels = 0;

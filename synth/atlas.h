@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -23,12 +24,14 @@ enum class AtlasMode {
 enum class ChartFlattening {
   kRigid,      ///< faces unfolded edge to edge: no distortion, cracks around vertices
   kConformal,  ///< least-squares conformal map: no cracks, texel stretch within a bound
+  kStrips,     ///< triangle strips mapped onto straight bands that tile atlas rows
+  kAuto,       ///< strips and rigid charts both laid out; the one with fewer atlas texels
 };
 
 /// Settings of BuildAtlases.
 struct AtlasOptions {
   AtlasMode mode = AtlasMode::kCharts;
-  ChartFlattening flattening = ChartFlattening::kRigid;
+  ChartFlattening flattening = ChartFlattening::kAuto;
   /// Width of every atlas and the most height (texels); the last atlas is cropped
   /// to the rows it uses. [64, 16384].
   int atlas_size = 2048;
@@ -42,9 +45,10 @@ struct AtlasOptions {
   double max_chart_normal_angle_deg = 180.0;
   /// kCharts: largest chart side in texels (0 = the atlas size); kConformal
   /// grows charts around their seed face within a square of this side on the
-  /// seed's tangent plane. Smaller charts nest better. [0, atlas_size].
+  /// seed's tangent plane. Smaller charts nest better. kStrips ignores it
+  /// (bands run as long as a row). [0, atlas_size].
   int max_chart_size = 192;
-  /// kConformal: most texel stretch of a face in a chart (the singular values of
+  /// kConformal, kStrips: most texel stretch of a face in a chart (the singular values of
   /// the chart map, texels per texel of the synthesis, stay in [1/s, s]); a
   /// chart beyond it is split. [1.01, 4].
   double max_chart_stretch = 1.25;
@@ -83,6 +87,10 @@ struct AtlasLayout {
   std::vector<FacePlacement> faces;
   std::vector<cv::Size> atlas_sizes;  ///< texels; the last atlas cropped to the rows it uses
   int num_charts = 0;
+  /// kCharts: the flattening the charts have (never kAuto: the one it chose).
+  ChartFlattening flattening = ChartFlattening::kRigid;
+  /// Texels of all atlases (the last one cropped).
+  std::int64_t Texels() const;
 };
 
 /// Lays out the faces (per triangle or in conformal charts, synth/charts.h) and
@@ -127,6 +135,7 @@ struct Atlases {
   std::vector<cv::Mat> coverage;  ///< CV_8UC1 per atlas: 255 inside a triangle, 128 gutter
   std::vector<FacePlacement> faces;
   int num_charts = 0;
+  ChartFlattening flattening = ChartFlattening::kRigid;  ///< as AtlasLayout::flattening
   /// Texels whose centre lies inside a triangle / all atlas texels.
   double occupancy = 0.0;
   double seconds = 0.0;
@@ -135,7 +144,7 @@ struct Atlases {
 
 AtlasStretch MeasureStretch(const std::vector<TrianglePatch>& patches, const AtlasLayout& layout);
 
-/// "rigid" or "conformal" (the manifest's and the CLI's names).
+/// "rigid", "conformal", "strips" or "auto" (the manifest's and the CLI's names).
 const char* ChartFlatteningName(ChartFlattening flattening);
 
 /// Lays out the faces (per triangle or in charts), packs them into atlases

@@ -3,9 +3,13 @@
 #include <Eigen/Sparse>
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <deque>
 #include <limits>
+#include <optional>
 #include <queue>
+#include <set>
+#include <tuple>
 #include <unordered_map>
 
 #include "sfm/errors.h"
@@ -339,10 +343,12 @@ Eigen::Vector2d SingularValues2(const Eigen::Matrix2d& m) {
   return {0.5 * (p + q), 0.5 * std::abs(p - q)};
 }
 
-std::vector<std::vector<ChartFace>> MakeConformalCharts(
+namespace {
+/// MakeConformalCharts over the faces `only` marks (all when empty).
+std::vector<std::vector<ChartFace>> ConformalChartsOf(
     const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const ConformalChartOptions& options,
-    ConformalChartStats* stats) {
+    const std::vector<char>& only, ConformalChartStats* stats) {
   const std::size_t num_faces = mesh.faces.size();
   if (patches.size() != num_faces || unfoldings.size() != num_faces)
     throw OptionError("charts: patches and unfoldings must have one entry per face");
@@ -364,9 +370,12 @@ std::vector<std::vector<ChartFace>> MakeConformalCharts(
   const double half_side = 0.5 * options.max_side_texels * t;
   const double min_cos = std::cos(options.max_normal_angle_deg * kPi / 180.0);
   std::vector<int> chart_of(num_faces, -1);
+  if (!only.empty())
+    for (std::size_t f = 0; f < num_faces; ++f)
+      if (!only[f]) chart_of[f] = -2;  // not to be charted here
   std::deque<std::vector<int>> work;
   for (const int seed : seed_order) {
-    if (chart_of[static_cast<std::size_t>(seed)] >= 0) continue;
+    if (chart_of[static_cast<std::size_t>(seed)] != -1) continue;
     const int id = st.grown++;
     const TriangleFrame& frame = patches[static_cast<std::size_t>(seed)].frame;
     const Eigen::Vector3d& origin = centroid[static_cast<std::size_t>(seed)];
@@ -384,7 +393,7 @@ std::vector<std::vector<ChartFace>> MakeConformalCharts(
       front.pop();
       faces.push_back(f);
       for (const Unfolding& u : unfoldings[static_cast<std::size_t>(f)]) {
-        if (u.face < 0 || chart_of[static_cast<std::size_t>(u.face)] >= 0) continue;
+        if (u.face < 0 || chart_of[static_cast<std::size_t>(u.face)] != -1) continue;
         if (patches[static_cast<std::size_t>(u.face)].frame.z_axis.dot(frame.z_axis) < min_cos)
           continue;
         const double d = distance(u.face);
@@ -452,6 +461,308 @@ std::vector<std::vector<ChartFace>> MakeConformalCharts(
     for (const auto* half : {&low, &high})
       for (auto& part : ConnectedParts(*half, unfoldings, mark, stamp))
         work.push_back(std::move(part));
+  }
+  return charts;
+}
+
+}  // namespace
+
+std::vector<std::vector<ChartFace>> MakeConformalCharts(
+    const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
+    const std::vector<std::array<Unfolding, 3>>& unfoldings, const ConformalChartOptions& options,
+    ConformalChartStats* stats) {
+  return ConformalChartsOf(mesh, patches, unfoldings, options, {}, stats);
+}
+
+namespace {
+
+/// One end of a strip being grown towards +x: the rung (the edge that crosses
+/// the band) from its top vertex to its bottom vertex, in band texels, and the
+/// strip's face on its -x side.
+struct Rung {
+  int face = -1;
+  int top = -1, bottom = -1;  ///< mesh vertices
+  Eigen::Vector2d top_xy, bottom_xy;
+};
+
+int CornerOf(const sfm::TriangleMesh& mesh, int face, int vertex) {
+  for (int k = 0; k < 3; ++k)
+    if (mesh.faces[static_cast<std::size_t>(face)][static_cast<std::size_t>(k)] == vertex) return k;
+  return -1;
+}
+
+/// The face across edge (a, b) of `face`, or -1.
+int FaceAcross(const sfm::TriangleMesh& mesh,
+               const std::vector<std::array<Unfolding, 3>>& unfoldings, int face, int a, int b) {
+  const auto& v = mesh.faces[static_cast<std::size_t>(face)];
+  for (std::size_t k = 0; k < 3; ++k) {
+    const int p = v[k], q = v[(k + 1) % 3];
+    if ((p == a && q == b) || (p == b && q == a))
+      return unfoldings[static_cast<std::size_t>(face)][k].face;
+  }
+  return -1;
+}
+
+/// The band's 180-degree turn about its centre line: maps a strip growing
+/// towards -x onto one growing towards +x, keeping the orientation. Corners
+/// are on the band's lines and stay exactly on them.
+Eigen::Vector2d TurnBand(const Eigen::Vector2d& q, double y_bottom, double y_top) {
+  return {-q.x(), std::abs(q.y() - y_bottom) < std::abs(q.y() - y_top) ? y_top : y_bottom};
+}
+
+}  // namespace
+
+std::vector<std::vector<ChartFace>> MakeStripCharts(
+    const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
+    const std::vector<std::array<Unfolding, 3>>& unfoldings, const StripChartOptions& options,
+    StripChartStats* stats) {
+  const std::size_t num_faces = mesh.faces.size();
+  if (patches.size() != num_faces || unfoldings.size() != num_faces)
+    throw OptionError("charts: patches and unfoldings must have one entry per face");
+  if (!(options.texel_size > 0.0) || !(options.max_stretch > 1.0) ||
+      !(options.max_length_texels > 0.0) || options.min_strip_faces < 1 ||
+      !(options.max_normal_angle_deg > 0.0 && options.max_normal_angle_deg <= 180.0))
+    throw OptionError("charts: bad options");
+  const double t = options.texel_size;
+  StripChartStats local_stats;
+  StripChartStats& st = stats ? *stats : local_stats;
+  const double min_cos = std::cos(options.max_normal_angle_deg * kPi / 180.0);
+  // Band lines a hair outside texel centres, so the centres on them are inside.
+  constexpr double kInset = 1e-3;  // texels
+  // A seed within this relative distance of the preferred height takes it
+  // (within the stretch bound, which also has to absorb the other faces).
+  const double snap_to_preferred = std::min(0.2, 0.8 * (options.max_stretch - 1.0));
+  std::vector<char> leftover(num_faces, 0);
+  bool any_leftover = false;
+
+  std::vector<char> used(num_faces, 0);
+  std::vector<std::vector<ChartFace>> charts;
+  // Seeds: the free face with the fewest free neighbours (so strips leave few
+  // faces stranded), then the earliest in breadth-first order.
+  const std::vector<int> bfs = SeedOrder(mesh, unfoldings);
+  std::vector<int> rank(num_faces, 0), free_neighbours(num_faces, 0);
+  for (std::size_t i = 0; i < bfs.size(); ++i)
+    rank[static_cast<std::size_t>(bfs[i])] = static_cast<int>(i);
+  std::set<std::tuple<int, int, int>> seeds;  // (free neighbours, rank, face)
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    for (const Unfolding& u : unfoldings[f]) free_neighbours[f] += u.face >= 0 ? 1 : 0;
+    seeds.emplace(free_neighbours[f], rank[f], static_cast<int>(f));
+  }
+  auto mark_used = [&](int f) {
+    const auto fs = static_cast<std::size_t>(f);
+    used[fs] = 1;
+    seeds.erase({free_neighbours[fs], rank[fs], f});
+    for (const Unfolding& u : unfoldings[fs]) {
+      if (u.face < 0 || used[static_cast<std::size_t>(u.face)]) continue;
+      const auto g = static_cast<std::size_t>(u.face);
+      seeds.erase({free_neighbours[g], rank[g], u.face});
+      --free_neighbours[g];
+      seeds.emplace(free_neighbours[g], rank[g], u.face);
+    }
+  };
+  // The preferred band height: the median of the faces' tallest heights, so
+  // bands of near-equal faces share one height and fill atlas rows evenly.
+  std::vector<double> tallest(num_faces, 0.0);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const Corners c = FrameCornersTexels(patches[f], t);
+    const double twice_area = Cross(c[1] - c[0], c[2] - c[0]);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double length = (c[(k + 1) % 3] - c[k]).norm();
+      if (length > 0.0) tallest[f] = std::max(tallest[f], twice_area / length);
+    }
+  }
+  double preferred_height = 0.0;
+  if (num_faces > 0) {
+    std::vector<double> sorted = tallest;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(num_faces / 2),
+                     sorted.end());
+    preferred_height = std::round(sorted[num_faces / 2]);
+  }
+  // The face's map into the band when its stretch is within the bound.
+  auto place = [&](int f, const Corners& band) -> std::optional<ChartFace> {
+    const Corners c = FrameCornersTexels(patches[static_cast<std::size_t>(f)], t);
+    const double twice_area = Cross(band[1] - band[0], band[2] - band[0]);
+    if (!(twice_area > 1e-6) || !(Cross(c[1] - c[0], c[2] - c[0]) > 1e-12)) return std::nullopt;
+    ChartFace cf = AffineBetween(f, c, band);
+    const Eigen::Vector2d sigma = SingularValues2(cf.linear);
+    if (!(sigma.x() <= options.max_stretch && sigma.y() >= 1.0 / options.max_stretch))
+      return std::nullopt;
+    return cf;
+  };
+
+  while (!seeds.empty()) {
+    const int seed = std::get<2>(*seeds.begin());
+    const Corners c = FrameCornersTexels(patches[static_cast<std::size_t>(seed)], t);
+    const Eigen::Vector3d& seed_normal = patches[static_cast<std::size_t>(seed)].frame.z_axis;
+    const double twice_area = Cross(c[1] - c[0], c[2] - c[0]);
+    // 1. The seed's side edge: one along the charted region or the mesh border
+    // (so bands lie along each other), the tallest such.
+    int side = -1;
+    double side_height = 0.0;
+    std::tuple<bool, double> side_key;
+    for (int k = 0; k < 3; ++k) {
+      const auto ks = static_cast<std::size_t>(k);
+      const double length = (c[(ks + 1) % 3] - c[ks]).norm();
+      if (!(length > 0.0)) continue;
+      const double height = twice_area / length;
+      const int across = unfoldings[static_cast<std::size_t>(seed)][ks].face;
+      const bool borders = across < 0 || used[static_cast<std::size_t>(across)];
+      // Prefer: along the charted region, then the tallest (or the nearest the
+      // preferred height).
+      const double h_key = options.side == StripSide::kNearestPreferred
+                               ? -std::abs(height - preferred_height)
+                               : height;
+      const auto key = std::make_tuple(borders, h_key);
+      if (side < 0 || key > side_key) side = k, side_key = key, side_height = height;
+    }
+    const double band_height = std::abs(side_height / preferred_height - 1.0) < snap_to_preferred
+                                   ? preferred_height
+                                   : std::max(1.0, std::round(side_height));
+    const double y_bottom = 0.5 - kInset, y_top = 0.5 + band_height + kInset;
+    std::optional<ChartFace> seed_placement;
+    Corners seed_band;
+    if (side >= 0) {
+      const auto k0 = static_cast<std::size_t>(side), k1 = (k0 + 1) % 3, k2 = (k0 + 2) % 3;
+      const Eigen::Vector2d along = (c[k1] - c[k0]).normalized();
+      seed_band[k0] = Eigen::Vector2d(0.0, y_bottom);
+      seed_band[k1] = Eigen::Vector2d((c[k1] - c[k0]).norm(), y_bottom);
+      seed_band[k2] = Eigen::Vector2d((c[k2] - c[k0]).dot(along), y_top);
+      seed_placement = place(seed, seed_band);
+    }
+    mark_used(seed);
+    if (!seed_placement) {  // degenerate or too small for a band: on its own, rigid
+      ++st.lone_faces;
+      charts.push_back({ChartFace{seed, Eigen::Matrix2d::Identity(), Eigen::Vector2d::Zero()}});
+      continue;
+    }
+    ++st.strips;
+    std::vector<std::pair<int, Corners>> band = {{seed, seed_band}};
+    double lo_x = std::min({seed_band[0].x(), seed_band[1].x(), seed_band[2].x()});
+    double hi_x = std::max({seed_band[0].x(), seed_band[1].x(), seed_band[2].x()});
+
+    // 2. Growth towards +x across `rung` while faces fit; `lo` is the band's
+    // far end in this direction's coordinates. Returns the faces added.
+    auto grow = [&](Rung rung, double lo) {
+      std::vector<std::pair<int, Corners>> added;
+      double hi = -std::numeric_limits<double>::max();
+      for (;;) {
+        const int g = FaceAcross(mesh, unfoldings, rung.face, rung.top, rung.bottom);
+        if (g < 0 || used[static_cast<std::size_t>(g)]) break;
+        if (patches[static_cast<std::size_t>(g)].frame.z_axis.dot(seed_normal) < min_cos) break;
+        const int k_top = CornerOf(mesh, g, rung.top), k_bottom = CornerOf(mesh, g, rung.bottom);
+        if (k_top < 0 || k_bottom < 0) break;
+        const int k_apex = 3 - k_top - k_bottom;
+        const Corners p = FrameCornersTexels(patches[static_cast<std::size_t>(g)], t);
+        // The similarity taking the rung's frame points onto its band points
+        // (as complex numbers: q = q_bottom + z (p - p_bottom)).
+        const std::complex<double> dp(p[k_top].x() - p[k_bottom].x(),
+                                      p[k_top].y() - p[k_bottom].y());
+        const std::complex<double> dq(rung.top_xy.x() - rung.bottom_xy.x(),
+                                      rung.top_xy.y() - rung.bottom_xy.y());
+        if (std::abs(dp) == 0.0) break;
+        const std::complex<double> z = dq / dp;
+        const std::complex<double> apex_c =
+            std::complex<double>(rung.bottom_xy.x(), rung.bottom_xy.y()) +
+            z * std::complex<double>(p[k_apex].x() - p[k_bottom].x(),
+                                     p[k_apex].y() - p[k_bottom].y());
+        // The apex goes to the nearer band line and must lie beyond the rung's
+        // end on that line (bands are monotone, so faces never overlap).
+        const bool apex_on_top = apex_c.imag() > 0.5 * (y_bottom + y_top);
+        const Eigen::Vector2d apex(apex_c.real(), apex_on_top ? y_top : y_bottom);
+        if (apex.x() <= (apex_on_top ? rung.top_xy.x() : rung.bottom_xy.x()) + 1e-3) break;
+        if (std::max(hi, apex.x()) - lo > options.max_length_texels) break;
+        Corners q;
+        q[static_cast<std::size_t>(k_top)] = rung.top_xy;
+        q[static_cast<std::size_t>(k_bottom)] = rung.bottom_xy;
+        q[static_cast<std::size_t>(k_apex)] = apex;
+        if (!place(g, q)) break;
+        mark_used(g);
+        added.emplace_back(g, q);
+        hi = std::max({hi, rung.top_xy.x(), rung.bottom_xy.x(), apex.x()});
+        const int apex_vertex =
+            mesh.faces[static_cast<std::size_t>(g)][static_cast<std::size_t>(k_apex)];
+        rung.face = g;
+        if (apex_on_top) {
+          rung.top = apex_vertex;
+          rung.top_xy = apex;
+        } else {
+          rung.bottom = apex_vertex;
+          rung.bottom_xy = apex;
+        }
+      }
+      return std::make_pair(added, hi);
+    };
+    const auto k0 = static_cast<std::size_t>(side), k1 = (k0 + 1) % 3, k2 = (k0 + 2) % 3;
+    const auto& sv = mesh.faces[static_cast<std::size_t>(seed)];
+    // Towards +x across (apex, v1).
+    Rung right{seed, sv[k2], sv[k1], seed_band[k2], seed_band[k1]};
+    auto [to_right, right_hi] = grow(right, lo_x);
+    for (auto& fq : to_right) band.push_back(fq);
+    if (!to_right.empty()) hi_x = std::max(hi_x, right_hi);
+    // Towards -x across (v0, apex), grown in the band turned by 180 degrees.
+    Rung left{seed, sv[k0], sv[k2], TurnBand(seed_band[k0], y_bottom, y_top),
+              TurnBand(seed_band[k2], y_bottom, y_top)};
+    auto to_left = grow(left, -hi_x).first;
+    for (auto& [f, q] : to_left) {
+      for (auto& p : q) p = TurnBand(p, y_bottom, y_top);
+      band.emplace_back(f, q);
+    }
+    // 3. Square ends: each end rung is made to cross the band straight (its
+    // two ends moved to their mean, or one onto the other) when the faces on it
+    // stay within the stretch bound, so bands abut in atlas rows.
+    for (const bool right_end : {true, false}) {
+      auto outer = [&](double y_line) {
+        double x =
+            right_end ? -std::numeric_limits<double>::max() : std::numeric_limits<double>::max();
+        for (const auto& fq : band)
+          for (const auto& p : fq.second)
+            if (p.y() == y_line) x = right_end ? std::max(x, p.x()) : std::min(x, p.x());
+        return x;
+      };
+      const double x_top = outer(y_top), x_bottom = outer(y_bottom);
+      for (const double x : {0.5 * (x_top + x_bottom), x_top, x_bottom}) {
+        auto moved = band;
+        bool ok = true;
+        for (auto& [f, q] : moved) {
+          bool touched = false;
+          for (auto& p : q)
+            if ((p.y() == y_top && p.x() == x_top) || (p.y() == y_bottom && p.x() == x_bottom)) {
+              p.x() = x;
+              touched = true;
+            }
+          if (touched && !place(f, q)) ok = false;
+        }
+        if (ok) {
+          band = std::move(moved);
+          break;
+        }
+      }
+    }
+    if (static_cast<int>(band.size()) < options.min_strip_faces) {
+      for (const auto& fq : band) leftover[static_cast<std::size_t>(fq.first)] = 1;
+      st.dissolved_faces += static_cast<int>(band.size());
+      --st.strips;
+      any_leftover = true;
+      continue;
+    }
+    std::vector<ChartFace> chart;
+    for (const auto& [f, q] : band) {
+      ChartFace cf =
+          AffineBetween(f, FrameCornersTexels(patches[static_cast<std::size_t>(f)], t), q);
+      cf.translation *= t;  // texels -> world units (linear is unitless)
+      chart.push_back(cf);
+    }
+    charts.push_back(std::move(chart));
+  }
+  if (any_leftover) {
+    ConformalChartOptions co;
+    co.texel_size = t;
+    co.max_side_texels = 512.0;
+    co.max_normal_angle_deg = options.max_normal_angle_deg;
+    co.max_stretch = options.max_stretch;
+    co.max_extent_texels = options.max_length_texels;
+    for (auto& chart : ConformalChartsOf(mesh, patches, unfoldings, co, leftover, nullptr))
+      charts.push_back(std::move(chart));
   }
   return charts;
 }

@@ -68,6 +68,58 @@ std::vector<std::vector<ChartFace>> MakeConformalCharts(
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const ConformalChartOptions& options,
     ConformalChartStats* stats = nullptr);
 
+/// Which edge of a strip's seed face lies on the band line (after preferring
+/// one along the charted region or the mesh border).
+enum class StripSide {
+  kTallest,           ///< the one the face is tallest over (its shortest edge)
+  kNearestPreferred,  ///< the one whose height is nearest the preferred band height
+};
+
+/// Settings of MakeStripCharts.
+struct StripChartOptions {
+  double texel_size = 1.0;  ///< world units
+  /// Every face's texel stretch (singular values of its map into the band) stays
+  /// in [1 / s, s]; a strip ends before a face that would exceed it. > 1.
+  double max_stretch = 1.25;
+  /// Longest band in texels (an atlas less its gutters). > 0.
+  double max_length_texels = 2044.0;
+  /// A face joins only while its normal is within this angle of the seed's. (0, 180].
+  double max_normal_angle_deg = 180.0;
+  StripSide side = StripSide::kTallest;
+  /// Strips of fewer faces are dissolved and their faces charted conformally
+  /// (MakeConformalCharts, within 512 texels), which suits fans such as
+  /// cylinder caps. >= 1 (1: every strip stays).
+  int min_strip_faces = 1;
+};
+
+/// What MakeStripCharts did.
+struct StripChartStats {
+  int strips = 0;
+  int lone_faces = 0;       ///< seeds that fit no band (placed rigidly on their own)
+  int dissolved_faces = 0;  ///< faces of strips shorter than min_strip_faces
+};
+
+/// Charts that tile: triangle strips mapped onto straight bands. From seeds
+/// with the fewest free neighbours (then in breadth-first order), a strip
+/// starts with a face whose side edge lies on the band's bottom line and whose
+/// apex sets the band's height (whole texels; the preferred height, the median
+/// of the faces' tallest heights, when it is near); it
+/// grows both ways across its rungs (the edges that cross the band): the next
+/// face's apex is placed by the similarity that maps the rung onto its place
+/// in the band and goes to the nearer band line, so every face has one edge on
+/// a line and its apex on the other (a piecewise-affine map, continuous
+/// across rungs). A strip ends at a used face, at a face whose stretch would
+/// leave [1/s, s], or at `max_length_texels`. Its ends are then squared (the end
+/// rung made to cross straight) where the stretch bound allows. Bands are
+/// rectangles but for slanted ends, so they pack into atlas rows with only their gutters
+/// between them. The band lines lie on texel centres (at 0.5 + whole texels, less
+/// a hair), so a band of height H texels fills H + 1 rows and the gutter rings
+/// beyond it are whole rows. Every face ends in exactly one chart.
+std::vector<std::vector<ChartFace>> MakeStripCharts(
+    const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
+    const std::vector<std::array<Unfolding, 3>>& unfoldings, const StripChartOptions& options,
+    StripChartStats* stats = nullptr);
+
 /// Singular values (largest first) of a 2x2 map.
 Eigen::Vector2d SingularValues2(const Eigen::Matrix2d& m);
 

@@ -254,6 +254,8 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
   summary.seconds_atlas = Since(t);
   summary.atlases = atlases.ptms.size();
   summary.charts = static_cast<std::size_t>(atlases.num_charts);
+  summary.chart_flattening =
+      options.atlas.mode == AtlasMode::kCharts ? ChartFlatteningName(atlases.flattening) : "none";
   summary.occupancy = atlases.occupancy;
   summary.stretch = atlases.stretch;
 
@@ -308,6 +310,7 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
                        {"random", summary.random},
                        {"atlases", summary.atlases},
                        {"charts", summary.charts},
+                       {"chart_flattening", summary.chart_flattening},
                        {"occupancy", summary.occupancy},
                        {"texel_stretch",
                         {{"mean", summary.stretch.mean},

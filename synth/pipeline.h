@@ -41,6 +41,7 @@ struct SynthJobSummary {
   std::size_t faces = 0, subdivisions = 0;
   std::size_t from_photos = 0, from_neighbours = 0, random = 0;
   std::size_t atlases = 0, charts = 0;
+  std::string chart_flattening;  ///< the one used ("auto" resolves to "strips" or "rigid")
   double occupancy = 0.0;
   AtlasStretch stretch;
   double seconds_load = 0, seconds_visibility = 0, seconds_synthesis = 0, seconds_atlas = 0,

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <opencv2/core.hpp>
+#include <random>
 #include <set>
 
 #include "datasets_synthetic/shapes.h"
@@ -80,21 +82,11 @@ TEST(Charts, ConformalChartsOfASphereStayWithinTheStretchBound) {
   }
 }
 
-// A conformal layout: the atlas frame (dP/du, n x dP/du, n) that a renderer
-// derives from the texture coordinates is the triangle frame turned by
-// AtlasFrameAngle, and FrameFromAtlas inverts the placement.
-TEST(Charts, ConformalLayoutAgreesWithTheTextureCoordinates) {
-  const sfm::TriangleMesh mesh = datasets::CoarseMesh(datasets::SceneShape::kTorus);
-  const PatchGeometry g = Geometry(mesh);
-  AtlasOptions o;
-  o.flattening = ChartFlattening::kConformal;
-  o.max_chart_size = 384;
-  const AtlasLayout layout = LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
-  EXPECT_LT(layout.num_charts, static_cast<int>(mesh.faces.size()) / 10);
-  const AtlasStretch stretch = MeasureStretch(g.patches, layout);
-  EXPECT_GE(stretch.min, 1 / o.max_chart_stretch - 1e-9);
-  EXPECT_LE(stretch.max, o.max_chart_stretch + 1e-9);
-  EXPECT_NEAR(stretch.mean, 1.0, 0.01);  // charts keep the surface's area
+// The atlas frame (dP/du, n x dP/du, n) that a renderer derives from the
+// texture coordinates is the triangle frame turned by AtlasFrameAngle, and
+// FrameFromAtlas inverts the placement.
+void ExpectLayoutAgreesWithTextureCoordinates(const sfm::TriangleMesh& mesh, const PatchGeometry& g,
+                                              const AtlasLayout& layout) {
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     const FacePlacement& fp = layout.faces[f];
     const TrianglePatch& patch = g.patches[f];
@@ -114,6 +106,167 @@ TEST(Charts, ConformalLayoutAgreesWithTheTextureCoordinates) {
   }
 }
 
+TEST(Charts, ConformalLayoutAgreesWithTheTextureCoordinates) {
+  const sfm::TriangleMesh mesh = datasets::CoarseMesh(datasets::SceneShape::kTorus);
+  const PatchGeometry g = Geometry(mesh);
+  AtlasOptions o;
+  o.flattening = ChartFlattening::kConformal;
+  o.max_chart_size = 384;
+  const AtlasLayout layout = LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+  EXPECT_LT(layout.num_charts, static_cast<int>(mesh.faces.size()) / 10);
+  const AtlasStretch stretch = MeasureStretch(g.patches, layout);
+  EXPECT_GE(stretch.min, 1 / o.max_chart_stretch - 1e-9);
+  EXPECT_LE(stretch.max, o.max_chart_stretch + 1e-9);
+  EXPECT_NEAR(stretch.mean, 1.0, 0.01);  // charts keep the surface's area
+  ExpectLayoutAgreesWithTextureCoordinates(mesh, g, layout);
+}
+
+/// Per strip chart: every face has its corners on the band's two lines (y in
+/// texels, two values per chart), no texel centre lies more than half a texel
+/// inside two of its faces, and no face is flipped or stretched beyond `bound`.
+void ExpectBands(const std::vector<std::vector<ChartFace>>& charts, const PatchGeometry& g,
+                 double bound) {
+  for (const auto& chart : charts) {
+    if (chart.size() == 1 && chart[0].linear.isIdentity()) continue;  // a lone face
+    std::set<long> ys;
+    std::set<std::pair<int, int>> inside;
+    for (const ChartFace& cf : chart) {
+      EXPECT_GT(cf.linear.determinant(), 0.0);
+      const Eigen::Vector2d s = SingularValues2(cf.linear);
+      EXPECT_LE(s.x(), bound + 1e-9);
+      EXPECT_GE(s.y(), 1 / bound - 1e-9);
+      std::array<Eigen::Vector2d, 3> q;
+      for (std::size_t k = 0; k < 3; ++k) {
+        q[k] = (cf.linear * g.patches[static_cast<std::size_t>(cf.face)].corners_in_frame[k] +
+                cf.translation) /
+               kTexel;
+        ys.insert(std::lround(q[k].y() * 1000));  // on a line to 1e-3 texels
+      }
+      const Eigen::Vector2d lo = q[0].cwiseMin(q[1]).cwiseMin(q[2]);
+      const Eigen::Vector2d hi = q[0].cwiseMax(q[1]).cwiseMax(q[2]);
+      for (int y = static_cast<int>(std::floor(lo.y())); y <= static_cast<int>(hi.y()); ++y)
+        for (int x = static_cast<int>(std::floor(lo.x())); x <= static_cast<int>(hi.x()); ++x)
+          if (SignedDistanceToTriangle(q, Eigen::Vector2d(x + 0.5, y + 0.5)) < -0.5)
+            EXPECT_TRUE(inside.emplace(x, y).second) << "faces overlap at " << x << ", " << y;
+    }
+    EXPECT_EQ(ys.size(), 2u) << "a strip's corners lie on more than two lines";
+  }
+}
+
+// A grid of right triangles maps onto bands almost rigidly: one band per row
+// of quads, whole texels high (so the only stretch is rounding the height).
+TEST(Charts, StripsOfAGridPlaneAreRowsOfQuads) {
+  const sfm::TriangleMesh mesh = datasets::MakeGridPlane(8, 0.5);  // 128 faces, 250 texels
+  const PatchGeometry g = Geometry(mesh);
+  StripChartOptions o;
+  o.texel_size = kTexel;
+  StripChartStats stats;
+  const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o, &stats);
+  EXPECT_EQ(charts.size(), 8u);
+  EXPECT_EQ(stats.strips, 8);
+  EXPECT_EQ(stats.lone_faces, 0);
+  std::set<int> seen;
+  for (const auto& chart : charts) {
+    EXPECT_EQ(chart.size(), 16u);
+    for (const ChartFace& cf : chart) {
+      EXPECT_TRUE(seen.insert(cf.face).second);
+      const Eigen::Vector2d s = SingularValues2(cf.linear);
+      EXPECT_NEAR(s.x(), 1.0, 0.01);  // 31.25 texels rounded to 31
+      EXPECT_NEAR(s.y(), 1.0, 0.01);
+    }
+  }
+  EXPECT_EQ(seen.size(), mesh.faces.size());
+  ExpectBands(charts, g, o.max_stretch);
+}
+
+// On a sphere every face lands in exactly one strip, strips are bands within
+// the stretch bound, and a tighter bound gives shorter strips (more of them).
+TEST(Charts, StripsOfASphereAreBandsWithinTheStretchBound) {
+  const sfm::TriangleMesh mesh = datasets::MakeIcosphere(3, 1.0);  // 1280 faces
+  const PatchGeometry g = Geometry(mesh);
+  StripChartOptions o;
+  o.texel_size = kTexel;
+  std::size_t previous_charts = 0;
+  for (const double bound : {1.25, 1.1}) {
+    o.max_stretch = bound;
+    for (const StripSide side : {StripSide::kTallest, StripSide::kNearestPreferred}) {
+      o.side = side;
+      const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o);
+      std::set<int> seen;
+      for (const auto& chart : charts)
+        for (const ChartFace& cf : chart) EXPECT_TRUE(seen.insert(cf.face).second);
+      EXPECT_EQ(seen.size(), mesh.faces.size());
+      ExpectBands(charts, g, bound);
+      if (side == StripSide::kTallest) {
+        EXPECT_GT(charts.size(), previous_charts);
+        previous_charts = charts.size();
+      }
+    }
+  }
+}
+
+// The default layout (auto) is strips on the demo's sphere and torus, fills the
+// atlases above 85 % there (bench/atlas_bench measures the rest), never puts
+// two charts on one texel, and agrees with the texture coordinates.
+TEST(Charts, StripLayoutsFillAtlasesAboveEightyFivePercent) {
+  for (const datasets::SceneShape shape :
+       {datasets::SceneShape::kSphere, datasets::SceneShape::kTorus}) {
+    const sfm::TriangleMesh mesh = datasets::CoarseMesh(shape);
+    const PatchGeometry g = Geometry(mesh);
+    AtlasOptions o;
+    ASSERT_EQ(o.flattening, ChartFlattening::kAuto);
+    const AtlasLayout layout = LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+    EXPECT_EQ(layout.flattening, ChartFlattening::kStrips);
+    std::vector<cv::Mat> owner;
+    for (const cv::Size& size : layout.atlas_sizes) owner.emplace_back(size, CV_32SC1, -1);
+    const AtlasCoverage coverage = VisitAtlasTexels(
+        layout, kTexel, o.gutter, [&](int atlas, int x, int y, int face, const Eigen::Vector2d&) {
+          int& who = owner[static_cast<std::size_t>(atlas)].at<int>(y, x);
+          const int chart = layout.faces[static_cast<std::size_t>(face)].chart;
+          // A texel is written again only by a face of the same chart.
+          if (who >= 0)
+            EXPECT_EQ(layout.faces[static_cast<std::size_t>(who)].chart, chart)
+                << "texel " << x << ", " << y;
+          who = face;
+        });
+    double texels = 0;
+    for (const cv::Size& size : layout.atlas_sizes) texels += size.area();
+    EXPECT_GT(static_cast<double>(coverage.inside_texels) / texels, 0.85)
+        << datasets::SceneShapeName(shape);
+    const AtlasStretch stretch = MeasureStretch(g.patches, layout);
+    EXPECT_LE(stretch.max, o.max_chart_stretch + 1e-9);
+    EXPECT_GE(stretch.min, 1 / o.max_chart_stretch - 1e-9);
+    ExpectLayoutAgreesWithTextureCoordinates(mesh, g, layout);
+  }
+}
+
+// On an irregular mesh (vertices moved along the surface by up to a third of
+// an edge) strips fragment; auto keeps whichever of strips and rigid charts
+// takes fewer atlas texels.
+TEST(Charts, AutoKeepsTheSmallerOfStripsAndRigidCharts) {
+  sfm::TriangleMesh mesh = datasets::MakeIcosphere(3, 1.0);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double edge = (mesh.Corner(0, 1) - mesh.Corner(0, 0)).norm();
+  for (Eigen::Vector3d& v : mesh.vertices) {
+    const Eigen::Vector3d n = v.normalized();
+    Eigen::Vector3d d(u(rng), u(rng), u(rng));
+    v = (v + (edge / 3.0) * (d - d.dot(n) * n)).normalized();
+  }
+  const PatchGeometry g = Geometry(mesh);
+  AtlasOptions o;
+  std::int64_t texels[3];
+  const ChartFlattening kinds[3] = {ChartFlattening::kAuto, ChartFlattening::kStrips,
+                                    ChartFlattening::kRigid};
+  for (int i = 0; i < 3; ++i) {
+    o.flattening = kinds[i];
+    const AtlasLayout layout = LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+    texels[i] = layout.Texels();
+    EXPECT_NE(layout.flattening, ChartFlattening::kAuto);
+  }
+  EXPECT_EQ(texels[0], std::min(texels[1], texels[2]));
+}
+
 // Options out of range are refused.
 TEST(Charts, BadChartOptionsAreRefused) {
   AtlasOptions o;
@@ -121,6 +274,12 @@ TEST(Charts, BadChartOptionsAreRefused) {
   EXPECT_THROW(o.Check(), OptionError);
   o.max_chart_stretch = 5.0;
   EXPECT_THROW(o.Check(), OptionError);
+  const sfm::TriangleMesh mesh = datasets::MakeGridPlane(2, 0.5);
+  const PatchGeometry g = Geometry(mesh);
+  StripChartOptions strips;
+  strips.texel_size = kTexel;
+  strips.min_strip_faces = 0;
+  EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), OptionError);
 }
 
 }  // namespace
