@@ -146,8 +146,9 @@ void ExpectBands(const std::vector<std::vector<ChartFace>>& charts, const PatchG
       const Eigen::Vector2d hi = q[0].cwiseMax(q[1]).cwiseMax(q[2]);
       for (int y = static_cast<int>(std::floor(lo.y())); y <= static_cast<int>(hi.y()); ++y)
         for (int x = static_cast<int>(std::floor(lo.x())); x <= static_cast<int>(hi.x()); ++x)
-          if (SignedDistanceToTriangle(q, Eigen::Vector2d(x + 0.5, y + 0.5)) < -0.5)
+          if (SignedDistanceToTriangle(q, Eigen::Vector2d(x + 0.5, y + 0.5)) < -0.5) {
             EXPECT_TRUE(inside.emplace(x, y).second) << "faces overlap at " << x << ", " << y;
+          }
     }
     EXPECT_EQ(ys.size(), 2u) << "a strip's corners lie on more than two lines";
   }
@@ -224,9 +225,10 @@ TEST(Charts, StripLayoutsFillAtlasesAboveEightyFivePercent) {
           int& who = owner[static_cast<std::size_t>(atlas)].at<int>(y, x);
           const int chart = layout.faces[static_cast<std::size_t>(face)].chart;
           // A texel is written again only by a face of the same chart.
-          if (who >= 0)
+          if (who >= 0) {
             EXPECT_EQ(layout.faces[static_cast<std::size_t>(who)].chart, chart)
                 << "texel " << x << ", " << y;
+          }
           who = face;
         });
     double texels = 0;
