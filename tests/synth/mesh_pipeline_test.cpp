@@ -289,6 +289,11 @@ TEST_F(MeshPipelineTest, AtlasFacesDoNotOverlapAndChartsPackTighter) {
   EXPECT_GT(s.occupancy, 0.3);
   EXPECT_LT(s.occupancy, 0.5);  // one box per triangle caps near 0.4 (DESIGN.md)
   EXPECT_GT(charts, s.occupancy);
+  EXPECT_EQ(s.chart_flattening, "none");
+  // The default (auto) says which flattening it chose.
+  const std::string chosen = manifest["summary"]["chart_flattening"].get<std::string>();
+  EXPECT_TRUE(chosen == "strips" || chosen == "rigid") << chosen;
+  EXPECT_EQ(manifest["settings"]["chart_flattening"], "auto");
 }
 
 TEST_F(MeshPipelineTest, ModelFolderRoundTripsAndTheGlbIsWellFormed) {
