@@ -251,7 +251,7 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
     return x / (3.0 * t);
   };
   std::vector<std::vector<ChartFace>> queue;
-  std::vector<double> height;
+  std::vector<int> height;  // texels, outline box at turn 0
   for (const auto& chart : charts) {
     std::vector<ChartFace> sorted = chart;
     std::stable_sort(sorted.begin(), sorted.end(),
@@ -285,25 +285,29 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
   std::size_t done = 0;
   for (const std::size_t c : order) {
     if (height[c] > atlas_size)
-      throw OptionError("a strip chart of " + std::to_string(static_cast<int>(height[c])) +
+      throw OptionError("a strip chart of " + std::to_string(height[c]) +
                         " texels' height does not fit an atlas of " + std::to_string(atlas_size));
     std::vector<ChartFace> rest = queue[c];
+    // The `count` faces at the front of the band (turn 0, placed from the left)
+    // or at its back (turned by 180 degrees, the back comes first).
+    auto end_of_rest = [&](int turn, std::size_t count) {
+      const auto n = static_cast<std::ptrdiff_t>(count);
+      return turn == 0 ? std::make_pair(rest.begin(), rest.begin() + n)
+                       : std::make_pair(rest.end() - n, rest.end());
+    };
     while (!rest.empty()) {
-      if (row_height == 0) new_row(static_cast<int>(height[c]));
+      if (row_height == 0) new_row(height[c]);
       // The longest prefix of `rest` (in the turned order) that fits this row.
       bool placed = false;
-      if (static_cast<int>(height[c]) <= row_height) {
+      if (height[c] <= row_height) {
         std::size_t count = rest.size();
         while (count > 0 && !placed) {
           int best_turn = -1, best_x = 0, best_dy = 0;
           ChartOutline best;
           for (int turn = 0; turn < 2; ++turn) {
-            std::vector<ChartFace> piece;
-            if (turn == 0)
-              piece.assign(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(count));
-            else
-              piece.assign(rest.end() - static_cast<std::ptrdiff_t>(count), rest.end());
-            ChartOutline o = Outline(piece, turn * kPi, patches, t, gutter);
+            const auto [first, last] = end_of_rest(turn, count);
+            ChartOutline o =
+                Outline(std::vector<ChartFace>(first, last), turn * kPi, patches, t, gutter);
             // Shorter pieces may sit lower in the row, under others.
             for (int dy = 0; dy + o.Height() <= row_height; ++dy) {
               const int x = slide(o, dy);
@@ -322,14 +326,9 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
             count = fit;
             continue;
           }
-          std::vector<ChartFace> piece;
-          if (best_turn == 0) {
-            piece.assign(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(count));
-            rest.erase(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(count));
-          } else {
-            piece.assign(rest.end() - static_cast<std::ptrdiff_t>(count), rest.end());
-            rest.erase(rest.end() - static_cast<std::ptrdiff_t>(count), rest.end());
-          }
+          const auto [first, last] = end_of_rest(best_turn, count);
+          std::vector<ChartFace> piece(first, last);
+          rest.erase(first, last);
           for (const ChartOutline::Run& r : best.runs) {
             int& edge = right_edge[static_cast<std::size_t>(r.row + best_dy)];
             edge = std::max(edge, best_x + r.x + r.length);
@@ -343,7 +342,7 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
       if (!placed) {
         if (std::all_of(right_edge.begin(), right_edge.end(), [](int e) { return e == 0; }))
           throw OptionError("a strip chart does not fit an atlas of " + std::to_string(atlas_size));
-        new_row(static_cast<int>(height[c]));
+        new_row(height[c]);
       }
     }
     ++done;
@@ -557,6 +556,19 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
   std::vector<std::pair<int, int>> sizes;
   std::vector<Eigen::Vector2i> chart_lo, chart_hi;
   std::vector<std::array<int, 3>> packed;
+  // Records a packed chart, turned to its outline's rotation, at (atlas, x, y).
+  auto drop_chart = [&](std::vector<ChartFace>& chart, const ChartOutline& o,
+                        const std::array<int, 3>& at) {
+    const Eigen::Matrix2d turn = Eigen::Rotation2Dd(o.angle).toRotationMatrix();
+    for (ChartFace& cf : chart) {
+      cf.linear = turn * cf.linear;
+      cf.translation = turn * cf.translation;
+    }
+    chart_lo.push_back(o.lo);
+    chart_hi.push_back(o.hi);
+    sizes.emplace_back(o.Width(), o.Height());
+    packed.push_back(at);
+  };
   if (options.mode == AtlasMode::kPerTriangle) {
     for (const auto& chart : charts) {
       const ChartOutline outline = Box(chart, 0.0, patches, t, gutter, nullptr);
@@ -587,18 +599,8 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
       }
     }
     charts = std::move(best.pieces);
-    for (std::size_t c = 0; c < charts.size(); ++c) {
-      const ChartOutline& o = best.outlines[c];
-      const Eigen::Matrix2d turn = Eigen::Rotation2Dd(o.angle).toRotationMatrix();
-      for (ChartFace& cf : charts[c]) {
-        cf.linear = turn * cf.linear;
-        cf.translation = turn * cf.translation;
-      }
-      chart_lo.push_back(o.lo);
-      chart_hi.push_back(o.hi);
-      sizes.emplace_back(o.Width(), o.Height());
-      packed.push_back(best.drops[c]);
-    }
+    for (std::size_t c = 0; c < charts.size(); ++c)
+      drop_chart(charts[c], best.outlines[c], best.drops[c]);
   } else {
     // Charts are packed by their outlines (the texels the bake writes), largest
     // first, each at the best of kPackingRotations turns and the first position
@@ -647,23 +649,10 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
       if (best_packing.drops.empty() || packing.texels < best_packing.texels)
         best_packing = std::move(packing);
     }
-    sizes.resize(charts.size());
-    chart_lo.resize(charts.size());
-    chart_hi.resize(charts.size());
-    packed.resize(charts.size());
     for (std::size_t c = 0; c < charts.size(); ++c) {
       const OutlineDrop& drop = best_packing.drops[c];
-      const ChartOutline& o = outlines[c][static_cast<std::size_t>(drop.rotation)];
-      // Turn the chart to the chosen rotation.
-      const Eigen::Matrix2d turn = Eigen::Rotation2Dd(o.angle).toRotationMatrix();
-      for (ChartFace& cf : charts[c]) {
-        cf.linear = turn * cf.linear;
-        cf.translation = turn * cf.translation;
-      }
-      chart_lo[c] = o.lo;
-      chart_hi[c] = o.hi;
-      sizes[c] = {o.Width(), o.Height()};
-      packed[c] = {drop.bin, drop.x, drop.y};
+      drop_chart(charts[c], outlines[c][static_cast<std::size_t>(drop.rotation)],
+                 {drop.bin, drop.x, drop.y});
     }
   }
 

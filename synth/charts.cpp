@@ -532,8 +532,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
   // A seed within this relative distance of the preferred height takes it
   // (within the stretch bound, which also has to absorb the other faces).
   const double snap_to_preferred = std::min(0.2, 0.8 * (options.max_stretch - 1.0));
-  std::vector<char> leftover(num_faces, 0);
-  bool any_leftover = false;
+  std::vector<char> leftover(num_faces, 0);  // faces of dissolved strips
 
   std::vector<char> used(num_faces, 0);
   std::vector<std::vector<ChartFace>> charts;
@@ -637,7 +636,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     }
     ++st.strips;
     std::vector<std::pair<int, Corners>> band = {{seed, seed_band}};
-    double lo_x = std::min({seed_band[0].x(), seed_band[1].x(), seed_band[2].x()});
+    const double lo_x = std::min({seed_band[0].x(), seed_band[1].x(), seed_band[2].x()});
     double hi_x = std::max({seed_band[0].x(), seed_band[1].x(), seed_band[2].x()});
 
     // 2. Growth towards +x across `rung` while faces fit; `lo` is the band's
@@ -742,7 +741,6 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
       for (const auto& fq : band) leftover[static_cast<std::size_t>(fq.first)] = 1;
       st.dissolved_faces += static_cast<int>(band.size());
       --st.strips;
-      any_leftover = true;
       continue;
     }
     std::vector<ChartFace> chart;
@@ -754,7 +752,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     }
     charts.push_back(std::move(chart));
   }
-  if (any_leftover) {
+  if (std::find(leftover.begin(), leftover.end(), 1) != leftover.end()) {
     ConformalChartOptions co;
     co.texel_size = t;
     co.max_side_texels = 512.0;

@@ -21,6 +21,16 @@ PatchGeometry Geometry(const sfm::TriangleMesh& mesh) {
   return MakePatchGeometry(mesh, kTexel, 8, TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
 }
 
+/// Every one of `num_faces` faces is in exactly one chart.
+void ExpectEachFaceInOneChart(const std::vector<std::vector<ChartFace>>& charts,
+                              std::size_t num_faces) {
+  std::set<int> seen;
+  for (const auto& chart : charts)
+    for (const ChartFace& cf : chart)
+      EXPECT_TRUE(seen.insert(cf.face).second) << "face " << cf.face << " in two charts";
+  EXPECT_EQ(seen.size(), num_faces);
+}
+
 TEST(Charts, SingularValuesOfKnownMaps) {
   const Eigen::Matrix2d rotation = Eigen::Rotation2Dd(0.7).toRotationMatrix();
   EXPECT_TRUE(SingularValues2(rotation).isApprox(Eigen::Vector2d(1, 1)));
@@ -65,16 +75,14 @@ TEST(Charts, ConformalChartsOfASphereStayWithinTheStretchBound) {
   for (const double bound : {1.25, 1.05}) {
     o.max_stretch = bound;
     const auto charts = MakeConformalCharts(mesh, g.patches, g.unfoldings, o);
-    std::set<int> seen;
+    ExpectEachFaceInOneChart(charts, mesh.faces.size());
     double worst = 1.0;
     for (const auto& chart : charts)
       for (const ChartFace& cf : chart) {
-        EXPECT_TRUE(seen.insert(cf.face).second) << "face " << cf.face << " in two charts";
         EXPECT_GT(cf.linear.determinant(), 0.0);
         const Eigen::Vector2d s = SingularValues2(cf.linear);
         worst = std::max({worst, s.x(), 1.0 / s.y()});
       }
-    EXPECT_EQ(seen.size(), mesh.faces.size());
     EXPECT_LE(worst, bound + 1e-9);
     EXPECT_GT(worst, 1.0 + 1e-3);  // curved: not an isometry
     EXPECT_GT(charts.size(), previous_charts);
@@ -166,17 +174,15 @@ TEST(Charts, StripsOfAGridPlaneAreRowsOfQuads) {
   EXPECT_EQ(charts.size(), 8u);
   EXPECT_EQ(stats.strips, 8);
   EXPECT_EQ(stats.lone_faces, 0);
-  std::set<int> seen;
+  ExpectEachFaceInOneChart(charts, mesh.faces.size());
   for (const auto& chart : charts) {
     EXPECT_EQ(chart.size(), 16u);
     for (const ChartFace& cf : chart) {
-      EXPECT_TRUE(seen.insert(cf.face).second);
       const Eigen::Vector2d s = SingularValues2(cf.linear);
       EXPECT_NEAR(s.x(), 1.0, 0.01);  // 31.25 texels rounded to 31
       EXPECT_NEAR(s.y(), 1.0, 0.01);
     }
   }
-  EXPECT_EQ(seen.size(), mesh.faces.size());
   ExpectBands(charts, g, o.max_stretch);
 }
 
@@ -193,10 +199,7 @@ TEST(Charts, StripsOfASphereAreBandsWithinTheStretchBound) {
     for (const StripSide side : {StripSide::kTallest, StripSide::kNearestPreferred}) {
       o.side = side;
       const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o);
-      std::set<int> seen;
-      for (const auto& chart : charts)
-        for (const ChartFace& cf : chart) EXPECT_TRUE(seen.insert(cf.face).second);
-      EXPECT_EQ(seen.size(), mesh.faces.size());
+      ExpectEachFaceInOneChart(charts, mesh.faces.size());
       ExpectBands(charts, g, bound);
       if (side == StripSide::kTallest) {
         EXPECT_GT(charts.size(), previous_charts);
