@@ -2,6 +2,8 @@
 // default material's texel size (and split 1-to-4 once), laid out in charts and
 // in per-triangle boxes, without synthesis.
 // Run: build/bench/atlas_bench [--gutter G] [--chart-size N]  (rigid, conformal, strips, boxes)
+// ATLAS_BENCH_DUMP=DIR writes each atlas's coverage (inside, gutter) as a PNG at
+// quarter size, or full size with ATLAS_BENCH_DUMP_FULL=1.
 // Prints per mesh and mode: occupancy (texels inside triangles / atlas texels),
 // charts, atlases, layout seconds, and the charts' texel stretch (area-weighted
 // mean and extremes of the per-face singular values of texels per texel size).
@@ -28,6 +30,7 @@ using namespace texlume;
 
 namespace {
 cv::Mat Thumbnail(const cv::Mat& coverage) {
+  if (std::getenv("ATLAS_BENCH_DUMP_FULL")) return coverage;
   cv::Mat small;
   cv::resize(coverage, small, cv::Size(), 0.25, 0.25, cv::INTER_AREA);
   return small;

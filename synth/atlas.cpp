@@ -300,10 +300,14 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
       // The longest prefix of `rest` (in the turned order) that fits this row.
       bool placed = false;
       if (height[c] <= row_height) {
-        std::size_t count = rest.size();
-        while (count > 0 && !placed) {
-          int best_turn = -1, best_x = 0, best_dy = 0;
-          ChartOutline best;
+        // The best slide of the `count` faces at the chosen end, over both
+        // turns and, for pieces shorter than the row, every height in it.
+        struct Slide {
+          int turn = -1, x = 0, dy = 0;
+          ChartOutline outline;
+        };
+        auto best_slide = [&](std::size_t count) {
+          Slide best;
           for (int turn = 0; turn < 2; ++turn) {
             const auto [first, last] = end_of_rest(turn, count);
             ChartOutline o =
@@ -312,30 +316,40 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
             for (int dy = 0; dy + o.Height() <= row_height; ++dy) {
               const int x = slide(o, dy);
               if (x + o.Width() > atlas_size) continue;
-              if (best_turn < 0 || x + o.Width() < best_x + best.Width())
-                best_turn = turn, best_x = x, best_dy = dy, best = o;
+              if (best.turn < 0 || x + o.Width() < best.x + best.outline.Width())
+                best = Slide{turn, x, dy, o};
             }
           }
-          if (best_turn < 0) {
-            // Fewer faces: those whose band x lies within the row's free width.
-            const int free_width =
-                atlas_size - *std::min_element(right_edge.begin(), right_edge.end());
-            const double x0 = band_x(rest.front());
-            std::size_t fit = 0;
-            while (fit + 1 < count && band_x(rest[fit]) - x0 < free_width) ++fit;
-            count = fit;
-            continue;
+          return best;
+        };
+        std::size_t count = rest.size();
+        Slide best = best_slide(count);
+        if (best.turn < 0) {
+          // The most faces that fit, by bisection (fewer faces never fit worse).
+          std::size_t fits = 0, fails = count;
+          while (fails - fits > 1) {
+            const std::size_t mid = fits + (fails - fits) / 2;
+            Slide s = best_slide(mid);
+            if (s.turn >= 0) {
+              fits = mid;
+              best = std::move(s);
+            } else {
+              fails = mid;
+            }
           }
-          const auto [first, last] = end_of_rest(best_turn, count);
+          count = fits;
+        }
+        if (count > 0 && best.turn >= 0) {
+          const auto [first, last] = end_of_rest(best.turn, count);
           std::vector<ChartFace> piece(first, last);
           rest.erase(first, last);
-          for (const ChartOutline::Run& r : best.runs) {
-            int& edge = right_edge[static_cast<std::size_t>(r.row + best_dy)];
-            edge = std::max(edge, best_x + r.x + r.length);
+          for (const ChartOutline::Run& r : best.outline.runs) {
+            int& edge = right_edge[static_cast<std::size_t>(r.row + best.dy)];
+            edge = std::max(edge, best.x + r.x + r.length);
           }
           out.pieces.push_back(std::move(piece));
-          out.outlines.push_back(std::move(best));
-          out.drops.push_back({atlas, best_x, row_y + best_dy});
+          out.outlines.push_back(std::move(best.outline));
+          out.drops.push_back({atlas, best.x, row_y + best.dy});
           placed = true;
         }
       }
@@ -578,14 +592,15 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
     }
     packed = PackSkyline(sizes, options.atlas_size, options.atlas_size);
   } else if (options.flattening == ChartFlattening::kStrips) {
-    // Strips from each seed-side rule, with and without dissolving strips of
-    // one or two faces (fans such as cylinder caps chart better conformally),
-    // each packed in rows; the layout with the fewest atlas texels wins.
+    // Strips (after fans) from each seed-side rule, with and without dissolving
+    // strips of one or two faces into conformal charts, each packed in rows;
+    // the layout with the fewest atlas texels wins.
     StripChartOptions so;
     so.texel_size = t;
     so.max_stretch = options.max_chart_stretch;
     so.max_length_texels = options.atlas_size - 2 * gutter - 2;  // a whole row (rows cut them)
     so.max_normal_angle_deg = options.max_chart_normal_angle_deg;
+    so.gutter = gutter;
     RowPacking best;
     std::int64_t best_texels = 0;
     for (const StripSide side : {StripSide::kTallest, StripSide::kNearestPreferred}) {

@@ -510,6 +510,197 @@ Eigen::Vector2d TurnBand(const Eigen::Vector2d& q, double y_bottom, double y_top
   return {-q.x(), std::abs(q.y() - y_bottom) < std::abs(q.y() - y_top) ? y_top : y_bottom};
 }
 
+/// The face after `f` around its corner at `v`, counter-clockwise (across the
+/// edge from the corner after next to `v`) or clockwise (across the edge from
+/// `v` to the next corner); -1 at the border.
+int FanNeighbour(const sfm::TriangleMesh& mesh,
+                 const std::vector<std::array<Unfolding, 3>>& unfoldings, int f, int v,
+                 bool counter_clockwise) {
+  const int k = CornerOf(mesh, f, v);
+  if (k < 0) return -1;
+  const auto edge = static_cast<std::size_t>(counter_clockwise ? (k + 2) % 3 : k);
+  return unfoldings[static_cast<std::size_t>(f)][edge].face;
+}
+
+/// The faces `in_fan` marks around `v`, as runs in counter-clockwise order:
+/// each run starts where its clockwise neighbour is not in the fan; a closed
+/// ring starts at its lowest face.
+std::vector<std::vector<int>> FanRuns(const sfm::TriangleMesh& mesh,
+                                      const std::vector<std::array<Unfolding, 3>>& unfoldings,
+                                      int v, const std::vector<int>& faces,
+                                      const std::vector<char>& in_fan) {
+  std::set<int> left;
+  for (const int f : faces)
+    if (in_fan[static_cast<std::size_t>(f)]) left.insert(f);
+  std::vector<std::vector<int>> runs;
+  auto walk = [&](int f) {
+    std::vector<int> run;
+    while (f >= 0 && left.erase(f)) {
+      run.push_back(f);
+      f = FanNeighbour(mesh, unfoldings, f, v, true);
+    }
+    runs.push_back(std::move(run));
+  };
+  for (const int f : faces) {
+    if (!left.count(f)) continue;
+    const int before = FanNeighbour(mesh, unfoldings, f, v, false);
+    if (before < 0 || !in_fan[static_cast<std::size_t>(before)]) walk(f);
+  }
+  while (!left.empty()) walk(*left.begin());
+  return runs;
+}
+
+/// A run of faces around `v` (counter-clockwise) unfolded rigidly about `v`
+/// and cut into sectors, each turned so its bisector is upright with `v` at
+/// (0, y_bottom): per sector its faces' corners in band texels. When the run is
+/// flat, each sector also takes the free faces beyond it in the same plane
+/// (a cap subdivided into rings) whose centroids lie within its angles. The
+/// number of sectors minimises the row area they need when upright and turned
+/// sectors alternate, about n (R^2 tan(beta / 2) + 2 g R / cos(beta / 2)) for
+/// n sectors of angle beta, radius R and gutter g, with beta at most 90
+/// degrees. Empty when the run is shorter than 3 faces or wider than `max_length`.
+std::vector<std::vector<std::pair<int, Corners>>> FanSectors(
+    const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
+    const std::vector<std::array<Unfolding, 3>>& unfoldings, const std::vector<char>& used, int v,
+    const std::vector<int>& run, double t, int gutter, double max_length, double y_bottom) {
+  constexpr double kMaxSectorAngle = 0.5 * kPi;
+  const double flat_cos = std::cos(0.25 * kPi / 180.0);  // coplanar faces
+  std::vector<Corners> unfolded;
+  std::vector<double> phi = {
+      0.0};  // angle of each face's first edge about v, then the last's second
+  double radius = 0.0;
+  int previous_last = -1;  // the previous face's second edge's far vertex
+  for (const int f : run) {
+    const int k = CornerOf(mesh, f, v);
+    const auto ks = static_cast<std::size_t>(k), a = (ks + 1) % 3, b = (ks + 2) % 3;
+    const auto& fv = mesh.faces[static_cast<std::size_t>(f)];
+    if (previous_last >= 0 && fv[a] != previous_last) break;  // orientation flips: run ends
+    const Corners c = FrameCornersTexels(patches[static_cast<std::size_t>(f)], t);
+    const Eigen::Vector2d ea = c[a] - c[ks], eb = c[b] - c[ks];
+    const double theta = std::atan2(Cross(ea, eb), ea.dot(eb));
+    if (!(theta > 1e-9) || !(ea.norm() > 0.0)) break;
+    const Eigen::Matrix2d turn =
+        Eigen::Rotation2Dd(phi.back() - std::atan2(ea.y(), ea.x())).toRotationMatrix();
+    Corners q;
+    q[ks] = Eigen::Vector2d::Zero();
+    q[b] = turn * eb;
+    if (unfolded.empty()) {
+      q[a] = turn * ea;
+    } else {  // the shared edge exactly where the previous face put it
+      const int pk = CornerOf(mesh, run[unfolded.size() - 1], v);
+      q[a] = unfolded.back()[static_cast<std::size_t>((pk + 2) % 3)];
+    }
+    unfolded.push_back(q);
+    phi.push_back(phi.back() + theta);
+    radius = std::max({radius, ea.norm(), eb.norm()});
+    previous_last = fv[b];
+  }
+  const std::size_t m = unfolded.size();
+  if (m < 3) return {};
+  const double total = phi.back();
+
+  // A flat run takes in the free faces of its plane beyond it, reached across
+  // edges, whose centroids lie within its angles (the plane's coordinates: x
+  // along the first face's first edge, counter-clockwise about the normal).
+  const Eigen::Vector3d& normal = patches[static_cast<std::size_t>(run[0])].frame.z_axis;
+  bool flat = true;
+  for (std::size_t i = 0; i < m; ++i)
+    flat = flat && patches[static_cast<std::size_t>(run[i])].frame.z_axis.dot(normal) >= flat_cos;
+  std::vector<int> beyond;
+  std::vector<Corners> beyond_q;
+  std::vector<double> beyond_angle;
+  if (flat) {
+    const Eigen::Vector3d& centre = mesh.vertices[static_cast<std::size_t>(v)];
+    const int first_a = mesh.faces[static_cast<std::size_t>(run[0])]
+                                  [static_cast<std::size_t>((CornerOf(mesh, run[0], v) + 1) % 3)];
+    Eigen::Vector3d e1 = mesh.vertices[static_cast<std::size_t>(first_a)] - centre;
+    e1 = (e1 - e1.dot(normal) * normal).normalized();
+    const Eigen::Vector3d e2 = normal.cross(e1);
+    auto plane = [&](int w) -> Eigen::Vector2d {
+      const Eigen::Vector3d d = mesh.vertices[static_cast<std::size_t>(w)] - centre;
+      return Eigen::Vector2d(d.dot(e1), d.dot(e2)) / t;
+    };
+    std::set<int> taken(run.begin(), run.begin() + static_cast<std::ptrdiff_t>(m));
+    std::deque<int> queue(run.begin(), run.begin() + static_cast<std::ptrdiff_t>(m));
+    while (!queue.empty()) {
+      const int f = queue.front();
+      queue.pop_front();
+      for (const Unfolding& u : unfoldings[static_cast<std::size_t>(f)]) {
+        const int g = u.face;
+        if (g < 0 || used[static_cast<std::size_t>(g)] || taken.count(g) ||
+            patches[static_cast<std::size_t>(g)].frame.z_axis.dot(normal) < flat_cos)
+          continue;
+        Corners q;
+        for (std::size_t k = 0; k < 3; ++k)
+          q[k] = plane(mesh.faces[static_cast<std::size_t>(g)][k]);
+        const Eigen::Vector2d centroid = (q[0] + q[1] + q[2]) / 3.0;
+        double angle = std::atan2(centroid.y(), centroid.x());
+        if (angle < 0.0) angle += 2.0 * kPi;
+        if (!(angle < total)) continue;
+        taken.insert(g);
+        queue.push_back(g);
+        beyond.push_back(g);
+        beyond_q.push_back(q);
+        beyond_angle.push_back(angle);
+        for (const auto& p : q) radius = std::max(radius, p.norm());
+      }
+    }
+  }
+  if (radius + 2.0 * gutter > max_length) return {};
+  std::size_t sectors = 0;
+  double best_cost = std::numeric_limits<double>::max();
+  for (std::size_t n = 1; n <= m; ++n) {
+    const double beta = total / static_cast<double>(n);
+    if (beta > kMaxSectorAngle && n < m) continue;
+    if (2.0 * radius * std::sin(0.5 * std::min(beta, kPi)) > max_length) continue;
+    const double cost = static_cast<double>(n) * (radius * radius * std::tan(0.5 * beta) +
+                                                  2.0 * gutter * radius / std::cos(0.5 * beta));
+    if (beta < kPi && cost < best_cost) best_cost = cost, sectors = n;
+  }
+  if (sectors == 0) return {};
+  // Cuts at the face edges nearest to equal angles.
+  std::vector<std::size_t> cuts = {0};
+  for (std::size_t j = 1; j < sectors; ++j) {
+    const double target = total * static_cast<double>(j) / static_cast<double>(sectors);
+    std::size_t best = cuts.back() + 1;
+    for (std::size_t i = best; i <= m - (sectors - j); ++i)  // leave a face per sector after
+      if (std::abs(phi[i] - target) < std::abs(phi[best] - target)) best = i;
+    cuts.push_back(best);
+  }
+  cuts.push_back(m);
+  std::vector<std::vector<std::pair<int, Corners>>> out;
+  for (std::size_t s = 0; s + 1 < cuts.size(); ++s) {
+    const double mid = 0.5 * (phi[cuts[s]] + phi[cuts[s + 1]]);
+    const Eigen::Matrix2d upright = Eigen::Rotation2Dd(0.5 * kPi - mid).toRotationMatrix();
+    std::vector<std::pair<int, Corners>> sector;
+    std::set<int> in_sector;
+    for (std::size_t i = cuts[s]; i < cuts[s + 1]; ++i) {
+      sector.emplace_back(run[i], unfolded[i]);
+      in_sector.insert(run[i]);
+    }
+    // The faces beyond within the sector's angles, reached from its own faces.
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (std::size_t j = 0; j < beyond.size(); ++j) {
+        if (in_sector.count(beyond[j]) || beyond_angle[j] < phi[cuts[s]] ||
+            beyond_angle[j] >= phi[cuts[s + 1]])
+          continue;
+        bool touches = false;
+        for (const Unfolding& u : unfoldings[static_cast<std::size_t>(beyond[j])])
+          touches = touches || (u.face >= 0 && in_sector.count(u.face));
+        if (!touches) continue;
+        sector.emplace_back(beyond[j], beyond_q[j]);
+        in_sector.insert(beyond[j]);
+        grew = true;
+      }
+    }
+    for (auto& [f, q] : sector)
+      for (auto& p : q) p = upright * p + Eigen::Vector2d(0.0, y_bottom);
+    out.push_back(std::move(sector));
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::vector<ChartFace>> MakeStripCharts(
@@ -521,6 +712,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     throw OptionError("charts: patches and unfoldings must have one entry per face");
   if (!(options.texel_size > 0.0) || !(options.max_stretch > 1.0) ||
       !(options.max_length_texels > 0.0) || options.min_strip_faces < 1 ||
+      (options.min_fan_faces != 0 && options.min_fan_faces < 3) || options.gutter < 0 ||
       !(options.max_normal_angle_deg > 0.0 && options.max_normal_angle_deg <= 180.0))
     throw OptionError("charts: bad options");
   const double t = options.texel_size;
@@ -588,6 +780,60 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
       return std::nullopt;
     return cf;
   };
+
+  // 0. Fans: the free faces around a vertex of at least `min_fan_faces` faces
+  // (cylinder caps, cone tips, the poles of latitude-longitude spheres) cannot
+  // follow a band, since every face shares the centre. Each fan is unfolded
+  // about its centre (rigid, stretch 1) and cut into sectors; a sector stands
+  // in its band with the centre on the bottom line and its bisector upright, so
+  // turned sectors nest between upright ones in an atlas row.
+  if (options.min_fan_faces > 0) {
+    std::vector<std::vector<int>> faces_of_vertex(mesh.vertices.size());
+    for (std::size_t f = 0; f < num_faces; ++f)
+      for (const int v : mesh.faces[f])
+        faces_of_vertex[static_cast<std::size_t>(v)].push_back(static_cast<int>(f));
+    std::vector<int> centres;
+    for (std::size_t v = 0; v < faces_of_vertex.size(); ++v)
+      if (static_cast<int>(faces_of_vertex[v].size()) >= options.min_fan_faces)
+        centres.push_back(static_cast<int>(v));
+    std::stable_sort(centres.begin(), centres.end(), [&](int a, int b) {
+      return faces_of_vertex[static_cast<std::size_t>(a)].size() >
+             faces_of_vertex[static_cast<std::size_t>(b)].size();
+    });
+    std::vector<char> in_fan(num_faces, 0);
+    for (const int v : centres) {
+      std::vector<int> free_faces;
+      Eigen::Vector3d mean_normal = Eigen::Vector3d::Zero();
+      for (const int f : faces_of_vertex[static_cast<std::size_t>(v)])
+        if (!used[static_cast<std::size_t>(f)]) {
+          free_faces.push_back(f);
+          mean_normal += patches[static_cast<std::size_t>(f)].frame.z_axis;
+        }
+      if (static_cast<int>(free_faces.size()) < options.min_fan_faces || !(mean_normal.norm() > 0))
+        continue;
+      mean_normal.normalize();
+      for (const int f : free_faces)
+        in_fan[static_cast<std::size_t>(f)] =
+            patches[static_cast<std::size_t>(f)].frame.z_axis.dot(mean_normal) >= min_cos;
+      for (const std::vector<int>& run : FanRuns(mesh, unfoldings, v, free_faces, in_fan)) {
+        for (auto& sector : FanSectors(mesh, patches, unfoldings, used, v, run, t, options.gutter,
+                                       options.max_length_texels, 0.5 - kInset)) {
+          for (const auto& [f, q] : sector) mark_used(f);
+          std::vector<ChartFace> chart;
+          for (const auto& [f, q] : sector) {
+            ChartFace cf =
+                AffineBetween(f, FrameCornersTexels(patches[static_cast<std::size_t>(f)], t), q);
+            cf.translation *= t;  // texels -> world units (linear is unitless)
+            chart.push_back(cf);
+          }
+          charts.push_back(std::move(chart));
+          ++st.fan_sectors;
+        }
+        ++st.fans;
+      }
+      for (const int f : free_faces) in_fan[static_cast<std::size_t>(f)] = 0;
+    }
+  }
 
   while (!seeds.empty()) {
     const int seed = std::get<2>(*seeds.begin());
@@ -762,6 +1008,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     for (auto& chart : ConformalChartsOf(mesh, patches, unfoldings, co, leftover, nullptr))
       charts.push_back(std::move(chart));
   }
+
   return charts;
 }
 

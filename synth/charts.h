@@ -87,9 +87,14 @@ struct StripChartOptions {
   double max_normal_angle_deg = 180.0;
   StripSide side = StripSide::kTallest;
   /// Strips of fewer faces are dissolved and their faces charted conformally
-  /// (MakeConformalCharts, within 512 texels), which suits fans such as
-  /// cylinder caps. >= 1 (1: every strip stays).
+  /// (MakeConformalCharts, within 512 texels), which suits stray faces
+  /// between strips. >= 1 (1: every strip stays).
   int min_strip_faces = 1;
+  /// Faces around a vertex of at least this many faces are charted first, as a
+  /// fan cut into sectors (0: no fans). 0 or >= 3.
+  int min_fan_faces = 8;
+  /// Atlas gutter in texels (>= 0): fan sectors are sized for it.
+  int gutter = 2;
 };
 
 /// What MakeStripCharts did.
@@ -97,6 +102,8 @@ struct StripChartStats {
   int strips = 0;
   int lone_faces = 0;       ///< seeds that fit no band (placed rigidly on their own)
   int dissolved_faces = 0;  ///< faces of strips shorter than min_strip_faces
+  int fans = 0;             ///< runs of faces around a vertex charted as fans
+  int fan_sectors = 0;      ///< their sectors: one chart each, the first charts returned
 };
 
 /// Charts that tile: triangle strips mapped onto straight bands. From seeds
@@ -114,7 +121,13 @@ struct StripChartStats {
 /// rectangles but for slanted ends, so they pack into atlas rows with only their gutters
 /// between them. The band lines lie on texel centres (at 0.5 + whole texels, less
 /// a hair), so a band of height H texels fills H + 1 rows and the gutter rings
-/// beyond it are whole rows. Every face ends in exactly one chart.
+/// beyond it are whole rows. Before any strip, fans (the faces around a vertex
+/// of at least `min_fan_faces` faces, such as cylinder caps, which no band can
+/// follow) are unfolded rigidly about their centre and cut into sectors of at
+/// most 90 degrees standing upright on the centre, so that sectors turned by
+/// 180 degrees nest between upright ones in an atlas row; a flat fan's sectors
+/// take in the faces of its plane beyond it (a subdivided cap's rings). Every
+/// face ends in exactly one chart.
 std::vector<std::vector<ChartFace>> MakeStripCharts(
     const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const StripChartOptions& options,

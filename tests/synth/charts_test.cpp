@@ -10,6 +10,7 @@
 #include "datasets_synthetic/shapes.h"
 #include "sfm/errors.h"
 #include "synth/atlas.h"
+#include "synth/pipeline.h"
 #include "synth/triangle_frame.h"
 
 namespace texlume::synth {
@@ -209,12 +210,63 @@ TEST(Charts, StripsOfASphereAreBandsWithinTheStretchBound) {
   }
 }
 
-// The default layout (auto) is strips on the demo's sphere and torus, fills the
+// Cylinder caps are fans: each is unfolded rigidly about its centre and cut
+// into sectors of at most 90 degrees standing upright on the centre; once the
+// mesh is subdivided, the sectors take in the cap's rings of faces.
+TEST(Charts, FansOfCylinderCapsAreUprightSectors) {
+  constexpr int kAround = 48;
+  for (const bool subdivided : {false, true}) {
+    sfm::TriangleMesh mesh = datasets::MakeCylinder(kAround, 12, 0.6, 1.6);
+    const int first_centre = static_cast<int>(mesh.vertices.size()) - 2;
+    if (subdivided) mesh = SubdivideMidpoint(mesh);
+    const PatchGeometry g = Geometry(mesh);
+    StripChartOptions o;
+    o.texel_size = kTexel;
+    StripChartStats stats;
+    const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o, &stats);
+    ExpectEachFaceInOneChart(charts, mesh.faces.size());
+    EXPECT_EQ(stats.fans, 2);
+    ASSERT_GE(stats.fan_sectors, 8);  // at most 90 degrees each
+    std::size_t cap_faces = 0;
+    for (std::size_t c = 0; c < static_cast<std::size_t>(stats.fan_sectors); ++c) {
+      double y_centre = std::numeric_limits<double>::quiet_NaN();
+      double y_min = std::numeric_limits<double>::max();
+      std::vector<Eigen::Vector2d> rim;
+      for (const ChartFace& cf : charts[c]) {
+        const auto f = static_cast<std::size_t>(cf.face);
+        EXPECT_GT(std::abs(g.patches[f].frame.z_axis.z()), 1 - 1e-9) << "a side face in a fan";
+        const Eigen::Vector2d s = SingularValues2(cf.linear);
+        EXPECT_NEAR(s.x(), 1.0, 1e-6);  // rigid: caps are flat
+        EXPECT_NEAR(s.y(), 1.0, 1e-6);
+        EXPECT_GT(cf.linear.determinant(), 0.0);
+        for (std::size_t k = 0; k < 3; ++k) {
+          const Eigen::Vector2d q =
+              (cf.linear * g.patches[f].corners_in_frame[k] + cf.translation) / kTexel;
+          y_min = std::min(y_min, q.y());
+          if (mesh.faces[f][k] >= first_centre && mesh.faces[f][k] < first_centre + 2)
+            y_centre = q.y();
+          else
+            rim.push_back(q);
+        }
+        ++cap_faces;
+      }
+      // The centre is the sector's lowest point, on the band's bottom line
+      // (a texel centre, less a hair), and the sector opens upwards.
+      EXPECT_NEAR(y_centre, 0.5 - 1e-3, 1e-9);
+      EXPECT_NEAR(y_min, y_centre, 1e-9);
+      for (const Eigen::Vector2d& q : rim) EXPECT_GT(q.y() - y_centre, 0.5 * q.norm() - 1.0);
+    }
+    EXPECT_EQ(cap_faces, 2u * kAround * (subdivided ? 4u : 1u));
+  }
+}
+
+// The default layout (auto) is strips on the demo's sphere, cylinder and torus, fills the
 // atlases above 85 % there (bench/atlas_bench measures the rest), never puts
 // two charts on one texel, and agrees with the texture coordinates.
 TEST(Charts, StripLayoutsFillAtlasesAboveEightyFivePercent) {
   for (const datasets::SceneShape shape :
-       {datasets::SceneShape::kSphere, datasets::SceneShape::kTorus}) {
+       {datasets::SceneShape::kSphere, datasets::SceneShape::kCylinder,
+        datasets::SceneShape::kTorus}) {
     const sfm::TriangleMesh mesh = datasets::CoarseMesh(shape);
     const PatchGeometry g = Geometry(mesh);
     AtlasOptions o;
@@ -285,6 +337,11 @@ TEST(Charts, BadChartOptionsAreRefused) {
   strips.texel_size = kTexel;
   strips.min_strip_faces = 0;
   EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), OptionError);
+  strips.min_strip_faces = 1;
+  strips.min_fan_faces = 2;  // a fan needs 3 faces
+  EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), OptionError);
+  strips.min_fan_faces = 0;  // no fans
+  EXPECT_NO_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips));
 }
 
 }  // namespace
