@@ -592,26 +592,30 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
     }
     packed = PackSkyline(sizes, options.atlas_size, options.atlas_size);
   } else if (options.flattening == ChartFlattening::kStrips) {
-    // Strips (after fans) from each seed-side rule, with and without dissolving
-    // strips of one or two faces into conformal charts, each packed in rows;
-    // the layout with the fewest atlas texels wins.
+    // Strips (after fans) from each seed-side rule, unstacked, and stacked up to
+    // a seventh of the atlas or up to the whole (which wins on developable
+    // surfaces such as a cylinder's side), each packed in rows; the layout with
+    // the fewest atlas texels wins.
     StripChartOptions so;
     so.texel_size = t;
     so.max_stretch = options.max_chart_stretch;
     so.max_length_texels = options.atlas_size - 2 * gutter - 2;  // a whole row (rows cut them)
     so.max_normal_angle_deg = options.max_chart_normal_angle_deg;
     so.gutter = gutter;
+    const double atlas_rows = so.max_length_texels;
+    const std::pair<StripSide, double> variants[] = {{StripSide::kTallest, 0.0},
+                                                     {StripSide::kNearestPreferred, 0.0},
+                                                     {StripSide::kTallest, atlas_rows / 7.0},
+                                                     {StripSide::kTallest, atlas_rows}};
     RowPacking best;
     std::int64_t best_texels = 0;
-    for (const StripSide side : {StripSide::kTallest, StripSide::kNearestPreferred}) {
-      for (const int min_strip_faces : {1, 3}) {
-        so.side = side;
-        so.min_strip_faces = min_strip_faces;
-        RowPacking rows = PackStripsInRows(MakeStripCharts(mesh, patches, unfoldings, so), patches,
-                                           t, gutter, options.atlas_size, progress);
-        if (best.pieces.empty() || rows.texels < best_texels)
-          best_texels = rows.texels, best = std::move(rows);
-      }
+    for (const auto& [side, stack] : variants) {
+      so.side = side;
+      so.max_stack_texels = stack;
+      RowPacking rows = PackStripsInRows(MakeStripCharts(mesh, patches, unfoldings, so), patches, t,
+                                         gutter, options.atlas_size, progress);
+      if (best.pieces.empty() || rows.texels < best_texels)
+        best_texels = rows.texels, best = std::move(rows);
     }
     charts = std::move(best.pieces);
     for (std::size_t c = 0; c < charts.size(); ++c)

@@ -713,6 +713,8 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
   if (!(options.texel_size > 0.0) || !(options.max_stretch > 1.0) ||
       !(options.max_length_texels > 0.0) || options.min_strip_faces < 1 ||
       (options.min_fan_faces != 0 && options.min_fan_faces < 3) || options.gutter < 0 ||
+      !(options.max_stack_texels >= 0.0) ||
+      !(options.min_stack_cover > 0.0 && options.min_stack_cover <= 1.0) ||
       !(options.max_normal_angle_deg > 0.0 && options.max_normal_angle_deg <= 180.0))
     throw OptionError("charts: bad options");
   const double t = options.texel_size;
@@ -750,6 +752,22 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
       --free_neighbours[g];
       seeds.emplace(free_neighbours[g], rank[g], u.face);
     }
+  };
+  // Undoes mark_used (faces freed in the reverse order they were used).
+  auto unmark_used = [&](int f) {
+    const auto fs = static_cast<std::size_t>(f);
+    used[fs] = 0;
+    int free = 0;
+    for (const Unfolding& u : unfoldings[fs]) {
+      if (u.face < 0 || used[static_cast<std::size_t>(u.face)]) continue;
+      const auto g = static_cast<std::size_t>(u.face);
+      seeds.erase({free_neighbours[g], rank[g], u.face});
+      ++free_neighbours[g];
+      seeds.emplace(free_neighbours[g], rank[g], u.face);
+      ++free;
+    }
+    free_neighbours[fs] = free;
+    seeds.emplace(free, rank[fs], f);
   };
   // The preferred band height: the median of the faces' tallest heights, so
   // bands of near-equal faces share one height and fill atlas rows evenly.
@@ -863,7 +881,8 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     const double band_height = std::abs(side_height / preferred_height - 1.0) < snap_to_preferred
                                    ? preferred_height
                                    : std::max(1.0, std::round(side_height));
-    const double y_bottom = 0.5 - kInset, y_top = 0.5 + band_height + kInset;
+    // The band's lines; a stacked band moves them up (step 4).
+    double y_bottom = 0.5 - kInset, y_top = 0.5 + band_height + kInset;
     std::optional<ChartFace> seed_placement;
     Corners seed_band;
     if (side >= 0) {
@@ -885,9 +904,16 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     const double lo_x = std::min({seed_band[0].x(), seed_band[1].x(), seed_band[2].x()});
     double hi_x = std::max({seed_band[0].x(), seed_band[1].x(), seed_band[2].x()});
 
+    // A stacked band's bottom line is the top line of the band under it: the
+    // vertices of that band's top chain keep their x there, and no other
+    // vertex may land on the line within the chain's span (step 4).
+    std::unordered_map<int, double> anchor_x;
+    double anchor_lo = 0.0, anchor_hi = 0.0;
+
     // 2. Growth towards +x across `rung` while faces fit; `lo` is the band's
-    // far end in this direction's coordinates. Returns the faces added.
-    auto grow = [&](Rung rung, double lo) {
+    // far end in this direction's coordinates (`turned`: the band turned by
+    // 180 degrees, growing towards -x). Returns the faces added.
+    auto grow = [&](Rung rung, double lo, bool turned) {
       std::vector<std::pair<int, Corners>> added;
       double hi = -std::numeric_limits<double>::max();
       for (;;) {
@@ -913,7 +939,17 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         // The apex goes to the nearer band line and must lie beyond the rung's
         // end on that line (bands are monotone, so faces never overlap).
         const bool apex_on_top = apex_c.imag() > 0.5 * (y_bottom + y_top);
-        const Eigen::Vector2d apex(apex_c.real(), apex_on_top ? y_top : y_bottom);
+        Eigen::Vector2d apex(apex_c.real(), apex_on_top ? y_top : y_bottom);
+        const int apex_vertex =
+            mesh.faces[static_cast<std::size_t>(g)][static_cast<std::size_t>(k_apex)];
+        if (!anchor_x.empty() && apex_on_top == turned) {  // onto the band below
+          const auto it = anchor_x.find(apex_vertex);
+          const double x = turned ? -apex.x() : apex.x();
+          if (it != anchor_x.end())
+            apex.x() = turned ? -it->second : it->second;
+          else if (x > anchor_lo - 1.0 && x < anchor_hi + 1.0)
+            break;
+        }
         if (apex.x() <= (apex_on_top ? rung.top_xy.x() : rung.bottom_xy.x()) + 1e-3) break;
         if (std::max(hi, apex.x()) - lo > options.max_length_texels) break;
         Corners q;
@@ -924,8 +960,6 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         mark_used(g);
         added.emplace_back(g, q);
         hi = std::max({hi, rung.top_xy.x(), rung.bottom_xy.x(), apex.x()});
-        const int apex_vertex =
-            mesh.faces[static_cast<std::size_t>(g)][static_cast<std::size_t>(k_apex)];
         rung.face = g;
         if (apex_on_top) {
           rung.top = apex_vertex;
@@ -941,13 +975,13 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     const auto& sv = mesh.faces[static_cast<std::size_t>(seed)];
     // Towards +x across (apex, v1).
     Rung right{seed, sv[k2], sv[k1], seed_band[k2], seed_band[k1]};
-    auto [to_right, right_hi] = grow(right, lo_x);
+    auto [to_right, right_hi] = grow(right, lo_x, false);
     for (auto& fq : to_right) band.push_back(fq);
     if (!to_right.empty()) hi_x = std::max(hi_x, right_hi);
     // Towards -x across (v0, apex), grown in the band turned by 180 degrees.
     Rung left{seed, sv[k0], sv[k2], TurnBand(seed_band[k0], y_bottom, y_top),
               TurnBand(seed_band[k2], y_bottom, y_top)};
-    auto to_left = grow(left, -hi_x).first;
+    auto to_left = grow(left, -hi_x, true).first;
     for (auto& [f, q] : to_left) {
       for (auto& p : q) p = TurnBand(p, y_bottom, y_top);
       band.emplace_back(f, q);
@@ -983,6 +1017,106 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         }
       }
     }
+    // 4. Stacking: a band grown on the top line of the last one, from a free
+    // face across one of its top edges, shares that line (no gutter rows
+    // between them). It is kept when it covers most of the band below and the
+    // stack stays within `max_stack_texels`; else its faces are freed.
+    std::vector<std::pair<int, Corners>> below = band;
+    double stack_height = band_height;
+    while (options.max_stack_texels > 0.0) {
+      anchor_x.clear();
+      anchor_lo = std::numeric_limits<double>::max();
+      anchor_hi = -anchor_lo;
+      for (const auto& [f, q] : below)
+        for (std::size_t k = 0; k < 3; ++k)
+          if (q[k].y() == y_top) {
+            anchor_x[mesh.faces[static_cast<std::size_t>(f)][k]] = q[k].x();
+            anchor_lo = std::min(anchor_lo, q[k].x());
+            anchor_hi = std::max(anchor_hi, q[k].x());
+          }
+      // The seed: across the top edge nearest the middle of the chain.
+      int next = -1;
+      std::size_t next_k0 = 0;
+      double next_key = std::numeric_limits<double>::max();
+      for (const auto& [f, q] : below) {
+        const auto& fv = mesh.faces[static_cast<std::size_t>(f)];
+        for (std::size_t k = 0; k < 3; ++k) {
+          const std::size_t kn = (k + 1) % 3;
+          if (q[k].y() != y_top || q[kn].y() != y_top) continue;
+          const int g = unfoldings[static_cast<std::size_t>(f)][k].face;
+          if (g < 0 || used[static_cast<std::size_t>(g)] ||
+              patches[static_cast<std::size_t>(g)].frame.z_axis.dot(seed_normal) < min_cos)
+            continue;
+          // The edge runs right to left along f's top, so left to right in g.
+          const int g0 = CornerOf(mesh, g, fv[kn]);
+          if (g0 < 0 ||
+              mesh.faces[static_cast<std::size_t>(g)][static_cast<std::size_t>((g0 + 1) % 3)] !=
+                  fv[k])
+            continue;
+          const double key = std::abs(0.5 * (q[k].x() + q[kn].x() - anchor_lo - anchor_hi));
+          if (key < next_key) next = g, next_k0 = static_cast<std::size_t>(g0), next_key = key;
+        }
+      }
+      if (next < 0) break;
+      const Corners cn = FrameCornersTexels(patches[static_cast<std::size_t>(next)], t);
+      const std::size_t n0 = next_k0, n1 = (n0 + 1) % 3, n2 = (n0 + 2) % 3;
+      const double edge = (cn[n1] - cn[n0]).norm();
+      if (!(edge > 0.0)) break;
+      const double height = Cross(cn[n1] - cn[n0], cn[n2] - cn[n0]) / edge;
+      const double next_height = std::abs(height / preferred_height - 1.0) < snap_to_preferred
+                                     ? preferred_height
+                                     : std::max(1.0, std::round(height));
+      if (stack_height + next_height > options.max_stack_texels) break;
+      const auto& nv = mesh.faces[static_cast<std::size_t>(next)];
+      Corners qn;
+      qn[n0] = Eigen::Vector2d(anchor_x.at(nv[n0]), y_top);
+      qn[n1] = Eigen::Vector2d(anchor_x.at(nv[n1]), y_top);
+      {  // the apex by the similarity taking the edge onto its place, on the new top line
+        const std::complex<double> z =
+            std::complex<double>(qn[n1].x() - qn[n0].x(), 0.0) /
+            std::complex<double>(cn[n1].x() - cn[n0].x(), cn[n1].y() - cn[n0].y());
+        const std::complex<double> a =
+            z * std::complex<double>(cn[n2].x() - cn[n0].x(), cn[n2].y() - cn[n0].y());
+        qn[n2] = Eigen::Vector2d(qn[n0].x() + a.real(), y_top + next_height);
+      }
+      const double old_bottom = y_bottom, old_top = y_top;
+      y_bottom = y_top;
+      y_top = y_top + next_height;
+      if (!place(next, qn)) {
+        y_bottom = old_bottom, y_top = old_top;
+        break;
+      }
+      mark_used(next);
+      std::vector<std::pair<int, Corners>> layer = {{next, qn}};
+      double chart_lo = std::numeric_limits<double>::max(), chart_hi = -chart_lo;
+      for (const auto& fq : band)
+        for (const auto& p : fq.second)
+          chart_lo = std::min(chart_lo, p.x()), chart_hi = std::max(chart_hi, p.x());
+      Rung up_right{next, nv[n2], nv[n1], qn[n2], qn[n1]};
+      for (auto& fq : grow(up_right, chart_lo, false).first) layer.push_back(fq);
+      Rung up_left{next, nv[n0], nv[n2], TurnBand(qn[n0], y_bottom, y_top),
+                   TurnBand(qn[n2], y_bottom, y_top)};
+      for (auto& [f, q] : grow(up_left, -chart_hi, true).first) {
+        for (auto& p : q) p = TurnBand(p, y_bottom, y_top);
+        layer.emplace_back(f, q);
+      }
+      double layer_lo = std::numeric_limits<double>::max(), layer_hi = -layer_lo;
+      for (const auto& fq : layer)
+        for (const auto& p : fq.second)
+          layer_lo = std::min(layer_lo, p.x()), layer_hi = std::max(layer_hi, p.x());
+      const double cover =
+          (std::min(layer_hi, anchor_hi) - std::max(layer_lo, anchor_lo)) / (anchor_hi - anchor_lo);
+      if (!(cover >= options.min_stack_cover)) {
+        for (auto it = layer.rbegin(); it != layer.rend(); ++it) unmark_used(it->first);
+        y_bottom = old_bottom, y_top = old_top;
+        break;
+      }
+      for (const auto& fq : layer) band.push_back(fq);
+      below = std::move(layer);
+      stack_height += next_height;
+      ++st.stacked;
+    }
+    anchor_x.clear();
     if (static_cast<int>(band.size()) < options.min_strip_faces) {
       for (const auto& fq : band) leftover[static_cast<std::size_t>(fq.first)] = 1;
       st.dissolved_faces += static_cast<int>(band.size());

@@ -93,6 +93,11 @@ struct StripChartOptions {
   /// Faces around a vertex of at least this many faces are charted first, as a
   /// fan cut into sectors (0: no fans). 0 or >= 3.
   int min_fan_faces = 8;
+  /// Bands are stacked on each other (sharing a line, so no gutter rows between
+  /// them) up to this height in texels; 0: no stacking. >= 0.
+  double max_stack_texels = 0.0;
+  /// A stacked band must span at least this fraction of the band below. (0, 1].
+  double min_stack_cover = 0.75;
   /// Atlas gutter in texels (>= 0): fan sectors are sized for it.
   int gutter = 2;
 };
@@ -103,6 +108,7 @@ struct StripChartStats {
   int lone_faces = 0;       ///< seeds that fit no band (placed rigidly on their own)
   int dissolved_faces = 0;  ///< faces of strips shorter than min_strip_faces
   int fans = 0;             ///< runs of faces around a vertex charted as fans
+  int stacked = 0;          ///< bands stacked on others (in their charts)
   int fan_sectors = 0;      ///< their sectors: one chart each, the first charts returned
 };
 
@@ -126,8 +132,11 @@ struct StripChartStats {
 /// follow) are unfolded rigidly about their centre and cut into sectors of at
 /// most 90 degrees standing upright on the centre, so that sectors turned by
 /// 180 degrees nest between upright ones in an atlas row; a flat fan's sectors
-/// take in the faces of its plane beyond it (a subdivided cap's rings). Every
-/// face ends in exactly one chart.
+/// take in the faces of its plane beyond it (a subdivided cap's rings). With
+/// `max_stack_texels`, a band is grown on the top line of the last one, its
+/// vertices on that line kept where the band below put them, so stacked bands
+/// form one chart with no gutter rows between them (a grid on developable
+/// surfaces such as a cylinder's side). Every face ends in exactly one chart.
 std::vector<std::vector<ChartFace>> MakeStripCharts(
     const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const StripChartOptions& options,

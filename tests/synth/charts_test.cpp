@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <opencv2/core.hpp>
 #include <random>
 #include <set>
@@ -130,27 +131,44 @@ TEST(Charts, ConformalLayoutAgreesWithTheTextureCoordinates) {
   ExpectLayoutAgreesWithTextureCoordinates(mesh, g, layout);
 }
 
-/// Per strip chart: every face has its corners on the band's two lines (y in
-/// texels, two values per chart), no texel centre lies more than half a texel
-/// inside two of its faces, and no face is flipped or stretched beyond `bound`.
+/// Per strip chart: every face has its corners on two band lines, which lie a
+/// hair (1e-3 texels) from texel centres; a chart has two lines unless its
+/// bands are `stacked`; no texel centre lies more than half a texel inside two
+/// of its faces; no face is flipped or stretched beyond `bound`; and a vertex
+/// shared by faces of the chart has one place in it (or places far apart).
 void ExpectBands(const std::vector<std::vector<ChartFace>>& charts, const PatchGeometry& g,
-                 double bound) {
+                 const sfm::TriangleMesh& mesh, double bound, bool stacked = false) {
   for (const auto& chart : charts) {
     if (chart.size() == 1 && chart[0].linear.isIdentity()) continue;  // a lone face
     std::set<long> ys;
     std::set<std::pair<int, int>> inside;
+    // Places of a vertex in the chart: one, or far apart (a band that wraps
+    // around, cut where it meets itself).
+    std::map<int, std::vector<Eigen::Vector2d>> places_of_vertex;
     for (const ChartFace& cf : chart) {
       EXPECT_GT(cf.linear.determinant(), 0.0);
       const Eigen::Vector2d s = SingularValues2(cf.linear);
       EXPECT_LE(s.x(), bound + 1e-9);
       EXPECT_GE(s.y(), 1 / bound - 1e-9);
       std::array<Eigen::Vector2d, 3> q;
+      std::set<long> face_ys;
       for (std::size_t k = 0; k < 3; ++k) {
         q[k] = (cf.linear * g.patches[static_cast<std::size_t>(cf.face)].corners_in_frame[k] +
                 cf.translation) /
                kTexel;
         ys.insert(std::lround(q[k].y() * 1000));  // on a line to 1e-3 texels
+        face_ys.insert(std::lround(q[k].y() * 1000));
+        const double off_centre = q[k].y() - 0.5 - std::round(q[k].y() - 0.5);
+        EXPECT_NEAR(std::abs(off_centre), 1e-3, 1e-6) << "a corner off the lines";
+        const int v = mesh.faces[static_cast<std::size_t>(cf.face)][k];
+        for (const Eigen::Vector2d& other : places_of_vertex[v]) {
+          const double d = (other - q[k]).norm();
+          EXPECT_TRUE(d < 1e-6 || d > 4.0)
+              << "vertex " << v << " has two places " << d << " texels apart";
+        }
+        places_of_vertex[v].push_back(q[k]);
       }
+      EXPECT_EQ(face_ys.size(), 2u) << "a face's corners lie on more than two lines";
       const Eigen::Vector2d lo = q[0].cwiseMin(q[1]).cwiseMin(q[2]);
       const Eigen::Vector2d hi = q[0].cwiseMax(q[1]).cwiseMax(q[2]);
       for (int y = static_cast<int>(std::floor(lo.y())); y <= static_cast<int>(hi.y()); ++y)
@@ -159,7 +177,9 @@ void ExpectBands(const std::vector<std::vector<ChartFace>>& charts, const PatchG
             EXPECT_TRUE(inside.emplace(x, y).second) << "faces overlap at " << x << ", " << y;
           }
     }
-    EXPECT_EQ(ys.size(), 2u) << "a strip's corners lie on more than two lines";
+    if (!stacked) {
+      EXPECT_EQ(ys.size(), 2u) << "a strip's corners lie on more than two lines";
+    }
   }
 }
 
@@ -184,7 +204,32 @@ TEST(Charts, StripsOfAGridPlaneAreRowsOfQuads) {
       EXPECT_NEAR(s.y(), 1.0, 0.01);
     }
   }
-  ExpectBands(charts, g, o.max_stretch);
+  ExpectBands(charts, g, mesh, o.max_stretch);
+}
+
+// Stacked, the grid plane's bands share their lines: one chart of 8 bands,
+// every vertex in one place, and still no stretch but the rounding of heights.
+TEST(Charts, StackedBandsOfAGridPlaneAreOneChart) {
+  const sfm::TriangleMesh mesh = datasets::MakeGridPlane(8, 0.5);
+  const PatchGeometry g = Geometry(mesh);
+  StripChartOptions o;
+  o.texel_size = kTexel;
+  o.max_stack_texels = 8 * 31;
+  StripChartStats stats;
+  const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o, &stats);
+  ASSERT_EQ(charts.size(), 1u);
+  EXPECT_EQ(stats.strips, 1);
+  EXPECT_EQ(stats.stacked, 7);
+  ExpectEachFaceInOneChart(charts, mesh.faces.size());
+  for (const ChartFace& cf : charts[0]) {
+    const Eigen::Vector2d s = SingularValues2(cf.linear);
+    EXPECT_NEAR(s.x(), 1.0, 0.015);  // heights rounded, ends squared
+    EXPECT_NEAR(s.y(), 1.0, 0.015);
+  }
+  ExpectBands(charts, g, mesh, o.max_stretch, true);
+  // One band less than the stack needs: two charts.
+  o.max_stack_texels = 8 * 31 - 1;
+  EXPECT_EQ(MakeStripCharts(mesh, g.patches, g.unfoldings, o).size(), 2u);
 }
 
 // On a sphere every face lands in exactly one strip, strips are bands within
@@ -201,13 +246,21 @@ TEST(Charts, StripsOfASphereAreBandsWithinTheStretchBound) {
       o.side = side;
       const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o);
       ExpectEachFaceInOneChart(charts, mesh.faces.size());
-      ExpectBands(charts, g, bound);
+      ExpectBands(charts, g, mesh, bound);
       if (side == StripSide::kTallest) {
         EXPECT_GT(charts.size(), previous_charts);
         previous_charts = charts.size();
       }
     }
   }
+  // Stacked: the bands still never overlap and their shared vertices agree.
+  o.max_stretch = 1.25;
+  o.max_stack_texels = 300;
+  StripChartStats stats;
+  const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o, &stats);
+  EXPECT_GT(stats.stacked, 0);
+  ExpectEachFaceInOneChart(charts, mesh.faces.size());
+  ExpectBands(charts, g, mesh, o.max_stretch, true);
 }
 
 // Cylinder caps are fans: each is unfolded rigidly about its centre and cut
@@ -342,6 +395,11 @@ TEST(Charts, BadChartOptionsAreRefused) {
   EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), OptionError);
   strips.min_fan_faces = 0;  // no fans
   EXPECT_NO_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips));
+  strips.max_stack_texels = -1.0;
+  EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), OptionError);
+  strips.max_stack_texels = 100.0;
+  strips.min_stack_cover = 0.0;
+  EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), OptionError);
 }
 
 }  // namespace
