@@ -566,8 +566,8 @@ std::vector<std::vector<std::pair<int, Corners>>> FanSectors(
   constexpr double kMaxSectorAngle = 0.5 * kPi;
   const double flat_cos = std::cos(0.25 * kPi / 180.0);  // coplanar faces
   std::vector<Corners> unfolded;
-  std::vector<double> phi = {
-      0.0};  // angle of each face's first edge about v, then the last's second
+  // The angle about v of each face's first edge, then of the last face's second.
+  std::vector<double> phi = {0.0};
   double radius = 0.0;
   int previous_last = -1;  // the previous face's second edge's far vertex
   for (const int f : run) {
@@ -834,8 +834,11 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         in_fan[static_cast<std::size_t>(f)] =
             patches[static_cast<std::size_t>(f)].frame.z_axis.dot(mean_normal) >= min_cos;
       for (const std::vector<int>& run : FanRuns(mesh, unfoldings, v, free_faces, in_fan)) {
-        for (auto& sector : FanSectors(mesh, patches, unfoldings, used, v, run, t, options.gutter,
-                                       options.max_length_texels, 0.5 - kInset)) {
+        const auto sectors = FanSectors(mesh, patches, unfoldings, used, v, run, t, options.gutter,
+                                        options.max_length_texels, 0.5 - kInset);
+        if (sectors.empty()) continue;  // too short or too large: left to strips
+        ++st.fans;
+        for (const auto& sector : sectors) {
           for (const auto& [f, q] : sector) mark_used(f);
           std::vector<ChartFace> chart;
           for (const auto& [f, q] : sector) {
@@ -847,7 +850,6 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
           charts.push_back(std::move(chart));
           ++st.fan_sectors;
         }
-        ++st.fans;
       }
       for (const int f : free_faces) in_fan[static_cast<std::size_t>(f)] = 0;
     }
