@@ -18,6 +18,7 @@ namespace texlume::synth {
 namespace {
 
 constexpr double kTexel = 0.002;  // the default material's texel size (world units)
+constexpr double kPi = 3.14159265358979323846;
 
 PatchGeometry Geometry(const sfm::TriangleMesh& mesh) {
   return MakePatchGeometry(mesh, kTexel, 8, TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
@@ -313,6 +314,75 @@ TEST(Charts, FansOfCylinderCapsAreUprightSectors) {
   }
 }
 
+/// Bakes the layout's coverage, expecting that a texel written twice is
+/// written by faces of one chart only.
+AtlasCoverage ExpectNoTexelInTwoCharts(const AtlasLayout& layout, int gutter) {
+  std::vector<cv::Mat> owner;
+  for (const cv::Size& size : layout.atlas_sizes) owner.emplace_back(size, CV_32SC1, -1);
+  return VisitAtlasTexels(layout, kTexel, gutter,
+                          [&](int atlas, int x, int y, int face, const Eigen::Vector2d&) {
+                            int& who = owner[static_cast<std::size_t>(atlas)].at<int>(y, x);
+                            const int chart = layout.faces[static_cast<std::size_t>(face)].chart;
+                            if (who >= 0) {
+                              EXPECT_EQ(layout.faces[static_cast<std::size_t>(who)].chart, chart)
+                                  << "texel " << x << ", " << y;
+                            }
+                            who = face;
+                          });
+}
+
+// A latitude-longitude sphere's poles are curved fans (their angles sum to
+// less than 360 degrees): unfolded about the pole, their sectors keep stretch
+// 1, and the strip layout stays valid (no texel in two charts, the stretch
+// bound, texture coordinates).
+TEST(Charts, CurvedFansOfALatitudeLongitudeSphere) {
+  constexpr int kAround = 24, kRings = 12;
+  sfm::TriangleMesh mesh;
+  mesh.vertices.emplace_back(0.0, 0.0, 1.0);  // north pole
+  for (int j = 1; j < kRings; ++j)
+    for (int i = 0; i < kAround; ++i) {
+      const double theta = kPi * j / kRings, phi = 2 * kPi * i / kAround;
+      mesh.vertices.emplace_back(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                 std::cos(theta));
+    }
+  mesh.vertices.emplace_back(0.0, 0.0, -1.0);  // south pole
+  const int south = static_cast<int>(mesh.vertices.size()) - 1;
+  auto at = [&](int ring, int i) { return 1 + (ring - 1) * kAround + (i % kAround); };
+  for (int i = 0; i < kAround; ++i) {
+    mesh.faces.push_back({0, at(1, i), at(1, i + 1)});
+    mesh.faces.push_back({south, at(kRings - 1, i + 1), at(kRings - 1, i)});
+    for (int j = 1; j + 1 < kRings; ++j) {
+      mesh.faces.push_back({at(j, i), at(j + 1, i), at(j + 1, i + 1)});
+      mesh.faces.push_back({at(j, i), at(j + 1, i + 1), at(j, i + 1)});
+    }
+  }
+  for (Eigen::Vector3d& v : mesh.vertices) v *= 0.5;  // radius 250 texels
+  const PatchGeometry g = Geometry(mesh);
+  StripChartOptions so;
+  so.texel_size = kTexel;
+  StripChartStats stats;
+  const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, so, &stats);
+  ExpectEachFaceInOneChart(charts, mesh.faces.size());
+  EXPECT_EQ(stats.fans, 2);
+  std::size_t pole_faces = 0;
+  for (std::size_t c = 0; c < static_cast<std::size_t>(stats.fan_sectors); ++c)
+    for (const ChartFace& cf : charts[c]) {
+      const Eigen::Vector2d s = SingularValues2(cf.linear);
+      EXPECT_NEAR(s.x(), 1.0, 1e-6);
+      EXPECT_NEAR(s.y(), 1.0, 1e-6);
+      ++pole_faces;
+    }
+  EXPECT_EQ(pole_faces, 2u * kAround);  // curved: nothing beyond the ring
+  AtlasOptions o;
+  o.flattening = ChartFlattening::kStrips;
+  const AtlasLayout layout = LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+  ExpectNoTexelInTwoCharts(layout, o.gutter);
+  const AtlasStretch stretch = MeasureStretch(g.patches, layout);
+  EXPECT_LE(stretch.max, o.max_chart_stretch + 1e-9);
+  EXPECT_GE(stretch.min, 1 / o.max_chart_stretch - 1e-9);
+  ExpectLayoutAgreesWithTextureCoordinates(mesh, g, layout);
+}
+
 // The default layout (auto) is strips on the demo's sphere, cylinder and torus, fills the
 // atlases above 85 % there (bench/atlas_bench measures the rest), never puts
 // two charts on one texel, and agrees with the texture coordinates.
@@ -326,19 +396,7 @@ TEST(Charts, StripLayoutsFillAtlasesAboveEightyFivePercent) {
     ASSERT_EQ(o.flattening, ChartFlattening::kAuto);
     const AtlasLayout layout = LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
     EXPECT_EQ(layout.flattening, ChartFlattening::kStrips);
-    std::vector<cv::Mat> owner;
-    for (const cv::Size& size : layout.atlas_sizes) owner.emplace_back(size, CV_32SC1, -1);
-    const AtlasCoverage coverage = VisitAtlasTexels(
-        layout, kTexel, o.gutter, [&](int atlas, int x, int y, int face, const Eigen::Vector2d&) {
-          int& who = owner[static_cast<std::size_t>(atlas)].at<int>(y, x);
-          const int chart = layout.faces[static_cast<std::size_t>(face)].chart;
-          // A texel is written again only by a face of the same chart.
-          if (who >= 0) {
-            EXPECT_EQ(layout.faces[static_cast<std::size_t>(who)].chart, chart)
-                << "texel " << x << ", " << y;
-          }
-          who = face;
-        });
+    const AtlasCoverage coverage = ExpectNoTexelInTwoCharts(layout, o.gutter);
     double texels = 0;
     for (const cv::Size& size : layout.atlas_sizes) texels += size.area();
     EXPECT_GT(static_cast<double>(coverage.inside_texels) / texels, 0.85)
