@@ -343,12 +343,10 @@ Eigen::Vector2d SingularValues2(const Eigen::Matrix2d& m) {
   return {0.5 * (p + q), 0.5 * std::abs(p - q)};
 }
 
-namespace {
-/// MakeConformalCharts over the faces `only` marks (all when empty).
-std::vector<std::vector<ChartFace>> ConformalChartsOf(
+std::vector<std::vector<ChartFace>> MakeConformalCharts(
     const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const ConformalChartOptions& options,
-    const std::vector<char>& only, ConformalChartStats* stats) {
+    ConformalChartStats* stats) {
   const std::size_t num_faces = mesh.faces.size();
   if (patches.size() != num_faces || unfoldings.size() != num_faces)
     throw OptionError("charts: patches and unfoldings must have one entry per face");
@@ -370,9 +368,6 @@ std::vector<std::vector<ChartFace>> ConformalChartsOf(
   const double half_side = 0.5 * options.max_side_texels * t;
   const double min_cos = std::cos(options.max_normal_angle_deg * kPi / 180.0);
   std::vector<int> chart_of(num_faces, -1);
-  if (!only.empty())
-    for (std::size_t f = 0; f < num_faces; ++f)
-      if (!only[f]) chart_of[f] = -2;  // not to be charted here
   std::deque<std::vector<int>> work;
   for (const int seed : seed_order) {
     if (chart_of[static_cast<std::size_t>(seed)] != -1) continue;
@@ -463,15 +458,6 @@ std::vector<std::vector<ChartFace>> ConformalChartsOf(
         work.push_back(std::move(part));
   }
   return charts;
-}
-
-}  // namespace
-
-std::vector<std::vector<ChartFace>> MakeConformalCharts(
-    const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
-    const std::vector<std::array<Unfolding, 3>>& unfoldings, const ConformalChartOptions& options,
-    ConformalChartStats* stats) {
-  return ConformalChartsOf(mesh, patches, unfoldings, options, {}, stats);
 }
 
 namespace {
@@ -711,7 +697,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
   if (patches.size() != num_faces || unfoldings.size() != num_faces)
     throw OptionError("charts: patches and unfoldings must have one entry per face");
   if (!(options.texel_size > 0.0) || !(options.max_stretch > 1.0) ||
-      !(options.max_length_texels > 0.0) || options.min_strip_faces < 1 ||
+      !(options.max_length_texels > 0.0) ||
       (options.min_fan_faces != 0 && options.min_fan_faces < 3) || options.gutter < 0 ||
       !(options.max_stack_texels >= 0.0) ||
       !(options.min_stack_cover > 0.0 && options.min_stack_cover <= 1.0) ||
@@ -726,7 +712,6 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
   // A seed within this relative distance of the preferred height takes it
   // (within the stretch bound, which also has to absorb the other faces).
   const double snap_to_preferred = std::min(0.2, 0.8 * (options.max_stretch - 1.0));
-  std::vector<char> leftover(num_faces, 0);  // faces of dissolved strips
 
   std::vector<char> used(num_faces, 0);
   std::vector<std::vector<ChartFace>> charts;
@@ -1119,12 +1104,6 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
       ++st.stacked;
     }
     anchor_x.clear();
-    if (static_cast<int>(band.size()) < options.min_strip_faces) {
-      for (const auto& fq : band) leftover[static_cast<std::size_t>(fq.first)] = 1;
-      st.dissolved_faces += static_cast<int>(band.size());
-      --st.strips;
-      continue;
-    }
     std::vector<ChartFace> chart;
     for (const auto& [f, q] : band) {
       ChartFace cf =
@@ -1134,17 +1113,6 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     }
     charts.push_back(std::move(chart));
   }
-  if (std::find(leftover.begin(), leftover.end(), 1) != leftover.end()) {
-    ConformalChartOptions co;
-    co.texel_size = t;
-    co.max_side_texels = 512.0;
-    co.max_normal_angle_deg = options.max_normal_angle_deg;
-    co.max_stretch = options.max_stretch;
-    co.max_extent_texels = options.max_length_texels;
-    for (auto& chart : ConformalChartsOf(mesh, patches, unfoldings, co, leftover, nullptr))
-      charts.push_back(std::move(chart));
-  }
-
   return charts;
 }
 

@@ -86,10 +86,6 @@ struct StripChartOptions {
   /// A face joins only while its normal is within this angle of the seed's. (0, 180].
   double max_normal_angle_deg = 180.0;
   StripSide side = StripSide::kTallest;
-  /// Strips of fewer faces are dissolved and their faces charted conformally
-  /// (MakeConformalCharts, within 512 texels), which suits stray faces
-  /// between strips. >= 1 (1: every strip stays).
-  int min_strip_faces = 1;
   /// Faces around a vertex of at least this many faces are charted first, as a
   /// fan cut into sectors (0: no fans). 0 or >= 3.
   int min_fan_faces = 8;
@@ -105,11 +101,10 @@ struct StripChartOptions {
 /// What MakeStripCharts did.
 struct StripChartStats {
   int strips = 0;
-  int lone_faces = 0;       ///< seeds that fit no band (placed rigidly on their own)
-  int dissolved_faces = 0;  ///< faces of strips shorter than min_strip_faces
-  int fans = 0;             ///< runs of faces around a vertex charted as fans
-  int stacked = 0;          ///< bands stacked on others (in their charts)
-  int fan_sectors = 0;      ///< their sectors: one chart each, the first charts returned
+  int lone_faces = 0;   ///< seeds that fit no band (placed rigidly on their own)
+  int fans = 0;         ///< runs of faces around a vertex charted as fans
+  int stacked = 0;      ///< bands stacked on others (in their charts)
+  int fan_sectors = 0;  ///< their sectors: one chart each, the first charts returned
 };
 
 /// Charts that tile: triangle strips mapped onto straight bands. From seeds
