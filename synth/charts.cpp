@@ -51,6 +51,35 @@ ChartFace AffineBetween(int face, const Corners& from, const Corners& to) {
   return cf;
 }
 
+/// The faces around each vertex.
+std::vector<std::vector<int>> FacesOfVertex(const sfm::TriangleMesh& mesh) {
+  std::vector<std::vector<int>> faces_of_vertex(mesh.vertices.size());
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    for (const int v : mesh.faces[f])
+      faces_of_vertex[static_cast<std::size_t>(v)].push_back(static_cast<int>(f));
+  return faces_of_vertex;
+}
+
+/// A chart from faces' corners in band texels (placements in world units).
+std::vector<ChartFace> ChartOfBand(const std::vector<TrianglePatch>& patches, double t,
+                                   const std::vector<std::pair<int, Corners>>& band) {
+  std::vector<ChartFace> chart;
+  for (const auto& [f, q] : band) {
+    ChartFace cf = AffineBetween(f, FrameCornersTexels(patches[static_cast<std::size_t>(f)], t), q);
+    cf.translation *= t;  // texels -> world units (linear is unitless)
+    chart.push_back(cf);
+  }
+  return chart;
+}
+
+/// The smallest and largest x of the faces' corners.
+std::pair<double, double> XRange(const std::vector<std::pair<int, Corners>>& faces) {
+  double lo = std::numeric_limits<double>::max(), hi = -lo;
+  for (const auto& fq : faces)
+    for (const auto& p : fq.second) lo = std::min(lo, p.x()), hi = std::max(hi, p.x());
+  return {lo, hi};
+}
+
 /// Least-squares conformal map of the faces (texel units): per face the chart
 /// coordinates of its corners, or false when the system is singular. The
 /// energy is, per face T of area A_T, A_T |grad u - R90 grad v|^2, zero exactly
@@ -240,10 +269,7 @@ std::vector<std::vector<ChartFace>> MakeRigidCharts(
   const double t = options.texel_size;
   const int gutter = options.gutter;
   std::vector<std::vector<ChartFace>> charts;
-  std::vector<std::vector<int>> faces_of_vertex(mesh.vertices.size());
-  for (std::size_t f = 0; f < num_faces; ++f)
-    for (int v : mesh.faces[f])
-      faces_of_vertex[static_cast<std::size_t>(v)].push_back(static_cast<int>(f));
+  const std::vector<std::vector<int>> faces_of_vertex = FacesOfVertex(mesh);
   auto shares_vertex = [&](int a, int b) {
     for (int v : mesh.faces[static_cast<std::size_t>(a)])
       for (int g : faces_of_vertex[static_cast<std::size_t>(v)])
@@ -772,6 +798,12 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
                      sorted.end());
     preferred_height = std::round(sorted[num_faces / 2]);
   }
+  // A band's height (whole texels) for a face of this height over its side edge.
+  auto band_height_for = [&](double height) {
+    return std::abs(height / preferred_height - 1.0) < snap_to_preferred
+               ? preferred_height
+               : std::max(1.0, std::round(height));
+  };
   // The face's map into the band when its stretch is within the bound.
   auto place = [&](int f, const Corners& band) -> std::optional<ChartFace> {
     const Corners c = FrameCornersTexels(patches[static_cast<std::size_t>(f)], t);
@@ -791,10 +823,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
   // in its band with the centre on the bottom line and its bisector upright, so
   // turned sectors nest between upright ones in an atlas row.
   if (options.min_fan_faces > 0) {
-    std::vector<std::vector<int>> faces_of_vertex(mesh.vertices.size());
-    for (std::size_t f = 0; f < num_faces; ++f)
-      for (const int v : mesh.faces[f])
-        faces_of_vertex[static_cast<std::size_t>(v)].push_back(static_cast<int>(f));
+    const std::vector<std::vector<int>> faces_of_vertex = FacesOfVertex(mesh);
     std::vector<int> centres;
     for (std::size_t v = 0; v < faces_of_vertex.size(); ++v)
       if (static_cast<int>(faces_of_vertex[v].size()) >= options.min_fan_faces)
@@ -825,14 +854,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         ++st.fans;
         for (const auto& sector : sectors) {
           for (const auto& [f, q] : sector) mark_used(f);
-          std::vector<ChartFace> chart;
-          for (const auto& [f, q] : sector) {
-            ChartFace cf =
-                AffineBetween(f, FrameCornersTexels(patches[static_cast<std::size_t>(f)], t), q);
-            cf.translation *= t;  // texels -> world units (linear is unitless)
-            chart.push_back(cf);
-          }
-          charts.push_back(std::move(chart));
+          charts.push_back(ChartOfBand(patches, t, sector));
           ++st.fan_sectors;
         }
       }
@@ -865,9 +887,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
       const auto key = std::make_tuple(borders, h_key);
       if (side < 0 || key > side_key) side = k, side_key = key, side_height = height;
     }
-    const double band_height = std::abs(side_height / preferred_height - 1.0) < snap_to_preferred
-                                   ? preferred_height
-                                   : std::max(1.0, std::round(side_height));
+    const double band_height = band_height_for(side_height);
     // The band's lines; a stacked band moves them up (step 4).
     double y_bottom = 0.5 - kInset, y_top = 0.5 + band_height + kInset;
     std::optional<ChartFace> seed_placement;
@@ -1050,9 +1070,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
       const double edge = (cn[n1] - cn[n0]).norm();
       if (!(edge > 0.0)) break;
       const double height = Cross(cn[n1] - cn[n0], cn[n2] - cn[n0]) / edge;
-      const double next_height = std::abs(height / preferred_height - 1.0) < snap_to_preferred
-                                     ? preferred_height
-                                     : std::max(1.0, std::round(height));
+      const double next_height = band_height_for(height);
       if (stack_height + next_height > options.max_stack_texels) break;
       const auto& nv = mesh.faces[static_cast<std::size_t>(next)];
       Corners qn;
@@ -1075,10 +1093,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
       }
       mark_used(next);
       std::vector<std::pair<int, Corners>> layer = {{next, qn}};
-      double chart_lo = std::numeric_limits<double>::max(), chart_hi = -chart_lo;
-      for (const auto& fq : band)
-        for (const auto& p : fq.second)
-          chart_lo = std::min(chart_lo, p.x()), chart_hi = std::max(chart_hi, p.x());
+      const auto [chart_lo, chart_hi] = XRange(band);
       Rung up_right{next, nv[n2], nv[n1], qn[n2], qn[n1]};
       for (auto& fq : grow(up_right, chart_lo, false).first) layer.push_back(fq);
       Rung up_left{next, nv[n0], nv[n2], TurnBand(qn[n0], y_bottom, y_top),
@@ -1087,10 +1102,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         for (auto& p : q) p = TurnBand(p, y_bottom, y_top);
         layer.emplace_back(f, q);
       }
-      double layer_lo = std::numeric_limits<double>::max(), layer_hi = -layer_lo;
-      for (const auto& fq : layer)
-        for (const auto& p : fq.second)
-          layer_lo = std::min(layer_lo, p.x()), layer_hi = std::max(layer_hi, p.x());
+      const auto [layer_lo, layer_hi] = XRange(layer);
       const double cover =
           (std::min(layer_hi, anchor_hi) - std::max(layer_lo, anchor_lo)) / (anchor_hi - anchor_lo);
       if (!(cover >= options.min_stack_cover)) {
@@ -1104,14 +1116,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
       ++st.stacked;
     }
     anchor_x.clear();
-    std::vector<ChartFace> chart;
-    for (const auto& [f, q] : band) {
-      ChartFace cf =
-          AffineBetween(f, FrameCornersTexels(patches[static_cast<std::size_t>(f)], t), q);
-      cf.translation *= t;  // texels -> world units (linear is unitless)
-      chart.push_back(cf);
-    }
-    charts.push_back(std::move(chart));
+    charts.push_back(ChartOfBand(patches, t, band));
   }
   return charts;
 }
