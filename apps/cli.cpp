@@ -430,36 +430,36 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
 }
 
 int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-  const Arguments a(
-      args,
-      {"model",
-       "images",
-       "lights",
-       "mesh",
-       "sample",
-       "btf",
-       "components",
-       "seam-band",
-       "sample-texel-size",
-       "out",
-       "strip",
-       "top-k",
-       "max-views",
-       "atlas",
-       "atlas-size",
-       "gutter",
-       "seed",
-       "tangent-field",
-       "max-subdivisions",
-       "max-buffer-size",
-       "correction-iterations",
-       "correction-sigma",
-       "correction-noise",
-       "chart-angle",
-       "chart-size",
-       "chart-flattening",
-       "chart-stretch"},
-      {"best-view-only", "no-additive-correction", "no-channel-correction", "no-report"});
+  const Arguments a(args,
+                    {"model",
+                     "images",
+                     "lights",
+                     "mesh",
+                     "sample",
+                     "btf",
+                     "components",
+                     "seam-band",
+                     "sample-texel-size",
+                     "out",
+                     "strip",
+                     "top-k",
+                     "max-views",
+                     "atlas",
+                     "atlas-size",
+                     "gutter",
+                     "seed",
+                     "tangent-field",
+                     "max-subdivisions",
+                     "max-buffer-size",
+                     "correction-iterations",
+                     "correction-sigma",
+                     "correction-noise",
+                     "chart-angle",
+                     "chart-size",
+                     "chart-flattening",
+                     "chart-stretch"},
+                    {"best-view-only", "no-additive-correction", "no-channel-correction",
+                     "no-detail-transfer", "no-report"});
   synth::SynthJobOptions o;
   o.model_dir = a.Require("model");
   o.images_dir = a.Require("images");
@@ -484,6 +484,7 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
   o.synthesis.correction_sigma = a.GetDouble("correction-sigma", o.synthesis.correction_sigma);
   o.synthesis.additive_correction = !a.Has("no-additive-correction");
   o.synthesis.channel_correction = !a.Has("no-channel-correction");
+  o.synthesis.detail_transfer = !a.Has("no-detail-transfer");
   o.synthesis.correction_noise = a.GetDouble("correction-noise", o.synthesis.correction_noise);
   if (const auto field = a.Get("tangent-field")) {
     const std::vector<double> d = ParseList(*field, 3, "--tangent-field");

@@ -2,11 +2,14 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numbers>
+#include <opencv2/flann.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -40,6 +43,39 @@ std::vector<cv::Mat> RawPlanes(const ptm::Ptm& p) {
     }
   }
   return planes;
+}
+
+// Bilinear value of a CV_32FC1 plane at (x, y) (pixel centres at integers),
+// clamped to the plane.
+double BilinearClamped(const cv::Mat& m, double x, double y) {
+  x = std::clamp(x, 0.0, m.cols - 1.0);
+  y = std::clamp(y, 0.0, m.rows - 1.0);
+  const int x0 = std::min(static_cast<int>(x), std::max(m.cols - 2, 0));
+  const int y0 = std::min(static_cast<int>(y), std::max(m.rows - 2, 0));
+  const int x1 = std::min(x0 + 1, m.cols - 1), y1 = std::min(y0 + 1, m.rows - 1);
+  const double fx = x - x0, fy = y - y0;
+  const float* r0 = m.ptr<float>(y0);
+  const float* r1 = m.ptr<float>(y1);
+  return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x1]);
+}
+
+// Detail transfer: a window of 3 x 3 points (dx, dy) texels apart around
+// (x, y), 6 orthonormal luminance coefficients each (5 x 5 matched worse on the
+// demo: SSIM 0.536 against 0.538).
+constexpr int kDetailWindowRadius = 1;
+constexpr int kDetailWindowLength =
+    (2 * kDetailWindowRadius + 1) * (2 * kDetailWindowRadius + 1) * 6;
+// Leaves the k-d trees visit per query: 8 matches as well as 32 on the demo
+// (SSIM 0.538 either way) in 60 % of the time.
+constexpr int kDetailChecks = 8;
+constexpr int kDetailTrees = 4;
+void CoarseWindow(const std::vector<cv::Mat>& coarse, double x, double y, double dx, double dy,
+                  float* window) {
+  for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
+    for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a)
+      for (int m = 0; m < 6; ++m)
+        *window++ = static_cast<float>(
+            BilinearClamped(coarse[static_cast<std::size_t>(m)], x + a * dx, y + b * dy));
 }
 
 // The sample reduced to a photo density r = 2^(-level/4) photo pixels per texel.
@@ -128,6 +164,32 @@ bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) 
     const float d = m.at<float>(patch.sample_y + y1, patch.sample_x + x0);
     const float e = m.at<float>(patch.sample_y + y1, patch.sample_x + x1);
     out[c] = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * d + fx * e);
+  }
+  if (!patch.detail_source.empty()) {
+    // Detail transfer: the patch's own detail band out, the band around each
+    // nearby cell's matched sample point in (bilinear over the 4 nearest cells).
+    const std::vector<cv::Mat>& band = detail_bands.at(patch.detail_level);
+    const double rx = patch.correction_density.x(), ry = patch.correction_density.y();
+    const cv::Mat& src = patch.detail_source;
+    const double gu = std::clamp((uc + 0.5) * rx - 0.5, 0.0, src.cols - 1.0);
+    const double gv = std::clamp((vc + 0.5) * ry - 0.5, 0.0, src.rows - 1.0);
+    const int gx0 = static_cast<int>(gu), gy0 = static_cast<int>(gv);
+    const int gx1 = std::min(gx0 + 1, src.cols - 1), gy1 = std::min(gy0 + 1, src.rows - 1);
+    const double gfx = gu - gx0, gfy = gv - gy0;
+    const std::array<std::pair<cv::Point, double>, 4> cells = {
+        std::pair{cv::Point(gx0, gy0), (1 - gfx) * (1 - gfy)},
+        std::pair{cv::Point(gx1, gy0), gfx * (1 - gfy)},
+        std::pair{cv::Point(gx0, gy1), (1 - gfx) * gfy}, std::pair{cv::Point(gx1, gy1), gfx * gfy}};
+    for (std::size_t c = 0; c < band.size(); ++c)
+      out[c] -= BilinearClamped(band[c], patch.sample_x + uc, patch.sample_y + vc);
+    for (const auto& [cell, w] : cells) {
+      if (w <= 0.0) continue;
+      const cv::Vec2f s = src.at<cv::Vec2f>(cell.y, cell.x);
+      const double x = s[0] + uc - ((cell.x + 0.5) / rx - 0.5);
+      const double y = s[1] + vc - ((cell.y + 0.5) / ry - 0.5);
+      for (std::size_t c = 0; c < band.size(); ++c)
+        out[c] += static_cast<float>(w * BilinearClamped(band[c], x, y));
+    }
   }
   if (!patch.correction.empty()) {
     const cv::Mat& c0 = patch.correction[0];
@@ -506,6 +568,59 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     ReducedPlanes r = ReduceToDensityLevel(sample_raw, level);
     return reduced.emplace(level, ReducedSample{std::move(r.planes), r.rx, r.ry}).first->second;
   };
+  // Detail transfer (beyond the paper): per density level, the sample's coarse
+  // luminance coefficients brought back to full size (orthonormal), and the
+  // window of them around every sample point, 3 x 3 points one photo cell
+  // apart, indexed for nearest-neighbour search. Its detail band (planes minus
+  // coarse) goes into the result.
+  struct DetailDictionary {
+    std::vector<cv::Mat> coarse;    // 6 orthonormal luminance planes, full size
+    cv::Mat windows;                // CV_32FC1, one kDetailWindowLength row per point
+    std::vector<cv::Point> points;  // window centres, texels
+    std::unique_ptr<cv::flann::Index> index;
+  };
+  std::map<int, DetailDictionary> dictionaries;
+  // Fills d and the band of a level whose reduced sample exists (touches no map,
+  // so levels can be built in parallel).
+  auto build_dictionary = [&](int level, const ReducedSample& red, DetailDictionary& d,
+                              std::vector<cv::Mat>& band) {
+    const cv::Size full(sample.width, sample.height);
+    std::vector<cv::Mat> coarse_raw(red.raw.size());
+    for (std::size_t c = 0; c < red.raw.size(); ++c)
+      cv::resize(red.raw[c], coarse_raw[c], full, 0, 0, cv::INTER_LINEAR);
+    const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
+    d.coarse.assign(6, cv::Mat());
+    for (cv::Mat& m : d.coarse) m = cv::Mat::zeros(full, CV_32FC1);
+    for (int y = 0; y < full.height; ++y)
+      for (int x = 0; x < full.width; ++x)
+        for (int m = 0; m < 6; ++m) {
+          double v = 0.0;
+          for (int k = 0; k < 6; ++k)
+            v += to(m, k) * coarse_raw[static_cast<std::size_t>(k)].at<float>(y, x);
+          d.coarse[static_cast<std::size_t>(m)].at<float>(y, x) = static_cast<float>(v);
+        }
+    band.resize(result.sample_planes.size());
+    for (std::size_t c = 0; c < band.size(); ++c)
+      band[c] = result.sample_planes[c] - (c < 6 ? d.coarse[c] : coarse_raw[c]);
+    const double dx = 1.0 / red.rx, dy = 1.0 / red.ry;
+    const int bx = static_cast<int>(std::ceil(kDetailWindowRadius * dx)),
+              by = static_cast<int>(std::ceil(kDetailWindowRadius * dy));
+    if (full.width - 2 * bx < 4 || full.height - 2 * by < 4) return;  // too coarse: none
+    for (int y = by; y < full.height - by; ++y)
+      for (int x = bx; x < full.width - bx; ++x) d.points.emplace_back(x, y);
+    d.windows = cv::Mat(static_cast<int>(d.points.size()), kDetailWindowLength, CV_32FC1);
+    for (std::size_t n = 0; n < d.points.size(); ++n)
+      CoarseWindow(d.coarse, d.points[n].x, d.points[n].y, dx, dy,
+                   d.windows.ptr<float>(static_cast<int>(n)));
+    // The randomised trees draw from this thread's cv::theRNG(): seeded per
+    // level, so that the matches do not depend on threads or earlier draws.
+    cv::RNG& rng_of_thread = cv::theRNG();
+    const std::uint64_t saved_state = rng_of_thread.state;
+    rng_of_thread.state = 0x7e41u + static_cast<std::uint64_t>(level) + options.seed * 1000003u;
+    d.index =
+        std::make_unique<cv::flann::Index>(d.windows, cv::flann::KDTreeIndexParams(kDetailTrees));
+    rng_of_thread.state = saved_state;
+  };
   const int polys = sample.NumPolynomials();
   auto relit_planes = [&](const ReducedSample& r, const LightList& lights, double gain) {
     std::vector<cv::Mat> out(3);
@@ -858,9 +973,76 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     }
   };
 
+  // Detail transfer of a corrected patch: per cell of its correction grid, the
+  // sample point whose coarse window (3 x 3 cells) is nearest the corrected
+  // coarse values (k-d tree), then two passes that take a neighbour cell's
+  // match moved by one cell wherever it is nearer (coherent matches keep the
+  // detail whole where their bands are blended).
+  auto TransferDetail = [&](TrianglePatch& patch, int level) {
+    const DetailDictionary& d = dictionaries.at(level);  // built before; read only here
+    const ReducedSample& red = reduced.at(level);
+    const double dx = 1.0 / red.rx, dy = 1.0 / red.ry;
+    const int gw = patch.correction[0].cols, gh = patch.correction[0].rows;
+    std::vector<cv::Mat> corrected(6);
+    for (std::size_t m = 0; m < 6; ++m) {
+      corrected[m] = cv::Mat(gh, gw, CV_32FC1);
+      for (int j = 0; j < gh; ++j)
+        for (int i = 0; i < gw; ++i)
+          corrected[m].at<float>(j, i) =
+              static_cast<float>(BilinearClamped(d.coarse[m], patch.sample_x + (i + 0.5) * dx - 0.5,
+                                                 patch.sample_y + (j + 0.5) * dy - 0.5) +
+                                 patch.correction[m].at<float>(j, i));
+    }
+    cv::Mat queries(gh * gw, kDetailWindowLength, CV_32FC1);
+    for (int j = 0; j < gh; ++j)
+      for (int i = 0; i < gw; ++i) {
+        float* q = queries.ptr<float>(j * gw + i);
+        for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
+          for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a)
+            for (std::size_t m = 0; m < 6; ++m)
+              *q++ = corrected[m].at<float>(std::clamp(j + b, 0, gh - 1),
+                                            std::clamp(i + a, 0, gw - 1));
+      }
+    cv::Mat indices, distances;
+    d.index->knnSearch(queries, indices, distances, 1, cv::flann::SearchParams(kDetailChecks));
+    patch.detail_source = cv::Mat(gh, gw, CV_32FC2);
+    cv::Mat best(gh, gw, CV_32FC1);
+    for (int j = 0; j < gh; ++j)
+      for (int i = 0; i < gw; ++i) {
+        const cv::Point p = d.points[static_cast<std::size_t>(indices.at<int>(j * gw + i, 0))];
+        patch.detail_source.at<cv::Vec2f>(j, i) =
+            cv::Vec2f(static_cast<float>(p.x), static_cast<float>(p.y));
+        best.at<float>(j, i) = distances.at<float>(j * gw + i, 0);
+      }
+    const double x_lo = kDetailWindowRadius * dx, x_hi = sample.width - 1 - x_lo;
+    const double y_lo = kDetailWindowRadius * dy, y_hi = sample.height - 1 - y_lo;
+    std::array<float, kDetailWindowLength> window;
+    auto try_shift = [&](int i, int j, int ni, int nj) {
+      if (ni < 0 || nj < 0 || ni >= gw || nj >= gh) return;
+      const cv::Vec2f n = patch.detail_source.at<cv::Vec2f>(nj, ni);
+      const double x = n[0] + (i - ni) * dx, y = n[1] + (j - nj) * dy;
+      if (x < x_lo || x > x_hi || y < y_lo || y > y_hi) return;
+      CoarseWindow(d.coarse, x, y, dx, dy, window.data());
+      const float* q = queries.ptr<float>(j * gw + i);
+      double e = 0.0;
+      for (int k = 0; k < kDetailWindowLength; ++k) e += (window[k] - q[k]) * (window[k] - q[k]);
+      if (e < best.at<float>(j, i)) {
+        best.at<float>(j, i) = static_cast<float>(e);
+        patch.detail_source.at<cv::Vec2f>(j, i) =
+            cv::Vec2f(static_cast<float>(x), static_cast<float>(y));
+      }
+    };
+    for (int j = 0; j < gh; ++j)
+      for (int i = 0; i < gw; ++i) try_shift(i, j, i - 1, j), try_shift(i, j, i, j - 1);
+    for (int j = gh - 1; j >= 0; --j)
+      for (int i = gw - 1; i >= 0; --i) try_shift(i, j, i + 1, j), try_shift(i, j, i, j + 1);
+    patch.detail_level = level;
+  };
+
   const std::vector<int> order =
       sfm::BreadthFirstFaceOrder(mesh, sfm::FaceNeighbours(mesh), seed_face);
   std::vector<char> done(num_faces, 0);
+  std::vector<int> correction_level(num_faces, -1);  // the primary view's density level
   std::mt19937_64 rng(options.seed);
   std::size_t processed = 0;
   for (const int face : order) {
@@ -966,11 +1148,44 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     if (!rects.empty() && options.correction_iterations > 0 &&
         sample.format == ptm::PtmFormat::kLrgb) {
       CorrectPatch(patch, rects);
+      correction_level[f] = rects[0].level;
     }
     done[f] = 1;
     ++processed;
     if (progress && (processed % 64 == 0 || processed == num_faces))
       progress("synthesis", processed, num_faces);
+  }
+  // 2c. Detail transfer of the corrected patches: independent of one another,
+  // so in parallel once the dictionaries of their levels are built.
+  std::vector<int> levels;
+  for (std::size_t f = 0; f < num_faces && options.detail_transfer; ++f) {
+    if (correction_level[f] >= 0 && !dictionaries.count(correction_level[f])) {
+      dictionaries[correction_level[f]];
+      result.detail_bands[correction_level[f]];
+      reduced_at(correction_level[f]);
+      levels.push_back(correction_level[f]);
+    }
+  }
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::size_t n = 0; n < levels.size(); ++n) {
+    const int level = levels[n];
+    build_dictionary(level, reduced.at(level), dictionaries.at(level),
+                     result.detail_bands.at(level));
+  }
+  std::vector<int> transferred;
+  for (std::size_t f = 0; f < num_faces && options.detail_transfer; ++f)
+    if (correction_level[f] >= 0 && dictionaries.at(correction_level[f]).index)
+      transferred.push_back(static_cast<int>(f));
+  std::atomic<std::size_t> transfers_done{0};
+#pragma omp parallel for schedule(dynamic, 8)
+  for (std::size_t n = 0; n < transferred.size(); ++n) {
+    const std::size_t f = static_cast<std::size_t>(transferred[n]);
+    TransferDetail(result.patches[f], correction_level[f]);
+    const std::size_t done_now = ++transfers_done;
+    if (progress && (done_now % 64 == 0 || done_now == transferred.size())) {
+#pragma omp critical(texlume_detail_progress)
+      progress("detail transfer", done_now, transferred.size());
+    }
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

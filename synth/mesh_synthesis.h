@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -73,6 +74,11 @@ struct MeshSynthesisOptions {
   bool channel_correction = true;
   /// Smoothing of the per-channel factors, in photo pixels (Gaussian sigma). > 0.
   double correction_sigma = 2.0;
+  /// Detail transfer after the photo-consistency pass: the detail finer than
+  /// the photo is taken from the sample where the sample's coarse coefficients
+  /// best match the corrected ones (a 3 x 3 window of photo cells), so that it
+  /// follows the photo's structure rather than the quilted patch's.
+  bool detail_transfer = true;
   /// Refuse up front when the patches would take more texels than this.
   std::int64_t max_texels = std::int64_t{1} << 30;
   std::uint32_t seed = 1;
@@ -110,6 +116,12 @@ struct TrianglePatch {
   /// differences: LRGB colour times the factor, RGB polynomial times it.
   std::vector<cv::Mat> channel_gain;
   Eigen::Vector2d correction_density = Eigen::Vector2d::Ones();
+  /// Detail transfer (beyond the paper): per cell of the correction grid, the
+  /// sample point (texels, CV_32FC2 x, y) whose detail band replaces the
+  /// patch's own around that cell; empty when none. The band is
+  /// MeshSynthesis::detail_bands[detail_level].
+  cv::Mat detail_source;
+  int detail_level = -1;
 };
 
 /// The unfolding of neighbour `face` across a shared edge into a triangle's
@@ -131,6 +143,9 @@ struct MeshSynthesis {
   std::vector<TrianglePatch> patches;                ///< per face
   std::vector<std::array<Unfolding, 3>> unfoldings;  ///< per face, edge k = (v_k, v_k+1)
   std::vector<double> photo_gains;  ///< per photo (linear-domain exposure x intensity)
+  /// Per photo-density level: the sample's detail band, its planes minus their
+  /// reduction to that density brought back to full size (all planes, texels).
+  std::map<int, std::vector<cv::Mat>> detail_bands;
   std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
   double seconds = 0.0;
 

@@ -298,6 +298,7 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
       {"additive_correction", so.additive_correction},
       {"correction_noise", so.correction_noise},
       {"channel_correction", so.channel_correction},
+      {"detail_transfer", so.detail_transfer},
       {"correction_sigma", so.correction_sigma},
       {"horizon_elevation_deg", kHorizonElevationDeg},
       {"seed", so.seed}};

