@@ -65,10 +65,13 @@ double BilinearClamped(const cv::Mat& m, double x, double y) {
 constexpr int kDetailWindowRadius = 1;
 constexpr int kDetailWindowLength =
     (2 * kDetailWindowRadius + 1) * (2 * kDetailWindowRadius + 1) * 6;
-// Leaves the k-d trees visit per query: 8 matches as well as 32 on the demo
+// Leaves visited per query (FLANN checks): 8 matches as well as 32 on the demo
 // (SSIM 0.538 either way) in 60 % of the time.
 constexpr int kDetailChecks = 8;
 constexpr int kDetailTrees = 4;
+// At most this many sample points per dictionary (2^16 windows take 14 MiB;
+// a 256 x 256 sample has about 62 000).
+constexpr std::size_t kDetailMaxPoints = std::size_t{1} << 16;
 void CoarseWindow(const std::vector<cv::Mat>& coarse, double x, double y, double dx, double dy,
                   float* window) {
   for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
@@ -605,9 +608,14 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     const double dx = 1.0 / red.rx, dy = 1.0 / red.ry;
     const int bx = static_cast<int>(std::ceil(kDetailWindowRadius * dx)),
               by = static_cast<int>(std::ceil(kDetailWindowRadius * dy));
-    if (full.width - 2 * bx < 4 || full.height - 2 * by < 4) return;  // too coarse: none
-    for (int y = by; y < full.height - by; ++y)
-      for (int x = bx; x < full.width - bx; ++x) d.points.emplace_back(x, y);
+    const int nx = full.width - 2 * bx, ny = full.height - 2 * by;
+    if (nx < 4 || ny < 4) return;  // windows wider than the sample: no transfer
+    // Large samples: points on a coarser grid, so a dictionary stays under
+    // kDetailMaxPoints windows.
+    const int stride = static_cast<int>(
+        std::ceil(std::sqrt(static_cast<double>(nx) * ny / static_cast<double>(kDetailMaxPoints))));
+    for (int y = by; y < full.height - by; y += stride)
+      for (int x = bx; x < full.width - bx; x += stride) d.points.emplace_back(x, y);
     d.windows = cv::Mat(static_cast<int>(d.points.size()), kDetailWindowLength, CV_32FC1);
     for (std::size_t n = 0; n < d.points.size(); ++n)
       CoarseWindow(d.coarse, d.points[n].x, d.points[n].y, dx, dy,
