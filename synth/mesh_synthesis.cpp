@@ -168,32 +168,6 @@ bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) 
     const float e = m.at<float>(patch.sample_y + y1, patch.sample_x + x1);
     out[c] = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * d + fx * e);
   }
-  if (!patch.detail_source.empty()) {
-    // Detail transfer: the patch's own detail band out, the band around each
-    // nearby cell's matched sample point in (bilinear over the 4 nearest cells).
-    const std::vector<cv::Mat>& band = detail_bands.at(patch.detail_level);
-    const double rx = patch.correction_density.x(), ry = patch.correction_density.y();
-    const cv::Mat& src = patch.detail_source;
-    const double gu = std::clamp((uc + 0.5) * rx - 0.5, 0.0, src.cols - 1.0);
-    const double gv = std::clamp((vc + 0.5) * ry - 0.5, 0.0, src.rows - 1.0);
-    const int gx0 = static_cast<int>(gu), gy0 = static_cast<int>(gv);
-    const int gx1 = std::min(gx0 + 1, src.cols - 1), gy1 = std::min(gy0 + 1, src.rows - 1);
-    const double gfx = gu - gx0, gfy = gv - gy0;
-    const std::array<std::pair<cv::Point, double>, 4> cells = {
-        std::pair{cv::Point(gx0, gy0), (1 - gfx) * (1 - gfy)},
-        std::pair{cv::Point(gx1, gy0), gfx * (1 - gfy)},
-        std::pair{cv::Point(gx0, gy1), (1 - gfx) * gfy}, std::pair{cv::Point(gx1, gy1), gfx * gfy}};
-    for (std::size_t c = 0; c < band.size(); ++c)
-      out[c] -= BilinearClamped(band[c], patch.sample_x + uc, patch.sample_y + vc);
-    for (const auto& [cell, w] : cells) {
-      if (w <= 0.0) continue;
-      const cv::Vec2f s = src.at<cv::Vec2f>(cell.y, cell.x);
-      const double x = s[0] + uc - ((cell.x + 0.5) / rx - 0.5);
-      const double y = s[1] + vc - ((cell.y + 0.5) / ry - 0.5);
-      for (std::size_t c = 0; c < band.size(); ++c)
-        out[c] += static_cast<float>(w * BilinearClamped(band[c], x, y));
-    }
-  }
   if (!patch.correction.empty()) {
     const cv::Mat& c0 = patch.correction[0];
     const double gu =
@@ -207,6 +181,29 @@ bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) 
       return (1 - gfy) * ((1 - gfx) * m.at<float>(gy0, gx0) + gfx * m.at<float>(gy0, gx1)) +
              gfy * ((1 - gfx) * m.at<float>(gy1, gx0) + gfx * m.at<float>(gy1, gx1));
     };
+    if (!patch.detail_source.empty()) {
+      // Detail transfer (on the correction's grid): the patch's own detail band
+      // out, the band around each of the 4 nearest cells' matched sample points
+      // in, weighted bilinearly.
+      const std::vector<cv::Mat>& band = detail_bands.at(patch.detail_level);
+      const double rx = patch.correction_density.x(), ry = patch.correction_density.y();
+      const std::array<std::pair<cv::Point, float>, 4> cells = {
+          std::pair{cv::Point(gx0, gy0), (1 - gfx) * (1 - gfy)},
+          std::pair{cv::Point(gx1, gy0), gfx * (1 - gfy)},
+          std::pair{cv::Point(gx0, gy1), (1 - gfx) * gfy},
+          std::pair{cv::Point(gx1, gy1), gfx * gfy}};
+      for (std::size_t c = 0; c < band.size(); ++c)
+        out[c] -=
+            static_cast<float>(BilinearClamped(band[c], patch.sample_x + uc, patch.sample_y + vc));
+      for (const auto& [cell, w] : cells) {
+        if (w <= 0.0f) continue;
+        const cv::Vec2f s = patch.detail_source.at<cv::Vec2f>(cell.y, cell.x);
+        const double x = s[0] + uc - ((cell.x + 0.5) / rx - 0.5);
+        const double y = s[1] + vc - ((cell.y + 0.5) / ry - 0.5);
+        for (std::size_t c = 0; c < band.size(); ++c)
+          out[c] += static_cast<float>(w * BilinearClamped(band[c], x, y));
+      }
+    }
     {
       // The additive change: Catmull-Rom (bicubic) over the 4 x 4 nearest cells,
       // which keeps the photo's detail sharper than bilinear.

@@ -34,6 +34,16 @@ void ExpectEachFaceInOneChart(const std::vector<std::vector<ChartFace>>& charts,
   EXPECT_EQ(seen.size(), num_faces);
 }
 
+// Strip charts of the mesh, every face in exactly one of them.
+std::vector<std::vector<ChartFace>> CheckedStripCharts(const sfm::TriangleMesh& mesh,
+                                                       const PatchGeometry& g,
+                                                       const StripChartOptions& o,
+                                                       StripChartStats* stats = nullptr) {
+  auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o, stats);
+  ExpectEachFaceInOneChart(charts, mesh.faces.size());
+  return charts;
+}
+
 TEST(Charts, SingularValuesOfKnownMaps) {
   const Eigen::Matrix2d rotation = Eigen::Rotation2Dd(0.7).toRotationMatrix();
   EXPECT_TRUE(SingularValues2(rotation).isApprox(Eigen::Vector2d(1, 1)));
@@ -192,11 +202,10 @@ TEST(Charts, StripsOfAGridPlaneAreRowsOfQuads) {
   StripChartOptions o;
   o.texel_size = kTexel;
   StripChartStats stats;
-  const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o, &stats);
+  const auto charts = CheckedStripCharts(mesh, g, o, &stats);
   EXPECT_EQ(charts.size(), 8u);
   EXPECT_EQ(stats.strips, 8);
   EXPECT_EQ(stats.lone_faces, 0);
-  ExpectEachFaceInOneChart(charts, mesh.faces.size());
   for (const auto& chart : charts) {
     EXPECT_EQ(chart.size(), 16u);
     for (const ChartFace& cf : chart) {
@@ -217,11 +226,10 @@ TEST(Charts, StackedBandsOfAGridPlaneAreOneChart) {
   o.texel_size = kTexel;
   o.max_stack_texels = 8 * 31;
   StripChartStats stats;
-  const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o, &stats);
+  const auto charts = CheckedStripCharts(mesh, g, o, &stats);
   ASSERT_EQ(charts.size(), 1u);
   EXPECT_EQ(stats.strips, 1);
   EXPECT_EQ(stats.stacked, 7);
-  ExpectEachFaceInOneChart(charts, mesh.faces.size());
   for (const ChartFace& cf : charts[0]) {
     const Eigen::Vector2d s = SingularValues2(cf.linear);
     EXPECT_NEAR(s.x(), 1.0, 0.015);  // heights rounded, ends squared
@@ -245,8 +253,7 @@ TEST(Charts, StripsOfASphereAreBandsWithinTheStretchBound) {
     o.max_stretch = bound;
     for (const StripSide side : {StripSide::kTallest, StripSide::kNearestPreferred}) {
       o.side = side;
-      const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o);
-      ExpectEachFaceInOneChart(charts, mesh.faces.size());
+      const auto charts = CheckedStripCharts(mesh, g, o);
       ExpectBands(charts, g, mesh, bound);
       if (side == StripSide::kTallest) {
         EXPECT_GT(charts.size(), previous_charts);
@@ -258,9 +265,8 @@ TEST(Charts, StripsOfASphereAreBandsWithinTheStretchBound) {
   o.max_stretch = 1.25;
   o.max_stack_texels = 300;
   StripChartStats stats;
-  const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o, &stats);
+  const auto charts = CheckedStripCharts(mesh, g, o, &stats);
   EXPECT_GT(stats.stacked, 0);
-  ExpectEachFaceInOneChart(charts, mesh.faces.size());
   ExpectBands(charts, g, mesh, o.max_stretch, true);
 }
 
@@ -277,8 +283,7 @@ TEST(Charts, FansOfCylinderCapsAreUprightSectors) {
     StripChartOptions o;
     o.texel_size = kTexel;
     StripChartStats stats;
-    const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, o, &stats);
-    ExpectEachFaceInOneChart(charts, mesh.faces.size());
+    const auto charts = CheckedStripCharts(mesh, g, o, &stats);
     EXPECT_EQ(stats.fans, 2);
     ASSERT_GE(stats.fan_sectors, 8);  // at most 90 degrees each
     std::size_t cap_faces = 0;
@@ -361,8 +366,7 @@ TEST(Charts, CurvedFansOfALatitudeLongitudeSphere) {
   StripChartOptions so;
   so.texel_size = kTexel;
   StripChartStats stats;
-  const auto charts = MakeStripCharts(mesh, g.patches, g.unfoldings, so, &stats);
-  ExpectEachFaceInOneChart(charts, mesh.faces.size());
+  const auto charts = CheckedStripCharts(mesh, g, so, &stats);
   EXPECT_EQ(stats.fans, 2);
   std::size_t pole_faces = 0;
   for (std::size_t c = 0; c < static_cast<std::size_t>(stats.fan_sectors); ++c)
