@@ -454,6 +454,7 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
                      "correction-iterations",
                      "correction-sigma",
                      "correction-noise",
+                     "correction-prior-shrink",
                      "chart-angle",
                      "chart-size",
                      "chart-flattening",
@@ -486,6 +487,11 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
   o.synthesis.channel_correction = !a.Has("no-channel-correction");
   o.synthesis.detail_transfer = !a.Has("no-detail-transfer");
   o.synthesis.correction_noise = a.GetDouble("correction-noise", o.synthesis.correction_noise);
+  if (const auto shrink = a.Get("correction-prior-shrink"); shrink && *shrink != "auto") {
+    o.synthesis.correction_prior_shrink = a.GetDouble("correction-prior-shrink", 0.0);
+    if (!(o.synthesis.correction_prior_shrink >= 0.0 && o.synthesis.correction_prior_shrink <= 1.0))
+      throw UsageError("--correction-prior-shrink: give auto or a number in [0, 1]");
+  }
   if (const auto field = a.Get("tangent-field")) {
     const std::vector<double> d = ParseList(*field, 3, "--tangent-field");
     o.synthesis.tangent_frame = synth::TangentFrame::kSmoothField;

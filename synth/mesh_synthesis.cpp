@@ -140,6 +140,8 @@ void MeshSynthesisOptions::Check() const {
   if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
   if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
   if (!(correction_sigma > 0.0)) throw OptionError("correction_sigma must be > 0");
+  if (!(correction_prior_shrink <= 1.0))
+    throw OptionError("correction_prior_shrink must be in [0, 1], or < 0 to estimate it");
   if (!(correction_noise > 0.0) || !std::isfinite(correction_noise))
     throw OptionError("correction_noise must be > 0");
   if (correction_iterations < 0 || correction_iterations > 5)
@@ -651,6 +653,7 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   // at the photo's own surface density, the triangle mask, the local lights.
   struct Rectified {
     std::size_t photo = 0;
+    sfm::TriangleView view;
     int level = 0;
     std::vector<cv::Mat> planes;  // RGB display
     cv::Mat mask;                 // CV_32FC1, 1 inside the triangle and the image
@@ -660,14 +663,16 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   // Cells within W_e / 2 of the triangle (its blending zone) are constrained
   // too, so that the blend across an edge mixes two photo-corrected patches.
   const double mask_margin = 0.5 * options.strip * t;
-  auto rectify = [&](std::size_t f, const sfm::TriangleView& view, Rectified& out) -> bool {
+  // level < 0: at the photo's own density level.
+  auto rectify = [&](std::size_t f, const sfm::TriangleView& view, Rectified& out,
+                     int level = -1) -> bool {
     const auto it = photo_index.find(view.image_id);
     if (it == photo_index.end()) return false;
     const MeshPhoto& photo = photos[it->second];
     const sfm::Image& image = reconstruction.images.at(view.image_id);
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
     const TrianglePatch& patch = result.patches[f];
-    const int level = PhotoDensityLevel(patch, view, t);
+    if (level < 0) level = PhotoDensityLevel(patch, view, t);
     const ReducedSample& r = reduced_at(level);
     const int tw = std::max(1, static_cast<int>(std::lround(patch.width * r.rx)));
     const int th = std::max(1, static_cast<int>(std::lround(patch.height * r.ry)));
@@ -687,6 +692,7 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
       out.lights.emplace_back(l, light.intensity);
     }
     out.photo = it->second;
+    out.view = view;
     out.level = level;
     return true;
   };
@@ -745,119 +751,166 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   // 2b. Breadth-first synthesis from a seed (the best-seen triangle).
   const int seed_face = BestSeenFace(visibility);
   // Photo-consistency pass of one patch (LRGB): per cell of the primary view's
-  // grid, dq = J^T (J J^T + lambda I)^-1 r over the views, J_n the derivative of
-  // the displayed luminance under photo n's lights (sRGB, gain and light mixture
-  // linearised at the current value) with respect to the orthonormal luminance
-  // coefficients, r_n the photo's luminance minus the prediction (eq. 3's
-  // residual). Cells outside the triangle take their neighbours' change.
+  // grid (every view rectified on it), the MAP change of the orthonormal
+  // luminance coefficients, q = m + Sigma J^T (J Sigma J^T + s^2 I)^-1 (r + J (q0 - m)),
+  // J_n the derivative of the displayed luminance under photo n's lights (sRGB,
+  // gain and light mixture linearised at the current value), r_n the photo's
+  // luminance minus the prediction (eq. 3's residual), m the prior mean (the
+  // patch moved toward the sample's mean). Cells outside the triangle take
+  // their neighbours' change.
   const Eigen::Matrix<double, 6, 6>& from_orthonormal =
       ptm::OrthonormalBasis::Hemisphere().FromOrthonormal();
-  std::map<int, Eigen::Matrix<double, 6, 6>> priors;
-  auto prior_at = [&](int level) -> Eigen::Matrix<double, 6, 6> {
+  // The prior at a density level: the mean and covariance of the reduced
+  // sample's orthonormal luminance coefficients.
+  struct CoefficientPrior {
+    Eigen::Matrix<double, 6, 1> mean;
+    Eigen::Matrix<double, 6, 6> covariance;
+  };
+  const Eigen::Matrix<double, 6, 6>& to_orthonormal =
+      ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
+  std::map<int, CoefficientPrior> priors;
+  auto prior_at = [&](int level) -> const CoefficientPrior& {
     auto it = priors.find(level);
     if (it != priors.end()) return it->second;
     const ReducedSample& red = reduced_at(level);
     const int n = static_cast<int>(red.raw[0].total());
     Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
     Eigen::Matrix<double, 6, 6> second = Eigen::Matrix<double, 6, 6>::Zero();
-    const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
     for (int y = 0; y < red.raw[0].rows; ++y)
       for (int x = 0; x < red.raw[0].cols; ++x) {
         Eigen::Matrix<double, 6, 1> a;
         for (int m = 0; m < 6; ++m) a[m] = red.raw[static_cast<std::size_t>(m)].at<float>(y, x);
-        const Eigen::Matrix<double, 6, 1> q = to * a;
+        const Eigen::Matrix<double, 6, 1> q = to_orthonormal * a;
         mean += q;
         second += q * q.transpose();
       }
     mean /= n;
     Eigen::Matrix<double, 6, 6> cov = second / n - mean * mean.transpose();
     cov.diagonal().array() += 1e-6 * cov.trace() / 6.0;  // keeps it positive definite
-    return priors.emplace(level, cov).first->second;
+    return priors.emplace(level, CoefficientPrior{mean, cov}).first->second;
   };
   auto CorrectPatch = [&](TrianglePatch& patch, const std::vector<Rectified>& rects) {
     const Rectified& primary = rects[0];
     const ReducedSample& red0 = reduced_at(primary.level);
     const int gw = primary.mask.cols, gh = primary.mask.rows;
     patch.correction_density = Eigen::Vector2d(red0.rx, red0.ry);
-    const Eigen::Matrix<double, 6, 6> prior = prior_at(primary.level);
+    const CoefficientPrior& prior = prior_at(primary.level);
     patch.correction.assign(6, cv::Mat());
     for (cv::Mat& m : patch.correction) m = cv::Mat::zeros(gh, gw, CV_32FC1);
     patch.channel_gain.assign(3, cv::Mat());
     for (cv::Mat& m : patch.channel_gain) m = cv::Mat::ones(gh, gw, CV_32FC1);
-    // Per view: frame point of a primary cell -> the view's cell.
-    auto view_cell = [&](const Rectified& r, int i, int j, int& vi, int& vj) {
-      const ReducedSample& red = reduced_at(r.level);
-      vi = static_cast<int>(std::floor((i + 0.5) / red0.rx * red.rx));
-      vj = static_cast<int>(std::floor((j + 0.5) / red0.ry * red.ry));
-      return vi >= 0 && vj >= 0 && vi < r.mask.cols && vj < r.mask.rows &&
-             r.mask.at<float>(vj, vi) > 0;
+    // Every view is rectified on the primary view's grid (the caller's part).
+    auto seen = [&](const Rectified& r, int i, int j) { return r.mask.at<float>(j, i) > 0; };
+    // Prediction and luminance Jacobian of view r at cell (i, j), with the
+    // change q_delta (orthonormal) added to the patch's coefficients.
+    auto predict_with =
+        [&](const Rectified& r, int i, int j, const Eigen::Matrix<double, 6, 1>& q_delta,
+            Eigen::Matrix<double, 1, 6>& jac, Eigen::Vector3d* channel_linear = nullptr) {
+          const ReducedSample& red = red0;
+          // Cell (i, j)'s centre in the reduced sample's pixel coordinates (centres
+          // at integers): (sample_x + (i + 0.5) / rx) rx - 0.5; bilinear there.
+          const double sx = std::clamp(patch.sample_x * red.rx + i, 0.0, red.raw[0].cols - 1.0);
+          const double sy = std::clamp(patch.sample_y * red.ry + j, 0.0, red.raw[0].rows - 1.0);
+          const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
+          const int x1 = std::min(x0 + 1, red.raw[0].cols - 1),
+                    y1 = std::min(y0 + 1, red.raw[0].rows - 1);
+          const float fx = static_cast<float>(sx - x0), fy = static_cast<float>(sy - y0);
+          auto sample_at = [&](const cv::Mat& m) {
+            return (1 - fy) * ((1 - fx) * m.at<float>(y0, x0) + fx * m.at<float>(y0, x1)) +
+                   fy * ((1 - fx) * m.at<float>(y1, x0) + fx * m.at<float>(y1, x1));
+          };
+          const Eigen::Matrix<double, 6, 1> a_delta = from_orthonormal * q_delta;
+          float a[6], colour[3];
+          for (int m = 0; m < 6; ++m)
+            a[m] = sample_at(red.raw[static_cast<std::size_t>(m)]) + static_cast<float>(a_delta[m]);
+          for (int c = 0; c < 3; ++c)
+            colour[c] = sample_at(red.raw[static_cast<std::size_t>(6 + c)]);
+          const double g = result.photo_gains[r.photo];
+          Eigen::Vector3d linear = Eigen::Vector3d::Zero();
+          Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
+          for (const auto& [l, intensity] : r.lights) {
+            if (l.z() <= 0) continue;
+            const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
+            const std::array<double, 6> phi = ptm::PtmBasis(l.x(), l.y());
+            const Eigen::Matrix<double, 1, 6> row =
+                Eigen::Map<const Eigen::Matrix<double, 1, 6>>(phi.data()) * from_orthonormal;
+            for (int c = 0; c < 3; ++c) {
+              const double v = lum * colour[c];
+              if (v <= 0.0 || v >= 1.0) continue;  // clamped: no derivative
+              const double h = 1e-3;
+              const double dlin = (SrgbToLinear(static_cast<float>(std::min(1.0, v + h))) -
+                                   SrgbToLinear(static_cast<float>(std::max(0.0, v - h)))) /
+                                  (std::min(1.0, v + h) - std::max(0.0, v - h));
+              linear[c] += intensity * SrgbToLinear(static_cast<float>(v));
+              dlinear.row(c) += intensity * dlin * colour[c] * row;
+            }
+          }
+          double y_pred = 0.0;
+          jac.setZero();
+          for (int c = 0; c < 3; ++c) {
+            const double lin = g * linear[c];
+            if (channel_linear) (*channel_linear)[c] = lin;
+            const double d = LinearToSrgb(static_cast<float>(lin));
+            const double h = 1e-4;
+            const double dsrgb = (LinearToSrgb(static_cast<float>(lin + h)) -
+                                  LinearToSrgb(static_cast<float>(std::max(0.0, lin - h)))) /
+                                 (lin + h - std::max(0.0, lin - h));
+            y_pred += d / 3.0;
+            jac += dsrgb * g * dlinear.row(c) / 3.0;
+          }
+          return y_pred;
+        };
+    auto correction_at = [&](int i, int j) {
+      Eigen::Matrix<double, 6, 1> q;
+      for (int m = 0; m < 6; ++m)
+        q[m] = patch.correction[static_cast<std::size_t>(m)].at<float>(j, i);
+      return q;
     };
-    // Prediction and luminance Jacobian of view r at its cell (vi, vj), with the
-    // current correction (primary grid cell (i, j)).
-    auto predict = [&](const Rectified& r, int vi, int vj, int i, int j,
-                       Eigen::Matrix<double, 1, 6>& jac,
+    auto predict = [&](const Rectified& r, int i, int j, Eigen::Matrix<double, 1, 6>& jac,
                        Eigen::Vector3d* channel_linear = nullptr) {
-      const ReducedSample& red = reduced_at(r.level);
-      // Cell (vi, vj)'s centre in the reduced sample's pixel coordinates (centres
-      // at integers): (sample_x + (vi + 0.5) / rx) rx - 0.5; bilinear there.
-      const double sx = std::clamp(patch.sample_x * red.rx + vi, 0.0, red.raw[0].cols - 1.0);
-      const double sy = std::clamp(patch.sample_y * red.ry + vj, 0.0, red.raw[0].rows - 1.0);
-      const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
-      const int x1 = std::min(x0 + 1, red.raw[0].cols - 1),
-                y1 = std::min(y0 + 1, red.raw[0].rows - 1);
-      const float fx = static_cast<float>(sx - x0), fy = static_cast<float>(sy - y0);
-      auto sample_at = [&](const cv::Mat& m) {
-        return (1 - fy) * ((1 - fx) * m.at<float>(y0, x0) + fx * m.at<float>(y0, x1)) +
-               fy * ((1 - fx) * m.at<float>(y1, x0) + fx * m.at<float>(y1, x1));
-      };
-      Eigen::Matrix<double, 6, 1> q_delta;
-      for (int m = 0; m < 6; ++m)
-        q_delta[m] = patch.correction[static_cast<std::size_t>(m)].at<float>(j, i);
-      const Eigen::Matrix<double, 6, 1> a_delta = from_orthonormal * q_delta;
-      float a[6], colour[3];
-      for (int m = 0; m < 6; ++m)
-        a[m] = sample_at(red.raw[static_cast<std::size_t>(m)]) + static_cast<float>(a_delta[m]);
-      for (int c = 0; c < 3; ++c) colour[c] = sample_at(red.raw[static_cast<std::size_t>(6 + c)]);
-      const double g = result.photo_gains[r.photo];
-      Eigen::Vector3d linear = Eigen::Vector3d::Zero();
-      Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
-      for (const auto& [l, intensity] : r.lights) {
-        if (l.z() <= 0) continue;
-        const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
-        const std::array<double, 6> phi = ptm::PtmBasis(l.x(), l.y());
-        const Eigen::Matrix<double, 1, 6> row =
-            Eigen::Map<const Eigen::Matrix<double, 1, 6>>(phi.data()) * from_orthonormal;
-        for (int c = 0; c < 3; ++c) {
-          const double v = lum * colour[c];
-          if (v <= 0.0 || v >= 1.0) continue;  // clamped: no derivative
-          const double h = 1e-3;
-          const double dlin = (SrgbToLinear(static_cast<float>(std::min(1.0, v + h))) -
-                               SrgbToLinear(static_cast<float>(std::max(0.0, v - h)))) /
-                              (std::min(1.0, v + h) - std::max(0.0, v - h));
-          linear[c] += intensity * SrgbToLinear(static_cast<float>(v));
-          dlinear.row(c) += intensity * dlin * colour[c] * row;
-        }
-      }
-      double y_pred = 0.0;
-      jac.setZero();
-      for (int c = 0; c < 3; ++c) {
-        const double lin = g * linear[c];
-        if (channel_linear) (*channel_linear)[c] = lin;
-        const double d = LinearToSrgb(static_cast<float>(lin));
-        const double h = 1e-4;
-        const double dsrgb = (LinearToSrgb(static_cast<float>(lin + h)) -
-                              LinearToSrgb(static_cast<float>(std::max(0.0, lin - h)))) /
-                             (lin + h - std::max(0.0, lin - h));
-        y_pred += d / 3.0;
-        jac += dsrgb * g * dlinear.row(c) / 3.0;
-      }
-      return y_pred;
+      return predict_with(r, i, j, correction_at(i, j), jac, channel_linear);
     };
-    auto photo_luminance = [](const Rectified& r, int vi, int vj) {
-      return (r.planes[0].at<float>(vj, vi) + r.planes[1].at<float>(vj, vi) +
-              r.planes[2].at<float>(vj, vi)) /
+    // The way from the patch's coefficients to the prior's mean at cell (i, j).
+    auto to_mean = [&](int i, int j) -> Eigen::Matrix<double, 6, 1> {
+      Eigen::Matrix<double, 6, 1> a_patch;
+      for (int m = 0; m < 6; ++m)
+        a_patch[m] =
+            BilinearClamped(red0.raw[static_cast<std::size_t>(m)],
+                            std::clamp(patch.sample_x * red0.rx + i, 0.0, red0.raw[0].cols - 1.0),
+                            std::clamp(patch.sample_y * red0.ry + j, 0.0, red0.raw[0].rows - 1.0));
+      return prior.mean - to_orthonormal * a_patch;
+    };
+    auto photo_luminance = [](const Rectified& r, int i, int j) {
+      return (r.planes[0].at<float>(j, i) + r.planes[1].at<float>(j, i) +
+              r.planes[2].at<float>(j, i)) /
              3.0;
     };
+    // How far the prior mean moves from the patch toward the sample's mean.
+    // Estimated: 1 - rho, rho the least-squares slope of the photos' departure
+    // from the mean's prediction on the patch's departure from it, over the
+    // patch's cells and views (how much of the patch's own structure the
+    // photos confirm where they see it), clamped to [0, 1]. The departure is
+    // linearised at the patch: d = -J (mean - patch).
+    double shrink = options.correction_prior_shrink;
+    if (shrink < 0.0) {
+      double photo_dot_patch = 0.0, patch_dot_patch = 0.0;
+      Eigen::Matrix<double, 1, 6> jac;
+      for (int j = 0; j < gh; ++j)
+        for (int i = 0; i < gw; ++i) {
+          const Eigen::Matrix<double, 6, 1> q_to_mean = to_mean(i, j);
+          for (const Rectified& r : rects) {
+            if (!seen(r, i, j)) continue;
+            const double at_patch = predict_with(r, i, j, Eigen::Matrix<double, 6, 1>::Zero(), jac);
+            const double patch_departure = -(jac * q_to_mean)(0);
+            photo_dot_patch +=
+                (photo_luminance(r, i, j) - at_patch + patch_departure) * patch_departure;
+            patch_dot_patch += patch_departure * patch_departure;
+          }
+        }
+      const double rho = patch_dot_patch > 1e-12 ? photo_dot_patch / patch_dot_patch : 0.0;
+      shrink = 1.0 - std::clamp(rho, 0.0, 1.0);
+    }
+    patch.prior_shrink = shrink;
     cv::Mat known = cv::Mat::zeros(gh, gw, CV_8UC1);
     for (int it = 0; it < options.correction_iterations; ++it) {
       // Per-channel factors at low frequency (stains, colour): photo over
@@ -872,14 +925,13 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
         for (int j = 0; j < gh; ++j) {
           for (int i = 0; i < gw; ++i) {
             for (const Rectified& r : rects) {
-              int vi, vj;
-              if (!view_cell(r, i, j, vi, vj)) continue;
+              if (!seen(r, i, j)) continue;
               Eigen::Matrix<double, 1, 6> row;
               Eigen::Vector3d lin;
-              predict(r, vi, vj, i, j, row, &lin);
+              predict(r, i, j, row, &lin);
               for (int c = 0; c < 3; ++c) {
                 photo_sum[static_cast<std::size_t>(c)].at<float>(j, i) +=
-                    SrgbToLinear(r.planes[static_cast<std::size_t>(c)].at<float>(vj, vi));
+                    SrgbToLinear(r.planes[static_cast<std::size_t>(c)].at<float>(j, i));
                 model_sum[static_cast<std::size_t>(c)].at<float>(j, i) +=
                     static_cast<float>(lin[c]);
               }
@@ -921,28 +973,29 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
           Eigen::VectorXd res(static_cast<int>(rects.size()));
           int rows = 0;
           for (const Rectified& r : rects) {
-            int vi, vj;
-            if (!view_cell(r, i, j, vi, vj)) continue;
+            if (!seen(r, i, j)) continue;
             Eigen::Matrix<double, 1, 6> row;
-            res[rows] = photo_luminance(r, vi, vj) - predict(r, vi, vj, i, j, row);
+            res[rows] = photo_luminance(r, i, j) - predict(r, i, j, row);
             jac.row(rows) = row;
             ++rows;
           }
           if (rows == 0) continue;
           known.at<std::uint8_t>(j, i) = 1;
           const auto jr = jac.topRows(rows);
-          Eigen::Matrix<double, 6, 1> q0;
-          for (int m = 0; m < 6; ++m)
-            q0[m] = patch.correction[static_cast<std::size_t>(m)].at<float>(j, i);
-          // Gauss-Newton step of the MAP estimate: q = Sigma J^T (J Sigma J^T +
-          // s^2 I)^-1 (r + J q0), s^2 = correction_noise x the mean predicted variance.
-          const Eigen::MatrixXd js = jr * prior;
+          const Eigen::Matrix<double, 6, 1> q0 = correction_at(i, j);
+          // Prior mean of the change, m: the way from the patch's coefficients
+          // to the sample's mean, correction_prior_shrink of it.
+          const Eigen::Matrix<double, 6, 1> q_mean = shrink * to_mean(i, j);
+          // Gauss-Newton step of the MAP estimate: q = m + Sigma J^T (J Sigma J^T +
+          // s^2 I)^-1 (r + J (q0 - m)), s^2 = correction_noise x the mean predicted
+          // variance.
+          const Eigen::MatrixXd js = jr * prior.covariance;
           Eigen::MatrixXd a = js * jr.transpose();
           const double scale = a.trace() / rows;
           if (!(scale > 1e-12)) continue;
           a.diagonal().array() += options.correction_noise * scale;
           const Eigen::Matrix<double, 6, 1> q_new =
-              js.transpose() * a.ldlt().solve(res.head(rows) + jr * q0);
+              q_mean + js.transpose() * a.ldlt().solve(res.head(rows) + jr * (q0 - q_mean));
           for (int m = 0; m < 6; ++m)
             patch.correction[static_cast<std::size_t>(m)].at<float>(j, i) =
                 static_cast<float>(q_new[m]);
@@ -1152,8 +1205,21 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     }
     if (!rects.empty() && options.correction_iterations > 0 &&
         sample.format == ptm::PtmFormat::kLrgb) {
-      CorrectPatch(patch, rects);
-      correction_level[f] = rects[0].level;
+      // The correction's views on the primary view's grid: a coarser photo,
+      // upsampled there, constrains each cell at its place instead of one of
+      // its own pixels constraining several cells alike.
+      const int primary_level = rects.front().level;
+      std::vector<Rectified> on_grid;
+      on_grid.reserve(rects.size());
+      for (Rectified& r : rects) {
+        Rectified again;
+        if (r.level == primary_level)
+          on_grid.push_back(std::move(r));
+        else if (rectify(f, r.view, again, primary_level))
+          on_grid.push_back(std::move(again));
+      }
+      CorrectPatch(patch, on_grid);
+      correction_level[f] = primary_level;
     }
     done[f] = 1;
     ++processed;

@@ -69,6 +69,15 @@ struct MeshSynthesisOptions {
   /// Photo noise of that estimate, as a share of the variance the prior predicts
   /// at the photo pixel: small trusts the photos, large keeps the sample. > 0.
   double correction_noise = 0.1;
+  /// Prior mean of that estimate: the quilted patch's coefficients moved this
+  /// share of the way to the sample's mean at the photo's density. The photos
+  /// fix only the coefficient directions their lights see; in the others the
+  /// quilted patch keeps its own structure, right only as far as the patch
+  /// matches the object. 0 = the quilted patch, 1 = the mean; < 0 (default):
+  /// estimated per patch as 1 - rho, rho in [0, 1] the share of the patch's
+  /// departure from the mean that the photos confirm where they see it.
+  /// [0, 1] or < 0.
+  double correction_prior_shrink = -1.0;
   /// Low-frequency per-channel factors normalised to keep the luminance
   /// (chromaticity: stains, colour), before the additive change.
   bool channel_correction = true;
@@ -106,7 +115,9 @@ struct TrianglePatch {
   int sample_x = 0, sample_y = 0;                   ///< texels, top-left in the sample
   PatchSource source = PatchSource::kRandom;
   int views_used = 0;
-  double image_score = 0.0;    ///< summed RMS photo difference of the chosen patch
+  double image_score = 0.0;  ///< summed RMS photo difference of the chosen patch
+  /// The photo-consistency pass's prior shrink used (see the option); -1 uncorrected.
+  double prior_shrink = -1.0;
   double overlap_error = 0.0;  ///< mean squared orthonormal distance to the neighbours
   /// Photo-consistency correction of the luminance coefficients (orthonormal
   /// space, 6 planes, LRGB), on a grid of `correction_density` cells per texel

@@ -33,6 +33,15 @@ fs::path PngName(const std::string& image_name) {
   return p;
 }
 
+// Mean prior shrink over the photo-corrected patches (null when none was).
+nlohmann::json MeanPriorShrink(const MeshSynthesis& synthesis) {
+  double sum = 0.0;
+  int n = 0;
+  for (const TrianglePatch& p : synthesis.patches)
+    if (p.prior_shrink >= 0.0) sum += p.prior_shrink, ++n;
+  return n ? nlohmann::json(sum / n) : nlohmann::json(nullptr);
+}
+
 }  // namespace
 
 cv::Mat ToBgr8(const cv::Mat& display_rgb) {
@@ -299,6 +308,9 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
       {"correction_noise", so.correction_noise},
       {"channel_correction", so.channel_correction},
       {"detail_transfer", so.detail_transfer},
+      {"correction_prior_shrink", so.correction_prior_shrink < 0.0
+                                      ? nlohmann::json("auto")
+                                      : nlohmann::json(so.correction_prior_shrink)},
       {"correction_sigma", so.correction_sigma},
       {"horizon_elevation_deg", kHorizonElevationDeg},
       {"seed", so.seed}};
@@ -317,7 +329,8 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
                         {{"mean", summary.stretch.mean},
                          {"min", summary.stretch.min},
                          {"max", summary.stretch.max}}},
-                       {"photo_gains", synthesis.photo_gains}};
+                       {"photo_gains", synthesis.photo_gains},
+                       {"mean_prior_shrink", MeanPriorShrink(synthesis)}};
   record["warnings"] = summary.warnings;
   std::vector<std::pair<std::string, cv::Mat>> extra = RecordBaselines(flat_albedo, baked, record);
   record["timings_s"] = {{"load", summary.seconds_load},
