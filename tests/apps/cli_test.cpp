@@ -161,6 +161,16 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
                     &out),
             2);
   EXPECT_NE(out.find("stretch"), std::string::npos) << out;
+  // So is a prior shrink that is neither auto nor in [0, 1].
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --correction-prior-shrink 1.5",
+                    &out),
+            2);
+  EXPECT_NE(out.find("correction-prior-shrink"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --correction-prior-shrink often",
+                    &out),
+            2);
   EXPECT_EQ(Texlume("render --model " + (tmp / "nomodel").string() +
                         " --cameras c --lights l "
                         "--out " +
