@@ -803,63 +803,62 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
     auto seen = [&](const Rectified& r, int i, int j) { return r.mask.at<float>(j, i) > 0; };
     // Prediction and luminance Jacobian of view r at cell (i, j), with the
     // change q_delta (orthonormal) added to the patch's coefficients.
-    auto predict_with =
-        [&](const Rectified& r, int i, int j, const Eigen::Matrix<double, 6, 1>& q_delta,
-            Eigen::Matrix<double, 1, 6>& jac, Eigen::Vector3d* channel_linear = nullptr) {
-          const ReducedSample& red = red0;
-          // Cell (i, j)'s centre in the reduced sample's pixel coordinates (centres
-          // at integers): (sample_x + (i + 0.5) / rx) rx - 0.5; bilinear there.
-          const double sx = std::clamp(patch.sample_x * red.rx + i, 0.0, red.raw[0].cols - 1.0);
-          const double sy = std::clamp(patch.sample_y * red.ry + j, 0.0, red.raw[0].rows - 1.0);
-          const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
-          const int x1 = std::min(x0 + 1, red.raw[0].cols - 1),
-                    y1 = std::min(y0 + 1, red.raw[0].rows - 1);
-          const float fx = static_cast<float>(sx - x0), fy = static_cast<float>(sy - y0);
-          auto sample_at = [&](const cv::Mat& m) {
-            return (1 - fy) * ((1 - fx) * m.at<float>(y0, x0) + fx * m.at<float>(y0, x1)) +
-                   fy * ((1 - fx) * m.at<float>(y1, x0) + fx * m.at<float>(y1, x1));
-          };
-          const Eigen::Matrix<double, 6, 1> a_delta = from_orthonormal * q_delta;
-          float a[6], colour[3];
-          for (int m = 0; m < 6; ++m)
-            a[m] = sample_at(red.raw[static_cast<std::size_t>(m)]) + static_cast<float>(a_delta[m]);
-          for (int c = 0; c < 3; ++c)
-            colour[c] = sample_at(red.raw[static_cast<std::size_t>(6 + c)]);
-          const double g = result.photo_gains[r.photo];
-          Eigen::Vector3d linear = Eigen::Vector3d::Zero();
-          Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
-          for (const auto& [l, intensity] : r.lights) {
-            if (l.z() <= 0) continue;
-            const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
-            const std::array<double, 6> phi = ptm::PtmBasis(l.x(), l.y());
-            const Eigen::Matrix<double, 1, 6> row =
-                Eigen::Map<const Eigen::Matrix<double, 1, 6>>(phi.data()) * from_orthonormal;
-            for (int c = 0; c < 3; ++c) {
-              const double v = lum * colour[c];
-              if (v <= 0.0 || v >= 1.0) continue;  // clamped: no derivative
-              const double h = 1e-3;
-              const double dlin = (SrgbToLinear(static_cast<float>(std::min(1.0, v + h))) -
-                                   SrgbToLinear(static_cast<float>(std::max(0.0, v - h)))) /
-                                  (std::min(1.0, v + h) - std::max(0.0, v - h));
-              linear[c] += intensity * SrgbToLinear(static_cast<float>(v));
-              dlinear.row(c) += intensity * dlin * colour[c] * row;
-            }
-          }
-          double y_pred = 0.0;
-          jac.setZero();
-          for (int c = 0; c < 3; ++c) {
-            const double lin = g * linear[c];
-            if (channel_linear) (*channel_linear)[c] = lin;
-            const double d = LinearToSrgb(static_cast<float>(lin));
-            const double h = 1e-4;
-            const double dsrgb = (LinearToSrgb(static_cast<float>(lin + h)) -
-                                  LinearToSrgb(static_cast<float>(std::max(0.0, lin - h)))) /
-                                 (lin + h - std::max(0.0, lin - h));
-            y_pred += d / 3.0;
-            jac += dsrgb * g * dlinear.row(c) / 3.0;
-          }
-          return y_pred;
-        };
+    auto predict_with = [&](const Rectified& r, int i, int j,
+                            const Eigen::Matrix<double, 6, 1>& q_delta,
+                            Eigen::Matrix<double, 1, 6>& jac,
+                            Eigen::Vector3d* channel_linear = nullptr) {
+      // Cell (i, j)'s centre in the reduced sample's pixel coordinates (centres
+      // at integers): (sample_x + (i + 0.5) / rx) rx - 0.5; bilinear there.
+      const double sx = std::clamp(patch.sample_x * red0.rx + i, 0.0, red0.raw[0].cols - 1.0);
+      const double sy = std::clamp(patch.sample_y * red0.ry + j, 0.0, red0.raw[0].rows - 1.0);
+      const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
+      const int x1 = std::min(x0 + 1, red0.raw[0].cols - 1),
+                y1 = std::min(y0 + 1, red0.raw[0].rows - 1);
+      const float fx = static_cast<float>(sx - x0), fy = static_cast<float>(sy - y0);
+      auto sample_at = [&](const cv::Mat& m) {
+        return (1 - fy) * ((1 - fx) * m.at<float>(y0, x0) + fx * m.at<float>(y0, x1)) +
+               fy * ((1 - fx) * m.at<float>(y1, x0) + fx * m.at<float>(y1, x1));
+      };
+      const Eigen::Matrix<double, 6, 1> a_delta = from_orthonormal * q_delta;
+      float a[6], colour[3];
+      for (int m = 0; m < 6; ++m)
+        a[m] = sample_at(red0.raw[static_cast<std::size_t>(m)]) + static_cast<float>(a_delta[m]);
+      for (int c = 0; c < 3; ++c) colour[c] = sample_at(red0.raw[static_cast<std::size_t>(6 + c)]);
+      const double g = result.photo_gains[r.photo];
+      Eigen::Vector3d linear = Eigen::Vector3d::Zero();
+      Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
+      for (const auto& [l, intensity] : r.lights) {
+        if (l.z() <= 0) continue;
+        const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
+        const std::array<double, 6> phi = ptm::PtmBasis(l.x(), l.y());
+        const Eigen::Matrix<double, 1, 6> row =
+            Eigen::Map<const Eigen::Matrix<double, 1, 6>>(phi.data()) * from_orthonormal;
+        for (int c = 0; c < 3; ++c) {
+          const double v = lum * colour[c];
+          if (v <= 0.0 || v >= 1.0) continue;  // clamped: no derivative
+          const double h = 1e-3;
+          const double dlin = (SrgbToLinear(static_cast<float>(std::min(1.0, v + h))) -
+                               SrgbToLinear(static_cast<float>(std::max(0.0, v - h)))) /
+                              (std::min(1.0, v + h) - std::max(0.0, v - h));
+          linear[c] += intensity * SrgbToLinear(static_cast<float>(v));
+          dlinear.row(c) += intensity * dlin * colour[c] * row;
+        }
+      }
+      double y_pred = 0.0;
+      jac.setZero();
+      for (int c = 0; c < 3; ++c) {
+        const double lin = g * linear[c];
+        if (channel_linear) (*channel_linear)[c] = lin;
+        const double d = LinearToSrgb(static_cast<float>(lin));
+        const double h = 1e-4;
+        const double dsrgb = (LinearToSrgb(static_cast<float>(lin + h)) -
+                              LinearToSrgb(static_cast<float>(std::max(0.0, lin - h)))) /
+                             (lin + h - std::max(0.0, lin - h));
+        y_pred += d / 3.0;
+        jac += dsrgb * g * dlinear.row(c) / 3.0;
+      }
+      return y_pred;
+    };
     auto correction_at = [&](int i, int j) {
       Eigen::Matrix<double, 6, 1> q;
       for (int m = 0; m < 6; ++m)
@@ -870,15 +869,22 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
                        Eigen::Vector3d* channel_linear = nullptr) {
       return predict_with(r, i, j, correction_at(i, j), jac, channel_linear);
     };
-    // The way from the patch's coefficients to the prior's mean at cell (i, j).
-    auto to_mean = [&](int i, int j) -> Eigen::Matrix<double, 6, 1> {
-      Eigen::Matrix<double, 6, 1> a_patch;
-      for (int m = 0; m < 6; ++m)
-        a_patch[m] =
-            BilinearClamped(red0.raw[static_cast<std::size_t>(m)],
-                            std::clamp(patch.sample_x * red0.rx + i, 0.0, red0.raw[0].cols - 1.0),
-                            std::clamp(patch.sample_y * red0.ry + j, 0.0, red0.raw[0].rows - 1.0));
-      return prior.mean - to_orthonormal * a_patch;
+    // The way from the patch's coefficients to the prior's mean, per cell (the
+    // patch is fixed during the pass, so once).
+    std::vector<Eigen::Matrix<double, 6, 1>> to_mean_of_cell(static_cast<std::size_t>(gw * gh));
+    for (int j = 0; j < gh; ++j)
+      for (int i = 0; i < gw; ++i) {
+        Eigen::Matrix<double, 6, 1> a_patch;
+        for (int m = 0; m < 6; ++m)
+          a_patch[m] = BilinearClamped(
+              red0.raw[static_cast<std::size_t>(m)],
+              std::clamp(patch.sample_x * red0.rx + i, 0.0, red0.raw[0].cols - 1.0),
+              std::clamp(patch.sample_y * red0.ry + j, 0.0, red0.raw[0].rows - 1.0));
+        to_mean_of_cell[static_cast<std::size_t>(j * gw + i)] =
+            prior.mean - to_orthonormal * a_patch;
+      }
+    auto to_mean = [&](int i, int j) -> const Eigen::Matrix<double, 6, 1>& {
+      return to_mean_of_cell[static_cast<std::size_t>(j * gw + i)];
     };
     auto photo_luminance = [](const Rectified& r, int i, int j) {
       return (r.planes[0].at<float>(j, i) + r.planes[1].at<float>(j, i) +
