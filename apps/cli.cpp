@@ -449,6 +449,7 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
                      "gutter",
                      "seed",
                      "tangent-field",
+                     "tangent-frame",
                      "max-subdivisions",
                      "max-buffer-size",
                      "correction-iterations",
@@ -491,6 +492,18 @@ int RunSynthCommand(const std::vector<std::string>& args, std::ostream& out, std
     o.synthesis.correction_prior_shrink = a.GetDouble("correction-prior-shrink", 0.0);
     if (!(o.synthesis.correction_prior_shrink >= 0.0 && o.synthesis.correction_prior_shrink <= 1.0))
       throw UsageError("--correction-prior-shrink: give auto or a number in [0, 1]");
+  }
+  if (const auto frame = a.Get("tangent-frame")) {
+    if (a.Has("tangent-field"))
+      throw UsageError("give --tangent-frame or --tangent-field, not both");
+    if (*frame == "first-edge")
+      o.synthesis.tangent_frame = synth::TangentFrame::kFirstEdge;
+    else if (*frame == "photos")
+      o.synthesis.tangent_frame = synth::TangentFrame::kPhotos;
+    else if (*frame == "auto")
+      o.synthesis.tangent_frame = synth::TangentFrame::kAuto;
+    else
+      throw UsageError("--tangent-frame: give first-edge, photos or auto");
   }
   if (const auto field = a.Get("tangent-field")) {
     const std::vector<double> d = ParseList(*field, 3, "--tangent-field");

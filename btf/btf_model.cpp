@@ -330,21 +330,19 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
                       {"lights", job.lights_file.string()},
                       {"mesh", job.mesh_file.string()},
                       {"btf", options.btf.string()}};
-  record["settings"] = {
-      {"sample_texel_size", so.sample_texel_size},
-      {"components", sample.Components()},
-      {"strip", so.strip},
-      {"seam_band", so.seam_band},
-      {"top_k", so.top_k},
-      {"max_views", so.max_views},
-      {"tangent_frame",
-       so.tangent_frame == synth::TangentFrame::kSmoothField ? "smooth_field" : "first_edge"},
-      {"tolerance", so.tolerance},
-      {"photo_correction", so.photo_correction},
-      {"correction_noise", so.correction_noise},
-      {"correction_sigma", so.correction_sigma},
-      {"seed", so.seed},
-      {"horizon_elevation_deg", synth::kHorizonElevationDeg}};
+  record["settings"] = {{"sample_texel_size", so.sample_texel_size},
+                        {"components", sample.Components()},
+                        {"strip", so.strip},
+                        {"seam_band", so.seam_band},
+                        {"top_k", so.top_k},
+                        {"max_views", so.max_views},
+                        {"tangent_frame", synth::TangentFrameName(so.tangent_frame)},
+                        {"tolerance", so.tolerance},
+                        {"photo_correction", so.photo_correction},
+                        {"correction_noise", so.correction_noise},
+                        {"correction_sigma", so.correction_sigma},
+                        {"seed", so.seed},
+                        {"horizon_elevation_deg", synth::kHorizonElevationDeg}};
   record["settings"].update(synth::AtlasSettingsJson(job.atlas));
   record["summary"] = {{"photos_used", summary.photos_used},
                        {"faces", summary.faces},
@@ -361,7 +359,11 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
                        {"straight_edge_cost_per_link", summary.edge_cost_per_link},
                        {"photo_rms_quilted", synthesis.photo_rms_quilted},
                        {"photo_rms_corrected", synthesis.photo_rms_corrected},
-                       {"photo_gains", synthesis.photo_gains}};
+                       {"photo_gains", synthesis.photo_gains},
+                       {"tangent_frame", synth::TangentFrameName(synthesis.tangent_frame)},
+                       {"sample_coherence", synthesis.sample_coherence >= 0.0
+                                                ? nlohmann::json(synthesis.sample_coherence)
+                                                : nlohmann::json(nullptr)}};
   record["warnings"] = summary.warnings;
   std::vector<std::pair<std::string, cv::Mat>> extra =
       synth::RecordBaselines(flat_albedo, baked, record);

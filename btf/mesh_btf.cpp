@@ -11,6 +11,7 @@
 #include <random>
 
 #include "sfm/errors.h"
+#include "synth/tangent_field.h"
 #include "synth/template_match.h"
 #include "synth/triangle_frame.h"
 
@@ -153,9 +154,7 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
   result.sample_height = sample.height;
 
   // 1. Frames, patch rectangles, unfoldings (Algorithm 2's set-up).
-  {
-    synth::PatchGeometry geometry = synth::MakePatchGeometry(
-        mesh, t, options.strip, options.tangent_frame, options.field_direction_in_world);
+  auto take_geometry = [&](synth::PatchGeometry geometry) {
     if (geometry.total_texels > options.max_texels) {
       throw InputError("mesh", "at a texel size of " + std::to_string(t) + " world units the " +
                                    std::to_string(num_faces) + " patches need " +
@@ -173,7 +172,9 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     }
     result.patches = std::move(geometry.patches);
     result.unfoldings = std::move(geometry.unfoldings);
-  }
+  };
+  take_geometry(synth::MakePatchGeometry(mesh, t, options.strip, options.tangent_frame,
+                                         options.field_direction_in_world));
   const std::vector<cv::Mat> planes = GeometryPlanes(sample);
   const cv::Mat planes_energy = synth::PlaneEnergy(planes);
   const Eigen::VectorXf mean_g = sample.geometry.colwise().mean().transpose();
@@ -266,6 +267,48 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
     }
     return out;
   };
+
+  // 1b. Frames turned to the photos (kPhotos, or kAuto for an anisotropic
+  // sample), as in the PTM synthesis (synth/tangent_field.h); the sample is
+  // relit seen from above.
+  result.tangent_frame = options.tangent_frame;
+  if (options.tangent_frame == synth::TangentFrame::kPhotos ||
+      options.tangent_frame == synth::TangentFrame::kAuto) {
+    std::vector<int> face_levels(num_faces, -1);
+    std::vector<synth::TriangleFrame> frames(num_faces);
+    for (std::size_t f = 0; f < num_faces; ++f) {
+      frames[f] = result.patches[f].frame;
+      const std::vector<sfm::TriangleView> views =
+          synth::ConstrainingViews(visibility.triangles[f], true, options.max_views);
+      if (!views.empty()) face_levels[f] = synth::PhotoDensityLevel(result.patches[f], views[0], t);
+    }
+    const synth::FrameChoice choice = synth::ChoosePhotoFrames(
+        options.tangent_frame, frames, result.unfoldings, face_levels,
+        [&](int level) {
+          const synth::ReducedPlanes& red = reduced_at(level);
+          return synth::SampleStructureTensor(
+              [&](const Eigen::Vector3d& l) {
+                return relit(red, InterpolateAppearance(sample, Eigen::Vector3d::UnitZ(), l), 1.0);
+              },
+              red.rx, red.ry);
+        },
+        [&](std::size_t f) {
+          Eigen::Matrix2d tensor = Eigen::Matrix2d::Zero();
+          for (const sfm::TriangleView& view :
+               synth::ConstrainingViews(visibility.triangles[f], true, options.max_views)) {
+            Rectified rect;
+            if (!rectify(f, view, rect, false)) continue;
+            const synth::ReducedPlanes& r = reduced_at(rect.level);
+            tensor += synth::LuminanceStructureTensor(rect.linear, rect.mask, r.rx, r.ry);
+          }
+          return tensor;
+        });
+    result.tangent_frame = choice.tangent_frame;
+    result.sample_coherence = choice.sample_coherence;
+    if (choice.tangent_frame == synth::TangentFrame::kPhotos)
+      take_geometry(
+          synth::MakePatchGeometry(mesh, t, options.strip, choice.field.tangents_in_world));
+  }
 
   // 2a. Gain per photo, as in the PTM synthesis: photo mean over the sample's
   // mean relit under the triangle's view and lights, m = a_T g_n, solved for

@@ -31,7 +31,8 @@ struct BtfMeshSynthesisOptions {
   /// Most photos constraining one triangle (the best view, then the most
   /// frontal fully visible ones). >= 1.
   int max_views = 4;
-  synth::TangentFrame tangent_frame = synth::TangentFrame::kFirstEdge;
+  /// As synth::MeshSynthesisOptions::tangent_frame.
+  synth::TangentFrame tangent_frame = synth::TangentFrame::kAuto;
   Eigen::Vector3d field_direction_in_world = Eigen::Vector3d::UnitZ();
   /// Triangles seen in no photo: pick at random among placements whose overlap
   /// error is within (1 + tolerance) of the best. >= 0.
@@ -99,6 +100,10 @@ struct BtfMeshSynthesis {
   double seam_cost_per_link = 0;        ///< mean E_smooth term of a cut pair (geometry-map units)
   double edge_cost_per_link = 0;  ///< the same for a straight seam along the mesh edge (no cut)
   double seconds_synthesis = 0, seconds_seams = 0;
+  /// The frames the patches have (kAuto resolved), and the sample's coherence
+  /// that kAuto judged by (-1: not measured); see synth::MeshSynthesis.
+  synth::TangentFrame tangent_frame = synth::TangentFrame::kFirstEdge;
+  double sample_coherence = -1.0;
 
   /// The sample texel a point of face `face` (its triangle frame, world units) shows.
   BtfSampleLookup Lookup(int face, const Eigen::Vector2d& p_in_frame) const;

@@ -16,6 +16,7 @@
 #include "ptm/coefficient_space.h"
 #include "sfm/errors.h"
 #include "synth/planar_synthesis.h"
+#include "synth/tangent_field.h"
 #include "synth/template_match.h"
 
 namespace texlume::synth {
@@ -291,6 +292,20 @@ ReducedPlanes ReduceToDensityLevel(const std::vector<cv::Mat>& planes, int level
   return r;
 }
 
+const char* TangentFrameName(TangentFrame frame) {
+  switch (frame) {
+    case TangentFrame::kFirstEdge:
+      return "first_edge";
+    case TangentFrame::kSmoothField:
+      return "smooth_field";
+    case TangentFrame::kPhotos:
+      return "photos";
+    case TangentFrame::kAuto:
+      return "auto";
+  }
+  return "first_edge";
+}
+
 int PhotoDensityLevel(const TrianglePatch& patch, const sfm::TriangleView& view, double t) {
   const auto& c = patch.corners_in_frame;
   const double area =
@@ -429,6 +444,27 @@ void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& can
 PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int strip,
                                 TangentFrame tangent_frame,
                                 const Eigen::Vector3d& field_direction_in_world) {
+  std::vector<Eigen::Vector3d> tangents(mesh.faces.size());
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    tangents[f] = mesh.Corner(f, 1) - mesh.Corner(f, 0);
+    if (tangent_frame != TangentFrame::kSmoothField) continue;
+    const Eigen::Vector3d n = (mesh.Corner(f, 1) - mesh.Corner(f, 0))
+                                  .cross(mesh.Corner(f, 2) - mesh.Corner(f, 0))
+                                  .normalized();
+    Eigen::Vector3d d = field_direction_in_world.normalized();
+    if ((d - n * n.dot(d)).norm() < 0.3) {
+      // Near the field's poles: the world axis least aligned with the normal.
+      Eigen::Index axis;
+      n.cwiseAbs().minCoeff(&axis);
+      d = Eigen::Vector3d::Unit(axis);
+    }
+    tangents[f] = d;
+  }
+  return MakePatchGeometry(mesh, t, strip, tangents);
+}
+
+PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int strip,
+                                const std::vector<Eigen::Vector3d>& tangents_in_world) {
   const std::size_t num_faces = mesh.faces.size();
   PatchGeometry result;
   std::int64_t& total_texels = result.total_texels;
@@ -437,21 +473,7 @@ PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int str
   result.patches.resize(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f) {
     TrianglePatch& patch = result.patches[f];
-    if (tangent_frame == TangentFrame::kSmoothField) {
-      const Eigen::Vector3d n = (mesh.Corner(f, 1) - mesh.Corner(f, 0))
-                                    .cross(mesh.Corner(f, 2) - mesh.Corner(f, 0))
-                                    .normalized();
-      Eigen::Vector3d d = field_direction_in_world.normalized();
-      if ((d - n * n.dot(d)).norm() < 0.3) {
-        // Near the field's poles: the world axis least aligned with the normal.
-        Eigen::Index axis;
-        n.cwiseAbs().minCoeff(&axis);
-        d = Eigen::Vector3d::Unit(axis);
-      }
-      patch.frame = MakeTriangleFrame(mesh, f, d);
-    } else {
-      patch.frame = MakeTriangleFrame(mesh, f);
-    }
+    patch.frame = MakeTriangleFrame(mesh, f, tangents_in_world[f]);
     Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
     Eigen::Vector2d hi = -lo;
     for (int k = 0; k < 3; ++k) {
@@ -529,36 +551,34 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   const cv::Mat sample_energy = PlaneEnergy(sample_coefficients);
   const std::vector<cv::Mat> sample_raw = RawPlanes(sample);
 
-  std::int64_t total_texels = 0;
-  int widest = 0, tallest = 0;
   // 1. Frames, patch rectangles, and the memory they need (refused up front).
-  {
-    PatchGeometry geometry = MakePatchGeometry(mesh, t, options.strip, options.tangent_frame,
-                                               options.field_direction_in_world);
+  auto take_geometry = [&](PatchGeometry geometry) {
+    if (geometry.total_texels > options.max_texels) {
+      throw InputError(
+          "mesh", "at a texel size of " + std::to_string(t) + " world units the " +
+                      std::to_string(num_faces) + " patches need " +
+                      std::to_string(geometry.total_texels) + " texels (about " +
+                      std::to_string(geometry.total_texels * 4 *
+                                         static_cast<std::int64_t>(result.sample_planes.size()) >>
+                                     20) +
+                      " MiB per copy), more than the limit of " +
+                      std::to_string(options.max_texels) +
+                      "; use a larger texel size or a finer mesh");
+    }
+    if (geometry.widest > sample.width || geometry.tallest > sample.height) {
+      throw InputError(
+          "mesh", "the largest triangle needs a patch of " + std::to_string(geometry.widest) +
+                      " x " + std::to_string(geometry.tallest) +
+                      " texels (strip included) but the sample is " + std::to_string(sample.width) +
+                      " x " + std::to_string(sample.height) +
+                      "; subdivide the mesh (texlume synth --subdivide) or capture a "
+                      "larger sample");
+    }
     result.patches = std::move(geometry.patches);
     result.unfoldings = std::move(geometry.unfoldings);
-    total_texels = geometry.total_texels;
-    widest = geometry.widest;
-    tallest = geometry.tallest;
-  }
-  if (total_texels > options.max_texels) {
-    throw InputError(
-        "mesh",
-        "at a texel size of " + std::to_string(t) + " world units the " +
-            std::to_string(num_faces) + " patches need " + std::to_string(total_texels) +
-            " texels (about " +
-            std::to_string(
-                total_texels * 4 * static_cast<std::int64_t>(result.sample_planes.size()) >> 20) +
-            " MiB per copy), more than the limit of " + std::to_string(options.max_texels) +
-            "; use a larger texel size or a finer mesh");
-  }
-  if (widest > sample.width || tallest > sample.height) {
-    throw InputError(
-        "mesh", "the largest triangle needs a patch of " + std::to_string(widest) + " x " +
-                    std::to_string(tallest) + " texels (strip included) but the sample is " +
-                    std::to_string(sample.width) + " x " + std::to_string(sample.height) +
-                    "; subdivide the mesh (texlume synth --subdivide) or capture a larger sample");
-  }
+  };
+  take_geometry(MakePatchGeometry(mesh, t, options.strip, options.tangent_frame,
+                                  options.field_direction_in_world));
 
   // Photos by image id, and the reduced samples by density level.
   std::map<sfm::ImageId, std::size_t> photo_index;
@@ -701,6 +721,49 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   auto views_of = [&](std::size_t f) {
     return ConstrainingViews(visibility.triangles[f], options.all_views, options.max_views);
   };
+
+  // 1b. Frames turned to the photos (beyond the paper; synth/tangent_field.h):
+  // the sample's structure tensor at the photos' median density against each
+  // face's photos' tensor in its first-edge frame; kAuto does so only for an
+  // anisotropic sample.
+  result.tangent_frame = options.tangent_frame;
+  if (options.tangent_frame == TangentFrame::kPhotos ||
+      options.tangent_frame == TangentFrame::kAuto) {
+    std::vector<int> face_levels(num_faces, -1);
+    std::vector<TriangleFrame> frames(num_faces);
+    for (std::size_t f = 0; f < num_faces; ++f) {
+      frames[f] = result.patches[f].frame;
+      const std::vector<sfm::TriangleView> views = views_of(f);
+      if (!views.empty()) face_levels[f] = PhotoDensityLevel(result.patches[f], views[0], t);
+    }
+    const FrameChoice choice = ChoosePhotoFrames(
+        options.tangent_frame, frames, result.unfoldings, face_levels,
+        [&](int level) {
+          const ReducedSample& red = reduced_at(level);
+          return SampleStructureTensor(
+              [&](const Eigen::Vector3d& l) {
+                return relit_planes(red, {{l, 1.0}}, 1.0);
+              },
+              red.rx, red.ry);
+        },
+        [&](std::size_t f) {
+          Eigen::Matrix2d tensor = Eigen::Matrix2d::Zero();
+          for (const sfm::TriangleView& view : views_of(f)) {
+            Rectified rect;
+            if (!rectify(f, view, rect)) continue;
+            const ReducedSample& r = reduced_at(rect.level);
+            tensor += LuminanceStructureTensor(rect.planes, rect.mask, r.rx, r.ry);
+          }
+          return tensor;
+        });
+    result.tangent_frame = choice.tangent_frame;
+    result.sample_coherence = choice.sample_coherence;
+    if (choice.tangent_frame == TangentFrame::kPhotos) {
+      take_geometry(MakePatchGeometry(mesh, t, options.strip, choice.field.tangents_in_world));
+      result.field_faces_with_photos = choice.field.faces_with_photos;
+      result.field_mean_coherence = choice.field.mean_coherence;
+    }
+  }
 
   // 2a. Per-photo gain (exposure x light intensity, linear domain). For every
   // triangle fully visible in a photo, m = photo mean / sample mean relit at the

@@ -32,7 +32,17 @@ enum class TangentFrame {
   kFirstEdge,    ///< v0 -> v1 (paper 003 §3.0.2)
   kSmoothField,  ///< a fixed world direction projected onto each face, so anisotropic
                  ///< materials keep their direction across triangles
+  kPhotos,       ///< turned so the sample's texture runs the way the photos show it, as a
+                 ///< smooth line field over the mesh (synth/tangent_field.h)
+  kAuto,         ///< kPhotos for an anisotropic sample (brick, grooves), else kFirstEdge
 };
+
+/// kAuto takes kPhotos when the sample's structure-tensor coherence (MeshSynthesis::
+/// sample_coherence) is at least this.
+inline constexpr double kAnisotropicSampleCoherence = 0.2;
+
+/// "first_edge", "smooth_field", "photos" or "auto" (the manifest's names).
+const char* TangentFrameName(TangentFrame frame);
 
 /// Settings of SynthesizeMeshPtm (paper 003 Algorithm 2).
 struct MeshSynthesisOptions {
@@ -47,7 +57,9 @@ struct MeshSynthesisOptions {
   bool all_views = true;
   /// Most views used per triangle with all_views. >= 1.
   int max_views = 4;
-  TangentFrame tangent_frame = TangentFrame::kFirstEdge;
+  /// Where each face's frame x axis points (the sample's texture is laid along
+  /// it). kAuto: turned to the photos when the sample is anisotropic.
+  TangentFrame tangent_frame = TangentFrame::kAuto;
   /// kSmoothField: the world direction projected onto each face (falls back to
   /// the orthogonal world axis of smallest normal component where it is nearly
   /// parallel to the normal).
@@ -159,6 +171,14 @@ struct MeshSynthesis {
   std::map<int, std::vector<cv::Mat>> detail_bands;
   std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
   double seconds = 0.0;
+  /// The frames the patches have (kAuto resolved to kPhotos or kFirstEdge).
+  TangentFrame tangent_frame = TangentFrame::kFirstEdge;
+  /// Coherence of the sample's structure tensor (0 isotropic, 1 one direction)
+  /// at the photos' median density; -1 when not measured (kFirstEdge, kSmoothField).
+  double sample_coherence = -1.0;
+  /// kPhotos: faces whose photos constrained the field, and their mean coherence.
+  int field_faces_with_photos = 0;
+  double field_mean_coherence = 0.0;
 
   /// Most planes a texel has (RGB: 18 coefficients; LRGB: 6 + 3 colour).
   static constexpr std::size_t kMaxPlanes = 18;
@@ -187,6 +207,11 @@ struct PatchGeometry {
 PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double texel_size, int strip,
                                 TangentFrame tangent_frame,
                                 const Eigen::Vector3d& field_direction_in_world);
+/// The same with each face's frame x axis along its tangent (projected onto the
+/// face; v0 -> v1 where it is nearly the normal). kPhotos and kAuto above give
+/// first-edge frames, the start that SynthesizeMeshPtm turns.
+PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double texel_size, int strip,
+                                const std::vector<Eigen::Vector3d>& tangents_in_world);
 
 /// Helpers of Algorithm 2 shared by the PTM and BTF synthesis.
 ///

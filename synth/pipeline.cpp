@@ -301,8 +301,7 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
       {"top_k", so.top_k},
       {"all_views", so.all_views},
       {"max_views", so.max_views},
-      {"tangent_frame",
-       so.tangent_frame == TangentFrame::kSmoothField ? "smooth_field" : "first_edge"},
+      {"tangent_frame", TangentFrameName(so.tangent_frame)},
       {"correction_iterations", so.correction_iterations},
       {"additive_correction", so.additive_correction},
       {"correction_noise", so.correction_noise},
@@ -330,7 +329,11 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
                          {"min", summary.stretch.min},
                          {"max", summary.stretch.max}}},
                        {"photo_gains", synthesis.photo_gains},
-                       {"mean_prior_shrink", MeanPriorShrink(synthesis)}};
+                       {"mean_prior_shrink", MeanPriorShrink(synthesis)},
+                       {"tangent_frame", TangentFrameName(synthesis.tangent_frame)},
+                       {"sample_coherence", synthesis.sample_coherence >= 0.0
+                                                ? nlohmann::json(synthesis.sample_coherence)
+                                                : nlohmann::json(nullptr)}};
   record["warnings"] = summary.warnings;
   std::vector<std::pair<std::string, cv::Mat>> extra = RecordBaselines(flat_albedo, baked, record);
   record["timings_s"] = {{"load", summary.seconds_load},

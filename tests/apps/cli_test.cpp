@@ -171,6 +171,16 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
                     "--sample-texel-size 0.01 --out f --correction-prior-shrink often",
                     &out),
             2);
+  // So is a tangent frame that is not one of the three, or given with a field.
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --tangent-frame sideways",
+                    &out),
+            2);
+  EXPECT_NE(out.find("--tangent-frame: give first-edge, photos or auto"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --tangent-frame photos --tangent-field 0,0,1",
+                    &out),
+            2);
   EXPECT_EQ(Texlume("render --model " + (tmp / "nomodel").string() +
                         " --cameras c --lights l "
                         "--out " +
