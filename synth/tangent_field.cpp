@@ -56,8 +56,8 @@ Eigen::Matrix2d SampleStructureTensor(
     const double azimuth = k * M_PI / 4.0, elevation = k < 0 ? M_PI / 2.0 : M_PI / 4.0;
     const Eigen::Vector3d light(std::cos(elevation) * std::cos(azimuth),
                                 std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
-    tensor += LuminanceStructureTensor(relit(light), cv::Mat(), cells_per_texel_x,
-                                       cells_per_texel_y);
+    tensor +=
+        LuminanceStructureTensor(relit(light), cv::Mat(), cells_per_texel_x, cells_per_texel_y);
   }
   return tensor;
 }
@@ -137,11 +137,11 @@ PhotoTangentField PhotoAlignedTangents(const std::vector<TriangleFrame>& frames,
   return field;
 }
 
-FrameChoice ChoosePhotoFrames(TangentFrame requested, const std::vector<TriangleFrame>& frames,
-                              const std::vector<std::array<Unfolding, 3>>& unfoldings,
-                              const std::vector<int>& face_levels,
-                              const std::function<Eigen::Matrix2d(int level)>& sample_tensor_at,
-                              const std::function<Eigen::Matrix2d(std::size_t face)>& photo_tensor) {
+FrameChoice ChoosePhotoFrames(
+    TangentFrame requested, const std::vector<TriangleFrame>& frames,
+    const std::vector<std::array<Unfolding, 3>>& unfoldings, const std::vector<int>& face_levels,
+    const std::function<Eigen::Matrix2d(int level)>& sample_tensor_at,
+    const std::function<Eigen::Matrix2d(std::size_t face)>& photo_tensor) {
   FrameChoice choice;
   if (requested != TangentFrame::kPhotos && requested != TangentFrame::kAuto) return choice;
   std::vector<int> levels;

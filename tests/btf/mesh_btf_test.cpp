@@ -315,5 +315,37 @@ TEST_F(MeshBtfTest, PhotoCorrectionBringsThePatchesCloserToThePhotos) {
   EXPECT_EQ(plain.photo_rms_corrected, 0.0);
 }
 
+// Frames turned to the photos (synth/tangent_field.h) in the BTF synthesis: on
+// this stone, an isotropic sample, auto keeps the first-edge frames; asked
+// for, the frames turn, and the patches still come from the photos, inside the
+// sample, and agree with the photos about as well.
+TEST_F(MeshBtfTest, FramesTurnToThePhotosWhenTheSampleIsDirectionalOrWhenAsked) {
+  const BtfMeshSynthesis& s = *synthesis_;
+  EXPECT_EQ(s.tangent_frame, synth::TangentFrame::kFirstEdge);
+  EXPECT_GE(s.sample_coherence, 0.0);
+  EXPECT_LT(s.sample_coherence, synth::kAnisotropicSampleCoherence);
+  BtfMeshSynthesisOptions photos = Options();
+  photos.tangent_frame = synth::TangentFrame::kPhotos;
+  const BtfMeshSynthesis turned =
+      SynthesizeMeshBtf(inputs_->mesh, inputs_->reconstruction, inputs_->visibility,
+                        inputs_->photos, *sample_, photos);
+  EXPECT_EQ(turned.tangent_frame, synth::TangentFrame::kPhotos);
+  std::size_t turned_faces = 0;
+  for (std::size_t f = 0; f < s.patches.size(); ++f) {
+    const synth::TrianglePatch& p = turned.patches[f];
+    turned_faces += p.frame.x_axis.dot(s.patches[f].frame.x_axis) < 0.99;
+    EXPECT_NEAR(p.frame.z_axis.dot(s.patches[f].frame.z_axis), 1.0, 1e-9);
+    EXPECT_GE(p.sample_x, 0);
+    EXPECT_GE(p.sample_y, 0);
+    EXPECT_LE(p.sample_x + p.width, sample_->width);
+    EXPECT_LE(p.sample_y + p.height, sample_->height);
+  }
+  std::printf("turned %zu of %zu frames; photo RMS quilted %.4f (first edge %.4f)\n", turned_faces,
+              s.patches.size(), turned.photo_rms_quilted, s.photo_rms_quilted);
+  EXPECT_GT(turned_faces, s.patches.size() / 2);
+  EXPECT_GT(turned.num_from_photos, s.num_from_photos * 98 / 100);
+  EXPECT_LT(turned.photo_rms_quilted, 1.1 * s.photo_rms_quilted);
+}
+
 }  // namespace
 }  // namespace texlume::btf

@@ -38,8 +38,8 @@ cv::Mat Stripes(cv::Size size, double angle, double period_texels, double rx, do
     for (int i = 0; i < size.width; ++i) {
       const double x = (i + 0.5) / rx, y = -(j + 0.5) / ry;
       m.at<float>(j, i) = static_cast<float>(
-          0.5 + 0.4 * std::sin(2 * kPi * (x * std::cos(angle) + y * std::sin(angle)) /
-                               period_texels));
+          0.5 +
+          0.4 * std::sin(2 * kPi * (x * std::cos(angle) + y * std::sin(angle)) / period_texels));
     }
   return m;
 }
@@ -48,7 +48,8 @@ TEST(LuminanceStructureTensor, FindsTheDirectionStripesVaryIn) {
   for (const double angle : {0.0, 0.4, 1.2, 2.0, 2.9}) {
     for (const auto& [rx, ry] : {std::pair{1.0, 1.0}, std::pair{0.5, 0.7}}) {
       const cv::Mat l = Stripes(cv::Size(48, 40), angle, 16.0, rx, ry);
-      const Orientation o = DominantOrientation(LuminanceStructureTensor({l, l, l}, cv::Mat(), rx, ry));
+      const Orientation o =
+          DominantOrientation(LuminanceStructureTensor({l, l, l}, cv::Mat(), rx, ry));
       EXPECT_LT(LineAngle(o.angle_rad, angle), 2.0 * kPi / 180.0) << angle << " " << rx;
       EXPECT_GT(o.coherence, 0.9);
       EXPECT_GE(o.angle_rad, 0.0);
@@ -267,7 +268,8 @@ TEST(PhotoFrames, BricksOnAColumnRunAroundItAndMatchThePhotosBetter) {
     ++side;
     const Eigen::Vector3d around = Eigen::Vector3d::UnitZ().cross(p.frame.origin_in_world);
     aligned += LineAngle(p.frame.x_axis, around) < 15.0 * kPi / 180.0;
-    aligned_first_edge += LineAngle(first_edge.patches[f].frame.x_axis, around) < 15.0 * kPi / 180.0;
+    aligned_first_edge +=
+        LineAngle(first_edge.patches[f].frame.x_axis, around) < 15.0 * kPi / 180.0;
     score_turned += p.image_score / p.views_used;
     score_first_edge += first_edge.patches[f].image_score / first_edge.patches[f].views_used;
   }
