@@ -571,8 +571,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
                       " x " + std::to_string(geometry.tallest) +
                       " texels (strip included) but the sample is " + std::to_string(sample.width) +
                       " x " + std::to_string(sample.height) +
-                      "; subdivide the mesh (texlume synth --subdivide) or capture a "
-                      "larger sample");
+                      "; subdivide the mesh (texlume synth --max-subdivisions) or capture "
+                      "a larger sample");
     }
     result.patches = std::move(geometry.patches);
     result.unfoldings = std::move(geometry.unfoldings);
@@ -758,11 +758,8 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
         });
     result.tangent_frame = choice.tangent_frame;
     result.sample_coherence = choice.sample_coherence;
-    if (choice.tangent_frame == TangentFrame::kPhotos) {
+    if (choice.tangent_frame == TangentFrame::kPhotos)
       take_geometry(MakePatchGeometry(mesh, t, options.strip, choice.field.tangents_in_world));
-      result.field_faces_with_photos = choice.field.faces_with_photos;
-      result.field_mean_coherence = choice.field.mean_coherence;
-    }
   }
 
   // 2a. Per-photo gain (exposure x light intensity, linear domain). For every

@@ -176,9 +176,6 @@ struct MeshSynthesis {
   /// Coherence of the sample's structure tensor (0 isotropic, 1 one direction)
   /// at the photos' median density; -1 when not measured (kFirstEdge, kSmoothField).
   double sample_coherence = -1.0;
-  /// kPhotos: faces whose photos constrained the field, and their mean coherence.
-  int field_faces_with_photos = 0;
-  double field_mean_coherence = 0.0;
 
   /// Most planes a texel has (RGB: 18 coefficients; LRGB: 6 + 3 colour).
   static constexpr std::size_t kMaxPlanes = 18;
