@@ -275,15 +275,13 @@ BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
   if (options.tangent_frame == synth::TangentFrame::kPhotos ||
       options.tangent_frame == synth::TangentFrame::kAuto) {
     std::vector<int> face_levels(num_faces, -1);
-    std::vector<synth::TriangleFrame> frames(num_faces);
     for (std::size_t f = 0; f < num_faces; ++f) {
-      frames[f] = result.patches[f].frame;
       const std::vector<sfm::TriangleView> views =
           synth::ConstrainingViews(visibility.triangles[f], true, options.max_views);
       if (!views.empty()) face_levels[f] = synth::PhotoDensityLevel(result.patches[f], views[0], t);
     }
     const synth::FrameChoice choice = synth::ChoosePhotoFrames(
-        options.tangent_frame, frames, result.unfoldings, face_levels,
+        options.tangent_frame, result.patches, result.unfoldings, face_levels,
         [&](int level) {
           const synth::ReducedPlanes& red = reduced_at(level);
           return synth::SampleStructureTensor(

@@ -730,14 +730,12 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
   if (options.tangent_frame == TangentFrame::kPhotos ||
       options.tangent_frame == TangentFrame::kAuto) {
     std::vector<int> face_levels(num_faces, -1);
-    std::vector<TriangleFrame> frames(num_faces);
     for (std::size_t f = 0; f < num_faces; ++f) {
-      frames[f] = result.patches[f].frame;
       const std::vector<sfm::TriangleView> views = views_of(f);
       if (!views.empty()) face_levels[f] = PhotoDensityLevel(result.patches[f], views[0], t);
     }
     const FrameChoice choice = ChoosePhotoFrames(
-        options.tangent_frame, frames, result.unfoldings, face_levels,
+        options.tangent_frame, result.patches, result.unfoldings, face_levels,
         [&](int level) {
           const ReducedSample& red = reduced_at(level);
           return SampleStructureTensor(

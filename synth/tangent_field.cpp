@@ -4,6 +4,7 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <opencv2/imgproc.hpp>
 
 namespace texlume::synth {
@@ -43,7 +44,7 @@ Orientation DominantOrientation(const Eigen::Matrix2d& tensor) {
   // The doubled-angle vector (a, b) has length l1 - l2 and angle 2 theta.
   o.coherence = std::clamp(std::hypot(a, b) / trace, 0.0, 1.0);
   double angle = 0.5 * std::atan2(b, a);
-  if (angle < 0.0) angle += M_PI;
+  if (angle < 0.0) angle += std::numbers::pi;
   o.angle_rad = angle;
   return o;
 }
@@ -53,7 +54,8 @@ Eigen::Matrix2d SampleStructureTensor(
     double cells_per_texel_x, double cells_per_texel_y) {
   Eigen::Matrix2d tensor = Eigen::Matrix2d::Zero();
   for (int k = -1; k < 8; ++k) {
-    const double azimuth = k * M_PI / 4.0, elevation = k < 0 ? M_PI / 2.0 : M_PI / 4.0;
+    const double azimuth = k * std::numbers::pi / 4.0,
+                 elevation = k < 0 ? std::numbers::pi / 2.0 : std::numbers::pi / 4.0;
     const Eigen::Vector3d light(std::cos(elevation) * std::cos(azimuth),
                                 std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
     tensor +=
@@ -138,7 +140,7 @@ PhotoTangentField PhotoAlignedTangents(const std::vector<TriangleFrame>& frames,
 }
 
 FrameChoice ChoosePhotoFrames(
-    TangentFrame requested, const std::vector<TriangleFrame>& frames,
+    TangentFrame requested, const std::vector<TrianglePatch>& patches,
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const std::vector<int>& face_levels,
     const std::function<Eigen::Matrix2d(int level)>& sample_tensor_at,
     const std::function<Eigen::Matrix2d(std::size_t face)>& photo_tensor) {
@@ -154,9 +156,12 @@ FrameChoice ChoosePhotoFrames(
   choice.sample_coherence = DominantOrientation(sample_tensor).coherence;
   if (requested == TangentFrame::kAuto && choice.sample_coherence < kAnisotropicSampleCoherence)
     return choice;
-  std::vector<Eigen::Matrix2d> photo_tensors(frames.size(), Eigen::Matrix2d::Zero());
-  for (std::size_t f = 0; f < frames.size(); ++f)
+  std::vector<Eigen::Matrix2d> photo_tensors(patches.size(), Eigen::Matrix2d::Zero());
+  std::vector<TriangleFrame> frames(patches.size());
+  for (std::size_t f = 0; f < patches.size(); ++f) {
+    frames[f] = patches[f].frame;
     if (face_levels[f] >= 0) photo_tensors[f] = photo_tensor(f);
+  }
   choice.field = PhotoAlignedTangents(frames, unfoldings, photo_tensors, sample_tensor);
   choice.tangent_frame = TangentFrame::kPhotos;
   return choice;

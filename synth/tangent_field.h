@@ -80,8 +80,9 @@ struct FrameChoice {
 /// (`face_levels`, -1 for a face seen in no photo) decides, for kAuto, whether
 /// the sample is anisotropic (coherence >= kAnisotropicSampleCoherence); then
 /// the photos' tensors (`photo_tensor(face)`, in the face's current frame) and
-/// PhotoAlignedTangents give the field. kFirstEdge: the frames stay.
-FrameChoice ChoosePhotoFrames(TangentFrame requested, const std::vector<TriangleFrame>& frames,
+/// PhotoAlignedTangents give the field, from the patches' current frames.
+/// kFirstEdge: the frames stay.
+FrameChoice ChoosePhotoFrames(TangentFrame requested, const std::vector<TrianglePatch>& patches,
                               const std::vector<std::array<Unfolding, 3>>& unfoldings,
                               const std::vector<int>& face_levels,
                               const std::function<Eigen::Matrix2d(int level)>& sample_tensor_at,

@@ -17,6 +17,7 @@
 #include "sfm/errors.h"
 #include "synth/model_io.h"
 #include "synth/pipeline.h"
+#include "tests/small_scene.h"
 #include "tests/test_util.h"
 
 namespace texlume::btf {
@@ -27,19 +28,12 @@ class MeshBtfTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     tmp_ = new testing::TempDir;
-    datasets::SceneOptions o;
-    o.shape = datasets::SceneShape::kSphere;
-    o.material.kind = datasets::MaterialKind::kStone;
-    o.material.texel_size = 0.004;
+    datasets::SceneOptions o =
+        testing::SmallObjectScene(datasets::SceneShape::kSphere, datasets::MaterialKind::kStone);
     o.material.relief_height = 0.012;
     o.material.specular = 0.5;  // view-dependent: a PTM cannot hold it
-    o.num_images = 12;
-    o.image_width = 320;
-    o.image_height = 240;
-    o.focal_px = 300;
     o.capture_size = 96;
-    o.num_capture_lights = 24;
-    o.num_held_out_capture_lights = 0;
+    o.write_btf = true;
     o.btf_size = 96;
     o.btf_view_count = 13;
     o.btf_light_count = 24;

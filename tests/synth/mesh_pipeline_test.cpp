@@ -26,6 +26,7 @@
 #include "synth/pipeline.h"
 #include "synth/report.h"
 #include "synth/web_model.h"
+#include "tests/small_scene.h"
 #include "tests/test_util.h"
 
 namespace texlume::synth {
@@ -36,28 +37,14 @@ class MeshPipelineTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     tmp_ = new testing::TempDir;
-    datasets::SceneOptions o;
-    o.shape = datasets::SceneShape::kSphere;
-    o.material.kind = datasets::MaterialKind::kStone;
-    o.material.texel_size = 0.004;
+    datasets::SceneOptions o =
+        testing::SmallObjectScene(datasets::SceneShape::kSphere, datasets::MaterialKind::kStone);
     o.material.relief_height = 0.012;
-    o.num_images = 12;
-    o.image_width = 320;
-    o.image_height = 240;
-    o.focal_px = 300;
-    o.capture_size = 128;
-    o.num_capture_lights = 24;
-    o.num_held_out_capture_lights = 0;
-    o.write_btf = false;
-    o.write_surface = false;
     o.num_held_out_views = 2;
     o.held_out_lights_per_view = 2;
     o.held_out_scale = 2;
     datasets::GenerateScene(o, tmp_->path() / "scene");
-    const fs::path capture = tmp_->path() / "scene/material/capture";
-    const ptm::RtiCapture rti = ptm::ReadRtiCapture(capture / "lights.lp", capture);
-    ptm::WritePtmExr(ptm::FitPtmFromFiles(rti.files, rti.lights, {}).ptm,
-                     tmp_->path() / "sample.exr");
+    ptm::WritePtmExr(testing::FitSceneSample(tmp_->path() / "scene"), tmp_->path() / "sample.exr");
     job_ = new SynthJobOptions(Job(tmp_->path() / "model"));
     summary_ = new SynthJobSummary(RunSynthJob(*job_));
   }

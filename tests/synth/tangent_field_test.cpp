@@ -8,11 +8,10 @@
 #include <numbers>
 #include <random>
 
-#include "datasets_synthetic/scene.h"
 #include "datasets_synthetic/shapes.h"
-#include "ptm/fit.h"
 #include "synth/mesh_synthesis.h"
 #include "synth/pipeline.h"
+#include "tests/small_scene.h"
 #include "tests/test_util.h"
 
 namespace texlume::synth {
@@ -93,17 +92,24 @@ Eigen::Matrix2d PhotoTensor(const TriangleFrame& frame, const Eigen::Vector3d& x
   return g.normalized() * g.normalized().transpose() + 0.25 * Eigen::Matrix2d::Identity();
 }
 
+// A mesh's first-edge patch geometry (texels of 0.01, strip 4).
+PatchGeometry FirstEdgeGeometry(const sfm::TriangleMesh& mesh) {
+  return MakePatchGeometry(mesh, 0.01, 4, TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
+}
+std::vector<TriangleFrame> FramesOf(const PatchGeometry& geometry) {
+  std::vector<TriangleFrame> frames;
+  for (const TrianglePatch& p : geometry.patches) frames.push_back(p.frame);
+  return frames;
+}
+
 Eigen::Matrix2d SampleTensor(double angle) {
   const Eigen::Vector2d g(std::cos(angle), std::sin(angle));
   return g * g.transpose() + 0.3 * Eigen::Matrix2d::Identity();
 }
 
 TEST(PhotoAlignedTangents, ALineFieldOnAPlaneFollowsThePhotosWhereverTheyAre) {
-  const sfm::TriangleMesh mesh = datasets::MakeGridPlane(12, 1.2);
-  const PatchGeometry geometry =
-      MakePatchGeometry(mesh, 0.01, 4, TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
-  std::vector<TriangleFrame> frames;
-  for (const TrianglePatch& p : geometry.patches) frames.push_back(p.frame);
+  const PatchGeometry geometry = FirstEdgeGeometry(datasets::MakeGridPlane(12, 1.2));
+  const std::vector<TriangleFrame> frames = FramesOf(geometry);
   const Eigen::Vector3d truth(std::cos(0.5), std::sin(0.5), 0.0);  // the texture's x axis
   const double sample_angle = kPi / 2;  // horizontal stripes: gradients along y
   std::mt19937 rng(3);
@@ -133,11 +139,8 @@ TEST(PhotoAlignedTangents, ALineFieldOnAPlaneFollowsThePhotosWhereverTheyAre) {
 }
 
 TEST(PhotoAlignedTangents, ACylindersFieldRunsAroundItAcrossCurvedEdges) {
-  const sfm::TriangleMesh mesh = datasets::MakeCylinder(24, 8, 0.6, 1.6);
-  const PatchGeometry geometry =
-      MakePatchGeometry(mesh, 0.01, 4, TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
-  std::vector<TriangleFrame> frames;
-  for (const TrianglePatch& p : geometry.patches) frames.push_back(p.frame);
+  const PatchGeometry geometry = FirstEdgeGeometry(datasets::MakeCylinder(24, 8, 0.6, 1.6));
+  const std::vector<TriangleFrame> frames = FramesOf(geometry);
   std::mt19937 rng(5);
   // The way around: horizontal in the face's plane.
   auto around = [&](std::size_t f) {
@@ -167,11 +170,8 @@ TEST(PhotoAlignedTangents, ACylindersFieldRunsAroundItAcrossCurvedEdges) {
 }
 
 TEST(ChoosePhotoFrames, AutoTurnsFramesOnlyForAnAnisotropicSample) {
-  const sfm::TriangleMesh mesh = datasets::MakeGridPlane(4, 1.0);
-  const PatchGeometry geometry =
-      MakePatchGeometry(mesh, 0.01, 4, TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
-  std::vector<TriangleFrame> frames;
-  for (const TrianglePatch& p : geometry.patches) frames.push_back(p.frame);
+  const PatchGeometry geometry = FirstEdgeGeometry(datasets::MakeGridPlane(4, 1.0));
+  const std::vector<TriangleFrame> frames = FramesOf(geometry);
   std::vector<int> levels(frames.size(), 3);
   levels[0] = -1;  // seen in no photo
   int sample_level = -1;
@@ -179,7 +179,7 @@ TEST(ChoosePhotoFrames, AutoTurnsFramesOnlyForAnAnisotropicSample) {
   auto choose = [&](TangentFrame requested, const Eigen::Matrix2d& sample) {
     asked.clear();
     return ChoosePhotoFrames(
-        requested, frames, geometry.unfoldings, levels,
+        requested, geometry.patches, geometry.unfoldings, levels,
         [&](int level) {
           sample_level = level;
           return sample;
@@ -218,24 +218,11 @@ TEST(ChoosePhotoFrames, AutoTurnsFramesOnlyForAnAnisotropicSample) {
 // with the photos better (paper 003 eq. 3, summed over the constraint views).
 TEST(PhotoFrames, BricksOnAColumnRunAroundItAndMatchThePhotosBetter) {
   testing::TempDir tmp;
-  datasets::SceneOptions o;
-  o.shape = datasets::SceneShape::kCylinder;
-  o.material.kind = datasets::MaterialKind::kBrick;
-  o.material.texel_size = 0.004;
-  o.num_images = 12;
-  o.image_width = 320;
-  o.image_height = 240;
-  o.focal_px = 300;
-  o.capture_size = 128;
-  o.num_capture_lights = 24;
-  o.num_held_out_capture_lights = 0;
-  o.write_btf = false;
-  o.write_surface = false;
+  datasets::SceneOptions o =
+      testing::SmallObjectScene(datasets::SceneShape::kCylinder, datasets::MaterialKind::kBrick);
   o.num_held_out_views = 0;
   datasets::GenerateScene(o, tmp.path() / "scene");
-  const std::filesystem::path capture = tmp.path() / "scene/material/capture";
-  const ptm::RtiCapture rti = ptm::ReadRtiCapture(capture / "lights.lp", capture);
-  const ptm::Ptm sample = ptm::FitPtmFromFiles(rti.files, rti.lights, {}).ptm;
+  const ptm::Ptm sample = testing::FitSceneSample(tmp.path() / "scene");
   SynthJobOptions job;
   const std::filesystem::path object = tmp.path() / "scene/object";
   job.model_dir = object / "sparse";
