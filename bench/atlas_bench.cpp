@@ -7,6 +7,9 @@
 // Prints per mesh and mode: occupancy (texels inside triangles / atlas texels),
 // charts, atlases, layout seconds, and the charts' texel stretch (area-weighted
 // mean and extremes of the per-face singular values of texels per texel size).
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Tools/Decimater/DecimaterT.hh>
+#include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -56,6 +59,51 @@ sfm::TriangleMesh Jittered(sfm::TriangleMesh mesh) {
   }
   return mesh;
 }
+/// A fine mesh of the shape decimated by quadric edge collapses (OpenMesh) to
+/// `num_faces`: irregular triangles of varying size and valence, as a
+/// photogrammetry mesh decimated for texturing has.
+sfm::TriangleMesh Decimated(const sfm::TriangleMesh& fine, std::size_t num_faces) {
+  struct Traits : OpenMesh::DefaultTraits {
+    using Point = OpenMesh::Vec3d;
+  };
+  using OmMesh = OpenMesh::TriMesh_ArrayKernelT<Traits>;
+  OmMesh om;
+  std::vector<OmMesh::VertexHandle> handles;
+  for (const Eigen::Vector3d& v : fine.vertices)
+    handles.push_back(om.add_vertex(OmMesh::Point(v.x(), v.y(), v.z())));
+  for (const auto& f : fine.faces)
+    om.add_face(handles[static_cast<std::size_t>(f[0])], handles[static_cast<std::size_t>(f[1])],
+                handles[static_cast<std::size_t>(f[2])]);
+  OpenMesh::Decimater::DecimaterT<OmMesh> decimater(om);
+  OpenMesh::Decimater::ModQuadricT<OmMesh>::Handle quadric;
+  decimater.add(quadric);
+  decimater.initialize();
+  decimater.decimate_to_faces(0, num_faces);
+  om.garbage_collection();
+  sfm::TriangleMesh mesh;
+  for (const auto& vh : om.vertices()) {
+    const auto& p = om.point(vh);
+    mesh.vertices.emplace_back(p[0], p[1], p[2]);
+  }
+  for (const auto& fh : om.faces()) {
+    std::array<int, 3> f{};
+    int k = 0;
+    for (const auto& vh : om.fv_range(fh)) f[static_cast<std::size_t>(k++)] = vh.idx();
+    mesh.faces.push_back(f);
+  }
+  return mesh;
+}
+
+sfm::TriangleMesh FineMesh(datasets::SceneShape shape) {
+  switch (shape) {
+    case datasets::SceneShape::kSphere:
+      return datasets::MakeIcosphere(6, 1.0);
+    case datasets::SceneShape::kCylinder:
+      return datasets::MakeCylinder(384, 96, 0.6, 1.6);
+    default:
+      return datasets::MakeTorus(384, 160, 0.8, 0.35);
+  }
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -63,6 +111,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--gutter")) charts.gutter = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--chart-size")) charts.max_chart_size = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--max-stretch")) charts.max_chart_stretch = std::atof(argv[i + 1]);
   }
   synth::AtlasOptions boxes = charts, conformal = charts, strips = charts;
   charts.flattening = synth::ChartFlattening::kRigid;
@@ -80,7 +129,12 @@ int main(int argc, char** argv) {
     // as decimated photogrammetry meshes have), normals kept.
     const sfm::TriangleMesh coarse = datasets::CoarseMesh(shape);
     std::vector<std::pair<std::string, sfm::TriangleMesh>> meshes = {
-        {"", coarse}, {"", synth::SubdivideMidpoint(coarse)}, {" jittered", Jittered(coarse)}};
+        {"", coarse},
+        {"", synth::SubdivideMidpoint(coarse)},
+        {" jittered", Jittered(coarse)},
+        {" decimated", Decimated(FineMesh(shape), coarse.faces.size())}};
+    if (const char* only = std::getenv("ATLAS_BENCH_ONLY"))
+      std::erase_if(meshes, [&](const auto& m) { return m.first != std::string(" ") + only; });
     for (const auto& [label, mesh] : meshes) {
       const synth::PatchGeometry geometry = synth::MakePatchGeometry(
           mesh, texel_size, 8, synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
@@ -95,7 +149,8 @@ int main(int argc, char** argv) {
         if (const char* dump = std::getenv("ATLAS_BENCH_DUMP"))
           for (std::size_t a = 0; a < coverage.coverage.size(); ++a)
             cv::imwrite(std::string(dump) + "/" + std::string(datasets::SceneShapeName(shape)) +
-                            std::to_string(mesh.faces.size()) + (label.empty() ? "" : "j") + "_" +
+                            std::to_string(mesh.faces.size()) +
+                            (label.empty() ? "" : label.substr(1, 1)) + "_" +
                             (options.mode == synth::AtlasMode::kPerTriangle
                                  ? std::string("boxes")
                                  : std::string(synth::ChartFlatteningName(options.flattening))) +

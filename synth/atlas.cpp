@@ -20,6 +20,9 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 /// Turns tried for every chart when packing (every 360/16 = 22.5 degrees).
 constexpr int kPackingRotations = 16;
+/// Charts whose upright box is this many times longer than wide are turned by
+/// quarter turns only.
+constexpr int kThinChartAspect = 4;
 
 /// A chart turned by `angle`: its texel box (chart units / t, x right, y up;
 /// gutters included) and, row by row (y down from the box top), the runs of
@@ -35,6 +38,14 @@ struct ChartOutline {
   int Width() const { return hi.x() - lo.x(); }
   int Height() const { return hi.y() - lo.y(); }
 };
+
+/// The texel columns [first, last] of [0, width) whose centres x + 0.5 lie in `span`.
+std::pair<int, int> TexelColumns(const std::pair<double, double>& span, int width) {
+  if (span.first > span.second) return {0, -1};
+  const double first = std::ceil(span.first - 0.5), last = std::floor(span.second - 0.5);
+  return {static_cast<int>(std::max(0.0, first)),
+          static_cast<int>(std::min(static_cast<double>(width - 1), last))};
+}
 
 /// A chart's corners turned by `angle` (texels, chart frame) and its texel box
 /// with the gutters (o.lo, o.hi); the outline's runs are left empty.
@@ -79,12 +90,14 @@ ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
     for (const auto& p : c) clo = clo.cwiseMin(p), chi = chi.cwiseMax(p);
     // Texels the bake writes for this face: centre within gutter + 0.5 of it
     // (and a hair more, so rounding in the bake cannot write beyond the outline).
+    const double reach = gutter + 0.5 + 1e-6;
     for (int y = std::max(0, static_cast<int>(clo.y()) - gutter - 1);
-         y <= std::min(h - 1, static_cast<int>(chi.y()) + gutter + 1); ++y)
-      for (int x = std::max(0, static_cast<int>(clo.x()) - gutter - 1);
-           x <= std::min(w - 1, static_cast<int>(chi.x()) + gutter + 1); ++x)
-        if (SignedDistanceToTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5)) <= gutter + 0.5 + 1e-6)
+         y <= std::min(h - 1, static_cast<int>(chi.y()) + gutter + 1); ++y) {
+      const auto [x_first, x_last] = TexelColumns(TriangleRowSpan(c, y + 0.5, reach), w);
+      for (int x = x_first; x <= x_last; ++x)
+        if (SignedDistanceToTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5)) <= reach)
           mask.at<std::uint8_t>(y, x) = 1;
+    }
   }
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w;) {
@@ -105,14 +118,60 @@ ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
   return o;
 }
 
+/// The turn that brings a chart's smallest bounding box upright (radians): the
+/// smallest box has a side along an edge of the convex hull, so every hull
+/// edge's turn is tried. Packing tries turns from it, so long thin charts
+/// (the slivers of decimated meshes) lie along the atlas axes.
+double UprightBoxAngle(const std::vector<ChartFace>& chart,
+                       const std::vector<TrianglePatch>& patches) {
+  std::vector<Eigen::Vector2d> points;
+  for (const ChartFace& cf : chart)
+    for (const auto& c : patches[static_cast<std::size_t>(cf.face)].corners_in_frame)
+      points.push_back(cf.linear * c + cf.translation);
+  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
+  });
+  // Monotone chain (Andrew 1979).
+  std::vector<Eigen::Vector2d> hull(2 * points.size());
+  std::size_t k = 0;
+  auto turn_left = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a,
+                      const Eigen::Vector2d& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x() > 0;
+  };
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && !turn_left(hull[k - 2], hull[k - 1], points[i])) --k;
+    hull[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && !turn_left(hull[k - 2], hull[k - 1], points[i])) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k > 1 ? k - 1 : k);
+  double best_area = std::numeric_limits<double>::max(), best_angle = 0.0;
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const Eigen::Vector2d e = hull[(i + 1) % hull.size()] - hull[i];
+    if (e.squaredNorm() == 0.0) continue;
+    const double angle = -std::atan2(e.y(), e.x());
+    const Eigen::Matrix2d r = Eigen::Rotation2Dd(angle).toRotationMatrix();
+    Eigen::Vector2d lo = r * hull[0], hi = lo;
+    for (const auto& p : hull) lo = lo.cwiseMin(r * p), hi = hi.cwiseMax(r * p);
+    const double area = (hi - lo).prod();
+    if (area < best_area - 1e-12 * std::abs(best_area)) best_area = area, best_angle = angle;
+  }
+  return best_angle;
+}
+
 /// One atlas being packed: per texel, the length of the free (> 0) or used
 /// (< 0) run of texels that starts there, to its right.
 struct PackingBin {
   int size = 0;
   std::vector<std::int16_t> run;  // size x size, row-major (|run| <= 16384)
+  std::vector<int> longest_free;  // per row: its longest free run
   int used_rows = 0;
   explicit PackingBin(int bin_size)
-      : size(bin_size), run(static_cast<std::size_t>(bin_size) * bin_size) {
+      : size(bin_size),
+        run(static_cast<std::size_t>(bin_size) * bin_size),
+        longest_free(static_cast<std::size_t>(bin_size), 0) {
     for (int y = 0; y < size; ++y) UpdateRow(y, nullptr);
   }
   int At(int x, int y) const {
@@ -128,6 +187,9 @@ struct PackingBin {
       r[x] =
           static_cast<std::int16_t>(taken ? (next < 0 ? next - 1 : -1) : (next > 0 ? next + 1 : 1));
     }
+    int longest = 0;
+    for (int x = 0; x < size; ++x) longest = std::max(longest, static_cast<int>(r[x]));
+    longest_free[static_cast<std::size_t>(y)] = longest;
   }
   /// 0 when the outline fits with its box's top-left at (x, y); otherwise how
   /// far right the next position that can fit on the blocking row is.
@@ -144,12 +206,17 @@ struct PackingBin {
   /// The first position, by rows then columns, where the outline fits, with the
   /// outline's row `y + Height()` not above `max_bottom`; (-1, -1): none.
   std::pair<int, int> FirstFit(const ChartOutline& o, int max_bottom) const {
-    for (int y = 0; y + o.Height() <= std::min(size, max_bottom); ++y)
+    for (int y = 0; y + o.Height() <= std::min(size, max_bottom); ++y) {
+      // Rows where the longest run has no room are passed at once.
+      if (!o.runs.empty() &&
+          longest_free[static_cast<std::size_t>(y + o.runs[0].row)] < o.runs[0].length)
+        continue;
       for (int x = 0; x + o.Width() <= size;) {
         const int skip = Skip(o, x, y);
         if (skip == 0) return {x, y};
         x += skip;
       }
+    }
     return {-1, -1};
   }
   void Take(const ChartOutline& o, int x0, int y0) {
@@ -629,9 +696,19 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
     std::size_t outlined = 0;
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::size_t c = 0; c < charts.size(); ++c) {
-      for (int r = 0; r < kPackingRotations; ++r)
-        outlines[c].push_back(
-            Outline(charts[c], 2.0 * kPi * r / kPackingRotations, patches, t, gutter));
+      const double upright = UprightBoxAngle(charts[c], patches);
+      outlines[c].push_back(Outline(charts[c], upright, patches, t, gutter));
+      // A long thin chart (a run of slivers) is tried at quarter turns only:
+      // turned by less, its outline is a tall diagonal that never packs better
+      // and is slow to place.
+      const ChartOutline& upright_outline = outlines[c][0];
+      const int long_side = std::max(upright_outline.Width(), upright_outline.Height());
+      const int short_side = std::min(upright_outline.Width(), upright_outline.Height());
+      const bool thin = long_side >= kThinChartAspect * short_side;
+      for (int r = 1; r < kPackingRotations; ++r)
+        if (!thin || r % (kPackingRotations / 4) == 0)
+          outlines[c].push_back(
+              Outline(charts[c], upright + 2.0 * kPi * r / kPackingRotations, patches, t, gutter));
       for (const auto& o : outlines[c]) area[c] = std::max(area[c], o.area);
 #pragma omp critical(texlume_chart_outlines)
       {
@@ -729,7 +806,9 @@ AtlasCoverage VisitAtlasTexels(const AtlasLayout& layout, double texel_size, int
     const int y0 = std::max(0, static_cast<int>(std::floor(lo.y())) - gutter);
     const int y1 = std::min(coverage.rows - 1, static_cast<int>(std::ceil(hi.y())) + gutter);
     for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) {
+      const auto [x_first, x_last] =
+          TexelColumns(TriangleRowSpan(fp.corners_px, y + 0.5, gutter + 0.5), coverage.cols);
+      for (int x = std::max(x0, x_first); x <= std::min(x1, x_last); ++x) {
         const Eigen::Vector2d q(x + 0.5, y + 0.5);
         const double d = SignedDistanceToTriangle(fp.corners_px, q);
         if (d > gutter + 0.5) continue;

@@ -209,15 +209,18 @@ bool ScaleAndCheck(const std::vector<TrianglePatch>& patches, const std::vector<
     Eigen::Vector2d qlo = q[0].cwiseMin(q[1]).cwiseMin(q[2]);
     Eigen::Vector2d qhi = q[0].cwiseMax(q[1]).cwiseMax(q[2]);
     for (int y = std::max(0, static_cast<int>(qlo.y()));
-         y <= std::min(h - 1, static_cast<int>(qhi.y())); ++y)
-      for (int x = std::max(0, static_cast<int>(qlo.x()));
-           x <= std::min(w - 1, static_cast<int>(qhi.x())); ++x) {
+         y <= std::min(h - 1, static_cast<int>(qhi.y())); ++y) {
+      const auto [x_lo, x_hi] = TriangleRowSpan(q, y + 0.5, 0.0);
+      if (x_lo > x_hi) continue;
+      for (int x = std::max(0, static_cast<int>(std::floor(x_lo)));
+           x <= std::min(w - 1, static_cast<int>(x_hi)); ++x) {
         if (SignedDistanceToTriangle(q, Eigen::Vector2d(x + 0.5, y + 0.5)) >= -0.5) continue;
         char& cell = inside[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) +
                             static_cast<std::size_t>(x)];
         if (cell) return false;
         cell = 1;
       }
+    }
   }
   return true;
 }
@@ -288,7 +291,7 @@ std::vector<std::vector<ChartFace>> MakeRigidCharts(
     const int chart_id = static_cast<int>(charts.size());
     std::vector<ChartFace> chart;
     std::unordered_map<std::int64_t, int> texels;  // chart texel -> face
-    Eigen::Vector2d lo(0, 0), hi(0, 0);
+    Eigen::Vector2d lo(0, 0), hi(0, 0), seed_extent(0, 0);
     bool first = true;
     auto corners_of = [&](const ChartFace& cf) {
       std::array<Eigen::Vector2d, 3> c;
@@ -301,13 +304,41 @@ std::vector<std::vector<ChartFace>> MakeRigidCharts(
     };
     // Accepts a placement when it overlaps nothing, keeps clear of faces it does
     // not touch on the mesh, and the chart still fits an atlas.
+    // Whether the chart's faces cover the way from p (inside a face the new
+    // face does not touch on the mesh) to the nearest point of the new face:
+    // then the two are near on the surface too, joined by the faces between
+    // (a run of slivers), and filtering across may read one from the other.
+    // An uncovered texel on the way is a crack, where their gutters would meet.
+    auto covered_path = [&](const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
+      Eigen::Vector2d nearest = c[0];
+      double best = std::numeric_limits<double>::max();
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Eigen::Vector2d a = c[k], ab = c[(k + 1) % 3] - a;
+        const double s = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+        const Eigen::Vector2d q = a + s * ab;
+        if ((q - p).squaredNorm() < best) best = (q - p).squaredNorm(), nearest = q;
+      }
+      const double length = std::sqrt(best);
+      const int steps = static_cast<int>(std::ceil(2.0 * length / t));
+      for (int i = 1; i < steps; ++i) {
+        const Eigen::Vector2d q = p + (nearest - p) * (static_cast<double>(i) / steps);
+        const int qx = static_cast<int>(std::floor(q.x() / t));
+        const int qy = static_cast<int>(std::floor(q.y() / t));
+        if (SignedDistanceToTriangle(c, Eigen::Vector2d((qx + 0.5) * t, (qy + 0.5) * t)) <= 0.0)
+          continue;
+        if (!texels.count(Key(qx, qy))) return false;
+      }
+      return true;
+    };
     auto try_add = [&](const ChartFace& cf) {
       const auto c = corners_of(cf);
       Eigen::Vector2d clo = c[0], chi = c[0];
       for (const auto& p : c) clo = clo.cwiseMin(p), chi = chi.cwiseMax(p);
       if (!first) {
+        // Within the extent, or the seed's own box (and a texel) when that is
+        // larger: a sliver longer than the extent still gathers its neighbours.
         const Eigen::Vector2d nlo = lo.cwiseMin(clo), nhi = hi.cwiseMax(chi);
-        if ((nhi - nlo).maxCoeff() > max_extent) return false;
+        if (((nhi - nlo).array() > seed_extent.array().max(max_extent)).any()) return false;
       }
       const double clearance = (2 * gutter + 1) * t;
       const int x0 = static_cast<int>(std::floor((clo.x() - clearance) / t));
@@ -316,19 +347,24 @@ std::vector<std::vector<ChartFace>> MakeRigidCharts(
       const int y1 = static_cast<int>(std::ceil((chi.y() + clearance) / t));
       std::vector<std::int64_t> mine;
       for (int y = y0; y <= y1; ++y) {
-        for (int x = x0; x <= x1; ++x) {
+        const auto [x_lo, x_hi] = TriangleRowSpan(c, (y + 0.5) * t, clearance);
+        if (x_lo > x_hi) continue;
+        for (int x = std::max(x0, static_cast<int>(std::floor(x_lo / t)));
+             x <= std::min(x1, static_cast<int>(std::floor(x_hi / t))); ++x) {
           const Eigen::Vector2d p((x + 0.5) * t, (y + 0.5) * t);
           const double d = SignedDistanceToTriangle(c, p);
           if (d > clearance) continue;
           const auto it = texels.find(Key(x, y));
           if (it != texels.end()) {
-            if (d < -0.5 * t) return false;                         // overlap
-            if (!shares_vertex(cf.face, it->second)) return false;  // too close
+            if (d < -0.5 * t) return false;  // overlap
+            if (!shares_vertex(cf.face, it->second) && (d <= 0.0 || !covered_path(c, p)))
+              return false;  // too close across a crack
           }
           if (d <= 0.0) mine.push_back(Key(x, y));
         }
       }
       for (const std::int64_t k : mine) texels.emplace(k, cf.face);
+      if (first) seed_extent = (chi - clo).array() + t;  // and a texel of rounding
       lo = first ? clo : lo.cwiseMin(clo);
       hi = first ? chi : hi.cwiseMax(chi);
       first = false;

@@ -49,4 +49,22 @@ double SignedDistanceToTriangle(const std::array<Eigen::Vector2d, 3>& c, const E
   return inside ? -nearest : nearest;
 }
 
+std::pair<double, double> TriangleRowSpan(const std::array<Eigen::Vector2d, 3>& c, double y,
+                                          double margin) {
+  const double y_lo = y - margin, y_hi = y + margin;
+  double lo = std::numeric_limits<double>::max(), hi = -lo;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const Eigen::Vector2d& a = c[k];
+    const Eigen::Vector2d& b = c[(k + 1) % 3];
+    if (a.y() >= y_lo && a.y() <= y_hi) lo = std::min(lo, a.x()), hi = std::max(hi, a.x());
+    for (const double line : {y_lo, y_hi})
+      if ((a.y() - line) * (b.y() - line) < 0.0) {
+        const double x = a.x() + (line - a.y()) / (b.y() - a.y()) * (b.x() - a.x());
+        lo = std::min(lo, x), hi = std::max(hi, x);
+      }
+  }
+  if (lo > hi) return {1.0, 0.0};
+  return {lo - margin, hi + margin};
+}
+
 }  // namespace texlume::synth

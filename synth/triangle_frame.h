@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <utility>
 
 #include "sfm/mesh.h"
 
@@ -44,5 +45,13 @@ double DistanceToSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 /// to the nearest edge inside (edges included), the distance outside.
 double SignedDistanceToTriangle(const std::array<Eigen::Vector2d, 3>& corners,
                                 const Eigen::Vector2d& p);
+
+/// The x range [first, second] that holds every point of the line at height
+/// `y` within `margin` (>= 0) of a 2D triangle: the triangle's x range inside
+/// the slab |y' - y| <= margin, widened by margin. Empty (first > second) when
+/// the line passes farther. Scanning rasters row by row over it keeps the work
+/// near the triangle's area, also for long thin triangles lying diagonally.
+std::pair<double, double> TriangleRowSpan(const std::array<Eigen::Vector2d, 3>& corners, double y,
+                                          double margin);
 
 }  // namespace texlume::synth

@@ -439,6 +439,46 @@ TEST(Charts, AutoKeepsTheSmallerOfStripsAndRigidCharts) {
   EXPECT_EQ(texels[0], std::min(texels[1], texels[2]));
 }
 
+// A run of parallel slivers (as quadric decimation leaves on flat or
+// cylindrical parts), each longer than the chart extent: rigid charts gather
+// them into one chart (the seed's box bounds the extent), which packs upright
+// into a band a little taller than the run. Slivers 3 texels wide bring
+// faces that share no vertex within two gutters of each other; the faces
+// between cover the way, so there is no crack and they still join.
+TEST(Charts, RigidChartsGatherARunOfSliversLongerThanTheExtent) {
+  constexpr int kSlivers = 12;
+  for (const int width_texels : {10, 3}) {
+    const double length = 800 * kTexel, width = width_texels * kTexel;
+    sfm::TriangleMesh mesh;
+    // Along a line 30 degrees off the x axis, so the chart lies diagonally in its frame.
+    const Eigen::Vector3d along(std::cos(kPi / 6), std::sin(kPi / 6), 0.0);
+    const Eigen::Vector3d across(-std::sin(kPi / 6), std::cos(kPi / 6), 0.0);
+    for (int i = 0; i <= kSlivers / 2; ++i) {
+      mesh.vertices.push_back(i * width * across);
+      mesh.vertices.push_back(i * width * across + length * along);
+    }
+    for (int i = 0; i < kSlivers / 2; ++i) {
+      const int a = 2 * i, b = a + 1, c = a + 2, d = a + 3;
+      mesh.faces.push_back({a, b, c});
+      mesh.faces.push_back({b, d, c});
+    }
+    const PatchGeometry g = Geometry(mesh);
+    RigidChartOptions ro;
+    ro.texel_size = kTexel;
+    const auto charts = MakeRigidCharts(mesh, g.patches, g.unfoldings, ro);
+    ExpectEachFaceInOneChart(charts, mesh.faces.size());
+    EXPECT_EQ(charts.size(), 1u) << width_texels;
+    AtlasOptions o;
+    o.flattening = ChartFlattening::kRigid;
+    const AtlasLayout layout = LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+    ASSERT_EQ(layout.atlas_sizes.size(), 1u);
+    // The run's width, a gutter ring each side, a texel of rounding.
+    EXPECT_LE(layout.atlas_sizes[0].height, kSlivers / 2 * width_texels + 2 * o.gutter + 2)
+        << width_texels;
+    ExpectNoTexelInTwoCharts(layout, o.gutter);
+  }
+}
+
 // Options out of range are refused.
 TEST(Charts, BadChartOptionsAreRefused) {
   AtlasOptions o;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include "synth/mesh_synthesis.h"
 
@@ -55,6 +56,37 @@ TEST(RelightMixture, LightsBelowTheHorizonElevationFadeToZero) {
   EXPECT_NEAR(at(kHorizonElevationDeg - 1e-6), at_h, 1e-4);
   EXPECT_EQ(at(-5.0), 0.0f);
   EXPECT_LT(at(2.0), at(10.0));
+}
+
+// The row span holds every point of the row within the margin of the
+// triangle (sampled densely), and no more than the margin beyond the points
+// of the triangle in the slab: a long thin triangle lying diagonally spans a
+// short stretch of each row, not its bounding box.
+TEST(TriangleRowSpan, HoldsThePointsWithinTheMarginAndLittleMore) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-50.0, 50.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    std::array<Eigen::Vector2d, 3> c = {Eigen::Vector2d(u(rng), u(rng)),
+                                        Eigen::Vector2d(u(rng), u(rng)),
+                                        Eigen::Vector2d(u(rng), u(rng))};
+    if (trial % 4 == 0) c[2] = c[0] + 0.02 * (c[1] - c[0]) + Eigen::Vector2d(0.3, -0.2);  // sliver
+    const double margin = trial % 3 == 0 ? 0.0 : 2.5;
+    for (double y = -60.0; y <= 60.0; y += 1.7) {
+      const auto [lo, hi] = TriangleRowSpan(c, y, margin);
+      for (double x = -60.0; x <= 60.0; x += 0.05)
+        if (SignedDistanceToTriangle(c, Eigen::Vector2d(x, y)) <= margin - 1e-9) {
+          EXPECT_GE(x, lo - 1e-9) << "trial " << trial << " y " << y;
+          EXPECT_LE(x, hi + 1e-9) << "trial " << trial << " y " << y;
+        }
+    }
+  }
+  // A sliver from (0, 0) to (800, 800), 2 wide: each row spans about its
+  // width plus twice the margin, not 800.
+  const std::array<Eigen::Vector2d, 3> sliver = {Eigen::Vector2d(0, 0), Eigen::Vector2d(800, 800),
+                                                 Eigen::Vector2d(2, 0)};
+  const auto [lo, hi] = TriangleRowSpan(sliver, 400.0, 2.5);
+  EXPECT_LT(hi - lo, 2.0 + 4 * 2.5 + 1e-9);
+  EXPECT_GT(TriangleRowSpan(sliver, 900.0, 2.5).first, TriangleRowSpan(sliver, 900.0, 2.5).second);
 }
 
 }  // namespace
