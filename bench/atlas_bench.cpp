@@ -1,7 +1,9 @@
 // Atlas layout alone (issue 6): the coarse meshes of the synthetic shapes at the
-// default material's texel size (and split 1-to-4 once), laid out in charts and
-// in per-triangle boxes, without synthesis.
-// Run: build/bench/atlas_bench [--gutter G] [--chart-size N]  (rigid, conformal, strips, boxes)
+// default material's texel size (split 1-to-4 once, at 4 times the resolution,
+// vertex-jittered, and decimated from a fine mesh), laid out in charts and in
+// per-triangle boxes, without synthesis.
+// Run: build/bench/atlas_bench [--gutter G] [--chart-size N] [--max-stretch S]
+//      (rigid, conformal, strips, boxes); ATLAS_BENCH_ONLY=dense|jittered|decimated
 // ATLAS_BENCH_DUMP=DIR writes each atlas's coverage (inside, gutter) as a PNG at
 // quarter size, or full size with ATLAS_BENCH_DUMP_FULL=1.
 // Prints per mesh and mode: occupancy (texels inside triangles / atlas texels),
@@ -94,6 +96,19 @@ sfm::TriangleMesh Decimated(const sfm::TriangleMesh& fine, std::size_t num_faces
   return mesh;
 }
 
+/// The shape at 4 times the coarse mesh's resolution along each direction, on
+/// the surface: 16 times the triangles (1280 -> 20480 on the sphere).
+sfm::TriangleMesh DenseMesh(datasets::SceneShape shape) {
+  switch (shape) {
+    case datasets::SceneShape::kSphere:
+      return datasets::MakeIcosphere(5, 1.0);
+    case datasets::SceneShape::kCylinder:
+      return datasets::MakeCylinder(192, 48, 0.6, 1.6);
+    default:
+      return datasets::MakeTorus(192, 80, 0.8, 0.35);
+  }
+}
+
 sfm::TriangleMesh FineMesh(datasets::SceneShape shape) {
   switch (shape) {
     case datasets::SceneShape::kSphere:
@@ -131,6 +146,7 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, sfm::TriangleMesh>> meshes = {
         {"", coarse},
         {"", synth::SubdivideMidpoint(coarse)},
+        {" dense", DenseMesh(shape)},
         {" jittered", Jittered(coarse)},
         {" decimated", Decimated(FineMesh(shape), coarse.faces.size())}};
     if (const char* only = std::getenv("ATLAS_BENCH_ONLY"))
@@ -150,7 +166,7 @@ int main(int argc, char** argv) {
           for (std::size_t a = 0; a < coverage.coverage.size(); ++a)
             cv::imwrite(std::string(dump) + "/" + std::string(datasets::SceneShapeName(shape)) +
                             std::to_string(mesh.faces.size()) +
-                            (label.empty() ? "" : label.substr(1, 1)) + "_" +
+                            (label.empty() ? "" : label.substr(1)) + "_" +
                             (options.mode == synth::AtlasMode::kPerTriangle
                                  ? std::string("boxes")
                                  : std::string(synth::ChartFlatteningName(options.flattening))) +

@@ -659,10 +659,13 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
     }
     packed = PackSkyline(sizes, options.atlas_size, options.atlas_size);
   } else if (options.flattening == ChartFlattening::kStrips) {
-    // Strips (after fans) from each seed-side rule, unstacked, and stacked up to
+    // Strips (after fans) from each seed-side rule, unstacked; stacked up to
     // a seventh of the atlas or up to the whole (which wins on developable
-    // surfaces such as a cylinder's side), each packed in rows; the layout with
-    // the fewest atlas texels wins.
+    // surfaces such as a cylinder's side); and in stacks of 4 or 8 bands of
+    // the preferred height, each band within half a band of the ends of the one
+    // below (near-rectangles: on curved surfaces, where bands of small faces
+    // lose most to gutters, but stacks of many bands turn into triangles).
+    // Each is packed in rows; the layout with the fewest atlas texels wins.
     StripChartOptions so;
     so.texel_size = t;
     so.max_stretch = options.max_chart_stretch;
@@ -670,15 +673,23 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
     so.max_normal_angle_deg = options.max_chart_normal_angle_deg;
     so.gutter = gutter;
     const double atlas_rows = so.max_length_texels;
-    const std::pair<StripSide, double> variants[] = {{StripSide::kTallest, 0.0},
-                                                     {StripSide::kNearestPreferred, 0.0},
-                                                     {StripSide::kTallest, atlas_rows / 7.0},
-                                                     {StripSide::kTallest, atlas_rows}};
+    const double band = PreferredBandHeight(patches, t);
+    struct Variant {
+      StripSide side;
+      double max_stack_texels, max_stack_overhang_texels;
+    };
+    const Variant variants[] = {{StripSide::kTallest, 0.0, -1.0},
+                                {StripSide::kNearestPreferred, 0.0, -1.0},
+                                {StripSide::kTallest, atlas_rows / 7.0, -1.0},
+                                {StripSide::kTallest, atlas_rows, -1.0},
+                                {StripSide::kTallest, 4.0 * band + 0.5, 0.5 * band},
+                                {StripSide::kTallest, 8.0 * band + 0.5, 0.5 * band}};
     RowPacking best;
     std::int64_t best_texels = 0;
-    for (const auto& [side, stack] : variants) {
-      so.side = side;
-      so.max_stack_texels = stack;
+    for (const Variant& variant : variants) {
+      so.side = variant.side;
+      so.max_stack_texels = variant.max_stack_texels;
+      so.max_stack_overhang_texels = variant.max_stack_overhang_texels;
       RowPacking rows = PackStripsInRows(MakeStripCharts(mesh, patches, unfoldings, so), patches, t,
                                          gutter, options.atlas_size, progress);
       if (best.pieces.empty() || rows.texels < best_texels)

@@ -751,6 +751,22 @@ std::vector<std::vector<std::pair<int, Corners>>> FanSectors(
 
 }  // namespace
 
+double PreferredBandHeight(const std::vector<TrianglePatch>& patches, double texel_size) {
+  if (patches.empty()) return 0.0;
+  std::vector<double> tallest(patches.size(), 0.0);
+  for (std::size_t f = 0; f < patches.size(); ++f) {
+    const Corners c = FrameCornersTexels(patches[f], texel_size);
+    const double twice_area = Cross(c[1] - c[0], c[2] - c[0]);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double length = (c[(k + 1) % 3] - c[k]).norm();
+      if (length > 0.0) tallest[f] = std::max(tallest[f], twice_area / length);
+    }
+  }
+  const auto middle = tallest.begin() + static_cast<std::ptrdiff_t>(tallest.size() / 2);
+  std::nth_element(tallest.begin(), middle, tallest.end());
+  return std::round(*middle);
+}
+
 std::vector<std::vector<ChartFace>> MakeStripCharts(
     const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const StripChartOptions& options,
@@ -761,7 +777,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
   if (!(options.texel_size > 0.0) || !(options.max_stretch > 1.0) ||
       !(options.max_length_texels > 0.0) ||
       (options.min_fan_faces != 0 && options.min_fan_faces < 3) || options.gutter < 0 ||
-      !(options.max_stack_texels >= 0.0) ||
+      !(options.max_stack_texels >= 0.0) || std::isnan(options.max_stack_overhang_texels) ||
       !(options.min_stack_cover > 0.0 && options.min_stack_cover <= 1.0) ||
       !(options.max_normal_angle_deg > 0.0 && options.max_normal_angle_deg <= 180.0))
     throw OptionError("charts: bad options");
@@ -816,24 +832,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     free_neighbours[fs] = free;
     seeds.emplace(free, rank[fs], f);
   };
-  // The preferred band height: the median of the faces' tallest heights, so
-  // bands of near-equal faces share one height and fill atlas rows evenly.
-  std::vector<double> tallest(num_faces, 0.0);
-  for (std::size_t f = 0; f < num_faces; ++f) {
-    const Corners c = FrameCornersTexels(patches[f], t);
-    const double twice_area = Cross(c[1] - c[0], c[2] - c[0]);
-    for (std::size_t k = 0; k < 3; ++k) {
-      const double length = (c[(k + 1) % 3] - c[k]).norm();
-      if (length > 0.0) tallest[f] = std::max(tallest[f], twice_area / length);
-    }
-  }
-  double preferred_height = 0.0;
-  if (num_faces > 0) {
-    std::vector<double> sorted = tallest;
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(num_faces / 2),
-                     sorted.end());
-    preferred_height = std::round(sorted[num_faces / 2]);
-  }
+  const double preferred_height = PreferredBandHeight(patches, t);
   // A band's height (whole texels) for a face of this height over its side edge.
   auto band_height_for = [&](double height) {
     return std::abs(height / preferred_height - 1.0) < snap_to_preferred
@@ -952,6 +951,13 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     // vertex may land on the line within the chain's span (step 4).
     std::unordered_map<int, double> anchor_x;
     double anchor_lo = 0.0, anchor_hi = 0.0;
+    // A stacked band stays within `max_stack_overhang_texels` beyond the ends
+    // of the chain it stands on, so stacks stay near rectangles.
+    auto within_overhang = [&](double x) {
+      return options.max_stack_overhang_texels < 0.0 ||
+             (x >= anchor_lo - options.max_stack_overhang_texels &&
+              x <= anchor_hi + options.max_stack_overhang_texels);
+    };
 
     // 2. Growth towards +x across `rung` while faces fit; `lo` is the band's
     // far end in this direction's coordinates (`turned`: the band turned by
@@ -985,6 +991,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         Eigen::Vector2d apex(apex_c.real(), apex_on_top ? y_top : y_bottom);
         const int apex_vertex =
             mesh.faces[static_cast<std::size_t>(g)][static_cast<std::size_t>(k_apex)];
+        if (!anchor_x.empty() && !within_overhang(turned ? -apex.x() : apex.x())) break;
         if (!anchor_x.empty() && apex_on_top == turned) {  // onto the band below
           const auto it = anchor_x.find(apex_vertex);
           const double x = turned ? -apex.x() : apex.x();
@@ -1120,6 +1127,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
             z * std::complex<double>(cn[n2].x() - cn[n0].x(), cn[n2].y() - cn[n0].y());
         qn[n2] = Eigen::Vector2d(qn[n0].x() + a.real(), y_top + next_height);
       }
+      if (!within_overhang(qn[n2].x())) break;
       const double old_bottom = y_bottom, old_top = y_top;
       y_bottom = y_top;
       y_top = y_top + next_height;

@@ -94,6 +94,9 @@ struct StripChartOptions {
   double max_stack_texels = 0.0;
   /// A stacked band must span at least this fraction of the band below. (0, 1].
   double min_stack_cover = 0.75;
+  /// A stacked band reaches at most this far (texels) beyond either end of the
+  /// chain of the band below it; < 0: no limit.
+  double max_stack_overhang_texels = -1.0;
   /// Atlas gutter in texels (>= 0): fan sectors are sized for it.
   int gutter = 2;
 };
@@ -131,11 +134,17 @@ struct StripChartStats {
 /// `max_stack_texels`, a band is grown on the top line of the last one, its
 /// vertices on that line kept where the band below put them, so stacked bands
 /// form one chart with no gutter rows between them (a grid on developable
-/// surfaces such as a cylinder's side). Every face ends in exactly one chart.
+/// surfaces such as a cylinder's side); with `max_stack_overhang_texels`, a
+/// stacked band stays near the ends of the band below (stacks stay near
+/// rectangles on curved surfaces). Every face ends in exactly one chart.
 std::vector<std::vector<ChartFace>> MakeStripCharts(
     const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const StripChartOptions& options,
     StripChartStats* stats = nullptr);
+
+/// The band height strips prefer (texels): the median over the faces of each
+/// face's tallest height, rounded, so bands of near-equal faces share one height.
+double PreferredBandHeight(const std::vector<TrianglePatch>& patches, double texel_size);
 
 /// Singular values (largest first) of a 2x2 map.
 Eigen::Vector2d SingularValues2(const Eigen::Matrix2d& m);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <opencv2/core.hpp>
 #include <random>
@@ -270,6 +271,63 @@ TEST(Charts, StripsOfASphereAreBandsWithinTheStretchBound) {
   ExpectBands(charts, g, mesh, o.max_stretch, true);
 }
 
+// Stacks of a few bands on a sphere: at most 4 bands of the preferred height
+// high, and each stacked band within half a band of the ends of the chain it
+// stands on (the top line of the band below), so stacks stay near rectangles.
+TEST(Charts, StacksOfFewBandsStayWithinTheirHeightAndOverhang) {
+  const sfm::TriangleMesh mesh = datasets::MakeIcosphere(4, 1.0);  // 5120 faces
+  const PatchGeometry g = Geometry(mesh);
+  const double band = PreferredBandHeight(g.patches, kTexel);
+  ASSERT_GT(band, 10.0);
+  StripChartOptions o;
+  o.texel_size = kTexel;
+  o.max_stack_texels = 4 * band + 0.5;
+  o.max_stack_overhang_texels = 0.5 * band;
+  StripChartStats stats;
+  const auto charts = CheckedStripCharts(mesh, g, o, &stats);
+  EXPECT_GT(stats.stacked, 100);
+  ExpectBands(charts, g, mesh, o.max_stretch, true);
+  int checked_layers = 0;
+  for (const auto& chart : charts) {
+    // Per band line (y in 1e-3 texels): the x of the corners of the faces
+    // above it and of those below it.
+    std::map<long, std::pair<std::vector<double>, std::vector<double>>> on_line;
+    for (const ChartFace& cf : chart) {
+      std::array<Eigen::Vector2d, 3> q;
+      long lo = std::numeric_limits<long>::max(), hi = std::numeric_limits<long>::min();
+      for (std::size_t k = 0; k < 3; ++k) {
+        q[k] = (cf.linear * g.patches[static_cast<std::size_t>(cf.face)].corners_in_frame[k] +
+                cf.translation) /
+               kTexel;
+        lo = std::min(lo, std::lround(q[k].y() * 1000));
+        hi = std::max(hi, std::lround(q[k].y() * 1000));
+      }
+      for (const auto& p : q) {
+        on_line[lo].first.push_back(p.x());   // a face above line lo
+        on_line[hi].second.push_back(p.x());  // a face below line hi
+      }
+    }
+    const double height = (on_line.rbegin()->first - on_line.begin()->first) / 1000.0;
+    EXPECT_LE(height, o.max_stack_texels + 0.01);
+    for (const auto& [y, xs] : on_line) {
+      const auto& [above, below] = xs;
+      if (above.empty() || below.empty()) continue;  // the stack's bottom or top line
+      // The chain: the corners of the band below on this line.
+      double chain_lo = std::numeric_limits<double>::max(), chain_hi = -chain_lo;
+      for (std::size_t i = 0; i < below.size(); ++i) {
+        chain_lo = std::min(chain_lo, below[i]);
+        chain_hi = std::max(chain_hi, below[i]);
+      }
+      for (const double x : above) {
+        EXPECT_GE(x, chain_lo - o.max_stack_overhang_texels - 1e-6);
+        EXPECT_LE(x, chain_hi + o.max_stack_overhang_texels + 1e-6);
+      }
+      ++checked_layers;
+    }
+  }
+  EXPECT_EQ(checked_layers, stats.stacked);
+}
+
 // Cylinder caps are fans: each is unfolded rigidly about its centre and cut
 // into sectors of at most 90 degrees standing upright on the centre; once the
 // mesh is subdivided, the sectors take in the cap's rings of faces.
@@ -498,6 +556,9 @@ TEST(Charts, BadChartOptionsAreRefused) {
   EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), OptionError);
   strips.max_stack_texels = 100.0;
   strips.min_stack_cover = 0.0;
+  EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), OptionError);
+  strips.min_stack_cover = 0.75;
+  strips.max_stack_overhang_texels = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), OptionError);
 }
 
