@@ -96,27 +96,17 @@ sfm::TriangleMesh Decimated(const sfm::TriangleMesh& fine, std::size_t num_faces
   return mesh;
 }
 
-/// The shape at 4 times the coarse mesh's resolution along each direction, on
-/// the surface: 16 times the triangles (1280 -> 20480 on the sphere).
-sfm::TriangleMesh DenseMesh(datasets::SceneShape shape) {
+/// The shape at 2^`doublings` times the coarse mesh's resolution along each
+/// direction (icosphere 3, cylinder 48 x 12, torus 48 x 20), on the surface.
+sfm::TriangleMesh FinerMesh(datasets::SceneShape shape, int doublings) {
+  const int k = 1 << doublings;
   switch (shape) {
     case datasets::SceneShape::kSphere:
-      return datasets::MakeIcosphere(5, 1.0);
+      return datasets::MakeIcosphere(3 + doublings, 1.0);
     case datasets::SceneShape::kCylinder:
-      return datasets::MakeCylinder(192, 48, 0.6, 1.6);
+      return datasets::MakeCylinder(48 * k, 12 * k, 0.6, 1.6);
     default:
-      return datasets::MakeTorus(192, 80, 0.8, 0.35);
-  }
-}
-
-sfm::TriangleMesh FineMesh(datasets::SceneShape shape) {
-  switch (shape) {
-    case datasets::SceneShape::kSphere:
-      return datasets::MakeIcosphere(6, 1.0);
-    case datasets::SceneShape::kCylinder:
-      return datasets::MakeCylinder(384, 96, 0.6, 1.6);
-    default:
-      return datasets::MakeTorus(384, 160, 0.8, 0.35);
+      return datasets::MakeTorus(48 * k, 20 * k, 0.8, 0.35);
   }
 }
 }  // namespace
@@ -146,9 +136,9 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, sfm::TriangleMesh>> meshes = {
         {"", coarse},
         {"", synth::SubdivideMidpoint(coarse)},
-        {" dense", DenseMesh(shape)},
+        {" dense", FinerMesh(shape, 2)},  // 16 times the triangles
         {" jittered", Jittered(coarse)},
-        {" decimated", Decimated(FineMesh(shape), coarse.faces.size())}};
+        {" decimated", Decimated(FinerMesh(shape, 3), coarse.faces.size())}};
     if (const char* only = std::getenv("ATLAS_BENCH_ONLY"))
       std::erase_if(meshes, [&](const auto& m) { return m.first != std::string(" ") + only; });
     for (const auto& [label, mesh] : meshes) {
