@@ -991,6 +991,37 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         Eigen::Vector2d apex(apex_c.real(), apex_on_top ? y_top : y_bottom);
         const int apex_vertex =
             mesh.faces[static_cast<std::size_t>(g)][static_cast<std::size_t>(k_apex)];
+        // In a stacked band, an apex on the free line is placed by the
+        // similarity of the next face, whose edge on the band below has both
+        // ends where that band put them, not by the rung's: so the differences
+        // between the two lines' lengths (a torus ring's circles) do not add up
+        // along the band.
+        if (!anchor_x.empty() && apex_on_top != turned) {
+          const int on_line = turned ? rung.top : rung.bottom;  // the rung's end on the band below
+          const Eigen::Vector2d on_line_xy = turned ? rung.top_xy : rung.bottom_xy;
+          const int h = FaceAcross(mesh, unfoldings, g, apex_vertex, on_line);
+          const auto hs = static_cast<std::size_t>(h);
+          const int h_on_line = h >= 0 ? CornerOf(mesh, h, on_line) : -1;
+          const int h_apex = h >= 0 ? CornerOf(mesh, h, apex_vertex) : -1;
+          if (h >= 0 && !used[hs] && h_on_line >= 0 && h_apex >= 0) {
+            const int h_next = 3 - h_on_line - h_apex;  // on the band below, if anchored
+            const auto it = anchor_x.find(mesh.faces[hs][static_cast<std::size_t>(h_next)]);
+            const double next_x = it == anchor_x.end() ? 0.0 : (turned ? -it->second : it->second);
+            if (it != anchor_x.end() && next_x > on_line_xy.x() + 1e-3) {
+              const Corners ph = FrameCornersTexels(patches[hs], t);
+              const Eigen::Vector2d edge =
+                  ph[static_cast<std::size_t>(h_next)] - ph[static_cast<std::size_t>(h_on_line)];
+              const Eigen::Vector2d to_apex =
+                  ph[static_cast<std::size_t>(h_apex)] - ph[static_cast<std::size_t>(h_on_line)];
+              const std::complex<double> zh = std::complex<double>(next_x - on_line_xy.x(), 0.0) /
+                                              std::complex<double>(edge.x(), edge.y());
+              const std::complex<double> apex_h =
+                  std::complex<double>(on_line_xy.x(), on_line_xy.y()) +
+                  zh * std::complex<double>(to_apex.x(), to_apex.y());
+              if ((apex_h.imag() > on_line_xy.y()) == apex_on_top) apex.x() = apex_h.real();
+            }
+          }
+        }
         if (!anchor_x.empty() && !within_overhang(turned ? -apex.x() : apex.x())) break;
         if (!anchor_x.empty() && apex_on_top == turned) {  // onto the band below
           const auto it = anchor_x.find(apex_vertex);

@@ -134,7 +134,10 @@ struct StripChartStats {
 /// `max_stack_texels`, a band is grown on the top line of the last one, its
 /// vertices on that line kept where the band below put them, so stacked bands
 /// form one chart with no gutter rows between them (a grid on developable
-/// surfaces such as a cylinder's side); with `max_stack_overhang_texels`, a
+/// surfaces such as a cylinder's side); a stacked band's vertex on its free
+/// line is placed from the next face's edge on the band below, so the
+/// difference of the two lines' lengths on a curved surface does not add up
+/// along the band; with `max_stack_overhang_texels`, a
 /// stacked band stays near the ends of the band below (stacks stay near
 /// rectangles on curved surfaces). Every face ends in exactly one chart.
 std::vector<std::vector<ChartFace>> MakeStripCharts(
