@@ -1000,10 +1000,10 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
           const int on_line = turned ? rung.top : rung.bottom;  // the rung's end on the band below
           const Eigen::Vector2d on_line_xy = turned ? rung.top_xy : rung.bottom_xy;
           const int h = FaceAcross(mesh, unfoldings, g, apex_vertex, on_line);
-          const auto hs = static_cast<std::size_t>(h);
           const int h_on_line = h >= 0 ? CornerOf(mesh, h, on_line) : -1;
           const int h_apex = h >= 0 ? CornerOf(mesh, h, apex_vertex) : -1;
-          if (h >= 0 && !used[hs] && h_on_line >= 0 && h_apex >= 0) {
+          if (h_on_line >= 0 && h_apex >= 0 && !used[static_cast<std::size_t>(h)]) {
+            const auto hs = static_cast<std::size_t>(h);
             const int h_next = 3 - h_on_line - h_apex;  // on the band below, if anchored
             const auto it = anchor_x.find(mesh.faces[hs][static_cast<std::size_t>(h_next)]);
             const double next_x = it == anchor_x.end() ? 0.0 : (turned ? -it->second : it->second);
