@@ -533,6 +533,19 @@ struct Rung {
   Eigen::Vector2d top_xy, bottom_xy;
 };
 
+/// The image of `p` under the similarity (rotation, uniform scale and
+/// translation) taking `from_a` to `to_a` and `from_b` to `to_b`, as complex
+/// numbers: to_a + (to_b - to_a) / (from_b - from_a) (p - from_a). from_a != from_b.
+Eigen::Vector2d MapBySimilarity(const Eigen::Vector2d& from_a, const Eigen::Vector2d& from_b,
+                                const Eigen::Vector2d& to_a, const Eigen::Vector2d& to_b,
+                                const Eigen::Vector2d& p) {
+  using Complex = std::complex<double>;
+  const Eigen::Vector2d from = from_b - from_a, to = to_b - to_a, d = p - from_a;
+  const Complex z = Complex(to.x(), to.y()) / Complex(from.x(), from.y());
+  const Complex q = Complex(to_a.x(), to_a.y()) + z * Complex(d.x(), d.y());
+  return {q.real(), q.imag()};
+}
+
 int CornerOf(const sfm::TriangleMesh& mesh, int face, int vertex) {
   for (int k = 0; k < 3; ++k)
     if (mesh.faces[static_cast<std::size_t>(face)][static_cast<std::size_t>(k)] == vertex) return k;
@@ -959,6 +972,34 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
               x <= anchor_hi + options.max_stack_overhang_texels);
     };
 
+    // In a stacked band, the x of face g's apex going onto the free line, by
+    // the similarity of the next face across (apex, the rung's end on the band
+    // below), whose edge on that band has both ends where the band put them; not
+    // by the rung's, so the differences between the two lines' lengths (a torus
+    // ring's circles) do not add up along the band. None when that face is used
+    // or its third corner is not on the band below.
+    auto free_line_x = [&](int g, int apex_vertex, const Rung& rung, bool turned,
+                           bool apex_on_top) -> std::optional<double> {
+      const int on_line = turned ? rung.top : rung.bottom;  // the rung's end on the band below
+      const Eigen::Vector2d& on_line_xy = turned ? rung.top_xy : rung.bottom_xy;
+      const int h = FaceAcross(mesh, unfoldings, g, apex_vertex, on_line);
+      if (h < 0 || used[static_cast<std::size_t>(h)]) return std::nullopt;
+      const int h_on_line = CornerOf(mesh, h, on_line), h_apex = CornerOf(mesh, h, apex_vertex);
+      if (h_on_line < 0 || h_apex < 0) return std::nullopt;
+      const auto hs = static_cast<std::size_t>(h);
+      const auto h_next = static_cast<std::size_t>(3 - h_on_line - h_apex);
+      const auto it = anchor_x.find(mesh.faces[hs][h_next]);
+      if (it == anchor_x.end()) return std::nullopt;
+      const double next_x = turned ? -it->second : it->second;
+      if (!(next_x > on_line_xy.x() + 1e-3)) return std::nullopt;
+      const Corners ph = FrameCornersTexels(patches[hs], t);
+      const Eigen::Vector2d q = MapBySimilarity(ph[static_cast<std::size_t>(h_on_line)], ph[h_next],
+                                                on_line_xy, Eigen::Vector2d(next_x, on_line_xy.y()),
+                                                ph[static_cast<std::size_t>(h_apex)]);
+      if ((q.y() > on_line_xy.y()) != apex_on_top) return std::nullopt;
+      return q.x();
+    };
+
     // 2. Growth towards +x across `rung` while faces fit; `lo` is the band's
     // far end in this direction's coordinates (`turned`: the band turned by
     // 180 degrees, growing towards -x). Returns the faces added.
@@ -973,55 +1014,18 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         if (k_top < 0 || k_bottom < 0) break;
         const int k_apex = 3 - k_top - k_bottom;
         const Corners p = FrameCornersTexels(patches[static_cast<std::size_t>(g)], t);
-        // The similarity taking the rung's frame points onto its band points
-        // (as complex numbers: q = q_bottom + z (p - p_bottom)).
-        const std::complex<double> dp(p[k_top].x() - p[k_bottom].x(),
-                                      p[k_top].y() - p[k_bottom].y());
-        const std::complex<double> dq(rung.top_xy.x() - rung.bottom_xy.x(),
-                                      rung.top_xy.y() - rung.bottom_xy.y());
-        if (std::abs(dp) == 0.0) break;
-        const std::complex<double> z = dq / dp;
-        const std::complex<double> apex_c =
-            std::complex<double>(rung.bottom_xy.x(), rung.bottom_xy.y()) +
-            z * std::complex<double>(p[k_apex].x() - p[k_bottom].x(),
-                                     p[k_apex].y() - p[k_bottom].y());
+        // The similarity taking the rung's frame points onto its band points.
+        if (p[k_top] == p[k_bottom]) break;
+        const Eigen::Vector2d apex_mapped =
+            MapBySimilarity(p[k_bottom], p[k_top], rung.bottom_xy, rung.top_xy, p[k_apex]);
         // The apex goes to the nearer band line and must lie beyond the rung's
         // end on that line (bands are monotone, so faces never overlap).
-        const bool apex_on_top = apex_c.imag() > 0.5 * (y_bottom + y_top);
-        Eigen::Vector2d apex(apex_c.real(), apex_on_top ? y_top : y_bottom);
+        const bool apex_on_top = apex_mapped.y() > 0.5 * (y_bottom + y_top);
+        Eigen::Vector2d apex(apex_mapped.x(), apex_on_top ? y_top : y_bottom);
         const int apex_vertex =
             mesh.faces[static_cast<std::size_t>(g)][static_cast<std::size_t>(k_apex)];
-        // In a stacked band, an apex on the free line is placed by the
-        // similarity of the next face, whose edge on the band below has both
-        // ends where that band put them, not by the rung's: so the differences
-        // between the two lines' lengths (a torus ring's circles) do not add up
-        // along the band.
-        if (!anchor_x.empty() && apex_on_top != turned) {
-          const int on_line = turned ? rung.top : rung.bottom;  // the rung's end on the band below
-          const Eigen::Vector2d on_line_xy = turned ? rung.top_xy : rung.bottom_xy;
-          const int h = FaceAcross(mesh, unfoldings, g, apex_vertex, on_line);
-          const int h_on_line = h >= 0 ? CornerOf(mesh, h, on_line) : -1;
-          const int h_apex = h >= 0 ? CornerOf(mesh, h, apex_vertex) : -1;
-          if (h_on_line >= 0 && h_apex >= 0 && !used[static_cast<std::size_t>(h)]) {
-            const auto hs = static_cast<std::size_t>(h);
-            const int h_next = 3 - h_on_line - h_apex;  // on the band below, if anchored
-            const auto it = anchor_x.find(mesh.faces[hs][static_cast<std::size_t>(h_next)]);
-            const double next_x = it == anchor_x.end() ? 0.0 : (turned ? -it->second : it->second);
-            if (it != anchor_x.end() && next_x > on_line_xy.x() + 1e-3) {
-              const Corners ph = FrameCornersTexels(patches[hs], t);
-              const Eigen::Vector2d edge =
-                  ph[static_cast<std::size_t>(h_next)] - ph[static_cast<std::size_t>(h_on_line)];
-              const Eigen::Vector2d to_apex =
-                  ph[static_cast<std::size_t>(h_apex)] - ph[static_cast<std::size_t>(h_on_line)];
-              const std::complex<double> zh = std::complex<double>(next_x - on_line_xy.x(), 0.0) /
-                                              std::complex<double>(edge.x(), edge.y());
-              const std::complex<double> apex_h =
-                  std::complex<double>(on_line_xy.x(), on_line_xy.y()) +
-                  zh * std::complex<double>(to_apex.x(), to_apex.y());
-              if ((apex_h.imag() > on_line_xy.y()) == apex_on_top) apex.x() = apex_h.real();
-            }
-          }
-        }
+        if (!anchor_x.empty() && apex_on_top != turned)
+          if (const auto x = free_line_x(g, apex_vertex, rung, turned, apex_on_top)) apex.x() = *x;
         if (!anchor_x.empty() && !within_overhang(turned ? -apex.x() : apex.x())) break;
         if (!anchor_x.empty() && apex_on_top == turned) {  // onto the band below
           const auto it = anchor_x.find(apex_vertex);
@@ -1150,14 +1154,9 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
       Corners qn;
       qn[n0] = Eigen::Vector2d(anchor_x.at(nv[n0]), y_top);
       qn[n1] = Eigen::Vector2d(anchor_x.at(nv[n1]), y_top);
-      {  // the apex by the similarity taking the edge onto its place, on the new top line
-        const std::complex<double> z =
-            std::complex<double>(qn[n1].x() - qn[n0].x(), 0.0) /
-            std::complex<double>(cn[n1].x() - cn[n0].x(), cn[n1].y() - cn[n0].y());
-        const std::complex<double> a =
-            z * std::complex<double>(cn[n2].x() - cn[n0].x(), cn[n2].y() - cn[n0].y());
-        qn[n2] = Eigen::Vector2d(qn[n0].x() + a.real(), y_top + next_height);
-      }
+      // The apex by the similarity taking the edge onto its place, on the new top line.
+      qn[n2] = Eigen::Vector2d(MapBySimilarity(cn[n0], cn[n1], qn[n0], qn[n1], cn[n2]).x(),
+                               y_top + next_height);
       if (!within_overhang(qn[n2].x())) break;
       const double old_bottom = y_bottom, old_top = y_top;
       y_bottom = y_top;
