@@ -7,6 +7,7 @@
 #include <deque>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <unordered_map>
 
 #include "ptm/coefficient_space.h"
@@ -23,6 +24,8 @@ constexpr int kPackingRotations = 16;
 /// Charts whose upright box is this many times longer than wide are turned by
 /// quarter turns only.
 constexpr int kThinChartAspect = 4;
+/// Strip charts compared for the best fit at each place in a row.
+constexpr int kBestFitCandidates = 64;
 
 /// A chart turned by `angle`: its texel box (chart units / t, x right, y up;
 /// gutters included) and, row by row (y down from the box top), the runs of
@@ -349,8 +352,59 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
       x = std::max(x, right_edge[static_cast<std::size_t>(r.row + dy)] - r.x);
     return x;
   };
+  // Texels left empty between the row's right edge and outline `o` slid to
+  // x at dy, per row of the outline: the gap its left end leaves.
+  auto gap_per_row = [&](const ChartOutline& o, int x, int dy) {
+    std::vector<int> first(static_cast<std::size_t>(o.Height()), std::numeric_limits<int>::max());
+    for (const ChartOutline::Run& r : o.runs)
+      first[static_cast<std::size_t>(r.row)] =
+          std::min(first[static_cast<std::size_t>(r.row)], r.x);
+    double gap = 0.0;
+    int rows = 0;
+    for (int row = 0; row < o.Height(); ++row) {
+      if (first[static_cast<std::size_t>(row)] == std::numeric_limits<int>::max()) continue;
+      gap +=
+          x + first[static_cast<std::size_t>(row)] - right_edge[static_cast<std::size_t>(row + dy)];
+      ++rows;
+    }
+    return rows > 0 ? gap / rows : 0.0;
+  };
+  // Whole charts' outlines at 0 and 180 degrees, made when first needed.
+  std::vector<std::array<std::optional<ChartOutline>, 2>> whole(queue.size());
+  auto whole_outline = [&](std::size_t c, int turn) -> const ChartOutline& {
+    auto& o = whole[c][static_cast<std::size_t>(turn)];
+    if (!o) o = Outline(queue[c], turn * kPi, patches, t, gutter);
+    return *o;
+  };
+  std::vector<char> pending(order.size(), 1);  // per position in `order`
+  std::size_t first_pending = 0;
   std::size_t done = 0;
-  for (const std::size_t c : order) {
+  while (done < order.size()) {
+    while (!pending[first_pending]) ++first_pending;
+    std::size_t pick = first_pending;
+    // Best fit: in a started row, the whole chart (of the next few that fit
+    // under the row's height) whose end leaves the least gap, so slanted ends
+    // nest instead of leaving triangles empty.
+    if (row_height > 0 &&
+        std::any_of(right_edge.begin(), right_edge.end(), [](int e) { return e > 0; })) {
+      double best_gap = std::numeric_limits<double>::max();
+      int tried = 0;
+      for (std::size_t i = first_pending; i < order.size() && tried < kBestFitCandidates; ++i) {
+        if (!pending[i] || height[order[i]] != row_height) continue;
+        ++tried;
+        for (int turn = 0; turn < 2; ++turn) {
+          const ChartOutline& o = whole_outline(order[i], turn);
+          for (int dy = 0; dy + o.Height() <= row_height; ++dy) {
+            const int x = slide(o, dy);
+            if (x + o.Width() > atlas_size) continue;
+            const double gap = gap_per_row(o, x, dy);
+            if (gap < best_gap) best_gap = gap, pick = i;
+          }
+        }
+      }
+    }
+    pending[pick] = 0;
+    const std::size_t c = order[pick];
     if (height[c] > atlas_size)
       throw OptionError("a strip chart of " + std::to_string(height[c]) +
                         " texels' height does not fit an atlas of " + std::to_string(atlas_size));
@@ -371,6 +425,7 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
         // turns and, for pieces shorter than the row, every height in it.
         struct Slide {
           int turn = -1, x = 0, dy = 0;
+          double gap = 0.0;
           ChartOutline outline;
         };
         auto best_slide = [&](std::size_t count) {
@@ -383,8 +438,10 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
             for (int dy = 0; dy + o.Height() <= row_height; ++dy) {
               const int x = slide(o, dy);
               if (x + o.Width() > atlas_size) continue;
-              if (best.turn < 0 || x + o.Width() < best.x + best.outline.Width())
-                best = Slide{turn, x, dy, o};
+              const double gap = gap_per_row(o, x, dy);
+              if (best.turn < 0 || gap < best.gap ||
+                  (gap == best.gap && x + o.Width() < best.x + best.outline.Width()))
+                best = Slide{turn, x, dy, gap, o};
             }
           }
           return best;
