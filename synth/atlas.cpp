@@ -743,15 +743,18 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
                                 {StripSide::kTallest, 8.0 * band + 0.5, 0.5 * band}};
     RowPacking best;
     std::int64_t best_texels = 0;
-    for (const Variant& variant : variants) {
-      so.side = variant.side;
-      so.max_stack_texels = variant.max_stack_texels;
-      so.max_stack_overhang_texels = variant.max_stack_overhang_texels;
-      RowPacking rows = PackStripsInRows(MakeStripCharts(mesh, patches, unfoldings, so), patches, t,
-                                         gutter, options.atlas_size, progress);
-      if (best.pieces.empty() || rows.texels < best_texels)
-        best_texels = rows.texels, best = std::move(rows);
-    }
+    // Every variant as it is and fitted to irregular faces (synth/charts.h).
+    for (const bool fit_irregular_faces : {false, true})
+      for (const Variant& variant : variants) {
+        so.side = variant.side;
+        so.max_stack_texels = variant.max_stack_texels;
+        so.max_stack_overhang_texels = variant.max_stack_overhang_texels;
+        so.fit_irregular_faces = fit_irregular_faces;
+        RowPacking rows = PackStripsInRows(MakeStripCharts(mesh, patches, unfoldings, so), patches,
+                                           t, gutter, options.atlas_size, progress);
+        if (best.pieces.empty() || rows.texels < best_texels)
+          best_texels = rows.texels, best = std::move(rows);
+      }
     charts = std::move(best.pieces);
     for (std::size_t c = 0; c < charts.size(); ++c)
       drop_chart(charts[c], best.outlines[c], best.drops[c]);

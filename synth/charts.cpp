@@ -546,6 +546,46 @@ Eigen::Vector2d MapBySimilarity(const Eigen::Vector2d& from_a, const Eigen::Vect
   return {q.real(), q.imag()};
 }
 
+/// The texel stretch of the map taking `from` onto `to`: its larger singular
+/// value or the inverse of its smaller, whichever is larger (infinite when `to`
+/// is degenerate or flipped).
+double StretchOf(const Corners& from, const Corners& to) {
+  if (!(Cross(to[1] - to[0], to[2] - to[0]) > 1e-6)) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector2d sigma = SingularValues2(AffineBetween(-1, from, to).linear);
+  return std::max(sigma.x(), 1.0 / sigma.y());
+}
+
+/// Where on the line y = `y_line`, beyond `x_min`, corner `k` of `to` goes so
+/// that the map from `from` stretches least: a scan over three times the
+/// face's longest side, then a ternary search around the best sample. Returns
+/// (x, stretch).
+std::pair<double, double> LeastStretchOnLine(const Corners& from, Corners to, std::size_t k,
+                                             double y_line, double x_min) {
+  double longest = 0.0;
+  for (std::size_t a = 0; a < 3; ++a)
+    longest = std::max(longest, (from[a] - from[(a + 1) % 3]).norm());
+  auto stretch = [&](double x) {
+    to[k] = Eigen::Vector2d(x, y_line);
+    return StretchOf(from, to);
+  };
+  constexpr int kSamples = 64;
+  const double step = 3.0 * longest / kSamples;
+  double best_x = x_min, best = stretch(x_min);
+  for (int i = 1; i <= kSamples; ++i)
+    if (const double s = stretch(x_min + i * step); s < best) best = s, best_x = x_min + i * step;
+  double a = std::max(x_min, best_x - step), b = best_x + step;
+  for (int i = 0; i < 40; ++i) {
+    const double m1 = a + (b - a) / 3.0, m2 = b - (b - a) / 3.0;
+    if (stretch(m1) < stretch(m2))
+      b = m2;
+    else
+      a = m1;
+  }
+  const double x = 0.5 * (a + b);
+  const double s = stretch(x);
+  return s < best ? std::make_pair(x, s) : std::make_pair(best_x, best);
+}
+
 int CornerOf(const sfm::TriangleMesh& mesh, int face, int vertex) {
   for (int k = 0; k < 3; ++k)
     if (mesh.faces[static_cast<std::size_t>(face)][static_cast<std::size_t>(k)] == vertex) return k;
@@ -848,9 +888,14 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
   const double preferred_height = PreferredBandHeight(patches, t);
   // A band's height (whole texels) for a face of this height over its side edge.
   auto band_height_for = [&](double height) {
-    return std::abs(height / preferred_height - 1.0) < snap_to_preferred
-               ? preferred_height
-               : std::max(1.0, std::round(height));
+    if (std::abs(height / preferred_height - 1.0) < snap_to_preferred) return preferred_height;
+    if (!options.fit_irregular_faces) return std::max(1.0, std::round(height));
+    // Else the nearest height of the ladder preferred * s^k (s the stretch
+    // bound): the face is stretched by at most sqrt(s) across the band, and the
+    // bands of an irregular mesh share few heights, so they fill atlas rows.
+    const double k =
+        std::round(std::log(height / preferred_height) / std::log(options.max_stretch));
+    return std::max(1.0, std::round(preferred_height * std::pow(options.max_stretch, k)));
   };
   // The face's map into the band when its stretch is within the bound.
   auto place = [&](int f, const Corners& band) -> std::optional<ChartFace> {
@@ -1020,7 +1065,7 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
             MapBySimilarity(p[k_bottom], p[k_top], rung.bottom_xy, rung.top_xy, p[k_apex]);
         // The apex goes to the nearer band line and must lie beyond the rung's
         // end on that line (bands are monotone, so faces never overlap).
-        const bool apex_on_top = apex_mapped.y() > 0.5 * (y_bottom + y_top);
+        bool apex_on_top = apex_mapped.y() > 0.5 * (y_bottom + y_top);
         Eigen::Vector2d apex(apex_mapped.x(), apex_on_top ? y_top : y_bottom);
         const int apex_vertex =
             mesh.faces[static_cast<std::size_t>(g)][static_cast<std::size_t>(k_apex)];
@@ -1041,6 +1086,20 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         q[static_cast<std::size_t>(k_top)] = rung.top_xy;
         q[static_cast<std::size_t>(k_bottom)] = rung.bottom_xy;
         q[static_cast<std::size_t>(k_apex)] = apex;
+        if (options.fit_irregular_faces && anchor_x.empty() && !place(g, q)) {
+          // An irregular face the rung's similarity stretches too far: its apex
+          // at the least-stretching place on either line instead.
+          const auto ka = static_cast<std::size_t>(k_apex);
+          double least = std::numeric_limits<double>::infinity();
+          for (const bool on_top : {apex_on_top, !apex_on_top}) {
+            const double x_min = (on_top ? rung.top_xy.x() : rung.bottom_xy.x()) + 1e-3;
+            const auto [x, s] = LeastStretchOnLine(p, q, ka, on_top ? y_top : y_bottom, x_min);
+            if (s < least) least = s, apex = Eigen::Vector2d(x, on_top ? y_top : y_bottom);
+          }
+          apex_on_top = apex.y() == y_top;
+          q[ka] = apex;
+          if (std::max(hi, apex.x()) - lo > options.max_length_texels) break;
+        }
         if (!place(g, q)) break;
         mark_used(g);
         added.emplace_back(g, q);

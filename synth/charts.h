@@ -99,6 +99,12 @@ struct StripChartOptions {
   double max_stack_overhang_texels = -1.0;
   /// Atlas gutter in texels (>= 0): fan sectors are sized for it.
   int gutter = 2;
+  /// For irregular meshes: a band whose seed is not near the preferred height
+  /// takes the nearest height of the ladder preferred * max_stretch^k (so the
+  /// bands share few heights and fill atlas rows), and an unstacked band's face
+  /// that the rung's similarity would stretch beyond the bound takes its apex
+  /// at the least-stretching place on either line instead of ending the band.
+  bool fit_irregular_faces = false;
 };
 
 /// What MakeStripCharts did.
