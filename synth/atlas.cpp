@@ -299,9 +299,10 @@ OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlin
 }
 
 /// Strip charts (bands of equal height, synth/charts.h) packed in rows: pieces
-/// go tallest first, left to right, each turned by 0 or 180 degrees to slide
-/// furthest left against the row's texel-exact right edge (so slanted ends
-/// nest); a band that overruns the row is cut at a rung, and its rest starts
+/// go tallest first, left to right, by best fit (each place in a row takes the
+/// piece of the row's height, and its turn by 0 or 180 degrees, whose left end
+/// slid against the row's texel-exact right edge leaves the least gap, so
+/// slanted ends nest); a band that overruns the row is cut at a rung, and its rest starts
 /// the next row, so rows end within a triangle of the atlas edge.
 struct RowPacking {
   std::vector<std::vector<ChartFace>> pieces;
@@ -382,9 +383,9 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
   while (done < order.size()) {
     while (!pending[first_pending]) ++first_pending;
     std::size_t pick = first_pending;
-    // Best fit: in a started row, the whole chart (of the next few that fit
-    // under the row's height) whose end leaves the least gap, so slanted ends
-    // nest instead of leaving triangles empty.
+    // Best fit: in a started row, the whole chart (of the next
+    // kBestFitCandidates of the row's height) whose left end leaves the least
+    // gap, so slanted ends nest instead of leaving triangles empty.
     if (row_height > 0 &&
         std::any_of(right_edge.begin(), right_edge.end(), [](int e) { return e > 0; })) {
       double best_gap = std::numeric_limits<double>::max();
