@@ -37,6 +37,8 @@ struct ChartOutline {
   double angle = 0.0;
   Eigen::Vector2i lo, hi;
   std::vector<Run> runs;
+  /// Per row, the x of its first run (INT_MAX for a row without runs).
+  std::vector<int> row_first_x;
   double area = 0.0;  ///< texels inside the outline
   int Width() const { return hi.x() - lo.x(); }
   int Height() const { return hi.y() - lo.y(); }
@@ -102,6 +104,7 @@ ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
           mask.at<std::uint8_t>(y, x) = 1;
     }
   }
+  o.row_first_x.assign(static_cast<std::size_t>(h), std::numeric_limits<int>::max());
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w;) {
       if (!mask.at<std::uint8_t>(y, x)) {
@@ -111,6 +114,8 @@ ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
       int end = x;
       while (end < w && mask.at<std::uint8_t>(y, end)) ++end;
       o.runs.push_back({y, x, end - x});
+      int& first = o.row_first_x[static_cast<std::size_t>(y)];
+      first = std::min(first, x);
       o.area += end - x;
       x = end;
     }
@@ -356,16 +361,12 @@ RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
   // Texels left empty between the row's right edge and outline `o` slid to
   // x at dy, per row of the outline: the gap its left end leaves.
   auto gap_per_row = [&](const ChartOutline& o, int x, int dy) {
-    std::vector<int> first(static_cast<std::size_t>(o.Height()), std::numeric_limits<int>::max());
-    for (const ChartOutline::Run& r : o.runs)
-      first[static_cast<std::size_t>(r.row)] =
-          std::min(first[static_cast<std::size_t>(r.row)], r.x);
     double gap = 0.0;
     int rows = 0;
     for (int row = 0; row < o.Height(); ++row) {
-      if (first[static_cast<std::size_t>(row)] == std::numeric_limits<int>::max()) continue;
-      gap +=
-          x + first[static_cast<std::size_t>(row)] - right_edge[static_cast<std::size_t>(row + dy)];
+      const int first = o.row_first_x[static_cast<std::size_t>(row)];
+      if (first == std::numeric_limits<int>::max()) continue;
+      gap += x + first - right_edge[static_cast<std::size_t>(row + dy)];
       ++rows;
     }
     return rows > 0 ? gap / rows : 0.0;

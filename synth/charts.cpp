@@ -1086,7 +1086,8 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
         q[static_cast<std::size_t>(k_top)] = rung.top_xy;
         q[static_cast<std::size_t>(k_bottom)] = rung.bottom_xy;
         q[static_cast<std::size_t>(k_apex)] = apex;
-        if (options.fit_irregular_faces && anchor_x.empty() && !place(g, q)) {
+        bool fits = place(g, q).has_value();
+        if (!fits && options.fit_irregular_faces && anchor_x.empty()) {
           // An irregular face the rung's similarity stretches too far: its apex
           // at the least-stretching place on either line instead.
           const auto ka = static_cast<std::size_t>(k_apex);
@@ -1099,8 +1100,9 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
           apex_on_top = apex.y() == y_top;
           q[ka] = apex;
           if (std::max(hi, apex.x()) - lo > options.max_length_texels) break;
+          fits = place(g, q).has_value();
         }
-        if (!place(g, q)) break;
+        if (!fits) break;
         mark_used(g);
         added.emplace_back(g, q);
         hi = std::max({hi, rung.top_xy.x(), rung.bottom_xy.x(), apex.x()});
