@@ -17,13 +17,13 @@
 #include "apps/progress_bar.h"
 #include "btf/btf.h"
 #include "btf/btf_model.h"
+#include "core/errors.h"
+#include "core/file_util.h"
 #include "datasets_synthetic/object_scene.h"
 #include "datasets_synthetic/scene.h"
 #include "ptm/fit.h"
 #include "ptm/ptm_io.h"
 #include "ptm/sphere_lights.h"
-#include "sfm/errors.h"
-#include "sfm/file_util.h"
 #include "sfm/inspect.h"
 #include "sfm/lights.h"
 #include "synth/pipeline.h"
@@ -165,7 +165,7 @@ void WriteRgbPng(const std::filesystem::path& path, const std::vector<float>& rg
                     bytes)) {
     throw std::runtime_error(path.string() + ": cannot encode the image (use .png, .jpg or .tif)");
   }
-  synth::WriteBytesAtomically(path, bytes);
+  WriteBytesAtomically(path, bytes);
 }
 
 }  // namespace

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "apps/cli.h"
-#include "sfm/errors.h"
+#include "core/errors.h"
 
 namespace {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <string_view>
 
-#include "sfm/progress.h"
+#include "core/progress.h"
 
 namespace texlume::apps {
 

@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
     synth::MeshPhoto p;
     p.image_id = id;
     p.name = image.name;
-    p.image = synth::ReadPhotoRgb(work / "object/images" / image.name);
+    p.image = ReadPhotoRgb(work / "object/images" / image.name);
     p.lights = lights.at(image.name);
     photos.push_back(p);
   }
@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
     o.sample_texel_size = scene.material.texel_size;
     const synth::MeshSynthesis s =
         synth::SynthesizeMeshPtm(mesh, reconstruction, visibility, photos, sample, o);
-    if (level == 0) base_synthesis = s.seconds;
+    if (level == 0) base_synthesis = s.seconds_synthesis;
     synth::AtlasOptions charts, boxes;
     boxes.mode = synth::AtlasMode::kPerTriangle;
     const synth::Atlases a_charts = synth::BuildAtlases(mesh, s, charts);
@@ -71,9 +71,10 @@ int main(int argc, char** argv) {
         "%6zu triangles: visibility %.2f s, synthesis %.2f s (%.2f ms per triangle, %.2fx the "
         "1280-triangle time), atlas %.2f s (charts) / %.2f s (boxes); occupancy charts %.3f in "
         "%zu atlas(es), %d charts; per triangle %.3f in %zu atlas(es)\n",
-        mesh.faces.size(), seconds_visibility, s.seconds, 1e3 * s.seconds / mesh.faces.size(),
-        s.seconds / base_synthesis, a_charts.seconds, a_boxes.seconds, a_charts.occupancy,
-        a_charts.ptms.size(), a_charts.num_charts, a_boxes.occupancy, a_boxes.ptms.size());
+        mesh.faces.size(), seconds_visibility, s.seconds_synthesis,
+        1e3 * s.seconds_synthesis / mesh.faces.size(), s.seconds_synthesis / base_synthesis,
+        a_charts.seconds, a_boxes.seconds, a_charts.occupancy, a_charts.ptms.size(),
+        a_charts.num_charts, a_boxes.occupancy, a_boxes.ptms.size());
   }
   return 0;
 }

@@ -149,13 +149,11 @@ int main(int argc, char** argv) {
   // light is nearest, upscaled; (b) Lambertian photometric stereo on the photos
   // (linear domain, per channel, exact with 3 lights), upscaled, relit.
   auto to_linear = [](cv::Mat m) {
-    for (float* p = m.ptr<float>(); p != m.ptr<float>() + m.total() * 3; ++p)
-      *p = synth::SrgbToLinear(*p);
+    for (float* p = m.ptr<float>(); p != m.ptr<float>() + m.total() * 3; ++p) *p = SrgbToLinear(*p);
     return m;
   };
   auto to_srgb = [](cv::Mat m) {
-    for (float* p = m.ptr<float>(); p != m.ptr<float>() + m.total() * 3; ++p)
-      *p = synth::LinearToSrgb(*p);
+    for (float* p = m.ptr<float>(); p != m.ptr<float>() + m.total() * 3; ++p) *p = LinearToSrgb(*p);
     return m;
   };
   std::vector<cv::Mat> up_linear;

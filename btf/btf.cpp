@@ -9,12 +9,11 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 
+#include "core/errors.h"
+#include "core/file_util.h"
+#include "core/image_io.h"
+#include "core/json_io.h"
 #include "ptm/exr_io.h"
-#include "sfm/errors.h"
-#include "sfm/file_util.h"
-#include "synth/mesh_synthesis.h"
-#include "synth/model_io.h"
-#include "synth/pipeline.h"
 
 namespace texlume::btf {
 namespace fs = std::filesystem;
@@ -67,7 +66,7 @@ nlohmann::json DirectionsJson(const std::vector<Eigen::Vector3d>& directions) {
 BtfCapture ReadBtfCapture(const fs::path& dir) {
   const fs::path json_path = dir / "btf.json";
   const std::string label = json_path.string();
-  const nlohmann::json j = synth::ReadJsonFile(json_path);
+  const nlohmann::json j = ReadJsonFile(json_path);
   BtfCapture capture;
   auto integer = [&](const char* key) {
     if (!j.contains(key) || !j[key].is_number_integer())
@@ -110,14 +109,14 @@ BtfCapture ReadBtfCapture(const fs::path& dir) {
       if (!fs::exists(file))
         throw InputError(file.string(), "is missing: the capture has no image for view " +
                                             std::to_string(a) + " and light " + std::to_string(b));
-      cv::Mat rgb = synth::ReadPhotoRgb(file);
+      cv::Mat rgb = ReadPhotoRgb(file);
       if (rgb.cols != capture.width || rgb.rows != capture.height)
         throw InputError(file.string(), "is " + std::to_string(rgb.cols) + " x " +
                                             std::to_string(rgb.rows) + ", not " +
                                             std::to_string(capture.width) + " x " +
                                             std::to_string(capture.height) + " as btf.json says");
       for (auto it = rgb.begin<cv::Vec3f>(); it != rgb.end<cv::Vec3f>(); ++it)
-        for (int c = 0; c < 3; ++c) (*it)[c] = synth::SrgbToLinear((*it)[c]);
+        for (int c = 0; c < 3; ++c) (*it)[c] = SrgbToLinear((*it)[c]);
       capture.images.push_back(std::move(rgb));
     }
   return capture;
@@ -318,7 +317,7 @@ void WriteBtfFactorisation(const BtfFactorisation& factorisation,
 BtfFactorisation ReadBtfFactorisation(const fs::path& dir) {
   const fs::path json_path = dir / "btf_svd.json";
   const std::string label = json_path.string();
-  const nlohmann::json j = synth::ReadJsonFile(json_path);
+  const nlohmann::json j = ReadJsonFile(json_path);
   if (j.value("format", "") != "texlume-btf-svd-1")
     throw InputError(label, "is not a texlume BTF factorisation (format texlume-btf-svd-1)");
   BtfFactorisation out;

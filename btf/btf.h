@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "sfm/progress.h"
+#include "core/progress.h"
 
 namespace texlume::btf {
 

@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "core/errors.h"
 #include "ptm/coefficient_space.h"
 #include "ptm/exr_io.h"
-#include "sfm/errors.h"
 #include "synth/model_io.h"
 #include "synth/web_model.h"
 
@@ -48,7 +48,7 @@ std::vector<Eigen::Vector3d> PreviewLights() {
 
 }  // namespace
 
-BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const BtfMeshSynthesis& synthesis,
+BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const synth::BtfMeshSynthesis& synthesis,
                            const BtfFactorisation& sample, const synth::AtlasOptions& options,
                            const ProgressCallback& progress) {
   BtfAtlases out;
@@ -67,7 +67,7 @@ BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const BtfMeshSynthesis
   synth::AtlasCoverage coverage = synth::VisitAtlasTexels(
       out.layout, synthesis.texel_size, options.gutter,
       [&](int atlas, int x, int y, int face, const Eigen::Vector2d& p_in_frame) {
-        const BtfSampleLookup look = synthesis.Lookup(face, p_in_frame);
+        const synth::BtfSampleLookup look = synthesis.Lookup(face, p_in_frame);
         auto& p = planes[static_cast<std::size_t>(atlas)];
         p[0].at<float>(y, x) = static_cast<float>(look.sample_px.x());
         p[1].at<float>(y, x) = static_cast<float>(look.sample_px.y());
@@ -76,7 +76,7 @@ BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const BtfMeshSynthesis
             WrapAngle(look.angle_rad - face_angle[static_cast<std::size_t>(face)]));
         for (int c = 0; c < 3; ++c)
           p[static_cast<std::size_t>(3 + c)].at<float>(y, x) = look.colour_gain[c];
-        SampleGeometry(sample, look.sample_px, g.data());
+        synth::SampleGeometry(sample, look.sample_px, g.data());
         for (int i = 0; i < n; ++i) p[static_cast<std::size_t>(6 + i)].at<float>(y, x) = g[i];
       },
       progress);
@@ -135,7 +135,7 @@ std::vector<ptm::Ptm> PreviewPtms(const BtfAtlases& atlases, const BtfFactorisat
         for (int j = 0; j < count; ++j) {
           double s = 0.0;
           for (int c = 0; c < 3; ++c) {
-            const double d = synth::LinearToSrgb(linear[j * 3 + c]);
+            const double d = LinearToSrgb(linear[j * 3 + c]);
             channel_sum[c] += d;
             s += d;
           }
@@ -219,7 +219,7 @@ Eigen::Vector3f ShadeBtf(const BtfModel& model, const synth::ModelRenderer::Surf
   const double ox = s.atlas_px.x() - (nx + 0.5), oy = -(s.atlas_px.y() - (ny + 0.5));  // y up
   const Eigen::Vector2d sample_px(texel[0] + (ca * ox - sa * oy), texel[1] - (sa * ox + ca * oy));
   Eigen::VectorXf g(n);
-  SampleGeometry(model.sample, sample_px, g.data());
+  synth::SampleGeometry(model.sample, sample_px, g.data());
   auto to_sample = [&](const Eigen::Vector3d& world) {
     const Eigen::Vector3d d = s.frame.transpose() * world;
     return Eigen::Vector3d(ca * d.x() - sa * d.y(), sa * d.x() + ca * d.y(), d.z());
@@ -237,8 +237,8 @@ Eigen::Vector3f ShadeBtf(const BtfModel& model, const synth::ModelRenderer::Surf
               (InterpolateAppearance(model.sample, view, l).transpose() * g);
   }
   const cv::Vec3f k = model.colour_gain[static_cast<std::size_t>(s.atlas)].at<cv::Vec3f>(ny, nx);
-  return {synth::LinearToSrgb(linear[0] * k[0]), synth::LinearToSrgb(linear[1] * k[1]),
-          synth::LinearToSrgb(linear[2] * k[2])};
+  return {LinearToSrgb(linear[0] * k[0]), LinearToSrgb(linear[1] * k[1]),
+          LinearToSrgb(linear[2] * k[2])};
 }
 
 BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
@@ -275,7 +275,7 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
     errors = SvdErrorTable(sample, ns);
   }
   summary.seconds_factorise = Since(t);
-  BtfMeshSynthesisOptions so = options.synthesis;
+  synth::BtfMeshSynthesisOptions so = options.synthesis;
   if (so.sample_texel_size == 0.0) so.sample_texel_size = sample.texel_size;
   so.Check();
 
@@ -286,7 +286,7 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
   summary.subdivisions = inputs.subdivisions;
   summary.faces = inputs.mesh.faces.size();
 
-  const BtfMeshSynthesis synthesis = SynthesizeMeshBtf(
+  const synth::BtfMeshSynthesis synthesis = synth::SynthesizeMeshBtf(
       inputs.mesh, inputs.reconstruction, inputs.visibility, inputs.photos, sample, so, progress);
   summary.seconds_synthesis = synthesis.seconds_synthesis;
   summary.seconds_seams = synthesis.seconds_seams;
@@ -433,8 +433,7 @@ BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
       names.insert(names.end(), kGainChannels.begin(), kGainChannels.end());
       ptm::WriteExr(folder / AtlasFileName(a), planes, names);
     }
-    for (const auto& [name, bytes] : geometry_png)
-      synth::WriteBytesAtomically(folder / name, bytes);
+    for (const auto& [name, bytes] : geometry_png) WriteBytesAtomically(folder / name, bytes);
   });
   summary.seconds_total = Since(start);
   return summary;

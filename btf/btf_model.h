@@ -7,10 +7,10 @@
 #include <vector>
 
 #include "btf/btf.h"
-#include "btf/mesh_btf.h"
+#include "core/progress.h"
 #include "ptm/ptm.h"
-#include "sfm/progress.h"
 #include "synth/atlas.h"
+#include "synth/mesh_btf.h"
 #include "synth/model_render.h"
 #include "synth/pipeline.h"
 
@@ -28,7 +28,7 @@ struct BtfAtlases {
   /// right, y = atlas up, z = normal) is R(angle) d in the sample's frame.
   std::vector<cv::Mat> sample_coords;
   /// CV_32FC3 per atlas: the photo-consistency factors (linear R, G, B) the
-  /// BTF is multiplied by at each texel (BtfMeshSynthesis::colour_gain).
+  /// BTF is multiplied by at each texel (synth::BtfMeshSynthesis::colour_gain).
   std::vector<cv::Mat> colour_gain;
   /// Per atlas, n CV_32FC1 planes: g_i at each texel's sample position.
   std::vector<std::vector<cv::Mat>> geometry;
@@ -37,7 +37,7 @@ struct BtfAtlases {
 
 /// Lays out and bakes the atlases. The graph-cut labels decide which patch a
 /// texel shows; nothing is blended.
-BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const BtfMeshSynthesis& synthesis,
+BtfAtlases BuildBtfAtlases(const sfm::TriangleMesh& mesh, const synth::BtfMeshSynthesis& synthesis,
                            const BtfFactorisation& sample, const synth::AtlasOptions& options,
                            const ProgressCallback& progress = {});
 
@@ -81,7 +81,7 @@ struct BtfSynthJobOptions {
   /// Components kept when factorising a capture (paper 004: 40).
   int components = 40;
   /// sample_texel_size 0 = the capture's texel size.
-  BtfMeshSynthesisOptions synthesis;
+  synth::BtfMeshSynthesisOptions synthesis;
 };
 
 struct BtfSynthJobSummary {
@@ -96,7 +96,7 @@ struct BtfSynthJobSummary {
 };
 
 /// The main job with a BTF sample: reads the inputs (synth::LoadSynthInputs),
-/// factorises the capture, synthesises (SynthesizeMeshBtf), lays out and bakes
+/// factorises the capture, synthesises (synth::SynthesizeMeshBtf), lays out and bakes
 /// the atlases, and writes a model folder: everything a PTM model folder holds
 /// (the PTM preview as its atlases, the baselines `texlume render` draws), plus
 /// `btf/` (the factorisation: geometry_maps.exr, appearance.bin, btf_svd.json),

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 
 namespace texlume::datasets {
 namespace {

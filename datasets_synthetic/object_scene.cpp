@@ -5,8 +5,8 @@
 #include <numbers>
 #include <random>
 
+#include "core/errors.h"
 #include "sfm/colmap_io.h"
-#include "sfm/errors.h"
 #include "sfm/visibility.h"
 
 namespace texlume::datasets {

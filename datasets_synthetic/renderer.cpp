@@ -6,8 +6,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "sfm/errors.h"
-#include "synth/ray_caster.h"
+#include "core/errors.h"
+#include "mesh/ray_caster.h"
 
 namespace texlume::datasets {
 namespace {
@@ -110,7 +110,7 @@ DisplacedGeometry DisplacePatches(const std::vector<SurfacePatch>& patches,
 }
 
 struct Renderer::Impl {
-  std::unique_ptr<synth::RayCaster> caster;
+  std::unique_ptr<mesh::RayCaster> caster;
 };
 
 Renderer::Renderer(DisplacedGeometry geometry, std::vector<const BakedMaterial*> materials)
@@ -118,8 +118,8 @@ Renderer::Renderer(DisplacedGeometry geometry, std::vector<const BakedMaterial*>
   for (std::uint16_t p : geometry_.triangle_patch) {
     if (p >= materials_.size()) throw std::invalid_argument("Renderer: missing material");
   }
-  impl_->caster = std::make_unique<synth::RayCaster>(geometry_.positions, geometry_.triangles,
-                                                     /*high_quality=*/true);
+  impl_->caster = std::make_unique<mesh::RayCaster>(geometry_.positions, geometry_.triangles,
+                                                    /*high_quality=*/true);
 }
 
 Renderer::~Renderer() = default;
@@ -148,7 +148,7 @@ Rendering Renderer::Render(int width, int height, const RayAt& ray_at,
         for (int sx = 0; sx < n; ++sx) {
           Eigen::Vector3d origin, direction;
           if (!ray_at(x + (sx + 0.5) / n, y + (sy + 0.5) / n, origin, direction)) continue;
-          const std::optional<synth::RayCaster::Hit> hit =
+          const std::optional<mesh::RayCaster::Hit> hit =
               impl_->caster->Intersect(origin, direction);
           if (!hit) continue;
           ++hits;

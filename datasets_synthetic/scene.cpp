@@ -11,12 +11,12 @@
 #include <random>
 #include <sstream>
 
+#include "core/errors.h"
+#include "core/file_util.h"
+#include "core/image_io.h"
 #include "datasets_synthetic/object_scene.h"
 #include "ptm/exr_io.h"
 #include "sfm/colmap_io.h"
-#include "sfm/errors.h"
-#include "sfm/file_util.h"
-#include "synth/model_io.h"
 
 namespace texlume::datasets {
 namespace {
@@ -151,7 +151,7 @@ std::vector<Eigen::Vector3d> DomeLights(int count, double min_elevation_deg,
 }
 
 void WritePngAtomically(const std::filesystem::path& path, const cv::Mat& image) {
-  synth::WriteBytesAtomically(path, synth::EncodePng(image, path.string()));
+  WriteBytesAtomically(path, EncodePng(image, path.string()));
 }
 
 PlanarSurfaceRenders RenderPlanarSurface(const PlanarSurfaceOptions& options,

@@ -5,12 +5,12 @@
 #include <string>
 #include <vector>
 
+#include "core/progress.h"
 #include "datasets_synthetic/material.h"
 #include "datasets_synthetic/renderer.h"
 #include "datasets_synthetic/shapes.h"
 #include "sfm/camera_models.h"
 #include "sfm/lights.h"
-#include "sfm/progress.h"
 
 namespace texlume::datasets {
 

@@ -5,7 +5,7 @@
 
 #include <stdexcept>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 
 namespace texlume::ptm {
 

@@ -11,7 +11,7 @@
 #include <memory>
 #include <thread>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 #include "sfm/lights.h"
 
 namespace texlume::ptm {

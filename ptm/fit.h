@@ -5,8 +5,8 @@
 #include <functional>
 #include <vector>
 
+#include "core/progress.h"
 #include "ptm/ptm.h"
-#include "sfm/progress.h"
 
 namespace texlume::ptm {
 

@@ -10,9 +10,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "core/errors.h"
+#include "core/file_util.h"
 #include "ptm/exr_io.h"
-#include "sfm/errors.h"
-#include "sfm/file_util.h"
 
 namespace texlume::ptm {
 namespace {

@@ -6,8 +6,8 @@
 #include <limits>
 #include <sstream>
 
-#include "sfm/errors.h"
-#include "sfm/file_util.h"
+#include "core/errors.h"
+#include "core/file_util.h"
 
 namespace texlume::sfm {
 namespace {

@@ -5,7 +5,7 @@
 #include <set>
 #include <sstream>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 #include "sfm/lights.h"
 
 namespace texlume::sfm {

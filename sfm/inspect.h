@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "core/progress.h"
 #include "sfm/colmap_io.h"
 #include "sfm/mesh.h"
-#include "sfm/progress.h"
 #include "sfm/visibility.h"
 
 namespace texlume::sfm {

@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 
 namespace texlume::sfm {
 namespace {

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 
 namespace texlume::sfm {
 namespace {

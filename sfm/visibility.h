@@ -3,8 +3,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/progress.h"
 #include "sfm/mesh.h"
-#include "sfm/progress.h"
 #include "sfm/reconstruction.h"
 
 namespace texlume::sfm {

@@ -10,8 +10,8 @@
 #include <optional>
 #include <unordered_map>
 
+#include "core/errors.h"
 #include "ptm/coefficient_space.h"
-#include "sfm/errors.h"
 #include "synth/charts.h"
 #include "synth/planar_synthesis.h"
 

@@ -7,9 +7,9 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "core/progress.h"
 #include "ptm/ptm.h"
 #include "sfm/mesh.h"
-#include "sfm/progress.h"
 #include "synth/mesh_synthesis.h"
 
 namespace texlume::synth {

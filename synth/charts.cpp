@@ -12,7 +12,7 @@
 #include <tuple>
 #include <unordered_map>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 #include "synth/triangle_frame.h"
 
 namespace texlume::synth {

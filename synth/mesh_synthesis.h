@@ -3,72 +3,22 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
-#include <functional>
 #include <map>
 #include <opencv2/core.hpp>
-#include <string>
 #include <vector>
 
+#include "core/progress.h"
 #include "ptm/ptm.h"
-#include "sfm/lights.h"
 #include "sfm/mesh.h"
-#include "sfm/progress.h"
 #include "sfm/reconstruction.h"
 #include "sfm/visibility.h"
-#include "synth/triangle_frame.h"
+#include "synth/triangle_engine.h"
+#include "synth/triangle_parts.h"
 
 namespace texlume::synth {
 
-/// An object photo with its light(s), as used to constrain the synthesis.
-struct MeshPhoto {
-  sfm::ImageId image_id;
-  std::string name;
-  cv::Mat image;  ///< CV_32FC3, RGB, display domain (sRGB-encoded) in [0, 1]
-  std::vector<sfm::ObjectLight> lights;
-};
-
-/// Where the tangent frame's X axis of each triangle comes from.
-enum class TangentFrame {
-  kFirstEdge,    ///< v0 -> v1 (paper 003 §3.0.2)
-  kSmoothField,  ///< a fixed world direction projected onto each face, so anisotropic
-                 ///< materials keep their direction across triangles
-  kPhotos,       ///< turned so the sample's texture runs the way the photos show it, as a
-                 ///< smooth line field over the mesh (synth/tangent_field.h)
-  kAuto,         ///< kPhotos for an anisotropic sample (brick, grooves), else kFirstEdge
-};
-
-/// kAuto takes kPhotos when the sample's structure-tensor coherence (MeshSynthesis::
-/// sample_coherence) is at least this.
-inline constexpr double kAnisotropicSampleCoherence = 0.2;
-
-/// "first_edge", "smooth_field", "photos" or "auto" (the manifest's names).
-const char* TangentFrameName(TangentFrame frame);
-
 /// Settings of SynthesizeMeshPtm (paper 003 Algorithm 2).
-struct MeshSynthesisOptions {
-  /// World units per texel of the sample PTM (COLMAP models have arbitrary scale). > 0.
-  double sample_texel_size = 0.0;
-  /// W_e: texels of strip around each triangle's bounding box (paper: 5-10). [2, 32].
-  int strip = 8;
-  /// Candidates kept by the image score before the neighbour constraint. >= 1.
-  int top_k = 12;
-  /// Constrain with every photo in which the triangle is fully visible (scores
-  /// summed, each under its own light), not only the best view (paper 003).
-  bool all_views = true;
-  /// Most views used per triangle with all_views. >= 1.
-  int max_views = 4;
-  /// Where each face's frame x axis points (the sample's texture is laid along
-  /// it). kAuto: turned to the photos when the sample is anisotropic.
-  TangentFrame tangent_frame = TangentFrame::kAuto;
-  /// kSmoothField: the world direction projected onto each face (falls back to
-  /// the orthogonal world axis of smallest normal component where it is nearly
-  /// parallel to the normal).
-  Eigen::Vector3d field_direction_in_world = Eigen::Vector3d::UnitZ();
-  /// Triangles seen in no photo: pick at random among placements whose overlap
-  /// error is within (1 + tolerance) of the best. >= 0.
-  double tolerance = 0.1;
-  /// Fewest rectified photo pixels inside a triangle for the photo to constrain it. >= 1.
-  int min_photo_pixels = 6;
+struct MeshSynthesisOptions : TriangleEngineOptions {
   /// Photo-consistency pass per triangle (beyond the paper, as in the planar
   /// synthesis): Gauss-Newton rounds of the most probable change of the
   /// luminance coefficients (a Gaussian prior with the sample's own coefficient
@@ -100,82 +50,20 @@ struct MeshSynthesisOptions {
   /// best match the corrected ones (a 3 x 3 window of photo cells), so that it
   /// follows the photo's structure rather than the quilted patch's.
   bool detail_transfer = true;
-  /// Refuse up front when the patches would take more texels than this.
-  std::int64_t max_texels = std::int64_t{1} << 30;
-  std::uint32_t seed = 1;
 
+  /// The engine's checks, then the photo-consistency pass's.
   void Check() const;
 };
 
-/// How a triangle's patch was chosen.
-enum class PatchSource {
-  kPhotos,      ///< image score, then neighbours (Algorithm 2 step 2)
-  kNeighbours,  ///< fully visible in no photo: overlap constraint alone
-  kRandom,      ///< no photo and no synthesised neighbour (first of an unseen component)
-};
-
-/// One triangle's patch: the sample PTM's rectangle [sample_x, sample_x + width)
-/// x [sample_y, sample_y + height) (texels, rows down) laid over the triangle's
-/// frame so that texel (i, j) has its centre at frame coordinates
-/// (x_min + (i + 0.5) t, y_max - (j + 0.5) t), t the texel size. The rectangle is
-/// the triangle's bounding box plus W_e texels of strip on every side.
-struct TrianglePatch {
-  TriangleFrame frame;
-  std::array<Eigen::Vector2d, 3> corners_in_frame;  ///< world units
-  double x_min = 0.0, y_max = 0.0;                  ///< world units, frame coordinates
-  int width = 0, height = 0;                        ///< texels
-  int sample_x = 0, sample_y = 0;                   ///< texels, top-left in the sample
-  PatchSource source = PatchSource::kRandom;
-  int views_used = 0;
-  double image_score = 0.0;  ///< summed RMS photo difference of the chosen patch
-  /// The photo-consistency pass's prior shrink used (see the option); -1 uncorrected.
-  double prior_shrink = -1.0;
-  double overlap_error = 0.0;  ///< mean squared orthonormal distance to the neighbours
-  /// Photo-consistency correction of the luminance coefficients (orthonormal
-  /// space, 6 planes, LRGB), on a grid of `correction_density` cells per texel
-  /// over the patch rectangle; empty when none. Added by SamplePatch.
-  std::vector<cv::Mat> correction;
-  /// Per-channel factors (3 planes on the same grid) for albedo-like
-  /// differences: LRGB colour times the factor, RGB polynomial times it.
-  std::vector<cv::Mat> channel_gain;
-  Eigen::Vector2d correction_density = Eigen::Vector2d::Ones();
-  /// Detail transfer (beyond the paper): per cell of the correction grid, the
-  /// sample point (texels, CV_32FC2 x, y) whose detail band replaces the
-  /// patch's own around that cell; empty when none. The band is
-  /// MeshSynthesis::detail_bands[detail_level].
-  cv::Mat detail_source;
-  int detail_level = -1;
-};
-
-/// The unfolding of neighbour `face` across a shared edge into a triangle's
-/// frame: p_neighbour = rotation * p + translation (2D, world units), and the
-/// coefficient map from the neighbour's frame to this one (orthonormal space).
-struct Unfolding {
-  int face = -1;  ///< -1: boundary edge
-  Eigen::Matrix2d rotation = Eigen::Matrix2d::Identity();
-  Eigen::Vector2d translation = Eigen::Vector2d::Zero();
-  Eigen::Matrix<double, 6, 6> coefficients_to_this = Eigen::Matrix<double, 6, 6>::Identity();
-};
-
-/// The result of the per-triangle synthesis: patches that reference the sample,
-/// the sample's orthonormal planes they reference, and per-edge unfoldings.
-struct MeshSynthesis {
+/// The per-triangle PTM synthesis: the engine's patches and unfoldings, the
+/// sample's orthonormal planes they reference, and the detail bands the detail
+/// transfer reads.
+struct MeshSynthesis : TriangleSynthesis {
   ptm::PtmFormat format = ptm::PtmFormat::kLrgb;
-  double texel_size = 0.0;                           ///< world units
-  std::vector<cv::Mat> sample_planes;                ///< orthonormal coefficients (+ LRGB colour)
-  std::vector<TrianglePatch> patches;                ///< per face
-  std::vector<std::array<Unfolding, 3>> unfoldings;  ///< per face, edge k = (v_k, v_k+1)
-  std::vector<double> photo_gains;  ///< per photo (linear-domain exposure x intensity)
+  std::vector<cv::Mat> sample_planes;  ///< orthonormal coefficients (+ LRGB colour)
   /// Per photo-density level: the sample's detail band, its planes minus their
   /// reduction to that density brought back to full size (all planes, texels).
   std::map<int, std::vector<cv::Mat>> detail_bands;
-  std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
-  double seconds = 0.0;
-  /// The frames the patches have (kAuto resolved to kPhotos or kFirstEdge).
-  TangentFrame tangent_frame = TangentFrame::kFirstEdge;
-  /// Coherence of the sample's structure tensor (0 isotropic, 1 one direction)
-  /// at the photos' median density; -1 when not measured (kFirstEdge, kSmoothField).
-  double sample_coherence = -1.0;
 
   /// Most planes a texel has (RGB: 18 coefficients; LRGB: 6 + 3 colour).
   static constexpr std::size_t kMaxPlanes = 18;
@@ -190,78 +78,6 @@ struct MeshSynthesis {
                      float* planes_out) const;
 };
 
-/// Per-face frames, corners and patch rectangles (the bounding box plus `strip`
-/// texels of size `texel_size` world units on every side; sample_x/y left 0),
-/// and the unfoldings across every shared edge (Algorithm 2's set-up, shared by
-/// the PTM and BTF synthesis). Throws InputError when a patch would be absurdly
-/// large (a texel size in other units than the mesh).
-struct PatchGeometry {
-  std::vector<TrianglePatch> patches;
-  std::vector<std::array<Unfolding, 3>> unfoldings;
-  std::int64_t total_texels = 0;
-  int widest = 0, tallest = 0;  ///< largest patch sides, texels
-};
-PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double texel_size, int strip,
-                                TangentFrame tangent_frame,
-                                const Eigen::Vector3d& field_direction_in_world);
-/// The same with each face's frame x axis along its tangent (projected onto the
-/// face; v0 -> v1 where it is nearly the normal). kPhotos and kAuto above give
-/// first-edge frames, the start that SynthesizeMeshPtm turns.
-PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double texel_size, int strip,
-                                const std::vector<Eigen::Vector3d>& tangents_in_world);
-
-/// Helpers of Algorithm 2 shared by the PTM and BTF synthesis.
-///
-/// The photo density level of a face in a view: r = 2^(-level/4) photo pixels
-/// per texel of `texel_size` world units, level in [0, 40].
-int PhotoDensityLevel(const TrianglePatch& patch, const sfm::TriangleView& view, double texel_size);
-/// Planes (one size, CV_32FC1) reduced by area to that density level, and the
-/// effective density (reduced size over full size) along x and y.
-struct ReducedPlanes {
-  std::vector<cv::Mat> planes;
-  double rx = 1.0, ry = 1.0;
-};
-ReducedPlanes ReduceToDensityLevel(const std::vector<cv::Mat>& planes, int level);
-/// cv::remap maps that rectify a photo into the patch grid of `grid` cells at
-/// density (rx, ry) cells per texel, and the mask (CV_32FC1) of cells within
-/// `mask_margin` world units of the triangle whose photo pixel lies in the
-/// image. Returns the number of masked cells.
-int RectificationMaps(const TrianglePatch& patch, double texel_size, double rx, double ry,
-                      cv::Size grid, const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
-                      cv::Size image_size, double mask_margin, cv::Mat& map_x, cv::Mat& map_y,
-                      cv::Mat& mask);
-/// The views that constrain a face: its best fully visible view, then (all_views)
-/// the other fully visible ones by angle, up to max_views; none when the face
-/// is fully visible nowhere.
-std::vector<sfm::TriangleView> ConstrainingViews(const sfm::TriangleVisibility& visibility,
-                                                 bool all_views, int max_views);
-/// One face seen fully in one photo: log of the photo's mean over the sample's
-/// mean relit there (m = a_T g_n), and its weight.
-struct GainObservation {
-  std::size_t face = 0, photo = 0;
-  double log_m = 0.0, weight = 0.0;
-};
-/// Gains g_n per photo: log m = log a_T + log g_n solved by alternating least
-/// squares (20 rounds) with the mean log a_T at 0, so the object's mean albedo is
-/// the sample's and stains do not leak into the gains. 1 for unobserved photos.
-std::vector<double> SolvePhotoGains(const std::vector<GainObservation>& observations,
-                                    std::size_t num_faces, std::size_t num_photos);
-/// The face with the largest projected area in its best fully visible view (0
-/// when there is none): where breadth-first synthesis starts.
-int BestSeenFace(const sfm::VisibilityResult& visibility);
-/// Adds eq. 3's RMS score of one photo (`ssd` from MaskedSsd at the photo's
-/// density (rx, ry), over `count` masked cells and 3 channels) to `total`, a map
-/// over sample placements in texels.
-void AddImageScore(const cv::Mat& ssd, int count, double rx, double ry, cv::Mat& total);
-/// The k lowest placements of a score map, looking every `stride` texels, best first.
-std::vector<std::pair<float, cv::Point>> BestPlacements(const cv::Mat& score, int stride, int k);
-/// Algorithm 2's second constraint: of the image score's candidates (BestPlacements),
-/// the one with the least `overlap_error(sample_x, sample_y)` (the first on a tie)
-/// becomes the patch's placement, with its image score and overlap error.
-void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& candidates,
-                             const std::function<double(int, int)>& overlap_error,
-                             TrianglePatch& patch);
-
 /// Per-triangle image-constrained PTM synthesis on a mesh (paper 003 Algorithm 2).
 /// `visibility` from sfm::ComputeVisibility for this mesh and reconstruction;
 /// `photos` the usable photos (each image_id in the reconstruction). Throws
@@ -273,24 +89,5 @@ MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
                                 const std::vector<MeshPhoto>& photos, const ptm::Ptm& sample,
                                 const MeshSynthesisOptions& options,
                                 const ProgressCallback& progress = {});
-
-/// Lights lower than this (degrees above the tangent plane) are evaluated at this
-/// elevation and faded linearly in l_z to 0 at the horizon (RelightMixture): RTI
-/// domes rarely light below it, and the biquadratic overshoots there. Recorded in
-/// the model's manifest and glTF extras so that viewers do the same.
-inline constexpr double kHorizonElevationDeg = 15.0;
-
-/// sRGB decoding/encoding of display values in [0, 1] (IEC 61966-2-1).
-float SrgbToLinear(float v);
-float LinearToSrgb(float v);
-
-/// The display value of a PTM texel under several lights (tangent frame) with
-/// intensities, times a gain: the sum is taken in the linear domain,
-/// srgb(gain * sum_i I_i lin(clamp(f(l_i)))). Lights below the horizon add 0;
-/// lights below kHorizonElevationDeg fade (see there).
-Eigen::Vector3f RelightMixture(const float* coefficients_or_l, const float* colour,
-                               ptm::PtmFormat format,
-                               const std::vector<std::pair<Eigen::Vector3d, double>>& lights,
-                               double gain);
 
 }  // namespace texlume::synth

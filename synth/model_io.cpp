@@ -8,9 +8,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "core/errors.h"
+#include "core/file_util.h"
 #include "ptm/ptm_io.h"
-#include "sfm/errors.h"
-#include "sfm/file_util.h"
 #include "synth/mesh_synthesis.h"
 
 namespace texlume::synth {
@@ -51,22 +51,6 @@ void WriteObj(const fs::path& path, const TexturedModel& model) {
 }
 
 }  // namespace
-
-std::vector<unsigned char> EncodePng(const cv::Mat& image, const std::string& label) {
-  std::vector<unsigned char> png;
-  if (!cv::imencode(".png", image, png)) throw InputError(label, "PNG encoding failed");
-  return png;
-}
-
-void WriteBytesAtomically(const fs::path& path, const std::vector<unsigned char>& bytes) {
-  WriteFileAtomically(
-      path,
-      [&](std::ostream& out) {
-        out.write(reinterpret_cast<const char*>(bytes.data()),
-                  static_cast<std::streamsize>(bytes.size()));
-      },
-      true);
-}
 
 std::vector<Eigen::Vector3d> VertexNormals(const sfm::TriangleMesh& mesh) {
   std::vector<Eigen::Vector3d> n(mesh.vertices.size(), Eigen::Vector3d::Zero());
@@ -318,15 +302,6 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
     std::error_code ec;
     fs::remove_all(tmp, ec);
     throw;
-  }
-}
-
-nlohmann::json ReadJsonFile(const fs::path& path) {
-  std::ifstream in = OpenForReading(path, false);
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(path.string(), std::string("is not valid JSON: ") + e.what());
   }
 }
 

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "core/image_io.h"
+#include "core/json_io.h"
 #include "ptm/ptm.h"
 #include "sfm/mesh.h"
 
@@ -45,10 +47,6 @@ void WriteModelFolder(const std::filesystem::path& dir, const TexturedModel& mod
 /// "atlases" array). Throws InputError naming the file otherwise.
 nlohmann::json ReadModelManifest(const std::filesystem::path& dir);
 
-/// Parses a JSON file. Throws InputError naming it when it cannot be opened or
-/// is not valid JSON.
-nlohmann::json ReadJsonFile(const std::filesystem::path& path);
-
 /// The frame face f's atlas coefficients are in, as columns in world
 /// coordinates: x = dP/du made orthogonal to the normal, y = n x x (dP/dv
 /// direction, v up), z = the face normal (x = the first edge without texture
@@ -63,12 +61,6 @@ TexturedModel ReadModelFolder(const std::filesystem::path& dir);
 /// (head-on value over the PTM normal's z, linear domain), as 8-bit BGR images.
 cv::Mat BaseColourImage(const ptm::Ptm& ptm);
 cv::Mat AlbedoImage(const ptm::Ptm& ptm);
-
-/// PNG bytes of an 8- or 16-bit image; throws InputError(label) on failure.
-std::vector<unsigned char> EncodePng(const cv::Mat& image, const std::string& label);
-/// Writes bytes under a temporary name, then renames (no half-written file).
-void WriteBytesAtomically(const std::filesystem::path& path,
-                          const std::vector<unsigned char>& bytes);
 
 /// Smooth (area-weighted) vertex normals.
 std::vector<Eigen::Vector3d> VertexNormals(const sfm::TriangleMesh& mesh);

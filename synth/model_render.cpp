@@ -8,8 +8,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
-#include "sfm/errors.h"
-#include "synth/ray_caster.h"
+#include "core/errors.h"
+#include "mesh/ray_caster.h"
 
 namespace texlume::synth {
 namespace {
@@ -37,7 +37,7 @@ Eigen::Vector2d ToOpenCv(const Eigen::Vector2d& colmap_px) {
 }  // namespace
 
 struct ModelRenderer::Impl {
-  std::unique_ptr<RayCaster> caster;
+  std::unique_ptr<mesh::RayCaster> caster;
 };
 
 ModelRenderer::ModelRenderer(const TexturedModel& model) : model_(model), impl_(new Impl) {
@@ -51,7 +51,7 @@ ModelRenderer::ModelRenderer(const TexturedModel& model) : model_(model), impl_(
   for (const auto& f : mesh.faces)
     triangles.push_back({static_cast<std::uint32_t>(f[0]), static_cast<std::uint32_t>(f[1]),
                          static_cast<std::uint32_t>(f[2])});
-  impl_->caster = std::make_unique<RayCaster>(positions, triangles);
+  impl_->caster = std::make_unique<mesh::RayCaster>(positions, triangles);
 }
 
 ModelRenderer::~ModelRenderer() = default;
@@ -79,7 +79,8 @@ RenderedView ModelRenderer::RenderWith(const sfm::Camera& camera,
         for (int sx = 0; sx < n; ++sx) {
           const Eigen::Vector2d pixel(x + (sx + 0.5) / n, y + (sy + 0.5) / n);  // COLMAP pixels
           const Eigen::Vector3d direction = world_from_cam.rotation * camera.CamRayFromImage(pixel);
-          const std::optional<RayCaster::Hit> hit = impl_->caster->Intersect(origin, direction);
+          const std::optional<mesh::RayCaster::Hit> hit =
+              impl_->caster->Intersect(origin, direction);
           if (!hit) continue;
           ++hits;
           SurfaceSample s;

@@ -7,10 +7,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/errors.h"
+#include "core/file_util.h"
 #include "ptm/ptm_io.h"
 #include "sfm/colmap_io.h"
-#include "sfm/errors.h"
-#include "sfm/file_util.h"
 #include "sfm/lights.h"
 #include "sfm/mesh.h"
 #include "synth/report.h"
@@ -43,47 +43,6 @@ nlohmann::json MeanPriorShrink(const MeshSynthesis& synthesis) {
 }
 
 }  // namespace
-
-cv::Mat ToBgr8(const cv::Mat& display_rgb) {
-  cv::Mat bgr, out;
-  cv::cvtColor(display_rgb, bgr, cv::COLOR_RGB2BGR);
-  bgr.convertTo(out, CV_8UC3, 255.0);
-  return out;
-}
-
-cv::Mat ReadPhotoRgb(const fs::path& path) {
-  if (!fs::exists(path)) throw InputError(path.string(), "does not exist");
-  const cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH);
-  if (raw.empty()) throw InputError(path.string(), "is not a readable image");
-  cv::Mat bgr;
-  if (raw.channels() == 1) {
-    cv::cvtColor(raw, bgr, cv::COLOR_GRAY2BGR);
-  } else if (raw.channels() == 4) {
-    cv::cvtColor(raw, bgr, cv::COLOR_BGRA2BGR);
-  } else if (raw.channels() == 3) {
-    bgr = raw;
-  } else {
-    throw InputError(path.string(), "has " + std::to_string(raw.channels()) + " channels");
-  }
-  double scale = 1.0;
-  switch (bgr.depth()) {
-    case CV_8U:
-      scale = 1.0 / 255.0;
-      break;
-    case CV_16U:
-      scale = 1.0 / 65535.0;
-      break;
-    case CV_32F:
-      scale = 1.0;
-      break;
-    default:
-      throw InputError(path.string(), "has an unsupported pixel type");
-  }
-  cv::Mat f, rgb;
-  bgr.convertTo(f, CV_32FC3, scale);
-  cv::cvtColor(f, rgb, cv::COLOR_BGR2RGB);
-  return rgb;
-}
 
 sfm::TriangleMesh SubdivideMidpoint(const sfm::TriangleMesh& mesh) {
   sfm::TriangleMesh out;

@@ -6,7 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "sfm/progress.h"
+#include "core/image_io.h"
+#include "core/progress.h"
 #include "sfm/visibility.h"
 #include "synth/atlas.h"
 #include "synth/mesh_synthesis.h"
@@ -136,13 +137,6 @@ std::vector<std::pair<std::string, cv::Mat>> RecordBaselines(const Eigen::Vector
 /// Throws InputError naming the manifest or texture when missing or malformed.
 ModelBaselines ReadModelBaselines(const std::filesystem::path& model_folder,
                                   const TexturedModel& model);
-
-/// Reads photos as CV_32FC3 RGB display values (8- or 16-bit, grey or colour).
-/// Throws InputError naming the file.
-cv::Mat ReadPhotoRgb(const std::filesystem::path& path);
-
-/// 8-bit BGR (for PNG) of a CV_32FC3 display RGB image in [0, 1].
-cv::Mat ToBgr8(const cv::Mat& display_rgb);
 
 /// 1-to-4 midpoint subdivision (shared edge midpoints welded).
 /// The atlas settings as the manifests record them (shared by the PTM and BTF jobs).

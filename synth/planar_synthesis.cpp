@@ -10,8 +10,8 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "core/errors.h"
 #include "ptm/coefficient_space.h"
-#include "sfm/errors.h"
 #include "synth/template_match.h"
 
 namespace texlume::synth {

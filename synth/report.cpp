@@ -10,8 +10,8 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
-#include "sfm/errors.h"
-#include "sfm/file_util.h"
+#include "core/errors.h"
+#include "core/file_util.h"
 
 namespace texlume::synth {
 namespace fs = std::filesystem;

@@ -6,10 +6,10 @@
 #include <utility>
 #include <vector>
 
+#include "core/progress.h"
 #include "ptm/ptm.h"
 #include "sfm/camera_models.h"
 #include "sfm/lights.h"
-#include "sfm/progress.h"
 #include "sfm/reconstruction.h"
 #include "synth/model_io.h"
 #include "synth/pipeline.h"

@@ -6,8 +6,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "synth/mesh_synthesis.h"
 #include "synth/triangle_frame.h"
+#include "synth/triangle_parts.h"
 
 namespace texlume::synth {
 

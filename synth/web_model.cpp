@@ -8,8 +8,8 @@
 #include <opencv2/core.hpp>
 #include <unordered_map>
 
-#include "sfm/errors.h"
-#include "sfm/file_util.h"
+#include "core/errors.h"
+#include "core/file_util.h"
 #include "synth/mesh_synthesis.h"
 
 namespace texlume::synth {

@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 
 namespace texlume::testing {
 

@@ -9,7 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 #include "synth/mesh_synthesis.h"
 #include "tests/test_util.h"
 
@@ -73,7 +73,7 @@ void WriteCapture(const BtfCapture& c, const std::filesystem::path& dir) {
         for (int x = 0; x < linear.cols; ++x)
           for (int ch = 0; ch < 3; ++ch)
             bgr16.at<cv::Vec3w>(y, x)[2 - ch] = static_cast<std::uint16_t>(
-                std::lround(synth::LinearToSrgb(linear.at<cv::Vec3f>(y, x)[ch]) * 65535.0));
+                std::lround(LinearToSrgb(linear.at<cv::Vec3f>(y, x)[ch]) * 65535.0));
       char name[64];
       std::snprintf(name, sizeof name, "view_%02zu_light_%02zu.png", a, b);
       cv::imwrite((dir / name).string(), bgr16);

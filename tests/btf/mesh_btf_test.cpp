@@ -1,6 +1,6 @@
 // Issue 8: per-triangle image-constrained BTF quilting with graph-cut seams,
 // the BTF model folder and its rendering, on a small glossy sphere.
-#include "btf/mesh_btf.h"
+#include "synth/mesh_btf.h"
 
 #include <gtest/gtest.h>
 
@@ -11,10 +11,10 @@
 
 #include "btf/btf.h"
 #include "btf/btf_model.h"
+#include "core/errors.h"
 #include "datasets_synthetic/scene.h"
 #include "ptm/fit.h"
 #include "ptm/ptm_io.h"
-#include "sfm/errors.h"
 #include "synth/model_io.h"
 #include "synth/pipeline.h"
 #include "tests/small_scene.h"
@@ -46,9 +46,9 @@ class MeshBtfTest : public ::testing::Test {
     job_ = new synth::SynthJobOptions(Job(tmp_->path() / "btf_model"));
     inputs_ = new synth::SynthInputs(synth::LoadSynthInputs(*job_));
     synth::PrepareSynthMesh(*inputs_, *job_, 96, 0.004, 8);
-    synthesis_ = new BtfMeshSynthesis(SynthesizeMeshBtf(inputs_->mesh, inputs_->reconstruction,
-                                                        inputs_->visibility, inputs_->photos,
-                                                        *sample_, Options()));
+    synthesis_ = new synth::BtfMeshSynthesis(
+        synth::SynthesizeMeshBtf(inputs_->mesh, inputs_->reconstruction, inputs_->visibility,
+                                 inputs_->photos, *sample_, Options()));
   }
   static void TearDownTestSuite() {
     delete synthesis_;
@@ -57,8 +57,8 @@ class MeshBtfTest : public ::testing::Test {
     delete sample_;
     delete tmp_;
   }
-  static BtfMeshSynthesisOptions Options() {
-    BtfMeshSynthesisOptions so;
+  static synth::BtfMeshSynthesisOptions Options() {
+    synth::BtfMeshSynthesisOptions so;
     so.sample_texel_size = 0.004;
     return so;
   }
@@ -113,16 +113,16 @@ class MeshBtfTest : public ::testing::Test {
   static BtfFactorisation* sample_;
   static synth::SynthJobOptions* job_;
   static synth::SynthInputs* inputs_;
-  static BtfMeshSynthesis* synthesis_;
+  static synth::BtfMeshSynthesis* synthesis_;
 };
 testing::TempDir* MeshBtfTest::tmp_ = nullptr;
 BtfFactorisation* MeshBtfTest::sample_ = nullptr;
 synth::SynthJobOptions* MeshBtfTest::job_ = nullptr;
 synth::SynthInputs* MeshBtfTest::inputs_ = nullptr;
-BtfMeshSynthesis* MeshBtfTest::synthesis_ = nullptr;
+synth::BtfMeshSynthesis* MeshBtfTest::synthesis_ = nullptr;
 
 TEST_F(MeshBtfTest, EveryTrianglePatchLiesInTheSampleMostFromThePhotos) {
-  const BtfMeshSynthesis& s = *synthesis_;
+  const synth::BtfMeshSynthesis& s = *synthesis_;
   ASSERT_EQ(s.patches.size(), 1280u);
   EXPECT_EQ(s.num_from_photos + s.num_from_neighbours + s.num_random, 1280u);
   EXPECT_GT(s.num_from_photos, 1280u * 6 / 10);
@@ -140,7 +140,7 @@ TEST_F(MeshBtfTest, EveryTrianglePatchLiesInTheSampleMostFromThePhotos) {
 }
 
 TEST_F(MeshBtfTest, GraphCutSeamsCostNoMoreThanTheStraightMeshEdge) {
-  const BtfMeshSynthesis& s = *synthesis_;
+  const synth::BtfMeshSynthesis& s = *synthesis_;
   EXPECT_EQ(s.seam_edges, 1920u);  // every edge of the closed sphere
   ASSERT_GT(s.edge_cost, 0.0);
   // The straight seam along the mesh edge is one feasible cut: the minimum is
@@ -161,7 +161,7 @@ TEST_F(MeshBtfTest, BothSidesOfAnEdgeSeeTheSameSampleTexelAndFrame) {
   // A point on a shared edge, looked up from either face: where both choose the
   // same patch, they must agree on the sample position and on the sample-frame
   // direction of a world tangent (the rotation each lookup reports).
-  const BtfMeshSynthesis& s = *synthesis_;
+  const synth::BtfMeshSynthesis& s = *synthesis_;
   const sfm::TriangleMesh& mesh = inputs_->mesh;
   int compared = 0;
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
@@ -173,8 +173,9 @@ TEST_F(MeshBtfTest, BothSidesOfAnEdgeSeeTheSameSampleTexelAndFrame) {
         const Eigen::Vector3d x = a + w * (b - a);
         const auto& ff = s.patches[f].frame;
         const auto& fh = s.patches[static_cast<std::size_t>(u.face)].frame;
-        const BtfSampleLookup lf = s.Lookup(static_cast<int>(f), ff.PointInFrame(x).head<2>());
-        const BtfSampleLookup lh = s.Lookup(u.face, fh.PointInFrame(x).head<2>());
+        const synth::BtfSampleLookup lf =
+            s.Lookup(static_cast<int>(f), ff.PointInFrame(x).head<2>());
+        const synth::BtfSampleLookup lh = s.Lookup(u.face, fh.PointInFrame(x).head<2>());
         if (lf.source_face != lh.source_face) continue;
         ++compared;
         EXPECT_NEAR((lf.sample_px - lh.sample_px).norm(), 0.0, 1e-6) << f << " " << k;
@@ -260,12 +261,12 @@ TEST_F(MeshBtfTest, OnAGlossyMaterialTheBtfModelBeatsThePtmModelAtHeldOutViews) 
   EXPECT_GT(btf.mean_psnr, ptm_plain.mean_psnr + 0.3);
   EXPECT_GT(btf.mean_psnr, preview.mean_psnr + 0.3);
   // The BTF model's files are what render.json says it drew.
-  const nlohmann::json record = synth::ReadJsonFile(tmp_->path() / "r_btf/render.json");
+  const nlohmann::json record = ReadJsonFile(tmp_->path() / "r_btf/render.json");
   EXPECT_EQ(record["settings"]["mode"], "btf");
 }
 
 TEST(MeshBtfOptions, BadValuesAreRefused) {
-  BtfMeshSynthesisOptions o;
+  synth::BtfMeshSynthesisOptions o;
   EXPECT_THROW(o.Check(), OptionError);  // no texel size
   o.sample_texel_size = 0.01;
   EXPECT_NO_THROW(o.Check());
@@ -282,7 +283,7 @@ TEST(MeshBtfOptions, BadValuesAreRefused) {
 }
 
 TEST_F(MeshBtfTest, PhotoCorrectionBringsThePatchesCloserToThePhotos) {
-  const BtfMeshSynthesis& s = *synthesis_;
+  const synth::BtfMeshSynthesis& s = *synthesis_;
   RecordProperty("photo_rms_quilted", std::to_string(s.photo_rms_quilted));
   RecordProperty("photo_rms_corrected", std::to_string(s.photo_rms_corrected));
   std::printf("photo RMS (linear): quilted %.4f, corrected %.4f\n", s.photo_rms_quilted,
@@ -300,9 +301,9 @@ TEST_F(MeshBtfTest, PhotoCorrectionBringsThePatchesCloserToThePhotos) {
     EXPECT_LE(hi, 5.0 + 1e-6);
   }
   // Without the pass, every factor is 1 and the residual is the quilted one.
-  BtfMeshSynthesisOptions off = Options();
+  synth::BtfMeshSynthesisOptions off = Options();
   off.photo_correction = false;
-  const BtfMeshSynthesis plain = SynthesizeMeshBtf(
+  const synth::BtfMeshSynthesis plain = synth::SynthesizeMeshBtf(
       inputs_->mesh, inputs_->reconstruction, inputs_->visibility, inputs_->photos, *sample_, off);
   const Eigen::Vector2d p = plain.patches[0].corners_in_frame[0] * 0.5;
   EXPECT_EQ(plain.Lookup(0, p).colour_gain, Eigen::Vector3f::Ones());
@@ -314,15 +315,15 @@ TEST_F(MeshBtfTest, PhotoCorrectionBringsThePatchesCloserToThePhotos) {
 // for, the frames turn, and the patches still come from the photos, inside the
 // sample, and agree with the photos about as well.
 TEST_F(MeshBtfTest, FramesTurnToThePhotosWhenTheSampleIsDirectionalOrWhenAsked) {
-  const BtfMeshSynthesis& s = *synthesis_;
+  const synth::BtfMeshSynthesis& s = *synthesis_;
   EXPECT_EQ(s.tangent_frame, synth::TangentFrame::kFirstEdge);
   EXPECT_GE(s.sample_coherence, 0.0);
   EXPECT_LT(s.sample_coherence, synth::kAnisotropicSampleCoherence);
-  BtfMeshSynthesisOptions photos = Options();
+  synth::BtfMeshSynthesisOptions photos = Options();
   photos.tangent_frame = synth::TangentFrame::kPhotos;
-  const BtfMeshSynthesis turned =
-      SynthesizeMeshBtf(inputs_->mesh, inputs_->reconstruction, inputs_->visibility,
-                        inputs_->photos, *sample_, photos);
+  const synth::BtfMeshSynthesis turned =
+      synth::SynthesizeMeshBtf(inputs_->mesh, inputs_->reconstruction, inputs_->visibility,
+                               inputs_->photos, *sample_, photos);
   EXPECT_EQ(turned.tangent_frame, synth::TangentFrame::kPhotos);
   std::size_t turned_faces = 0;
   for (std::size_t f = 0; f < s.patches.size(); ++f) {

@@ -6,8 +6,8 @@
 
 #include <random>
 
+#include "core/errors.h"
 #include "datasets_synthetic/scene.h"
-#include "sfm/errors.h"
 #include "sfm/lights.h"
 #include "tests/test_util.h"
 

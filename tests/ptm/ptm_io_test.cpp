@@ -6,7 +6,7 @@
 #include <random>
 #include <sstream>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 #include "tests/test_util.h"
 
 namespace texlume::ptm {

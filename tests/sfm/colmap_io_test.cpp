@@ -5,8 +5,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "sfm/errors.h"
-#include "sfm/file_util.h"
+#include "core/errors.h"
+#include "core/file_util.h"
 #include "tests/sfm/reconstruction_matchers.h"
 #include "tests/test_util.h"
 

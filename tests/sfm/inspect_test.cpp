@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/errors.h"
 #include "datasets_synthetic/object_scene.h"
-#include "sfm/errors.h"
 #include "tests/test_util.h"
 
 namespace texlume::sfm {

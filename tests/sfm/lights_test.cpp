@@ -4,7 +4,7 @@
 
 #include <sstream>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 #include "tests/test_util.h"
 
 namespace texlume::sfm {

@@ -9,8 +9,8 @@
 #include <random>
 #include <set>
 
+#include "core/errors.h"
 #include "datasets_synthetic/shapes.h"
-#include "sfm/errors.h"
 #include "synth/atlas.h"
 #include "synth/pipeline.h"
 #include "synth/triangle_frame.h"

@@ -11,12 +11,12 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "core/errors.h"
 #include "datasets_synthetic/scene.h"
 #include "ptm/coefficient_space.h"
 #include "ptm/fit.h"
 #include "ptm/ptm_io.h"
 #include "sfm/colmap_io.h"
-#include "sfm/errors.h"
 #include "sfm/lights.h"
 #include "sfm/mesh.h"
 #include "synth/atlas.h"

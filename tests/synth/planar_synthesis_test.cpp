@@ -5,9 +5,9 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "core/errors.h"
 #include "datasets_synthetic/scene.h"
 #include "ptm/fit.h"
-#include "sfm/errors.h"
 #include "synth/template_match.h"
 #include "tests/test_util.h"
 

@@ -1,4 +1,4 @@
-#include "sfm/file_util.h"
+#include "core/file_util.h"
 
 #include <unistd.h>
 
@@ -9,7 +9,7 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "sfm/errors.h"
+#include "core/errors.h"
 
 namespace texlume {
 

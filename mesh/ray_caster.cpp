@@ -1,4 +1,4 @@
-#include "synth/ray_caster.h"
+#include "mesh/ray_caster.h"
 
 #include <embree3/rtcore.h>
 
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace texlume::synth {
+namespace texlume::mesh {
 
 struct RayCaster::Impl {
   RTCDevice device = nullptr;
@@ -89,4 +89,4 @@ bool RayCaster::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& d
   return ray.tfar < 0.0f;
 }
 
-}  // namespace texlume::synth
+}  // namespace texlume::mesh

@@ -7,7 +7,7 @@
 #include <optional>
 #include <vector>
 
-namespace texlume::synth {
+namespace texlume::mesh {
 
 /// Nearest-hit and shadow rays against a triangle mesh (Embree 3), thread safe
 /// after construction. Shared by the model renderer and the synthetic-scene
@@ -38,4 +38,4 @@ class RayCaster {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace texlume::synth
+}  // namespace texlume::mesh

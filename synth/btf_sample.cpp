@@ -1,0 +1,88 @@
+#include "synth/btf_sample.h"
+
+#include <algorithm>
+
+#include "synth/template_match.h"
+
+namespace texlume::synth {
+namespace {
+
+// Geometry maps as CV_32FC1 planes (for reductions and FFT matching).
+std::vector<cv::Mat> GeometryPlanes(const btf::BtfFactorisation& s) {
+  std::vector<cv::Mat> planes(static_cast<std::size_t>(s.Components()));
+  for (int i = 0; i < s.Components(); ++i) {
+    cv::Mat& m = planes[static_cast<std::size_t>(i)];
+    m = cv::Mat(s.height, s.width, CV_32FC1);
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x)
+        m.at<float>(y, x) = s.geometry(static_cast<Eigen::Index>(y) * s.width + x, i);
+  }
+  return planes;
+}
+
+}  // namespace
+
+void SampleGeometry(const btf::BtfFactorisation& s, const Eigen::Vector2d& sample_px, float* out) {
+  const double u = std::clamp(sample_px.x() - 0.5, 0.0, s.width - 1.0);
+  const double v = std::clamp(sample_px.y() - 0.5, 0.0, s.height - 1.0);
+  const int x0 = std::min(static_cast<int>(u), std::max(0, s.width - 2));
+  const int y0 = std::min(static_cast<int>(v), std::max(0, s.height - 2));
+  const int x1 = std::min(x0 + 1, s.width - 1), y1 = std::min(y0 + 1, s.height - 1);
+  const float fx = static_cast<float>(u - x0), fy = static_cast<float>(v - y0);
+  const Eigen::Index w = s.width;
+  const auto r00 = s.geometry.row(y0 * w + x0), r01 = s.geometry.row(y0 * w + x1);
+  const auto r10 = s.geometry.row(y1 * w + x0), r11 = s.geometry.row(y1 * w + x1);
+  for (int i = 0; i < s.Components(); ++i)
+    out[i] = (1 - fy) * ((1 - fx) * r00[i] + fx * r01[i]) + fy * ((1 - fx) * r10[i] + fx * r11[i]);
+}
+
+BtfSample::BtfSample(const btf::BtfFactorisation& btf)
+    : btf_(btf),
+      geometry_(GeometryPlanes(btf)),
+      energy_(PlaneEnergy(geometry_)),
+      mean_g_(btf.geometry.colwise().mean().transpose()) {}
+
+bool BtfSample::PatchFeatures(const TrianglePatch& patch, double t, const Eigen::Vector2d& p,
+                              float* out) const {
+  const double sx = patch.sample_x + (p.x() - patch.x_min) / t;
+  const double sy = patch.sample_y + (patch.y_max - p.y()) / t;
+  if (sx < patch.sample_x || sy < patch.sample_y || sx > patch.sample_x + patch.width ||
+      sy > patch.sample_y + patch.height)
+    return false;
+  SampleGeometry(btf_, Eigen::Vector2d(sx, sy), out);
+  return true;
+}
+
+void BtfSample::FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const {
+  SampleGeometry(btf_, sample_px, out);
+}
+
+Eigen::MatrixX3f BtfSample::Appearance(const FaceLighting& lighting) const {
+  const Eigen::Vector3d& v = lighting.view_in_frame;
+  Eigen::MatrixX3f a = Eigen::MatrixX3f::Zero(btf_.Components(), 3);
+  for (const auto& [l, intensity] : lighting.lights) {
+    if (l.z() <= 0.0 || v.z() <= 0.0) continue;
+    a += static_cast<float>(intensity) * btf::InterpolateAppearance(btf_, v, l);
+  }
+  return a;
+}
+
+std::vector<cv::Mat> BtfSample::Relight(const ReducedPlanes& r, const FaceLighting& lighting,
+                                        double gain) const {
+  const Eigen::MatrixX3f a = Appearance(lighting);
+  std::vector<cv::Mat> out(3);
+  for (int ch = 0; ch < 3; ++ch) {
+    cv::Mat& m = out[static_cast<std::size_t>(ch)];
+    m = cv::Mat::zeros(r.planes[0].size(), CV_32FC1);
+    for (int i = 0; i < btf_.Components(); ++i)
+      cv::scaleAdd(r.planes[static_cast<std::size_t>(i)], static_cast<double>(a(i, ch)) * gain, m,
+                   m);
+  }
+  return out;
+}
+
+double BtfSample::RelitLinearSum(const FaceLighting& lighting, int cells) const {
+  return (mean_g_.transpose() * Appearance(lighting)).sum() * cells;
+}
+
+}  // namespace texlume::synth

@@ -1,0 +1,552 @@
+#include "synth/coefficient_correction.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <opencv2/flann.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/image_io.h"
+#include "ptm/coefficient_space.h"
+
+namespace texlume::synth {
+namespace {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Row6d = Eigen::Matrix<double, 1, 6>;
+
+// Detail transfer: a window of 3 x 3 points (dx, dy) texels apart around
+// (x, y), 6 orthonormal luminance coefficients each (5 x 5 matched worse on the
+// demo: SSIM 0.536 against 0.538).
+constexpr int kDetailWindowRadius = 1;
+constexpr int kDetailWindowLength =
+    (2 * kDetailWindowRadius + 1) * (2 * kDetailWindowRadius + 1) * 6;
+// Leaves visited per query (FLANN checks): 8 matches as well as 32 on the demo
+// (SSIM 0.538 either way) in 60 % of the time.
+constexpr int kDetailChecks = 8;
+constexpr int kDetailTrees = 4;
+// At most this many sample points per dictionary (2^16 windows take 14 MiB;
+// a 256 x 256 sample has about 62 000).
+constexpr std::size_t kDetailMaxPoints = std::size_t{1} << 16;
+
+void CoarseWindow(const std::vector<cv::Mat>& coarse, double x, double y, double dx, double dy,
+                  float* window) {
+  for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
+    for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a)
+      for (int m = 0; m < 6; ++m)
+        *window++ = static_cast<float>(
+            BilinearClamped(coarse[static_cast<std::size_t>(m)], x + a * dx, y + b * dy));
+}
+
+}  // namespace
+
+// One patch's photo-consistency pass: the state the Gauss-Newton rounds share.
+class CoefficientCorrection::PatchPass {
+ public:
+  PatchPass(TrianglePatch& patch, const std::vector<RectifiedView>& views,
+            const ReducedPlanes& reduced, const CoefficientPrior& prior,
+            const std::vector<double>& photo_gains, const MeshSynthesisOptions& options)
+      : patch_(patch),
+        views_(views),
+        red0_(reduced),
+        prior_(prior),
+        gains_(photo_gains),
+        options_(options),
+        gw_(views[0].mask.cols),
+        gh_(views[0].mask.rows),
+        known_(cv::Mat::zeros(gh_, gw_, CV_8UC1)) {
+    patch.correction_density = Eigen::Vector2d(red0_.rx, red0_.ry);
+    patch.correction.assign(6, cv::Mat());
+    for (cv::Mat& m : patch.correction) m = cv::Mat::zeros(gh_, gw_, CV_32FC1);
+    patch.channel_gain.assign(3, cv::Mat());
+    for (cv::Mat& m : patch.channel_gain) m = cv::Mat::ones(gh_, gw_, CV_32FC1);
+    ComputeWayToMean();
+  }
+
+  void Run() {
+    const double shrink = PriorShrink();
+    patch_.prior_shrink = shrink;
+    for (int it = 0; it < options_.correction_iterations; ++it) {
+      if (options_.channel_correction) UpdateChannelFactors();
+      if (options_.additive_correction) UpdateAdditiveChange(shrink);
+    }
+    ExtendIntoStrip();
+  }
+
+ private:
+  static bool Seen(const RectifiedView& r, int i, int j) { return r.mask.at<float>(j, i) > 0; }
+  static double PhotoLuminance(const RectifiedView& r, int i, int j) {
+    return (r.planes[0].at<float>(j, i) + r.planes[1].at<float>(j, i) +
+            r.planes[2].at<float>(j, i)) /
+           3.0;
+  }
+  Vector6d CorrectionAt(int i, int j) const {
+    Vector6d q;
+    for (int m = 0; m < 6; ++m)
+      q[m] = patch_.correction[static_cast<std::size_t>(m)].at<float>(j, i);
+    return q;
+  }
+  const Vector6d& ToMean(int i, int j) const {
+    return to_mean_of_cell_[static_cast<std::size_t>(j * gw_ + i)];
+  }
+
+  // The way from the patch's coefficients to the prior's mean, per cell (the
+  // patch is fixed during the pass, so once).
+  void ComputeWayToMean() {
+    const Eigen::Matrix<double, 6, 6>& to_orthonormal =
+        ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
+    to_mean_of_cell_.resize(static_cast<std::size_t>(gw_ * gh_));
+    for (int j = 0; j < gh_; ++j)
+      for (int i = 0; i < gw_; ++i) {
+        Vector6d a_patch;
+        for (int m = 0; m < 6; ++m)
+          a_patch[m] = BilinearClamped(
+              red0_.planes[static_cast<std::size_t>(m)],
+              std::clamp(patch_.sample_x * red0_.rx + i, 0.0, red0_.planes[0].cols - 1.0),
+              std::clamp(patch_.sample_y * red0_.ry + j, 0.0, red0_.planes[0].rows - 1.0));
+        to_mean_of_cell_[static_cast<std::size_t>(j * gw_ + i)] =
+            prior_.mean - to_orthonormal * a_patch;
+      }
+  }
+
+  // Prediction (displayed luminance) and luminance Jacobian of view r at cell
+  // (i, j), with the change q_delta (orthonormal) added to the patch's
+  // coefficients; the linear value per channel into `channel_linear`.
+  double Predict(const RectifiedView& r, int i, int j, const Vector6d& q_delta, Row6d& jac,
+                 Eigen::Vector3d* channel_linear = nullptr) const {
+    // Cell (i, j)'s centre in the reduced sample's pixel coordinates (centres
+    // at integers): (sample_x + (i + 0.5) / rx) rx - 0.5; bilinear there.
+    const cv::Mat& p0 = red0_.planes[0];
+    const double sx = std::clamp(patch_.sample_x * red0_.rx + i, 0.0, p0.cols - 1.0);
+    const double sy = std::clamp(patch_.sample_y * red0_.ry + j, 0.0, p0.rows - 1.0);
+    const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
+    const int x1 = std::min(x0 + 1, p0.cols - 1), y1 = std::min(y0 + 1, p0.rows - 1);
+    const float fx = static_cast<float>(sx - x0), fy = static_cast<float>(sy - y0);
+    auto sample_at = [&](const cv::Mat& m) {
+      return (1 - fy) * ((1 - fx) * m.at<float>(y0, x0) + fx * m.at<float>(y0, x1)) +
+             fy * ((1 - fx) * m.at<float>(y1, x0) + fx * m.at<float>(y1, x1));
+    };
+    const Eigen::Matrix<double, 6, 6>& from_orthonormal =
+        ptm::OrthonormalBasis::Hemisphere().FromOrthonormal();
+    const Vector6d a_delta = from_orthonormal * q_delta;
+    float a[6], colour[3];
+    for (int m = 0; m < 6; ++m)
+      a[m] = sample_at(red0_.planes[static_cast<std::size_t>(m)]) + static_cast<float>(a_delta[m]);
+    for (int c = 0; c < 3; ++c)
+      colour[c] = sample_at(red0_.planes[static_cast<std::size_t>(6 + c)]);
+    Eigen::Vector3d linear = Eigen::Vector3d::Zero();
+    Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
+    for (const auto& [l, intensity] : r.lighting.lights) {
+      if (l.z() <= 0) continue;
+      const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
+      const std::array<double, 6> phi = ptm::PtmBasis(l.x(), l.y());
+      const Row6d row = Eigen::Map<const Row6d>(phi.data()) * from_orthonormal;
+      for (int c = 0; c < 3; ++c) {
+        const double v = lum * colour[c];
+        if (v <= 0.0 || v >= 1.0) continue;  // clamped: no derivative
+        const double h = 1e-3;
+        const double dlin = (SrgbToLinear(static_cast<float>(std::min(1.0, v + h))) -
+                             SrgbToLinear(static_cast<float>(std::max(0.0, v - h)))) /
+                            (std::min(1.0, v + h) - std::max(0.0, v - h));
+        linear[c] += intensity * SrgbToLinear(static_cast<float>(v));
+        dlinear.row(c) += intensity * dlin * colour[c] * row;
+      }
+    }
+    const double g = gains_[r.photo];
+    double y_pred = 0.0;
+    jac.setZero();
+    for (int c = 0; c < 3; ++c) {
+      const double lin = g * linear[c];
+      if (channel_linear) (*channel_linear)[c] = lin;
+      const double d = LinearToSrgb(static_cast<float>(lin));
+      const double h = 1e-4;
+      const double dsrgb = (LinearToSrgb(static_cast<float>(lin + h)) -
+                            LinearToSrgb(static_cast<float>(std::max(0.0, lin - h)))) /
+                           (lin + h - std::max(0.0, lin - h));
+      y_pred += d / 3.0;
+      jac += dsrgb * g * dlinear.row(c) / 3.0;
+    }
+    return y_pred;
+  }
+
+  // How far the prior mean moves from the patch toward the sample's mean. With
+  // the option < 0, estimated: 1 - rho, rho the least-squares slope of the
+  // photos' departure from the mean's prediction on the patch's departure from
+  // it, over the patch's cells and views (how much of the patch's own structure
+  // the photos confirm where they see it), clamped to [0, 1]. The departure is
+  // linearised at the patch: d = -J (mean - patch).
+  double PriorShrink() const {
+    if (options_.correction_prior_shrink >= 0.0) return options_.correction_prior_shrink;
+    double photo_dot_patch = 0.0, patch_dot_patch = 0.0;
+    Row6d jac;
+    for (int j = 0; j < gh_; ++j)
+      for (int i = 0; i < gw_; ++i) {
+        const Vector6d q_to_mean = ToMean(i, j);
+        for (const RectifiedView& r : views_) {
+          if (!Seen(r, i, j)) continue;
+          const double at_patch = Predict(r, i, j, Vector6d::Zero(), jac);
+          const double patch_departure = -(jac * q_to_mean)(0);
+          photo_dot_patch +=
+              (PhotoLuminance(r, i, j) - at_patch + patch_departure) * patch_departure;
+          patch_dot_patch += patch_departure * patch_departure;
+        }
+      }
+    const double rho = patch_dot_patch > 1e-12 ? photo_dot_patch / patch_dot_patch : 0.0;
+    return 1.0 - std::clamp(rho, 0.0, 1.0);
+  }
+
+  // Per-channel factors at low frequency (stains, colour): photo over
+  // prediction in the linear domain, summed over the views and smoothed over a
+  // few photo pixels (normalised convolution), taken back to display values
+  // (x^(1/2.2)), chromaticity only. Finer detail stays the sample's.
+  void UpdateChannelFactors() {
+    std::vector<cv::Mat> photo_sum(3), model_sum(3);
+    for (int c = 0; c < 3; ++c)
+      photo_sum[static_cast<std::size_t>(c)] = cv::Mat::zeros(gh_, gw_, CV_32FC1),
+      model_sum[static_cast<std::size_t>(c)] = cv::Mat::zeros(gh_, gw_, CV_32FC1);
+    for (int j = 0; j < gh_; ++j) {
+      for (int i = 0; i < gw_; ++i) {
+        for (const RectifiedView& r : views_) {
+          if (!Seen(r, i, j)) continue;
+          Row6d row;
+          Eigen::Vector3d lin;
+          Predict(r, i, j, CorrectionAt(i, j), row, &lin);
+          for (int c = 0; c < 3; ++c) {
+            photo_sum[static_cast<std::size_t>(c)].at<float>(j, i) +=
+                SrgbToLinear(r.planes[static_cast<std::size_t>(c)].at<float>(j, i));
+            model_sum[static_cast<std::size_t>(c)].at<float>(j, i) += static_cast<float>(lin[c]);
+          }
+          known_.at<std::uint8_t>(j, i) = 1;
+        }
+      }
+    }
+    std::vector<cv::Mat> pb(3), mb(3);
+    for (std::size_t c = 0; c < 3; ++c) {
+      cv::GaussianBlur(photo_sum[c], pb[c], cv::Size(0, 0), options_.correction_sigma);
+      cv::GaussianBlur(model_sum[c], mb[c], cv::Size(0, 0), options_.correction_sigma);
+    }
+    for (int j = 0; j < gh_; ++j)
+      for (int i = 0; i < gw_; ++i) {
+        if (!known_.at<std::uint8_t>(j, i)) continue;
+        double ratio[3];
+        bool ok = true;
+        for (std::size_t c = 0; c < 3; ++c) {
+          const float p = pb[c].at<float>(j, i), m = mb[c].at<float>(j, i);
+          ok = ok && m > 1e-4f && p > 1e-4f;
+          ratio[c] = ok ? std::pow(p / m, 1.0 / 2.2) : 1.0;
+        }
+        if (!ok) continue;
+        // Chromaticity only: the luminance is the additive change's.
+        const double mean = (ratio[0] + ratio[1] + ratio[2]) / 3.0;
+        for (double& r : ratio) r /= mean;
+        for (std::size_t c = 0; c < 3; ++c) {
+          float& k = patch_.channel_gain[c].at<float>(j, i);
+          k = std::clamp(k * static_cast<float>(ratio[c]), 0.25f, 4.0f);
+        }
+      }
+  }
+
+  // One Gauss-Newton step of the MAP estimate per seen cell:
+  // q = m + Sigma J^T (J Sigma J^T + s^2 I)^-1 (r + J (q0 - m)), with m the
+  // way to the sample's mean times `shrink` and s^2 = correction_noise x the
+  // mean predicted variance.
+  void UpdateAdditiveChange(double shrink) {
+    for (int j = 0; j < gh_; ++j) {
+      for (int i = 0; i < gw_; ++i) {
+        Eigen::Matrix<double, Eigen::Dynamic, 6> jac(static_cast<int>(views_.size()), 6);
+        Eigen::VectorXd res(static_cast<int>(views_.size()));
+        int rows = 0;
+        for (const RectifiedView& r : views_) {
+          if (!Seen(r, i, j)) continue;
+          Row6d row;
+          res[rows] = PhotoLuminance(r, i, j) - Predict(r, i, j, CorrectionAt(i, j), row);
+          jac.row(rows) = row;
+          ++rows;
+        }
+        if (rows == 0) continue;
+        known_.at<std::uint8_t>(j, i) = 1;
+        const auto jr = jac.topRows(rows);
+        const Vector6d q0 = CorrectionAt(i, j);
+        const Vector6d q_mean = shrink * ToMean(i, j);
+        const Eigen::MatrixXd js = jr * prior_.covariance;
+        Eigen::MatrixXd a = js * jr.transpose();
+        const double scale = a.trace() / rows;
+        if (!(scale > 1e-12)) continue;
+        a.diagonal().array() += options_.correction_noise * scale;
+        const Vector6d q_new =
+            q_mean + js.transpose() * a.ldlt().solve(res.head(rows) + jr * (q0 - q_mean));
+        for (int m = 0; m < 6; ++m)
+          patch_.correction[static_cast<std::size_t>(m)].at<float>(j, i) =
+              static_cast<float>(q_new[m]);
+      }
+    }
+  }
+
+  // Extend the change into the strip: rings of neighbour averages.
+  void ExtendIntoStrip() {
+    for (int ring = 0; ring < std::max(gw_, gh_); ++ring) {
+      const cv::Mat before = known_.clone();
+      bool any = false;
+      for (int j = 0; j < gh_; ++j)
+        for (int i = 0; i < gw_; ++i) {
+          if (before.at<std::uint8_t>(j, i)) continue;
+          double sum[6] = {0, 0, 0, 0, 0, 0};
+          int n = 0;
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) {
+              const int jj = j + dj, ii = i + di;
+              if (jj < 0 || ii < 0 || jj >= gh_ || ii >= gw_ || !before.at<std::uint8_t>(jj, ii))
+                continue;
+              for (int m = 0; m < 6; ++m)
+                sum[m] += patch_.correction[static_cast<std::size_t>(m)].at<float>(jj, ii);
+              ++n;
+            }
+          if (!n) continue;
+          for (int m = 0; m < 6; ++m)
+            patch_.correction[static_cast<std::size_t>(m)].at<float>(j, i) =
+                static_cast<float>(sum[m] / n);
+          known_.at<std::uint8_t>(j, i) = 1;
+          any = true;
+        }
+      if (!any) break;
+    }
+  }
+
+  TrianglePatch& patch_;
+  const std::vector<RectifiedView>& views_;
+  const ReducedPlanes& red0_;
+  const CoefficientPrior& prior_;
+  const std::vector<double>& gains_;
+  const MeshSynthesisOptions& options_;
+  int gw_, gh_;
+  std::vector<Vector6d> to_mean_of_cell_;
+  cv::Mat known_;  // CV_8UC1: cells with a change
+};
+
+// Detail transfer's dictionary at one density level: the sample's coarse
+// luminance coefficients brought back to full size (orthonormal), and the
+// window of them around every sample point, 3 x 3 points one photo cell apart,
+// indexed for nearest-neighbour search. Its detail band (planes minus coarse)
+// is what the transferred patches read.
+class CoefficientCorrection::DetailDictionary {
+ public:
+  // Touches no shared state, so levels can be built in parallel.
+  DetailDictionary(const PtmSample& sample, int level, std::uint32_t seed,
+                   std::vector<cv::Mat>& band) {
+    const ReducedPlanes& red = sample.Reduced(level);
+    dx_ = 1.0 / red.rx, dy_ = 1.0 / red.ry;
+    const cv::Size full(sample.Width(), sample.Height());
+    std::vector<cv::Mat> coarse_raw(red.planes.size());
+    for (std::size_t c = 0; c < red.planes.size(); ++c)
+      cv::resize(red.planes[c], coarse_raw[c], full, 0, 0, cv::INTER_LINEAR);
+    const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
+    coarse_.assign(6, cv::Mat());
+    for (cv::Mat& m : coarse_) m = cv::Mat::zeros(full, CV_32FC1);
+    for (int y = 0; y < full.height; ++y)
+      for (int x = 0; x < full.width; ++x)
+        for (int m = 0; m < 6; ++m) {
+          double v = 0.0;
+          for (int k = 0; k < 6; ++k)
+            v += to(m, k) * coarse_raw[static_cast<std::size_t>(k)].at<float>(y, x);
+          coarse_[static_cast<std::size_t>(m)].at<float>(y, x) = static_cast<float>(v);
+        }
+    const std::vector<cv::Mat>& values = sample.Values();
+    band.resize(values.size());
+    for (std::size_t c = 0; c < band.size(); ++c)
+      band[c] = values[c] - (c < 6 ? coarse_[c] : coarse_raw[c]);
+    IndexWindows(full, level, seed);
+  }
+
+  bool Usable() const { return index_ != nullptr; }
+
+  // Matches for every cell of a corrected patch (its correction grid).
+  void Transfer(TrianglePatch& patch, int level) const;
+
+ private:
+  void IndexWindows(cv::Size full, int level, std::uint32_t seed) {
+    const int bx = static_cast<int>(std::ceil(kDetailWindowRadius * dx_)),
+              by = static_cast<int>(std::ceil(kDetailWindowRadius * dy_));
+    const int nx = full.width - 2 * bx, ny = full.height - 2 * by;
+    if (nx < 4 || ny < 4) return;  // windows wider than the sample: no transfer
+    // Large samples: points on a coarser grid, so a dictionary stays under
+    // kDetailMaxPoints windows.
+    const int stride = static_cast<int>(
+        std::ceil(std::sqrt(static_cast<double>(nx) * ny / static_cast<double>(kDetailMaxPoints))));
+    for (int y = by; y < full.height - by; y += stride)
+      for (int x = bx; x < full.width - bx; x += stride) points_.emplace_back(x, y);
+    windows_ = cv::Mat(static_cast<int>(points_.size()), kDetailWindowLength, CV_32FC1);
+    for (std::size_t n = 0; n < points_.size(); ++n)
+      CoarseWindow(coarse_, points_[n].x, points_[n].y, dx_, dy_,
+                   windows_.ptr<float>(static_cast<int>(n)));
+    // The randomised trees draw from this thread's cv::theRNG(): seeded per
+    // level, so that the matches do not depend on threads or earlier draws.
+    cv::RNG& rng_of_thread = cv::theRNG();
+    const std::uint64_t saved_state = rng_of_thread.state;
+    rng_of_thread.state = 0x7e41u + static_cast<std::uint64_t>(level) + seed * 1000003u;
+    index_ =
+        std::make_unique<cv::flann::Index>(windows_, cv::flann::KDTreeIndexParams(kDetailTrees));
+    rng_of_thread.state = saved_state;
+  }
+
+  double dx_ = 1.0, dy_ = 1.0;     // texels per photo cell
+  std::vector<cv::Mat> coarse_;    // 6 orthonormal luminance planes, full size
+  cv::Mat windows_;                // CV_32FC1, one kDetailWindowLength row per point
+  std::vector<cv::Point> points_;  // window centres, texels
+  std::unique_ptr<cv::flann::Index> index_;
+};
+
+void CoefficientCorrection::DetailDictionary::Transfer(TrianglePatch& patch, int level) const {
+  const int gw = patch.correction[0].cols, gh = patch.correction[0].rows;
+  std::vector<cv::Mat> corrected(6);
+  for (std::size_t m = 0; m < 6; ++m) {
+    corrected[m] = cv::Mat(gh, gw, CV_32FC1);
+    for (int j = 0; j < gh; ++j)
+      for (int i = 0; i < gw; ++i)
+        corrected[m].at<float>(j, i) =
+            static_cast<float>(BilinearClamped(coarse_[m], patch.sample_x + (i + 0.5) * dx_ - 0.5,
+                                               patch.sample_y + (j + 0.5) * dy_ - 0.5) +
+                               patch.correction[m].at<float>(j, i));
+  }
+  cv::Mat queries(gh * gw, kDetailWindowLength, CV_32FC1);
+  for (int j = 0; j < gh; ++j)
+    for (int i = 0; i < gw; ++i) {
+      float* q = queries.ptr<float>(j * gw + i);
+      for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
+        for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a)
+          for (std::size_t m = 0; m < 6; ++m)
+            *q++ =
+                corrected[m].at<float>(std::clamp(j + b, 0, gh - 1), std::clamp(i + a, 0, gw - 1));
+    }
+  cv::Mat indices, distances;
+  index_->knnSearch(queries, indices, distances, 1, cv::flann::SearchParams(kDetailChecks));
+  patch.detail_source = cv::Mat(gh, gw, CV_32FC2);
+  cv::Mat best(gh, gw, CV_32FC1);
+  for (int j = 0; j < gh; ++j)
+    for (int i = 0; i < gw; ++i) {
+      const cv::Point p = points_[static_cast<std::size_t>(indices.at<int>(j * gw + i, 0))];
+      patch.detail_source.at<cv::Vec2f>(j, i) =
+          cv::Vec2f(static_cast<float>(p.x), static_cast<float>(p.y));
+      best.at<float>(j, i) = distances.at<float>(j * gw + i, 0);
+    }
+  // Coherent matches keep the detail whole where their bands are blended: a
+  // neighbour cell's match moved by one cell wherever it is nearer.
+  const int sample_width = coarse_[0].cols, sample_height = coarse_[0].rows;
+  const double x_lo = kDetailWindowRadius * dx_, x_hi = sample_width - 1 - x_lo;
+  const double y_lo = kDetailWindowRadius * dy_, y_hi = sample_height - 1 - y_lo;
+  std::array<float, kDetailWindowLength> window;
+  auto try_shift = [&](int i, int j, int ni, int nj) {
+    if (ni < 0 || nj < 0 || ni >= gw || nj >= gh) return;
+    const cv::Vec2f n = patch.detail_source.at<cv::Vec2f>(nj, ni);
+    const double x = n[0] + (i - ni) * dx_, y = n[1] + (j - nj) * dy_;
+    if (x < x_lo || x > x_hi || y < y_lo || y > y_hi) return;
+    CoarseWindow(coarse_, x, y, dx_, dy_, window.data());
+    const float* q = queries.ptr<float>(j * gw + i);
+    double e = 0.0;
+    for (int k = 0; k < kDetailWindowLength; ++k) e += (window[k] - q[k]) * (window[k] - q[k]);
+    if (e < best.at<float>(j, i)) {
+      best.at<float>(j, i) = static_cast<float>(e);
+      patch.detail_source.at<cv::Vec2f>(j, i) =
+          cv::Vec2f(static_cast<float>(x), static_cast<float>(y));
+    }
+  };
+  for (int j = 0; j < gh; ++j)
+    for (int i = 0; i < gw; ++i) try_shift(i, j, i - 1, j), try_shift(i, j, i, j - 1);
+  for (int j = gh - 1; j >= 0; --j)
+    for (int i = gw - 1; i >= 0; --i) try_shift(i, j, i + 1, j), try_shift(i, j, i, j + 1);
+  patch.detail_level = level;
+}
+
+CoefficientCorrection::CoefficientCorrection(const PtmSample& sample,
+                                             const MeshSynthesisOptions& options)
+    : sample_(sample), options_(options) {}
+
+CoefficientCorrection::~CoefficientCorrection() = default;
+
+const CoefficientCorrection::CoefficientPrior& CoefficientCorrection::PriorAt(int level) {
+  auto it = priors_.find(level);
+  if (it != priors_.end()) return it->second;
+  const Eigen::Matrix<double, 6, 6>& to_orthonormal =
+      ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
+  const ReducedPlanes& red = sample_.Reduced(level);
+  const int n = static_cast<int>(red.planes[0].total());
+  Vector6d mean = Vector6d::Zero();
+  Eigen::Matrix<double, 6, 6> second = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int y = 0; y < red.planes[0].rows; ++y)
+    for (int x = 0; x < red.planes[0].cols; ++x) {
+      Vector6d a;
+      for (int m = 0; m < 6; ++m) a[m] = red.planes[static_cast<std::size_t>(m)].at<float>(y, x);
+      const Vector6d q = to_orthonormal * a;
+      mean += q;
+      second += q * q.transpose();
+    }
+  mean /= n;
+  Eigen::Matrix<double, 6, 6> cov = second / n - mean * mean.transpose();
+  cov.diagonal().array() += 1e-6 * cov.trace() / 6.0;  // keeps it positive definite
+  return priors_.emplace(level, CoefficientPrior{mean, cov}).first->second;
+}
+
+void CoefficientCorrection::Correct(TriangleEngine& engine, std::size_t face,
+                                    std::vector<RectifiedView>& views,
+                                    const std::vector<std::vector<cv::Mat>>& /*relit*/) {
+  // Every view on the best view's grid: a coarser photo, upsampled there,
+  // constrains each cell at its place instead of one of its own pixels
+  // constraining several cells alike.
+  const int primary_level = views.front().level;
+  std::vector<RectifiedView> on_grid;
+  on_grid.reserve(views.size());
+  for (RectifiedView& r : views) {
+    RectifiedView again;
+    if (r.level == primary_level)
+      on_grid.push_back(std::move(r));
+    else if (engine.Rectify(face, r.view, again, primary_level))
+      on_grid.push_back(std::move(again));
+  }
+  TrianglePatch& patch = engine.result().patches[face];
+  PatchPass(patch, on_grid, sample_.Reduced(primary_level), PriorAt(primary_level),
+            engine.result().photo_gains, options_)
+      .Run();
+  if (correction_level_.empty()) correction_level_.assign(engine.result().patches.size(), -1);
+  correction_level_[face] = primary_level;
+}
+
+void CoefficientCorrection::Finish(TriangleEngine& engine, const ProgressCallback& progress) {
+  if (!options_.detail_transfer) return;
+  std::vector<TrianglePatch>& patches = engine.result().patches;
+  // The dictionaries of the levels used, in parallel (their reductions first:
+  // the sample's cache is not thread-safe).
+  std::vector<int> levels;
+  for (const int level : correction_level_) {
+    if (level < 0 || dictionaries_.count(level)) continue;
+    dictionaries_[level];
+    detail_bands_[level];
+    sample_.Reduced(level);
+    levels.push_back(level);
+  }
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::size_t n = 0; n < levels.size(); ++n) {
+    const int level = levels[n];
+    dictionaries_.at(level) =
+        std::make_unique<DetailDictionary>(sample_, level, options_.seed, detail_bands_.at(level));
+  }
+  // The corrected patches, independent of one another.
+  std::vector<std::size_t> transferred;
+  for (std::size_t f = 0; f < correction_level_.size(); ++f)
+    if (correction_level_[f] >= 0 && dictionaries_.at(correction_level_[f])->Usable())
+      transferred.push_back(f);
+  std::atomic<std::size_t> transfers_done{0};
+#pragma omp parallel for schedule(dynamic, 8)
+  for (std::size_t n = 0; n < transferred.size(); ++n) {
+    const std::size_t f = transferred[n];
+    dictionaries_.at(correction_level_[f])->Transfer(patches[f], correction_level_[f]);
+    const std::size_t done_now = ++transfers_done;
+    if (progress && (done_now % 64 == 0 || done_now == transferred.size())) {
+#pragma omp critical(texlume_detail_progress)
+      progress("detail transfer", done_now, transferred.size());
+    }
+  }
+}
+
+}  // namespace texlume::synth

@@ -1,0 +1,68 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "synth/material_sample.h"
+#include "synth/mesh_synthesis.h"
+#include "synth/triangle_engine.h"
+
+namespace texlume::synth {
+
+/// The PTM photo-consistency pass (beyond paper 003, as the planar synthesis's)
+/// and detail transfer, as the engine's "correct" and "transfer detail" stages
+/// for an LRGB sample.
+///
+/// Correct: per cell of the best view's grid (every view rectified on it), the
+/// most probable change of the orthonormal luminance coefficients,
+///   q = m + Sigma J^T (J Sigma J^T + s^2 I)^-1 (r + J (q0 - m)),
+/// J_n the derivative of the displayed luminance under photo n's lights (sRGB,
+/// gain and light mixture linearised at the current value), r_n the photo's
+/// luminance minus the prediction (eq. 3's residual), Sigma the sample's own
+/// coefficient covariance at the photo's density, m the prior mean (the patch
+/// moved toward the sample's mean); low-frequency per-channel factors carry
+/// the photos' chromaticity. Cells outside the triangle take their
+/// neighbours' change.
+///
+/// Finish (detail transfer): per cell of each corrected patch's grid, the
+/// sample point whose coarse window (3 x 3 cells) is nearest the corrected
+/// coarse values (k-d tree per density level), then two passes that take a
+/// neighbour cell's match moved by one cell wherever it is nearer.
+class CoefficientCorrection : public PhotoCorrection {
+ public:
+  CoefficientCorrection(const PtmSample& sample, const MeshSynthesisOptions& options);
+  ~CoefficientCorrection() override;
+
+  void Correct(TriangleEngine& engine, std::size_t face, std::vector<RectifiedView>& views,
+               const std::vector<std::vector<cv::Mat>>& relit) override;
+  void Finish(TriangleEngine& engine, const ProgressCallback& progress) override;
+
+  /// Per density level, the detail bands the transferred patches read
+  /// (MeshSynthesis::detail_bands).
+  std::map<int, std::vector<cv::Mat>> TakeDetailBands() { return std::move(detail_bands_); }
+
+  /// The prior of the pass at a density level: the mean and covariance of the
+  /// reduced sample's orthonormal luminance coefficients.
+  struct CoefficientPrior {
+    Eigen::Matrix<double, 6, 1> mean;
+    Eigen::Matrix<double, 6, 6> covariance;
+  };
+
+ private:
+  class PatchPass;
+  class DetailDictionary;
+  const CoefficientPrior& PriorAt(int level);
+  void TransferDetail(TrianglePatch& patch, int level) const;
+
+  const PtmSample& sample_;
+  const MeshSynthesisOptions& options_;
+  std::map<int, CoefficientPrior> priors_;
+  std::vector<int> correction_level_;  ///< per face: the grid's density level, -1 uncorrected
+  std::map<int, std::unique_ptr<DetailDictionary>> dictionaries_;
+  std::map<int, std::vector<cv::Mat>> detail_bands_;
+};
+
+}  // namespace texlume::synth

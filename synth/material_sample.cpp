@@ -1,0 +1,236 @@
+#include "synth/material_sample.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/image_io.h"
+#include "ptm/coefficient_space.h"
+#include "synth/planar_synthesis.h"
+#include "synth/template_match.h"
+
+namespace texlume::synth {
+namespace {
+
+// The PTM's raw coefficient planes (a0..a5 per polynomial, then LRGB colour).
+std::vector<cv::Mat> RawPlanes(const ptm::Ptm& p) {
+  const int polys = p.NumPolynomials();
+  const int count = polys * 6 + (p.format == ptm::PtmFormat::kLrgb ? 3 : 0);
+  std::vector<cv::Mat> planes(static_cast<std::size_t>(count));
+  for (cv::Mat& m : planes) m = cv::Mat(p.height, p.width, CV_32FC1);
+  for (int y = 0; y < p.height; ++y) {
+    for (int x = 0; x < p.width; ++x) {
+      const std::size_t t = static_cast<std::size_t>(y) * p.width + x;
+      for (int q = 0; q < polys; ++q)
+        for (int i = 0; i < 6; ++i)
+          planes[static_cast<std::size_t>(q * 6 + i)].at<float>(y, x) = p.Coefficients(t, q)[i];
+      if (p.format == ptm::PtmFormat::kLrgb)
+        for (int c = 0; c < 3; ++c)
+          planes[static_cast<std::size_t>(6 + c)].at<float>(y, x) = p.colour[t * 3 + c];
+    }
+  }
+  return planes;
+}
+
+// A patch texel position (u, v) (texels, centres at integers) on the patch's
+// correction grid: the cell coordinates, clamped, and the 2 x 2 cells around.
+struct GridPoint {
+  double gu = 0.0, gv = 0.0;
+  int gx0 = 0, gy0 = 0, gx1 = 0, gy1 = 0;
+  float gfx = 0.0f, gfy = 0.0f;
+  float Bilinear(const cv::Mat& m) const {
+    return (1 - gfy) * ((1 - gfx) * m.at<float>(gy0, gx0) + gfx * m.at<float>(gy0, gx1)) +
+           gfy * ((1 - gfx) * m.at<float>(gy1, gx0) + gfx * m.at<float>(gy1, gx1));
+  }
+};
+
+GridPoint OnCorrectionGrid(const TrianglePatch& patch, double u, double v) {
+  const cv::Mat& c0 = patch.correction[0];
+  GridPoint g;
+  g.gu = std::clamp((u + 0.5) * patch.correction_density.x() - 0.5, 0.0, c0.cols - 1.0);
+  g.gv = std::clamp((v + 0.5) * patch.correction_density.y() - 0.5, 0.0, c0.rows - 1.0);
+  g.gx0 = static_cast<int>(g.gu), g.gy0 = static_cast<int>(g.gv);
+  g.gx1 = std::min(g.gx0 + 1, c0.cols - 1), g.gy1 = std::min(g.gy0 + 1, c0.rows - 1);
+  g.gfx = static_cast<float>(g.gu - g.gx0), g.gfy = static_cast<float>(g.gv - g.gy0);
+  return g;
+}
+
+// Detail transfer (on the correction's grid): the patch's own detail band out,
+// the band around each of the 4 nearest cells' matched sample points in,
+// weighted bilinearly. (uc, vc): the patch texel position, clamped.
+void TransferredDetail(const TrianglePatch& patch, const std::vector<cv::Mat>& band,
+                       const GridPoint& g, double uc, double vc, float* out) {
+  const double rx = patch.correction_density.x(), ry = patch.correction_density.y();
+  const std::array<std::pair<cv::Point, float>, 4> cells = {
+      std::pair{cv::Point(g.gx0, g.gy0), (1 - g.gfx) * (1 - g.gfy)},
+      std::pair{cv::Point(g.gx1, g.gy0), g.gfx * (1 - g.gfy)},
+      std::pair{cv::Point(g.gx0, g.gy1), (1 - g.gfx) * g.gfy},
+      std::pair{cv::Point(g.gx1, g.gy1), g.gfx * g.gfy}};
+  for (std::size_t c = 0; c < band.size(); ++c)
+    out[c] -=
+        static_cast<float>(BilinearClamped(band[c], patch.sample_x + uc, patch.sample_y + vc));
+  for (const auto& [cell, w] : cells) {
+    if (w <= 0.0f) continue;
+    const cv::Vec2f s = patch.detail_source.at<cv::Vec2f>(cell.y, cell.x);
+    const double x = s[0] + uc - ((cell.x + 0.5) / rx - 0.5);
+    const double y = s[1] + vc - ((cell.y + 0.5) / ry - 0.5);
+    for (std::size_t c = 0; c < band.size(); ++c)
+      out[c] += static_cast<float>(w * BilinearClamped(band[c], x, y));
+  }
+}
+
+// Catmull-Rom weights of the 4 taps around t in [0, 1).
+void CatmullRomWeights(double t, double w[4]) {
+  const double t2 = t * t, t3 = t2 * t;
+  w[0] = -0.5 * t3 + t2 - 0.5 * t;
+  w[1] = 1.5 * t3 - 2.5 * t2 + 1.0;
+  w[2] = -1.5 * t3 + 2.0 * t2 + 0.5 * t;
+  w[3] = 0.5 * t3 - 0.5 * t2;
+}
+
+// The additive change of the 6 luminance coefficients: Catmull-Rom (bicubic)
+// over the 4 x 4 nearest cells, which keeps the photo's detail sharper than
+// bilinear.
+void AddCorrection(const TrianglePatch& patch, const GridPoint& g, float* out) {
+  const int bx = static_cast<int>(std::floor(g.gu)), by = static_cast<int>(std::floor(g.gv));
+  double wx[4], wy[4];
+  CatmullRomWeights(g.gu - bx, wx);
+  CatmullRomWeights(g.gv - by, wy);
+  for (int i = 0; i < 6; ++i) {
+    const cv::Mat& m = patch.correction[static_cast<std::size_t>(i)];
+    double acc = 0.0;
+    for (int a = 0; a < 4; ++a) {
+      const float* row = m.ptr<float>(std::clamp(by - 1 + a, 0, m.rows - 1));
+      double r = 0.0;
+      for (int b = 0; b < 4; ++b) r += wx[b] * row[std::clamp(bx - 1 + b, 0, m.cols - 1)];
+      acc += wy[a] * r;
+    }
+    out[i] += static_cast<float>(acc);
+  }
+}
+
+}  // namespace
+
+const ReducedPlanes& MaterialSample::Reduced(int level) const {
+  auto it = reduced_.find(level);
+  if (it != reduced_.end()) return it->second;
+  return reduced_.emplace(level, ReduceToDensityLevel(RelightPlanes(), level)).first->second;
+}
+
+double BilinearClamped(const cv::Mat& m, double x, double y) {
+  x = std::clamp(x, 0.0, m.cols - 1.0);
+  y = std::clamp(y, 0.0, m.rows - 1.0);
+  const int x0 = std::min(static_cast<int>(x), std::max(m.cols - 2, 0));
+  const int y0 = std::min(static_cast<int>(y), std::max(m.rows - 2, 0));
+  const int x1 = std::min(x0 + 1, m.cols - 1), y1 = std::min(y0 + 1, m.rows - 1);
+  const double fx = x - x0, fy = y - y0;
+  const float* r0 = m.ptr<float>(y0);
+  const float* r1 = m.ptr<float>(y1);
+  return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x1]);
+}
+
+bool SamplePtmPatch(const std::vector<cv::Mat>& values, ptm::PtmFormat format,
+                    const std::map<int, std::vector<cv::Mat>>& detail_bands,
+                    const TrianglePatch& patch, double texel_size, const Eigen::Vector2d& p,
+                    float* out) {
+  const double u = (p.x() - patch.x_min) / texel_size - 0.5;
+  const double v = (patch.y_max - p.y()) / texel_size - 0.5;
+  if (u < -0.5 || v < -0.5 || u > patch.width - 0.5 || v > patch.height - 0.5) return false;
+  const double uc = std::clamp(u, 0.0, patch.width - 1.0),
+               vc = std::clamp(v, 0.0, patch.height - 1.0);
+  const int x0 = std::min(static_cast<int>(uc), patch.width - 2 < 0 ? 0 : patch.width - 2);
+  const int y0 = std::min(static_cast<int>(vc), patch.height - 2 < 0 ? 0 : patch.height - 2);
+  const int x1 = std::min(x0 + 1, patch.width - 1), y1 = std::min(y0 + 1, patch.height - 1);
+  const float fx = static_cast<float>(uc - x0), fy = static_cast<float>(vc - y0);
+  for (std::size_t c = 0; c < values.size(); ++c) {
+    const cv::Mat& m = values[c];
+    const float a = m.at<float>(patch.sample_y + y0, patch.sample_x + x0);
+    const float b = m.at<float>(patch.sample_y + y0, patch.sample_x + x1);
+    const float d = m.at<float>(patch.sample_y + y1, patch.sample_x + x0);
+    const float e = m.at<float>(patch.sample_y + y1, patch.sample_x + x1);
+    out[c] = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * d + fx * e);
+  }
+  if (patch.correction.empty()) return true;
+  const GridPoint g = OnCorrectionGrid(patch, u, v);
+  if (!patch.detail_source.empty())
+    TransferredDetail(patch, detail_bands.at(patch.detail_level), g, uc, vc, out);
+  AddCorrection(patch, g, out);
+  // Per-channel factors: LRGB colour times the factor, RGB polynomial times it.
+  for (int c = 0; c < 3 && c < static_cast<int>(patch.channel_gain.size()); ++c) {
+    const float k = g.Bilinear(patch.channel_gain[static_cast<std::size_t>(c)]);
+    if (format == ptm::PtmFormat::kLrgb) {
+      out[6 + c] *= k;
+    } else {
+      for (int i = 0; i < 6; ++i) out[6 * c + i] *= k;
+    }
+  }
+  return true;
+}
+
+PtmSample::PtmSample(const ptm::Ptm& ptm)
+    : ptm_(ptm), values_(ToOrthonormalPlanes(ptm)), raw_(RawPlanes(ptm)) {
+  const int coefficient_planes = ptm.format == ptm::PtmFormat::kLrgb ? 6 : 18;
+  coefficients_.assign(values_.begin(), values_.begin() + coefficient_planes);
+  energy_ = PlaneEnergy(coefficients_);
+  coarse_level_ = std::max(
+      0, static_cast<int>(std::ceil(4.0 * std::log2(std::max(ptm.width, ptm.height) / 16.0))));
+}
+
+bool PtmSample::PatchFeatures(const TrianglePatch& patch, double texel_size,
+                              const Eigen::Vector2d& p_in_frame, float* out) const {
+  static const std::map<int, std::vector<cv::Mat>> kNoDetail;
+  std::array<float, 18> all{};  // coefficients (+ LRGB colour): at most 18 values
+  if (!SamplePtmPatch(values_, ptm_.format, kNoDetail, patch, texel_size, p_in_frame, all.data()))
+    return false;
+  std::copy(all.begin(), all.begin() + CoefficientPlanes(), out);
+  return true;
+}
+
+void PtmSample::FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const {
+  for (std::size_t c = 0; c < coefficients_.size(); ++c)
+    out[c] = static_cast<float>(
+        BilinearClamped(coefficients_[c], sample_px.x() - 0.5, sample_px.y() - 0.5));
+}
+
+void PtmSample::TurnFeatures(const Unfolding& u, float* features) const {
+  for (int q = 0; q < CoefficientPlanes() / 6; ++q) {
+    Eigen::Matrix<double, 6, 1> c;
+    for (int m = 0; m < 6; ++m) c[m] = features[q * 6 + m];
+    c = u.coefficients_to_this * c;
+    for (int m = 0; m < 6; ++m) features[q * 6 + m] = static_cast<float>(c[m]);
+  }
+}
+
+std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighting& lighting,
+                                        double gain) const {
+  const int polys = ptm_.NumPolynomials();
+  std::vector<cv::Mat> out(3);
+  for (cv::Mat& m : out) m = cv::Mat(r.planes[0].size(), CV_32FC1);
+  std::vector<float> a(static_cast<std::size_t>(polys * 6)), colour(3, 1.0f);
+  for (int y = 0; y < r.planes[0].rows; ++y) {
+    for (int x = 0; x < r.planes[0].cols; ++x) {
+      for (int i = 0; i < polys * 6; ++i)
+        a[static_cast<std::size_t>(i)] = r.planes[static_cast<std::size_t>(i)].at<float>(y, x);
+      if (ptm_.format == ptm::PtmFormat::kLrgb)
+        for (int c = 0; c < 3; ++c)
+          colour[static_cast<std::size_t>(c)] =
+              r.planes[static_cast<std::size_t>(6 + c)].at<float>(y, x);
+      const Eigen::Vector3f v =
+          RelightMixture(a.data(), colour.data(), ptm_.format, lighting.lights, gain);
+      for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(c)].at<float>(y, x) = v[c];
+    }
+  }
+  return out;
+}
+
+double PtmSample::RelitLinearSum(const FaceLighting& lighting, int cells) const {
+  const std::vector<cv::Mat> relit = Relight(Reduced(coarse_level_), lighting, 1.0);
+  double sum = 0.0;
+  for (int c = 0; c < 3; ++c)
+    for (int j = 0; j < relit[0].rows; ++j)
+      for (int i = 0; i < relit[0].cols; ++i)
+        sum += SrgbToLinear(relit[static_cast<std::size_t>(c)].at<float>(j, i));
+  return sum * (cells / static_cast<double>(relit[0].total()));
+}
+
+}  // namespace texlume::synth

@@ -1,0 +1,151 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ptm/ptm.h"
+#include "synth/triangle_parts.h"
+
+namespace texlume::synth {
+
+/// The domain in which a sample's relit values are compared with the photos
+/// (eq. 3 of paper 003): the photos are rectified into it.
+enum class PhotoDomain {
+  kDisplay,  ///< sRGB-encoded display values in [0, 1] (PTMs hold them, as RTI tools fit them)
+  kLinear,   ///< linear RGB (measured BTFs, and light mixtures)
+};
+
+/// What lights one face in one photo, in the face's frame: the direction
+/// towards the camera and every light of the photo (direction towards the
+/// light, unit; intensity). Lights below the face's horizon are kept: each
+/// sample decides how they act.
+struct FaceLighting {
+  Eigen::Vector3d view_in_frame = Eigen::Vector3d::UnitZ();
+  std::vector<std::pair<Eigen::Vector3d, double>> lights;
+};
+
+/// A material sample as the synthesis engines see it (DESIGN.md, "Engines and
+/// samples"). An engine never looks inside a sample: it compares feature
+/// planes, turns them with the face frames, relights the sample for the image
+/// constraint and asks whether values may be blended. Reductions are cached on
+/// first use (not thread-safe; build the levels before parallel sections).
+class MaterialSample {
+ public:
+  virtual ~MaterialSample() = default;
+
+  /// "PTM", "BTF", "colour": for messages and manifests.
+  virtual std::string Name() const = 0;
+  /// Size in texels.
+  virtual int Width() const = 0;
+  virtual int Height() const = 0;
+
+  /// Feature planes (CV_32FC1, full size) in which Euclidean distance is the
+  /// right distance between texels (PTM: the orthonormal coefficients, paper
+  /// 003 §2.3; BTF: the geometry maps, paper 004 §III), and their summed squares.
+  virtual const std::vector<cv::Mat>& FeaturePlanes() const = 0;
+  virtual const cv::Mat& FeatureEnergy() const = 0;
+  int NumFeatures() const { return static_cast<int>(FeaturePlanes().size()); }
+
+  /// The features a placed patch shows at a point of its face's frame (world
+  /// units), with whatever the photo-consistency pass changed in them;
+  /// false outside the patch rectangle. `out` holds NumFeatures() values.
+  virtual bool PatchFeatures(const TrianglePatch& patch, double texel_size,
+                             const Eigen::Vector2d& p_in_frame, float* out) const = 0;
+  /// The features at a continuous sample position (texels, x right, y down,
+  /// centres at +0.5), bilinear, clamped to the sample.
+  virtual void FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const = 0;
+  /// Features of a neighbour's frame carried into this one across a shared
+  /// edge (in place): what a rotation of the frame does to them.
+  virtual void TurnFeatures(const Unfolding& unfolding, float* features) const = 0;
+
+  /// Whether values of two patches may be mixed where they overlap (a PTM's
+  /// coefficients may; a BTF's mesostructure must be cut, never blended).
+  virtual bool Blendable() const = 0;
+  /// Whether the view direction changes what the sample shows.
+  virtual bool ViewDependent() const = 0;
+  /// The domain of Relight's values (and of the photos compared with them).
+  virtual PhotoDomain Domain() const = 0;
+
+  /// What Relight reads, reduced to a photo density level (r = 2^(-level/4)
+  /// photo pixels per texel; ReduceToDensityLevel), cached.
+  const ReducedPlanes& Reduced(int level) const;
+  /// The reduced sample relit under a face's lighting times a gain: 3 planes
+  /// (R, G, B) of the reduced size, in Domain().
+  virtual std::vector<cv::Mat> Relight(const ReducedPlanes& reduced, const FaceLighting& lighting,
+                                       double gain) const = 0;
+  /// What `cells` texels of the sample sum to on average under a face's
+  /// lighting, over R, G and B, in the linear domain (the photo gains compare
+  /// it with the photo's sum over as many cells).
+  virtual double RelitLinearSum(const FaceLighting& lighting, int cells) const = 0;
+
+ protected:
+  /// The planes Reduced() reduces.
+  virtual const std::vector<cv::Mat>& RelightPlanes() const = 0;
+
+ private:
+  mutable std::map<int, ReducedPlanes> reduced_;
+};
+
+/// A PTM sample (paper 003): features are the orthonormal coefficients (6 LRGB,
+/// 18 RGB), turned by the frame rotation's 6 x 6 map; values (coefficients and
+/// LRGB colour) may be blended; relit in the display domain (RelightMixture).
+class PtmSample : public MaterialSample {
+ public:
+  explicit PtmSample(const ptm::Ptm& ptm);
+
+  std::string Name() const override { return "PTM"; }
+  int Width() const override { return ptm_.width; }
+  int Height() const override { return ptm_.height; }
+  const std::vector<cv::Mat>& FeaturePlanes() const override { return coefficients_; }
+  const cv::Mat& FeatureEnergy() const override { return energy_; }
+  bool PatchFeatures(const TrianglePatch& patch, double texel_size,
+                     const Eigen::Vector2d& p_in_frame, float* out) const override;
+  void FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const override;
+  void TurnFeatures(const Unfolding& unfolding, float* features) const override;
+  bool Blendable() const override { return true; }
+  bool ViewDependent() const override { return false; }
+  PhotoDomain Domain() const override { return PhotoDomain::kDisplay; }
+  std::vector<cv::Mat> Relight(const ReducedPlanes& reduced, const FaceLighting& lighting,
+                               double gain) const override;
+  double RelitLinearSum(const FaceLighting& lighting, int cells) const override;
+
+  const ptm::Ptm& ptm() const { return ptm_; }
+  ptm::PtmFormat format() const { return ptm_.format; }
+  /// Coefficient planes (6 LRGB, 18 RGB); LRGB colour planes follow in Values().
+  int CoefficientPlanes() const { return static_cast<int>(coefficients_.size()); }
+  /// Everything a texel holds: orthonormal coefficients, then LRGB colour.
+  const std::vector<cv::Mat>& Values() const { return values_; }
+
+ protected:
+  /// Raw coefficients a0..a5 per polynomial, then LRGB colour: evaluation is
+  /// linear in them, so reducing them equals reducing the relit image (up to
+  /// the clamp).
+  const std::vector<cv::Mat>& RelightPlanes() const override { return raw_; }
+
+ private:
+  const ptm::Ptm& ptm_;
+  std::vector<cv::Mat> values_, coefficients_, raw_;
+  cv::Mat energy_;
+  int coarse_level_ = 0;  ///< the level RelitLinearSum averages at (about 16 texels a side)
+};
+
+/// Bilinear value of a CV_32FC1 plane at (x, y) (pixel centres at integers),
+/// clamped to the plane.
+double BilinearClamped(const cv::Mat& plane, double x, double y);
+
+/// The values of a PTM patch at a point of its face's frame (world units),
+/// bilinear within the patch rectangle, with its photo-consistency correction
+/// (additive change, per-channel factors) and detail transfer when it has them
+/// (TrianglePatch); `detail_bands` by level as MeshSynthesis holds them. False
+/// outside the rectangle. Writes values.size() planes.
+bool SamplePtmPatch(const std::vector<cv::Mat>& values, ptm::PtmFormat format,
+                    const std::map<int, std::vector<cv::Mat>>& detail_bands,
+                    const TrianglePatch& patch, double texel_size,
+                    const Eigen::Vector2d& p_in_frame, float* out);
+
+}  // namespace texlume::synth

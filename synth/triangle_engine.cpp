@@ -1,0 +1,362 @@
+#include "synth/triangle_engine.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "core/errors.h"
+#include "core/image_io.h"
+#include "synth/tangent_field.h"
+#include "synth/template_match.h"
+
+namespace texlume::synth {
+namespace {
+
+double Since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// The photo's sum over a view's masked cells and R, G, B, in the linear domain.
+double PhotoLinearSum(const RectifiedView& r, PhotoDomain domain) {
+  double sum = 0.0;
+  if (domain == PhotoDomain::kLinear) {
+    for (const cv::Mat& plane : r.planes) sum += cv::sum(plane.mul(r.mask))[0];
+    return sum;
+  }
+  for (int j = 0; j < r.mask.rows; ++j)
+    for (int i = 0; i < r.mask.cols; ++i)
+      if (r.mask.at<float>(j, i) > 0)
+        for (const cv::Mat& plane : r.planes) sum += SrgbToLinear(plane.at<float>(j, i));
+  return sum;
+}
+
+}  // namespace
+
+void TriangleEngineOptions::Check() const {
+  if (!(sample_texel_size > 0.0) || !std::isfinite(sample_texel_size))
+    throw OptionError("sample texel size must be a positive number of world units");
+  if (strip < 2 || strip > 32) throw OptionError("strip (W_e) must be in [2, 32] texels");
+  if (top_k < 1) throw OptionError("top_k must be >= 1");
+  if (max_views < 1) throw OptionError("max_views must be >= 1");
+  if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
+  if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
+  if (max_texels < 1) throw OptionError("max_texels must be >= 1");
+  if (!(field_direction_in_world.norm() > 0.0))
+    throw OptionError("field direction must be nonzero");
+}
+
+TriangleEngine::TriangleEngine(const sfm::TriangleMesh& mesh,
+                               const sfm::Reconstruction& reconstruction,
+                               const sfm::VisibilityResult& visibility,
+                               const std::vector<MeshPhoto>& photos, const MaterialSample& sample,
+                               const TriangleEngineOptions& options, PhotoCorrection* correction)
+    : mesh_(mesh),
+      reconstruction_(reconstruction),
+      visibility_(visibility),
+      photos_(photos),
+      sample_(sample),
+      options_(options),
+      correction_(correction) {
+  for (std::size_t n = 0; n < photos.size(); ++n) photo_index_[photos[n].image_id] = n;
+}
+
+TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
+  options_.Check();
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t num_faces = mesh_.faces.size();
+  if (visibility_.triangles.size() != num_faces)
+    throw InputError("visibility", "does not match the mesh's face count");
+  const double t = options_.sample_texel_size;
+  result_.texel_size = t;
+  score_margin_ = sample_.Blendable() ? 0.5 * options_.strip * t : 0.0;
+  SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, options_.tangent_frame,
+                                 options_.field_direction_in_world));
+  TurnFramesToPhotos();
+  EstimatePhotoGains();
+
+  // Breadth first from the best-seen face (Algorithm 2, step 2).
+  const std::vector<int> order =
+      sfm::BreadthFirstFaceOrder(mesh_, sfm::FaceNeighbours(mesh_), BestSeenFace(visibility_));
+  done_.assign(num_faces, 0);
+  std::mt19937_64 rng(options_.seed);
+  std::size_t processed = 0;
+  for (const int face : order) {
+    SynthesizeFace(static_cast<std::size_t>(face), rng);
+    done_[static_cast<std::size_t>(face)] = 1;
+    ++processed;
+    if (progress && (processed % 64 == 0 || processed == num_faces))
+      progress("synthesis", processed, num_faces);
+  }
+  if (correction_) correction_->Finish(*this, progress);
+  result_.seconds_synthesis = Since(start);
+  return std::move(result_);
+}
+
+void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
+  const double t = options_.sample_texel_size;
+  if (geometry.total_texels > options_.max_texels) {
+    const std::int64_t mib =
+        geometry.total_texels * 4 * static_cast<std::int64_t>(sample_.NumFeatures()) >> 20;
+    throw InputError("mesh", "at a texel size of " + std::to_string(t) + " world units the " +
+                                 std::to_string(mesh_.faces.size()) + " patches need " +
+                                 std::to_string(geometry.total_texels) + " texels (about " +
+                                 std::to_string(mib) +
+                                 " MiB of features), more than the limit of " +
+                                 std::to_string(options_.max_texels) +
+                                 "; use a larger texel size or a finer mesh");
+  }
+  if (geometry.widest > sample_.Width() || geometry.tallest > sample_.Height()) {
+    throw InputError(
+        "mesh", "the largest triangle needs a patch of " + std::to_string(geometry.widest) + " x " +
+                    std::to_string(geometry.tallest) + " texels (strip included) but the " +
+                    sample_.Name() + " sample is " + std::to_string(sample_.Width()) + " x " +
+                    std::to_string(sample_.Height()) +
+                    "; subdivide the mesh (texlume synth --max-subdivisions) or "
+                    "capture a larger sample");
+  }
+  result_.patches = std::move(geometry.patches);
+  result_.unfoldings = std::move(geometry.unfoldings);
+}
+
+bool TriangleEngine::Rectify(std::size_t face, const sfm::TriangleView& view, RectifiedView& out,
+                             int level, bool wide_mask) const {
+  const auto it = photo_index_.find(view.image_id);
+  if (it == photo_index_.end()) return false;
+  const double t = options_.sample_texel_size;
+  const MeshPhoto& photo = photos_[it->second];
+  const sfm::Image& image = reconstruction_.images.at(view.image_id);
+  const sfm::Camera& camera = reconstruction_.cameras.at(image.camera_id);
+  const TrianglePatch& patch = result_.patches[face];
+  if (level < 0) level = PhotoDensityLevel(patch, view, t);
+  const ReducedPlanes& r = sample_.Reduced(level);
+  const int tw = std::max(1, static_cast<int>(std::lround(patch.width * r.rx)));
+  const int th = std::max(1, static_cast<int>(std::lround(patch.height * r.ry)));
+  if (tw > r.planes[0].cols || th > r.planes[0].rows) return false;
+  cv::Mat map_x, map_y;
+  out.count =
+      RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera, image.cam_from_world,
+                        photo.image.size(), score_margin_, map_x, map_y, out.mask);
+  if (out.count < options_.min_photo_pixels) return false;
+  if (wide_mask && correction_ && correction_->WideMaskMargin() >= 0.0) {
+    cv::Mat wide_x, wide_y;
+    RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera, image.cam_from_world,
+                      photo.image.size(), correction_->WideMaskMargin(), wide_x, wide_y,
+                      out.wide_mask);
+  }
+  cv::Mat rectified;
+  cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
+  cv::split(rectified, out.planes);
+  if (sample_.Domain() == PhotoDomain::kLinear)
+    for (cv::Mat& plane : out.planes)
+      for (int j = 0; j < th; ++j)
+        for (int i = 0; i < tw; ++i) plane.at<float>(j, i) = SrgbToLinear(plane.at<float>(j, i));
+  const Eigen::Vector3d& origin = patch.frame.origin_in_world;
+  out.lighting.view_in_frame =
+      patch.frame.DirectionInFrame((image.ProjectionCenter() - origin).normalized());
+  out.steep = !sample_.ViewDependent() || out.lighting.view_in_frame.z() > 0.5;
+  out.lighting.lights.clear();
+  for (const sfm::ObjectLight& light : photo.lights) {
+    const Eigen::Vector3d l = patch.frame.DirectionInFrame(light.DirectionFrom(origin));
+    out.lighting.lights.emplace_back(l, light.intensity);
+    out.steep = out.steep && l.z() > 0.5;
+  }
+  out.photo = it->second;
+  out.view = view;
+  out.level = level;
+  return true;
+}
+
+std::vector<RectifiedView> TriangleEngine::RectifiedViews(std::size_t face, bool wide_mask) const {
+  std::vector<RectifiedView> views;
+  for (const sfm::TriangleView& view :
+       ConstrainingViews(visibility_.triangles[face], options_.all_views, options_.max_views)) {
+    RectifiedView r;
+    if (Rectify(face, view, r, -1, wide_mask)) views.push_back(std::move(r));
+  }
+  return views;
+}
+
+void TriangleEngine::TurnFramesToPhotos() {
+  // Beyond the paper (synth/tangent_field.h): the sample's structure tensor at
+  // the photos' median density against each face's photos' tensor in its
+  // first-edge frame; kAuto turns only for an anisotropic sample. The sample
+  // is relit seen from above.
+  result_.tangent_frame = options_.tangent_frame;
+  if (options_.tangent_frame != TangentFrame::kPhotos &&
+      options_.tangent_frame != TangentFrame::kAuto)
+    return;
+  const double t = options_.sample_texel_size;
+  const std::size_t num_faces = mesh_.faces.size();
+  std::vector<int> face_levels(num_faces, -1);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    const std::vector<sfm::TriangleView> views =
+        ConstrainingViews(visibility_.triangles[f], options_.all_views, options_.max_views);
+    if (!views.empty()) face_levels[f] = PhotoDensityLevel(result_.patches[f], views[0], t);
+  }
+  const auto sample_tensor_at = [&](int level) {
+    const ReducedPlanes& red = sample_.Reduced(level);
+    return SampleStructureTensor(
+        [&](const Eigen::Vector3d& l) {
+          return sample_.Relight(red, FaceLighting{Eigen::Vector3d::UnitZ(), {{l, 1.0}}}, 1.0);
+        },
+        red.rx, red.ry);
+  };
+  const auto photo_tensor = [&](std::size_t f) {
+    Eigen::Matrix2d tensor = Eigen::Matrix2d::Zero();
+    for (const RectifiedView& rect : RectifiedViews(f, false)) {
+      const ReducedPlanes& r = sample_.Reduced(rect.level);
+      tensor += LuminanceStructureTensor(rect.planes, rect.mask, r.rx, r.ry);
+    }
+    return tensor;
+  };
+  const FrameChoice choice =
+      ChoosePhotoFrames(options_.tangent_frame, result_.patches, result_.unfoldings, face_levels,
+                        sample_tensor_at, photo_tensor);
+  result_.tangent_frame = choice.tangent_frame;
+  result_.sample_coherence = choice.sample_coherence;
+  if (choice.tangent_frame == TangentFrame::kPhotos)
+    SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, choice.field.tangents_in_world));
+}
+
+void TriangleEngine::EstimatePhotoGains() {
+  // For every face fully visible in a photo from steep enough directions,
+  // m = photo mean / sample mean relit at the face's lighting = a_T g_n (a_T
+  // the face's albedo relative to the sample's); log m = log a_T + log g_n is
+  // solved by alternating least squares with the mean log a_T at 0, so stains
+  // and colour do not leak into the gains.
+  std::vector<GainObservation> ratios;
+  const std::size_t num_faces = mesh_.faces.size();
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    int used = 0;
+    for (const sfm::TriangleView& view : visibility_.triangles[f].views) {
+      if (!view.fully_visible || used >= 8) continue;
+      RectifiedView rect;
+      // Grazing or hidden lights: the sample is least reliable there (and shadows).
+      if (!Rectify(f, view, rect) || !rect.steep) continue;
+      const double photo_linear = PhotoLinearSum(rect, sample_.Domain());
+      const double model_linear = sample_.RelitLinearSum(rect.lighting, rect.count);
+      // Dim faces (grazing light, shadow) say little about the gain.
+      if (!(model_linear > 0.02 * 3 * rect.count) || !(photo_linear > 1e-6)) continue;
+      ratios.push_back({f, rect.photo, std::log(photo_linear / model_linear), model_linear});
+      ++used;
+    }
+  }
+  result_.photo_gains = SolvePhotoGains(ratios, num_faces, photos_.size());
+}
+
+double TriangleEngine::OverlapTargets::Error(const MaterialSample& sample, int width, int sx,
+                                             int sy) const {
+  if (texels.empty()) return 0.0;
+  const std::vector<cv::Mat>& planes = sample.FeaturePlanes();
+  const std::size_t n = planes.size();
+  double e = 0.0;
+  for (std::size_t m = 0; m < texels.size(); ++m) {
+    const int i = texels[m] % width, j = texels[m] / width;
+    for (std::size_t c = 0; c < n; ++c) {
+      const double d = planes[c].at<float>(sy + j, sx + i) - targets[m * n + c];
+      e += d * d;
+    }
+  }
+  return e / static_cast<double>(texels.size());
+}
+
+TriangleEngine::OverlapTargets TriangleEngine::CollectOverlapTargets(std::size_t f) const {
+  const TrianglePatch& patch = result_.patches[f];
+  const double t = options_.sample_texel_size;
+  const int w = patch.width, h = patch.height;
+  OverlapTargets overlap;
+  std::vector<float> value(static_cast<std::size_t>(sample_.NumFeatures()));
+  for (int j = 0; j < h; ++j) {
+    for (int i = 0; i < w; ++i) {
+      const Eigen::Vector2d p(patch.x_min + (i + 0.5) * t, patch.y_max - (j + 0.5) * t);
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Unfolding& u = result_.unfoldings[f][k];
+        if (u.face < 0 || !done_[static_cast<std::size_t>(u.face)]) continue;
+        const double d =
+            DistanceToSegment(patch.corners_in_frame[k], patch.corners_in_frame[(k + 1) % 3], p);
+        if (d > options_.strip * t) continue;
+        const TrianglePatch& other = result_.patches[static_cast<std::size_t>(u.face)];
+        if (!sample_.PatchFeatures(other, t, u.rotation * p + u.translation, value.data()))
+          continue;
+        sample_.TurnFeatures(u, value.data());
+        overlap.texels.push_back(j * w + i);
+        overlap.targets.insert(overlap.targets.end(), value.begin(), value.end());
+        break;
+      }
+    }
+  }
+  return overlap;
+}
+
+void TriangleEngine::ScoreAndPlace(TrianglePatch& patch, const std::vector<RectifiedView>& views,
+                                   const OverlapTargets& overlap,
+                                   std::vector<std::vector<cv::Mat>>& relit) {
+  // Eq. 3 of paper 003 per photo (RMS at the photo's density), summed over the
+  // photos, at every placement of the patch in the sample.
+  cv::Mat total = cv::Mat::zeros(sample_.Height() - patch.height + 1,
+                                 sample_.Width() - patch.width + 1, CV_32FC1);
+  for (const RectifiedView& r : views) {
+    const ReducedPlanes& red = sample_.Reduced(r.level);
+    const std::vector<cv::Mat>& model =
+        relit.emplace_back(sample_.Relight(red, r.lighting, result_.photo_gains[r.photo]));
+    AddImageScore(MaskedSsd(model, PlaneEnergy(model), r.planes, r.mask), r.count, red.rx, red.ry,
+                  total);
+  }
+  // Top-k distinct positions at the coarsest density used (neighbouring texel
+  // positions share one photo-density cell and score alike), then the one
+  // closest to the synthesised neighbours.
+  const int stride =
+      std::max(1, static_cast<int>(std::floor(1.0 / sample_.Reduced(views[0].level).rx)));
+  KeepClosestToNeighbours(
+      BestPlacements(total, stride, options_.top_k),
+      [&](int sx, int sy) { return overlap.Error(sample_, patch.width, sx, sy); }, patch);
+}
+
+void TriangleEngine::PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap,
+                                       std::mt19937_64& rng) const {
+  const int w = patch.width, h = patch.height;
+  const std::size_t n = static_cast<std::size_t>(sample_.NumFeatures());
+  std::vector<cv::Mat> target_planes(n);
+  for (cv::Mat& m : target_planes) m = cv::Mat::zeros(h, w, CV_32FC1);
+  cv::Mat mask = cv::Mat::zeros(h, w, CV_32FC1);
+  for (std::size_t m = 0; m < overlap.texels.size(); ++m) {
+    const int i = overlap.texels[m] % w, j = overlap.texels[m] / w;
+    mask.at<float>(j, i) = 1.0f;
+    for (std::size_t c = 0; c < n; ++c)
+      target_planes[c].at<float>(j, i) = overlap.targets[m * n + c];
+  }
+  const cv::Mat errors =
+      MaskedSsd(sample_.FeaturePlanes(), sample_.FeatureEnergy(), target_planes, mask);
+  const cv::Point p = PickWithinTolerance(errors, options_.tolerance, rng);
+  patch.sample_x = p.x;
+  patch.sample_y = p.y;
+  patch.overlap_error = errors.at<float>(p.y, p.x) / static_cast<double>(overlap.texels.size());
+}
+
+void TriangleEngine::SynthesizeFace(std::size_t f, std::mt19937_64& rng) {
+  TrianglePatch& patch = result_.patches[f];
+  const OverlapTargets overlap = CollectOverlapTargets(f);
+  std::vector<RectifiedView> views =
+      RectifiedViews(f, correction_ && correction_->WideMaskMargin() >= 0.0);
+  if (!views.empty()) {
+    std::vector<std::vector<cv::Mat>> relit;  // per view: the sample relit at its density
+    ScoreAndPlace(patch, views, overlap, relit);
+    patch.source = PatchSource::kPhotos;
+    patch.views_used = static_cast<int>(views.size());
+    ++result_.num_from_photos;
+    if (correction_) correction_->Correct(*this, f, views, relit);
+  } else if (!overlap.texels.empty()) {
+    PlaceByNeighbours(patch, overlap, rng);
+    patch.source = PatchSource::kNeighbours;
+    ++result_.num_from_neighbours;
+  } else {
+    patch.sample_x = std::uniform_int_distribution<int>(0, sample_.Width() - patch.width)(rng);
+    patch.sample_y = std::uniform_int_distribution<int>(0, sample_.Height() - patch.height)(rng);
+    patch.source = PatchSource::kRandom;
+    ++result_.num_random;
+  }
+}
+
+}  // namespace texlume::synth

@@ -1,0 +1,188 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <random>
+#include <vector>
+
+#include "core/progress.h"
+#include "sfm/mesh.h"
+#include "sfm/reconstruction.h"
+#include "sfm/visibility.h"
+#include "synth/material_sample.h"
+#include "synth/triangle_parts.h"
+
+namespace texlume::synth {
+
+/// Settings every sample shares in the per-triangle engine (paper 003
+/// Algorithm 2). The PTM and BTF options add their photo-consistency passes.
+struct TriangleEngineOptions {
+  /// World units per texel of the sample (COLMAP models have arbitrary scale). > 0.
+  double sample_texel_size = 0.0;
+  /// W_e: texels of strip around each triangle's bounding box (paper: 5-10). [2, 32].
+  int strip = 8;
+  /// Candidates kept by the image score before the neighbour constraint. >= 1.
+  int top_k = 12;
+  /// Constrain with every photo in which the triangle is fully visible (scores
+  /// summed, each under its own light), not only the best view (paper 003).
+  bool all_views = true;
+  /// Most views used per triangle with all_views. >= 1.
+  int max_views = 4;
+  /// Where each face's frame x axis points (the sample's texture is laid along
+  /// it). kAuto: turned to the photos when the sample is anisotropic.
+  TangentFrame tangent_frame = TangentFrame::kAuto;
+  /// kSmoothField: the world direction projected onto each face (falls back to
+  /// the orthogonal world axis of smallest normal component where it is nearly
+  /// parallel to the normal).
+  Eigen::Vector3d field_direction_in_world = Eigen::Vector3d::UnitZ();
+  /// Triangles seen in no photo: pick at random among placements whose overlap
+  /// error is within (1 + tolerance) of the best. >= 0.
+  double tolerance = 0.1;
+  /// Fewest rectified photo pixels inside a triangle for the photo to constrain it. >= 1.
+  int min_photo_pixels = 6;
+  /// Refuse up front when the patches would take more texels than this.
+  std::int64_t max_texels = std::int64_t{1} << 30;
+  std::uint32_t seed = 1;
+
+  /// Throws OptionError naming the first invalid setting.
+  void Check() const;
+};
+
+/// One face seen in one photo (the engine's "rectify" stage): the photo
+/// rectified into the face frame on the patch grid at a photo density level,
+/// in the sample's photo domain, with the face's lighting in that photo.
+struct RectifiedView {
+  std::size_t photo = 0;  ///< index into the engine's photos
+  sfm::TriangleView view;
+  int level = 0;                ///< photo density level of the grid (PhotoDensityLevel)
+  std::vector<cv::Mat> planes;  ///< R, G, B (CV_32FC1), MaterialSample::Domain()
+  /// CV_32FC1: 1 on the cells the score reads (within the score margin of the
+  /// triangle, photo pixel inside the image), else 0.
+  cv::Mat mask;
+  /// The same within the photo correction's margin (empty unless it asks).
+  cv::Mat wide_mask;
+  int count = 0;  ///< cells of `mask`
+  FaceLighting lighting;
+  /// Every light, and the view for a view-dependent sample, above 60 degrees
+  /// from the face's horizon (the photo gains trust only such views).
+  bool steep = true;
+};
+
+/// What the engine produces: every face's placed patch in the sample (with
+/// what the photo-consistency pass added to it), the unfoldings across its
+/// edges, the photo gains, and the graph-cut labels for a sample that is cut.
+struct TriangleSynthesis {
+  double texel_size = 0.0;                           ///< world units
+  std::vector<TrianglePatch> patches;                ///< per face
+  std::vector<std::array<Unfolding, 3>> unfoldings;  ///< per face, edge k = (v_k, v_k+1)
+  std::vector<double> photo_gains;  ///< per photo (linear-domain exposure x intensity)
+  std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
+  /// The frames the patches have (kAuto resolved to kPhotos or kFirstEdge).
+  TangentFrame tangent_frame = TangentFrame::kFirstEdge;
+  /// Coherence of the sample's structure tensor (0 isotropic, 1 one direction)
+  /// at the photos' median density; -1 when not measured.
+  double sample_coherence = -1.0;
+  double seconds_synthesis = 0.0;  ///< set-up, placement and the photo pass
+};
+
+class TriangleEngine;
+
+/// The engine's "correct" and "transfer detail" stages for one kind of sample:
+/// after a face seen in photos is placed, its patch is made to agree with the
+/// photos (PTM: the most probable change of the luminance coefficients; BTF:
+/// per-channel factors), then, once every face is placed, whatever needs all
+/// of them (PTM: detail transfer).
+class PhotoCorrection {
+ public:
+  virtual ~PhotoCorrection() = default;
+  /// Margin (world units) of the wide mask the pass reads; < 0: none.
+  virtual double WideMaskMargin() const { return -1.0; }
+  /// Corrects face `face`'s placed patch. `views` are the score's (best view
+  /// first), `relit[r]` the sample relit under view r at its density with its
+  /// photo's gain (what the score compared with the photo).
+  virtual void Correct(TriangleEngine& engine, std::size_t face, std::vector<RectifiedView>& views,
+                       const std::vector<std::vector<cv::Mat>>& relit) = 0;
+  /// After the last face.
+  virtual void Finish(TriangleEngine& /*engine*/, const ProgressCallback& /*progress*/) {}
+};
+
+/// Paper 003 Algorithm 2 for any MaterialSample: each face's frame and patch
+/// rectangle, frames turned to the photos, photo gains, then breadth first
+/// from the best-seen face: rectify every photo that sees the face fully,
+/// score every placement of the patch in the sample by eq. 3 summed over the
+/// photos (FFT), keep of the top_k the one closest to the synthesised
+/// neighbours in feature space (place), and correct it with the photos; faces
+/// seen in no photo take the overlap constraint alone, or a random placement.
+/// Stitching (blending or graph-cut seams) follows from the sample's kind.
+class TriangleEngine {
+ public:
+  /// All references must outlive the engine. `correction` may be null (no pass).
+  TriangleEngine(const sfm::TriangleMesh& mesh, const sfm::Reconstruction& reconstruction,
+                 const sfm::VisibilityResult& visibility, const std::vector<MeshPhoto>& photos,
+                 const MaterialSample& sample, const TriangleEngineOptions& options,
+                 PhotoCorrection* correction);
+
+  /// Runs every stage. Throws OptionError for bad options and InputError when
+  /// the patches would not fit the sample or would exceed max_texels.
+  TriangleSynthesis Run(const ProgressCallback& progress = {});
+
+  /// Rectifies a photo that sees face `face` on the patch grid at density
+  /// `level` (< 0: the photo's own). False when the photo is not among the
+  /// engine's, the grid exceeds the reduced sample, or fewer than
+  /// min_photo_pixels cells are seen.
+  bool Rectify(std::size_t face, const sfm::TriangleView& view, RectifiedView& out, int level = -1,
+               bool wide_mask = false) const;
+
+  const MaterialSample& sample() const { return sample_; }
+  const TriangleEngineOptions& options() const { return options_; }
+  TriangleSynthesis& result() { return result_; }
+  const TriangleSynthesis& result() const { return result_; }
+
+ private:
+  // Stage 1: frames, patch rectangles and unfoldings; refused when too large.
+  void SetUpPatches(PatchGeometry geometry);
+  // Stage 1b: frames turned to the photos (synth/tangent_field.h).
+  void TurnFramesToPhotos();
+  // Stage 2a: a gain per photo (exposure x light intensity, linear domain).
+  void EstimatePhotoGains();
+  // Stage 2b: one face, breadth first.
+  void SynthesizeFace(std::size_t face, std::mt19937_64& rng);
+  // The views that constrain a face, rectified.
+  std::vector<RectifiedView> RectifiedViews(std::size_t face, bool wide_mask) const;
+
+  // The synthesised neighbours' features unfolded into a face's frame, on the
+  // patch texels within W_e of a shared edge.
+  struct OverlapTargets {
+    std::vector<int> texels;     // j * width + i
+    std::vector<float> targets;  // NumFeatures() per texel
+    double Error(const MaterialSample& sample, int width, int sx, int sy) const;
+  };
+  OverlapTargets CollectOverlapTargets(std::size_t face) const;
+  // Score (eq. 3 summed over the views) and place (top_k, then the neighbours).
+  void ScoreAndPlace(TrianglePatch& patch, const std::vector<RectifiedView>& views,
+                     const OverlapTargets& overlap, std::vector<std::vector<cv::Mat>>& relit);
+  // Unseen faces: the overlap constraint over every placement (FFT).
+  void PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap,
+                         std::mt19937_64& rng) const;
+
+  const sfm::TriangleMesh& mesh_;
+  const sfm::Reconstruction& reconstruction_;
+  const sfm::VisibilityResult& visibility_;
+  const std::vector<MeshPhoto>& photos_;
+  const MaterialSample& sample_;
+  const TriangleEngineOptions& options_;
+  PhotoCorrection* correction_;
+  std::map<sfm::ImageId, std::size_t> photo_index_;
+  std::vector<char> done_;
+  /// Cells the score reads beyond the triangle (world units): W_e / 2 for a
+  /// blended sample (its blending zone, so that a blend mixes two
+  /// photo-corrected patches), none for a sample that is cut.
+  double score_margin_ = 0.0;
+  TriangleSynthesis result_;
+};
+
+}  // namespace texlume::synth

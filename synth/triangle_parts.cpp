@@ -1,0 +1,303 @@
+#include "synth/triangle_parts.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "core/errors.h"
+#include "ptm/coefficient_space.h"
+
+namespace texlume::synth {
+
+using LightList = std::vector<std::pair<Eigen::Vector3d, double>>;  // (tangent-frame dir, I)
+
+Eigen::Vector3f RelightMixture(const float* coefficients, const float* colour,
+                               ptm::PtmFormat format, const LightList& lights, double gain) {
+  Eigen::Vector3f linear = Eigen::Vector3f::Zero();
+  static const double z_horizon = std::sin(kHorizonElevationDeg * std::numbers::pi / 180.0);
+  for (const auto& [l_in, intensity] : lights) {
+    if (l_in.z() <= 0.0) continue;
+    // Below kHorizonElevationDeg the biquadratic is extrapolated beyond any
+    // capture light and overshoots: take its value at that elevation (same
+    // azimuth) fading linearly with l_z to 0 at the horizon.
+    Eigen::Vector3d l = l_in;
+    double fall = 1.0;
+    if (l.z() < z_horizon) {
+      fall = l.z() / z_horizon;
+      const double r = std::hypot(l.x(), l.y());
+      const double s = std::sqrt(1.0 - z_horizon * z_horizon) / r;
+      l = Eigen::Vector3d(l.x() * s, l.y() * s, z_horizon);
+    }
+    for (int c = 0; c < 3; ++c) {
+      double v;
+      if (format == ptm::PtmFormat::kLrgb) {
+        v = ptm::EvaluatePolynomial(coefficients, l.x(), l.y()) * colour[c];
+      } else {
+        v = ptm::EvaluatePolynomial(coefficients + 6 * c, l.x(), l.y());
+      }
+      linear[c] += static_cast<float>(intensity * fall) * SrgbToLinear(static_cast<float>(v));
+    }
+  }
+  Eigen::Vector3f out;
+  for (int c = 0; c < 3; ++c) out[c] = LinearToSrgb(static_cast<float>(gain) * linear[c]);
+  return out;
+}
+
+ReducedPlanes ReduceToDensityLevel(const std::vector<cv::Mat>& planes, int level) {
+  ReducedPlanes r;
+  const int width = planes[0].cols, height = planes[0].rows;
+  const double density = std::pow(2.0, -level / 4.0);
+  const int rw = std::max(1, static_cast<int>(std::lround(width * density)));
+  const int rh = std::max(1, static_cast<int>(std::lround(height * density)));
+  for (const cv::Mat& m : planes) {
+    cv::Mat small;
+    cv::resize(m, small, cv::Size(rw, rh), 0, 0, cv::INTER_AREA);
+    r.planes.push_back(small);
+  }
+  r.rx = static_cast<double>(rw) / width;
+  r.ry = static_cast<double>(rh) / height;
+  return r;
+}
+
+const char* TangentFrameName(TangentFrame frame) {
+  switch (frame) {
+    case TangentFrame::kFirstEdge:
+      return "first_edge";
+    case TangentFrame::kSmoothField:
+      return "smooth_field";
+    case TangentFrame::kPhotos:
+      return "photos";
+    case TangentFrame::kAuto:
+      return "auto";
+  }
+  return "first_edge";
+}
+
+int PhotoDensityLevel(const TrianglePatch& patch, const sfm::TriangleView& view, double t) {
+  const auto& c = patch.corners_in_frame;
+  const double area =
+      0.5 * std::abs((c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x());
+  const double density = std::sqrt(std::max(view.projected_area_px, 1e-6f) / (area / (t * t)));
+  return std::clamp(static_cast<int>(std::lround(-4.0 * std::log2(density))), 0, 40);
+}
+
+int RectificationMaps(const TrianglePatch& patch, double t, double rx, double ry, cv::Size grid,
+                      const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
+                      cv::Size image_size, double mask_margin, cv::Mat& map_x, cv::Mat& map_y,
+                      cv::Mat& mask) {
+  map_x.create(grid, CV_32FC1);
+  map_y.create(grid, CV_32FC1);
+  mask = cv::Mat::zeros(grid, CV_32FC1);
+  int count = 0;
+  for (int j = 0; j < grid.height; ++j) {
+    for (int i = 0; i < grid.width; ++i) {
+      const Eigen::Vector2d p(patch.x_min + (i + 0.5) / rx * t, patch.y_max - (j + 0.5) / ry * t);
+      const Eigen::Vector3d world =
+          patch.frame.origin_in_world + p.x() * patch.frame.x_axis + p.y() * patch.frame.y_axis;
+      const Eigen::Vector3d cam = cam_from_world.rotation * world + cam_from_world.translation;
+      const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(cam);
+      map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
+      map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
+      if (px && SignedDistanceToTriangle(patch.corners_in_frame, p) <= mask_margin &&
+          px->x() >= 0.5 && px->y() >= 0.5 && px->x() <= image_size.width - 0.5 &&
+          px->y() <= image_size.height - 0.5) {
+        mask.at<float>(j, i) = 1.0f;
+        ++count;
+      }
+    }
+  }
+  return count;
+}
+
+std::vector<sfm::TriangleView> ConstrainingViews(const sfm::TriangleVisibility& tv, bool all_views,
+                                                 int max_views) {
+  std::vector<sfm::TriangleView> v;
+  if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) return v;
+  for (const sfm::TriangleView& view : tv.views)
+    if (view.fully_visible && view.image_id == tv.best_view) v.push_back(view);
+  if (all_views) {
+    std::vector<sfm::TriangleView> others;
+    for (const sfm::TriangleView& view : tv.views)
+      if (view.fully_visible && view.image_id != tv.best_view) others.push_back(view);
+    std::sort(others.begin(), others.end(),
+              [](const auto& a, const auto& b) { return a.angle_rad < b.angle_rad; });
+    for (const auto& view : others)
+      if (static_cast<int>(v.size()) < max_views) v.push_back(view);
+  }
+  return v;
+}
+
+std::vector<double> SolvePhotoGains(const std::vector<GainObservation>& ratios,
+                                    std::size_t num_faces, std::size_t num_photos) {
+  std::vector<double> log_gain(num_photos, 0.0), log_albedo(num_faces, 0.0);
+  for (int it = 0; it < 20; ++it) {
+    std::vector<double> sum(num_faces, 0.0), weight(num_faces, 0.0);
+    for (const GainObservation& r : ratios) {
+      sum[r.face] += r.weight * (r.log_m - log_gain[r.photo]);
+      weight[r.face] += r.weight;
+    }
+    double mean = 0.0, total = 0.0;
+    for (std::size_t f = 0; f < num_faces; ++f)
+      if (weight[f] > 0)
+        log_albedo[f] = sum[f] / weight[f], mean += weight[f] * log_albedo[f], total += weight[f];
+    if (total > 0) mean /= total;
+    for (double& v : log_albedo) v -= mean;
+    std::vector<double> gsum(num_photos, 0.0), gweight(num_photos, 0.0);
+    for (const GainObservation& r : ratios) {
+      gsum[r.photo] += r.weight * (r.log_m - log_albedo[r.face]);
+      gweight[r.photo] += r.weight;
+    }
+    for (std::size_t n = 0; n < num_photos; ++n)
+      if (gweight[n] > 0) log_gain[n] = gsum[n] / gweight[n];
+  }
+  std::vector<double> gains(num_photos, 1.0);
+  for (std::size_t n = 0; n < num_photos; ++n) gains[n] = std::exp(log_gain[n]);
+  return gains;
+}
+
+int BestSeenFace(const sfm::VisibilityResult& visibility) {
+  int seed_face = 0;
+  float best_area = -1.0f;
+  for (std::size_t f = 0; f < visibility.triangles.size(); ++f) {
+    const auto& tv = visibility.triangles[f];
+    if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) continue;
+    for (const auto& v : tv.views)
+      if (v.image_id == tv.best_view && v.projected_area_px > best_area) {
+        best_area = v.projected_area_px;
+        seed_face = static_cast<int>(f);
+      }
+  }
+  return seed_face;
+}
+
+void AddImageScore(const cv::Mat& ssd, int count, double rx, double ry, cv::Mat& total) {
+  for (int sy = 0; sy < total.rows; ++sy) {
+    const int py = std::min(static_cast<int>(std::lround(sy * ry)), ssd.rows - 1);
+    for (int sx = 0; sx < total.cols; ++sx) {
+      const int px = std::min(static_cast<int>(std::lround(sx * rx)), ssd.cols - 1);
+      total.at<float>(sy, sx) += std::sqrt(ssd.at<float>(py, px) / (3.0f * count));
+    }
+  }
+}
+
+std::vector<std::pair<float, cv::Point>> BestPlacements(const cv::Mat& score, int stride, int k) {
+  std::vector<std::pair<float, cv::Point>> all;
+  for (int sy = 0; sy < score.rows; sy += stride)
+    for (int sx = 0; sx < score.cols; sx += stride)
+      all.emplace_back(score.at<float>(sy, sx), cv::Point(sx, sy));
+  const std::size_t kept = std::min<std::size_t>(static_cast<std::size_t>(k), all.size());
+  std::partial_sort(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(kept), all.end(),
+                    [](const auto& a, const auto& b) { return a.first < b.first; });
+  all.resize(kept);
+  return all;
+}
+
+void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& candidates,
+                             const std::function<double(int, int)>& overlap_error,
+                             TrianglePatch& patch) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& [score, at] : candidates) {
+    const double e = overlap_error(at.x, at.y);
+    if (e < best) {
+      best = e;
+      patch.sample_x = at.x;
+      patch.sample_y = at.y;
+      patch.image_score = score;
+      patch.overlap_error = e;
+    }
+  }
+}
+
+PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int strip,
+                                TangentFrame tangent_frame,
+                                const Eigen::Vector3d& field_direction_in_world) {
+  std::vector<Eigen::Vector3d> tangents(mesh.faces.size());
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    tangents[f] = mesh.Corner(f, 1) - mesh.Corner(f, 0);
+    if (tangent_frame != TangentFrame::kSmoothField) continue;
+    const Eigen::Vector3d n = (mesh.Corner(f, 1) - mesh.Corner(f, 0))
+                                  .cross(mesh.Corner(f, 2) - mesh.Corner(f, 0))
+                                  .normalized();
+    Eigen::Vector3d d = field_direction_in_world.normalized();
+    if ((d - n * n.dot(d)).norm() < 0.3) {
+      // Near the field's poles: the world axis least aligned with the normal.
+      Eigen::Index axis;
+      n.cwiseAbs().minCoeff(&axis);
+      d = Eigen::Vector3d::Unit(axis);
+    }
+    tangents[f] = d;
+  }
+  return MakePatchGeometry(mesh, t, strip, tangents);
+}
+
+PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int strip,
+                                const std::vector<Eigen::Vector3d>& tangents_in_world) {
+  const std::size_t num_faces = mesh.faces.size();
+  PatchGeometry result;
+  std::int64_t& total_texels = result.total_texels;
+  int& widest = result.widest;
+  int& tallest = result.tallest;
+  result.patches.resize(num_faces);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    TrianglePatch& patch = result.patches[f];
+    patch.frame = MakeTriangleFrame(mesh, f, tangents_in_world[f]);
+    Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
+    Eigen::Vector2d hi = -lo;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = patch.frame.PointInFrame(mesh.Corner(f, k));
+      patch.corners_in_frame[static_cast<std::size_t>(k)] = p.head<2>();
+      lo = lo.cwiseMin(p.head<2>());
+      hi = hi.cwiseMax(p.head<2>());
+    }
+    patch.x_min = lo.x() - strip * t;
+    patch.y_max = hi.y() + strip * t;
+    const double w = std::ceil((hi.x() - lo.x()) / t) + 2.0 * strip;
+    const double h = std::ceil((hi.y() - lo.y()) / t) + 2.0 * strip;
+    if (!(w < 1e7 && h < 1e7)) {
+      throw InputError("mesh", "face " + std::to_string(f) + " needs a patch of " +
+                                   std::to_string(w) + " x " + std::to_string(h) +
+                                   " texels; is the sample texel size in the model's units?");
+    }
+    patch.width = static_cast<int>(w);
+    patch.height = static_cast<int>(h);
+    widest = std::max(widest, patch.width);
+    tallest = std::max(tallest, patch.height);
+    total_texels += static_cast<std::int64_t>(patch.width) * patch.height;
+  }
+  // Unfoldings across every shared edge.
+  const std::vector<std::array<int, 3>> neighbours = sfm::FaceNeighbours(mesh);
+  result.unfoldings.resize(num_faces);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int nb = neighbours[f][static_cast<std::size_t>(k)];
+      Unfolding& u = result.unfoldings[f][static_cast<std::size_t>(k)];
+      if (nb < 0) continue;
+      const int va = mesh.faces[f][static_cast<std::size_t>(k)];
+      const int vb = mesh.faces[f][static_cast<std::size_t>((k + 1) % 3)];
+      const TrianglePatch& other = result.patches[static_cast<std::size_t>(nb)];
+      const Eigen::Vector2d a_this =
+          result.patches[f].corners_in_frame[static_cast<std::size_t>(k)];
+      const Eigen::Vector2d b_this =
+          result.patches[f].corners_in_frame[static_cast<std::size_t>((k + 1) % 3)];
+      const Eigen::Vector2d a_nb =
+          other.frame.PointInFrame(mesh.vertices[static_cast<std::size_t>(va)]).head<2>();
+      const Eigen::Vector2d b_nb =
+          other.frame.PointInFrame(mesh.vertices[static_cast<std::size_t>(vb)]).head<2>();
+      const double angle = std::atan2((b_nb - a_nb).y(), (b_nb - a_nb).x()) -
+                           std::atan2((b_this - a_this).y(), (b_this - a_this).x());
+      u.face = nb;
+      u.rotation = Eigen::Rotation2Dd(angle).toRotationMatrix();
+      u.translation = a_nb - u.rotation * a_this;
+      // This frame's x axis is (cos angle, sin angle) in the neighbour's frame.
+      u.coefficients_to_this = ptm::OrthonormalFrameRotation(angle);
+    }
+  }
+
+  return result;
+}
+
+}  // namespace texlume::synth
