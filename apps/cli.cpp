@@ -275,12 +275,7 @@ int RunRelightCommand(const std::vector<std::string>& args, std::ostream& out,
   ptm::EnhancementOptions enhancement;
   enhancement.diffuse_gain = a.GetDouble("gain", 1.0);
   enhancement.specular = a.GetDouble("specular", 0.0);
-  if (!(enhancement.diffuse_gain >= 1.0 && enhancement.diffuse_gain <= 100.0)) {
-    throw UsageError("--gain must be in [1, 100]");
-  }
-  if (!(enhancement.specular >= 0.0 && enhancement.specular <= 10.0)) {
-    throw UsageError("--specular must be in [0, 10]");
-  }
+  enhancement.Check();
   const std::filesystem::path out_path = a.Require("out");
   const ptm::Ptm ptm = ptm::ReadPtmAnyFormat(a.Require("ptm"));
   WriteRgbPng(out_path, ptm::Relight(ptm, light, enhancement), ptm.width, ptm.height, false);
@@ -355,11 +350,7 @@ int RunSynth2dCommand(const std::vector<std::string>& args, std::ostream& out,
     const ptm::RtiCapture capture = ptm::ReadRtiCapture(lp, dir);
     for (std::size_t k = 0; k < capture.files.size(); ++k) {
       const std::filesystem::path& file = capture.files[k];
-      const cv::Mat bgr = cv::imread(file.string(), cv::IMREAD_COLOR | cv::IMREAD_ANYDEPTH);
-      if (bgr.empty()) throw InputError(file.string(), "cannot read image");
-      cv::Mat f;
-      bgr.convertTo(f, CV_32FC3, bgr.depth() == CV_16U ? 1.0 / 65535 : 1.0 / 255);
-      cv::cvtColor(f, f, cv::COLOR_BGR2RGB);
+      const cv::Mat f = ReadPhotoRgb(file);
       synth::PlanarPhoto photo;
       photo.image = {f.cols, f.rows,
                      std::vector<float>(reinterpret_cast<float*>(f.data),

@@ -38,8 +38,9 @@ class Arguments {
 
 /// Exit codes of the texlume program.
 inline constexpr int kExitOk = 0;
-inline constexpr int kExitInputError = 1;  ///< bad or missing input files, problems found
-inline constexpr int kExitUsage = 2;       ///< bad command line
+inline constexpr int kExitInputError = 1;     ///< bad or missing input files, problems found
+inline constexpr int kExitUsage = 2;          ///< bad command line
+inline constexpr int kExitInternalError = 3;  ///< a broken internal invariant (a bug)
 
 /// `texlume inspect`: see docs/cli.md. Returns the exit code.
 int RunInspectCommand(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);

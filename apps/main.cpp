@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "apps/cli.h"
+#include "core/check.h"
 #include "core/errors.h"
 
 namespace {
@@ -62,7 +63,8 @@ constexpr const char* kUsage =
     "  help, --help\n"
     "  version, --version\n"
     "\n"
-    "Exit codes: 0 success, 1 bad input (the message names the file), 2 bad command line.\n";
+    "Exit codes: 0 success, 1 bad input (the message names the file), 2 bad command line,\n"
+    "3 internal error (a bug in texlume).\n";
 
 }  // namespace
 
@@ -102,6 +104,10 @@ int main(int argc, char** argv) {
   } catch (const texlume::OptionError& e) {
     std::cerr << "texlume " << command << ": invalid option: " << e.what() << "\n";
     return kExitUsage;
+  } catch (const texlume::InternalError& e) {
+    std::cerr << "internal error (a bug in texlume; please report it with the command line): "
+              << e.what() << "\n";
+    return kExitInternalError;
   } catch (const texlume::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return kExitInputError;

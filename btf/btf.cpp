@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <numeric>
 
+#include "core/check.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
@@ -127,8 +128,8 @@ BtfFactorisation FactoriseBtf(const BtfCapture& capture, int components,
   const std::size_t texels =
       static_cast<std::size_t>(capture.width) * static_cast<std::size_t>(capture.height);
   const std::size_t columns = capture.images.size() * 3;
-  if (capture.images.size() != capture.views.size() * capture.lights.size() || texels == 0)
-    throw OptionError("FactoriseBtf: the capture's images do not match its directions");
+  TEXLUME_CHECK(capture.images.size() == capture.views.size() * capture.lights.size() && texels > 0,
+                "a capture has one image per view and light");
   const std::size_t most = std::min(texels, columns);
   if (components < 1 || static_cast<std::size_t>(components) > most)
     throw OptionError("--components must be in [1, " + std::to_string(most) +

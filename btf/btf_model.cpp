@@ -241,14 +241,22 @@ Eigen::Vector3f ShadeBtf(const BtfModel& model, const synth::ModelRenderer::Surf
           LinearToSrgb(linear[2] * k[2])};
 }
 
+void BtfSynthJobOptions::Check() const {
+  job.CheckInputsAndLayout();
+  if (btf.empty()) throw OptionError("synth --btf needs a BTF capture or factorisation folder");
+  if (components < 1) throw OptionError("components must be >= 1");
+  if (!(synthesis.sample_texel_size >= 0.0))
+    throw OptionError("sample texel size must be >= 0 (0: the capture's)");
+  synth::BtfMeshSynthesisOptions resolved = synthesis;
+  if (resolved.sample_texel_size == 0.0) resolved.sample_texel_size = 1.0;  // any valid size
+  resolved.Check();
+}
+
 BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
                                   const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
+  options.Check();
   const synth::SynthJobOptions& job = options.job;
-  job.atlas.Check();
-  job.visibility.Check();
-  if (job.max_subdivisions < 0 || job.max_subdivisions > 6)
-    throw OptionError("max subdivisions must be in [0, 6]");
   if (fs::exists(job.out_dir) &&
       (!fs::is_directory(job.out_dir) ||
        (!fs::exists(job.out_dir / "manifest.json") && !fs::is_empty(job.out_dir)))) {

@@ -82,6 +82,10 @@ struct BtfSynthJobOptions {
   int components = 40;
   /// sample_texel_size 0 = the capture's texel size.
   synth::BtfMeshSynthesisOptions synthesis;
+
+  /// Throws OptionError when a path is missing or a setting is out of range
+  /// (the synthesis settings with the texel size still to be resolved).
+  void Check() const;
 };
 
 struct BtfSynthJobSummary {

@@ -1,5 +1,7 @@
 #include "core/image_io.h"
 
+#include <OpenImageIO/imageio.h>
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
@@ -21,38 +23,115 @@ float LinearToSrgb(float v) {
   return v <= 0.0031308f ? v * 12.92f : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
 
+namespace {
+
+// Opens an image with OpenImageIO and checks what its header announces.
+std::unique_ptr<OIIO::ImageInput> OpenChecked(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw InputError(path.string(), "does not exist");
+  // Colour as stored: no premultiplication by an alpha channel.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto in = OIIO::ImageInput::open(path.string(), &config);
+  if (!in) throw InputError(path.string(), "is not a readable image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.width > 65536 || spec.height > 65536)
+    throw InputError(path.string(), "has an implausible size of " + std::to_string(spec.width) +
+                                        " x " + std::to_string(spec.height) + " pixels");
+  if (spec.nchannels <= 0 || spec.nchannels > 64)
+    throw InputError(path.string(),
+                     "has an implausible channel count of " + std::to_string(spec.nchannels));
+  return in;
+}
+
+// The whole image with its first min(channels, 3) channels in their stored
+// type (8- or 16-bit integers; anything else as float), rows top to bottom.
+cv::Mat ReadNative(const fs::path& path) {
+  const std::unique_ptr<OIIO::ImageInput> in = OpenChecked(path);
+  const OIIO::ImageSpec& spec = in->spec();
+  const int channels = std::min(spec.nchannels, 3);
+  OIIO::TypeDesc type = OIIO::TypeDesc::FLOAT;
+  int depth = CV_32F;
+  if (spec.format == OIIO::TypeDesc::UINT8) {
+    type = OIIO::TypeDesc::UINT8, depth = CV_8U;
+  } else if (spec.format == OIIO::TypeDesc::UINT16) {
+    type = OIIO::TypeDesc::UINT16, depth = CV_16U;
+  }
+  cv::Mat image(spec.height, spec.width, CV_MAKETYPE(depth, channels));
+  if (!in->read_image(0, 0, 0, channels, type, image.data))
+    throw InputError(path.string(), "cannot read its pixels: " + in->geterror());
+  return image;
+}
+
+double ScaleToUnit(int depth) {
+  return depth == CV_8U ? 1.0 / 255.0 : depth == CV_16U ? 1.0 / 65535.0 : 1.0;
+}
+
+}  // namespace
+
+struct ImageReader::Input {
+  std::unique_ptr<OIIO::ImageInput> in;
+};
+
+ImageReader::ImageReader(const fs::path& path)
+    : in_(std::make_unique<Input>(Input{OpenChecked(path)})), path_(path) {
+  const OIIO::ImageSpec& spec = in_->in->spec();
+  width_ = spec.width;
+  height_ = spec.height;
+  channels_ = spec.nchannels;
+}
+
+ImageReader::~ImageReader() = default;
+ImageReader::ImageReader(ImageReader&&) noexcept = default;
+ImageReader& ImageReader::operator=(ImageReader&&) noexcept = default;
+
+void ImageReader::ReadRows(int y0, int y1, int channels, float* out) {
+  const int read = std::min(channels_, channels);
+  const std::size_t pixels = static_cast<std::size_t>(y1 - y0) * static_cast<std::size_t>(width_);
+  std::vector<float> raw;
+  float* target = out;
+  if (read != channels) {
+    raw.resize(pixels * static_cast<std::size_t>(read));
+    target = raw.data();
+  }
+  if (!in_->in->read_scanlines(0, 0, y0, y1, 0, 0, read, OIIO::TypeDesc::FLOAT, target))
+    throw InputError(path_.string(), "cannot read rows " + std::to_string(y0) + ".." +
+                                         std::to_string(y1) + ": " + in_->in->geterror());
+  if (read == channels) return;
+  for (std::size_t i = 0; i < pixels; ++i)
+    for (int c = 0; c < channels; ++c)
+      out[i * static_cast<std::size_t>(channels) + static_cast<std::size_t>(c)] =
+          raw[i * static_cast<std::size_t>(read) + static_cast<std::size_t>(std::min(c, read - 1))];
+}
+
 cv::Mat ReadPhotoRgb(const fs::path& path) {
-  if (!fs::exists(path)) throw InputError(path.string(), "does not exist");
-  const cv::Mat raw = cv::imread(path.string(), cv::IMREAD_UNCHANGED | cv::IMREAD_ANYDEPTH);
-  if (raw.empty()) throw InputError(path.string(), "is not a readable image");
-  cv::Mat bgr;
-  if (raw.channels() == 1) {
-    cv::cvtColor(raw, bgr, cv::COLOR_GRAY2BGR);
-  } else if (raw.channels() == 4) {
-    cv::cvtColor(raw, bgr, cv::COLOR_BGRA2BGR);
-  } else if (raw.channels() == 3) {
-    bgr = raw;
-  } else {
-    throw InputError(path.string(), "has " + std::to_string(raw.channels()) + " channels");
+  cv::Mat image = ReadNative(path);
+  if (image.channels() == 1) {
+    cv::Mat rgb;
+    cv::merge(std::vector<cv::Mat>{image, image, image}, rgb);
+    image = rgb;
+  } else if (image.channels() == 2) {
+    cv::Mat grey;
+    cv::extractChannel(image, grey, 0);
+    cv::merge(std::vector<cv::Mat>{grey, grey, grey}, image);
   }
-  double scale = 1.0;
-  switch (bgr.depth()) {
-    case CV_8U:
-      scale = 1.0 / 255.0;
-      break;
-    case CV_16U:
-      scale = 1.0 / 65535.0;
-      break;
-    case CV_32F:
-      scale = 1.0;
-      break;
-    default:
-      throw InputError(path.string(), "has an unsupported pixel type");
-  }
-  cv::Mat f, rgb;
-  bgr.convertTo(f, CV_32FC3, scale);
-  cv::cvtColor(f, rgb, cv::COLOR_BGR2RGB);
+  cv::Mat rgb;
+  image.convertTo(rgb, CV_32FC3, ScaleToUnit(image.depth()));
   return rgb;
+}
+
+cv::Mat ReadImageGrey(const fs::path& path) {
+  const cv::Mat image = ReadNative(path);
+  cv::Mat f;
+  image.convertTo(f, CV_MAKETYPE(CV_32F, image.channels()), ScaleToUnit(image.depth()));
+  if (f.channels() < 3) {
+    cv::Mat grey;
+    cv::extractChannel(f, grey, 0);
+    return grey;
+  }
+  cv::Mat grey;
+  cv::transform(f, grey, cv::Matx13f(0.299f, 0.587f, 0.114f));
+  return grey;
 }
 
 cv::Mat ToBgr8(const cv::Mat& display_rgb) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -13,11 +14,46 @@ namespace texlume {
 float SrgbToLinear(float v);
 float LinearToSrgb(float v);
 
-/// Reads a photo as CV_32FC3 RGB display values in [0, 1] (8- or 16-bit
-/// integers scaled, float taken as is; grey and RGBA become RGB).
-/// Throws InputError naming the file when it is missing, unreadable, or of an
-/// unsupported channel count or pixel type.
+/// texlume's one image reader (OpenImageIO: PNG, JPEG, TIFF, EXR, ...), with
+/// one orientation policy: pixels are taken in the order the file stores them
+/// and the EXIF orientation tag is ignored, as COLMAP 3.8 reads images
+/// (FreeImage without JPEG_EXIFROTATE), so that pixel (x, y) of a photo is the
+/// one the model's camera projects to. Values are display values in [0, 1]:
+/// 8- and 16-bit integers scaled by 1/255 and 1/65535, floats as stored.
+/// Throws InputError naming the file when it is missing or unreadable, or its
+/// size or channel count is implausible (over 65536 a side, 0 or over 64
+/// channels).
+class ImageReader {
+ public:
+  explicit ImageReader(const std::filesystem::path& path);
+  ~ImageReader();
+  ImageReader(ImageReader&&) noexcept;
+  ImageReader& operator=(ImageReader&&) noexcept;
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int channels() const { return channels_; }
+  const std::filesystem::path& path() const { return path_; }
+
+  /// Rows [y0, y1) into `out` (row-major, `channels` floats per pixel): the
+  /// file's first channels; a grey file's channel repeated.
+  void ReadRows(int y0, int y1, int channels, float* out);
+
+ private:
+  struct Input;
+  std::unique_ptr<Input> in_;
+  std::filesystem::path path_;
+  int width_ = 0, height_ = 0, channels_ = 0;
+};
+
+/// A photo as CV_32FC3 RGB display values in [0, 1] (ImageReader; grey
+/// repeated, alpha dropped).
 cv::Mat ReadPhotoRgb(const std::filesystem::path& path);
+
+/// An image as CV_32FC1 values in [0, 1]: a grey file's channel, or the luma of
+/// an RGB one (Rec. 601: 0.299 R + 0.587 G + 0.114 B). Masks and the
+/// highlight-sphere photos.
+cv::Mat ReadImageGrey(const std::filesystem::path& path);
 
 /// 8-bit BGR (for PNG) of a CV_32FC3 display RGB image in [0, 1].
 cv::Mat ToBgr8(const cv::Mat& display_rgb);

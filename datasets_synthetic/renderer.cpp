@@ -124,13 +124,18 @@ Renderer::Renderer(DisplacedGeometry geometry, std::vector<const BakedMaterial*>
 
 Renderer::~Renderer() = default;
 
+void ShadingOptions::Check() const {
+  if (!(ambient >= 0.0 && ambient <= 1.0)) throw OptionError("ambient must be in [0, 1]");
+  if (!(exposure > 0.0) || !std::isfinite(exposure)) throw OptionError("exposure must be > 0");
+  if (samples_per_axis < 1 || samples_per_axis > 8)
+    throw OptionError("samples_per_axis must be in [1, 8]");
+}
+
 template <typename RayAt>
 Rendering Renderer::Render(int width, int height, const RayAt& ray_at,
                            const std::vector<RenderLight>& lights,
                            const ShadingOptions& options) const {
-  if (options.samples_per_axis < 1 || options.samples_per_axis > 8) {
-    throw OptionError("samples_per_axis must be in [1, 8]");
-  }
+  options.Check();
   Rendering out;
   out.linear_rgb = cv::Mat(height, width, CV_32FC3, cv::Scalar::all(0));
   out.coverage = cv::Mat(height, width, CV_32FC1, cv::Scalar::all(0));

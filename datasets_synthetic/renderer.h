@@ -49,6 +49,9 @@ struct ShadingOptions {
   /// Samples per pixel along each axis (stratified, fixed positions): n x n per pixel. [1, 8].
   int samples_per_axis = 2;
   bool shadows = true;
+
+  /// Throws OptionError naming the first setting out of range.
+  void Check() const;
 };
 
 /// A rendered image: linear RGB radiance (CV_32FC3, R G B order) and the share of

@@ -93,8 +93,7 @@ void SceneOptions::Check() const {
   in(btf_view_count, 1, 64, "btf_view_count");
   in(btf_light_count, 1, 128, "btf_light_count");
   in(tessellation_step, 0, 1, "tessellation_step");
-  in(shading.ambient, 0, 1, "ambient");
-  in(shading.samples_per_axis, 1, 8, "samples_per_axis");
+  shading.Check();
   if (camera_model != sfm::CameraModelId::kPinhole && camera_model != sfm::CameraModelId::kOpenCV) {
     throw OptionError("camera_model must be PINHOLE or OPENCV");
   }
@@ -154,13 +153,18 @@ void WritePngAtomically(const std::filesystem::path& path, const cv::Mat& image)
   WriteBytesAtomically(path, EncodePng(image, path.string()));
 }
 
+void PlanarSurfaceOptions::Check() const {
+  material.Check();
+  if (size < 1 || size > 16384) throw OptionError("surface size must be in [1, 16384] texels");
+  if (scale < 1 || size % scale != 0) throw OptionError("scale must be >= 1 and divide size");
+  if (offset < 0) throw OptionError("surface offset must be >= 0 texels");
+  shading.Check();
+}
+
 PlanarSurfaceRenders RenderPlanarSurface(const PlanarSurfaceOptions& options,
                                          const std::vector<Eigen::Vector3d>& photo_lights,
                                          const std::vector<Eigen::Vector3d>& truth_lights) {
-  options.material.Check();
-  if (options.scale < 1 || options.size % options.scale != 0) {
-    throw OptionError("scale must be >= 1 and divide size");
-  }
+  options.Check();
   const double t = options.material.texel_size;
   const Material material(options.material);
   SurfacePatch patch = ShapePatches(SceneShape::kPlane)[0];

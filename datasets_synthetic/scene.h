@@ -100,6 +100,9 @@ struct PlanarSurfaceOptions {
   /// RTI-captured area so the photos are of unseen surface).
   int offset = 512;
   ShadingOptions shading;
+
+  /// Throws OptionError naming the first setting out of range.
+  void Check() const;
 };
 struct PlanarSurfaceRenders {
   /// 8-bit sRGB (OpenCV BGR order) photos, size/scale pixels per side, one per light.

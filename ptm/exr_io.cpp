@@ -5,20 +5,18 @@
 
 #include <stdexcept>
 
+#include "core/check.h"
 #include "core/errors.h"
 
 namespace texlume::ptm {
 
 void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& planes,
               const std::vector<std::string>& channel_names) {
-  if (planes.empty() || planes.size() != channel_names.size()) {
-    throw std::invalid_argument("WriteExr: one name per plane");
-  }
+  TEXLUME_CHECK(!planes.empty() && planes.size() == channel_names.size(), "one name per plane");
   const int width = planes[0].cols, height = planes[0].rows;
   for (const cv::Mat& p : planes) {
-    if (p.type() != CV_32FC1 || p.cols != width || p.rows != height) {
-      throw std::invalid_argument("WriteExr: planes must be CV_32FC1 of one size");
-    }
+    TEXLUME_CHECK(p.type() == CV_32FC1 && p.cols == width && p.rows == height,
+                  "EXR planes are CV_32FC1 of one size");
   }
   const int channels = static_cast<int>(planes.size());
   std::vector<float> interleaved(static_cast<std::size_t>(width) * height * channels);

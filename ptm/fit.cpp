@@ -1,6 +1,5 @@
 #include "ptm/fit.h"
 
-#include <OpenImageIO/imageio.h>
 #include <ceres/ceres.h>
 
 #include <Eigen/SVD>
@@ -11,7 +10,9 @@
 #include <memory>
 #include <thread>
 
+#include "core/check.h"
 #include "core/errors.h"
+#include "core/image_io.h"
 #include "sfm/lights.h"
 
 namespace texlume::ptm {
@@ -276,27 +277,20 @@ FitResult FitPtmFromFiles(const std::vector<std::filesystem::path>& files,
                           const ProgressCallback& progress) {
   options.Check();
   const auto start = std::chrono::steady_clock::now();
-  if (files.size() != lights.size()) throw std::invalid_argument("one light per file");
+  TEXLUME_CHECK(files.size() == lights.size(), "one light per file");
   const std::string label = files.empty() ? "images" : files[0].parent_path().string();
   CheckLightSet(lights, options, label);
-  std::vector<std::unique_ptr<OIIO::ImageInput>> inputs;
+  // The one image reader (core/image_io.h), streamed by bands of rows.
+  std::vector<ImageReader> inputs;
   int width = 0, height = 0;
   for (const auto& file : files) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(file, ec))
-      throw InputError(file.string(), "image file not found");
-    auto in = OIIO::ImageInput::open(file.string());
-    if (!in) throw InputError(file.string(), "cannot read image: " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
+    ImageReader in(file);
     if (inputs.empty()) {
-      width = spec.width;
-      height = spec.height;
-      if (width <= 0 || height <= 0 || width > 65536 || height > 65536) {
-        throw InputError(file.string(), "implausible image size");
-      }
-    } else if (spec.width != width || spec.height != height) {
-      throw InputError(file.string(), "is " + std::to_string(spec.width) + "x" +
-                                          std::to_string(spec.height) + " but " +
+      width = in.width();
+      height = in.height();
+    } else if (in.width() != width || in.height() != height) {
+      throw InputError(file.string(), "is " + std::to_string(in.width()) + "x" +
+                                          std::to_string(in.height()) + " but " +
                                           files[0].string() + " is " + std::to_string(width) + "x" +
                                           std::to_string(height));
     }
@@ -313,34 +307,8 @@ FitResult FitPtmFromFiles(const std::vector<std::filesystem::path>& files,
   for (auto& set : bands) set.assign(files.size(), std::vector<float>(band_floats));
   auto read_band = [&](int y0, std::vector<std::vector<float>>& band) {
     const int rows = std::min(options.band_rows, height - y0);
-    std::vector<float> raw;
-    for (std::size_t k = 0; k < inputs.size(); ++k) {
-      const int read = std::min(inputs[k]->spec().nchannels, 3);
-      float* out = band[k].data();
-      if (read == 3) {
-        if (!inputs[k]->read_scanlines(0, 0, y0, y0 + rows, 0, 0, 3, OIIO::TypeDesc::FLOAT, out)) {
-          throw InputError(files[k].string(), "cannot read rows " + std::to_string(y0) + ".." +
-                                                  std::to_string(y0 + rows) + ": " +
-                                                  inputs[k]->geterror());
-        }
-        continue;
-      }
-      raw.resize(static_cast<std::size_t>(rows) * width * static_cast<std::size_t>(read));
-      if (!inputs[k]->read_scanlines(0, 0, y0, y0 + rows, 0, 0, read, OIIO::TypeDesc::FLOAT,
-                                     raw.data())) {
-        throw InputError(files[k].string(), "cannot read rows " + std::to_string(y0) + ".." +
-                                                std::to_string(y0 + rows) + ": " +
-                                                inputs[k]->geterror());
-      }
-      const std::size_t n = static_cast<std::size_t>(rows) * width;
-      for (std::size_t i = 0; i < n; ++i) {
-        for (int c = 0; c < 3; ++c) {
-          out[i * 3 + static_cast<std::size_t>(c)] =
-              raw[i * static_cast<std::size_t>(read) +
-                  static_cast<std::size_t>(std::min(c, read - 1))];
-        }
-      }
-    }
+    for (std::size_t k = 0; k < inputs.size(); ++k)
+      inputs[k].ReadRows(y0, y0 + rows, 3, band[k].data());
   };
   read_band(0, bands[0]);
   for (int b = 0, y0 = 0; y0 < height; ++b, y0 += options.band_rows) {
@@ -376,7 +344,7 @@ FitResult FitPtmPerTexelLights(
     const FitOptions& options) {
   options.Check();
   const auto start = std::chrono::steady_clock::now();
-  if (images.empty()) throw std::invalid_argument("no images");
+  TEXLUME_CHECK(!images.empty(), "a fit needs images");
   const int width = images[0].width, height = images[0].height;
   FitResult result;
   result.ptm.Resize(options.format, width, height);

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/errors.h"
+
 namespace texlume::ptm {
 
 void Ptm::Resize(PtmFormat ptm_format, int ptm_width, int ptm_height) {
@@ -90,8 +92,17 @@ void DiffuseGain(const float* a, double g, float* out) {
 
 }  // namespace
 
+void EnhancementOptions::Check() const {
+  if (!(diffuse_gain >= 1.0 && diffuse_gain <= 100.0))
+    throw OptionError("diffuse gain must be in [1, 100]");
+  if (!(specular >= 0.0 && specular <= 10.0)) throw OptionError("specular must be in [0, 10]");
+  if (!(specular_exponent > 0.0 && specular_exponent <= 1000.0))
+    throw OptionError("specular exponent must be in (0, 1000]");
+}
+
 std::vector<float> Relight(const Ptm& ptm, const Eigen::Vector3d& light,
                            const EnhancementOptions& enhancement) {
+  enhancement.Check();
   const Eigen::Vector3d l = light.normalized();
   const Eigen::Vector3d half = (l + Eigen::Vector3d::UnitZ()).normalized();
   std::vector<float> out(ptm.NumTexels() * 3);

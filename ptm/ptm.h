@@ -74,7 +74,11 @@ struct EnhancementOptions {
   /// Specular enhancement: ks (n.h)^exponent added per texel with the PTM normal
   /// and the viewer along +z; 0 = off. [0, 10].
   double specular = 0.0;
+  /// Exponent of that lobe. (0, 1000].
   double specular_exponent = 40.0;
+
+  /// Throws OptionError naming the first setting out of range.
+  void Check() const;
 };
 
 /// Renders the PTM under the light (unit direction, tangent frame) into an

@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/errors.h"
+#include "core/image_io.h"
 
 namespace texlume::ptm {
 
@@ -107,20 +108,25 @@ SphereCircle DetectSphere(const std::vector<cv::Mat>& gray_images, const std::st
   return {sx / area, sy / area, std::sqrt(area / M_PI)};
 }
 
+void HighlightOptions::Check() const {
+  if (!(threshold_fraction > 0.0 && threshold_fraction <= 1.0))
+    throw OptionError("highlight threshold must be in (0, 1]");
+  if (!(search_radius_fraction > 0.0 && search_radius_fraction <= 1.0))
+    throw OptionError("highlight search radius must be in (0, 1] of the sphere's");
+}
+
 std::vector<sfm::LpEntry> LightsFromSphere(const std::vector<std::filesystem::path>& files,
                                            std::optional<SphereCircle> circle,
                                            const HighlightOptions& options,
                                            std::vector<std::string>* skipped,
                                            SphereCircle* used_circle) {
+  options.Check();
   std::vector<cv::Mat> gray;
   for (const auto& file : files) {
-    const cv::Mat image = cv::imread(file.string(), cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
-    if (image.empty()) throw InputError(file.string(), "cannot read image");
-    if (!gray.empty() && image.size() != gray[0].size()) {
+    cv::Mat f = ReadImageGrey(file);
+    if (!gray.empty() && f.size() != gray[0].size()) {
       throw InputError(file.string(), "differs in size from " + files[0].string());
     }
-    cv::Mat f;
-    image.convertTo(f, CV_32FC1, image.depth() == CV_16U ? 1.0 / 65535.0 : 1.0 / 255.0);
     gray.push_back(f);
   }
   const std::string label = files.empty() ? "images" : files[0].parent_path().string();

@@ -26,6 +26,9 @@ struct HighlightOptions {
   /// Only the inner part of the disk is searched (rim pixels mix with the
   /// background). (0, 1].
   double search_radius_fraction = 0.97;
+
+  /// Throws OptionError naming the first setting out of range.
+  void Check() const;
 };
 
 /// The highlight's centre in a grayscale float image, or nullopt when the sphere

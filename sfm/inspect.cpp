@@ -10,9 +10,14 @@
 
 namespace texlume::sfm {
 
+void InspectOptions::Check() const {
+  if (model_dir.empty()) throw OptionError("inspect needs a COLMAP model folder");
+  mesh_clean.Check();
+  visibility.Check();
+}
+
 InspectReport RunInspect(const InspectOptions& options, const ProgressCallback& progress) {
-  options.mesh_clean.Check();
-  options.visibility.Check();
+  options.Check();
   InspectReport report;
   LoadedModel model = ReadModel(options.model_dir);
   const Reconstruction& r = model.reconstruction;

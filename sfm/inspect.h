@@ -21,6 +21,9 @@ struct InspectOptions {
   std::optional<std::filesystem::path> lights;      ///< object-lights .json or an .lp file
   MeshCleanOptions mesh_clean;
   VisibilityOptions visibility;
+
+  /// Throws OptionError when no model folder is given or a nested setting is out of range.
+  void Check() const;
 };
 
 /// Everything `texlume inspect` found.

@@ -10,6 +10,7 @@
 #include <optional>
 #include <unordered_map>
 
+#include "core/check.h"
 #include "core/errors.h"
 #include "ptm/coefficient_space.h"
 #include "synth/charts.h"
@@ -634,8 +635,8 @@ AtlasLayout LayoutAtlases(const sfm::TriangleMesh& mesh, const std::vector<Trian
   options.Check();
   if (!(texel_size > 0.0)) throw OptionError("atlas texel size must be > 0");
   const std::size_t num_faces = mesh.faces.size();
-  if (patches.size() != num_faces || unfoldings.size() != num_faces)
-    throw OptionError("atlas layout: patches and unfoldings must have one entry per face");
+  TEXLUME_CHECK(patches.size() == num_faces && unfoldings.size() == num_faces,
+                "an atlas layout needs one patch and one unfolding per face");
   if (options.mode == AtlasMode::kCharts && options.flattening == ChartFlattening::kAuto) {
     // Strips fill atlases best on regular meshes; on irregular ones (decimated
     // photogrammetry) they fragment and rigid charts do better. Both are laid

@@ -12,6 +12,7 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "core/check.h"
 #include "core/errors.h"
 #include "synth/triangle_frame.h"
 
@@ -263,12 +264,56 @@ std::vector<std::vector<int>> ConnectedParts(
 
 }  // namespace
 
+namespace {
+
+// Throws OptionError unless lo < v <= hi (open_low) or lo <= v <= hi.
+void RequireIn(double v, double lo, double hi, bool open_low, const char* what) {
+  const bool ok = (open_low ? v > lo : v >= lo) && v <= hi;
+  if (!ok)
+    throw OptionError(std::string(what) + " must be in " + (open_low ? "(" : "[") +
+                      std::to_string(lo) + ", " + std::to_string(hi) + "]");
+}
+
+constexpr double kLarge = 1e9;
+
+}  // namespace
+
+void RigidChartOptions::Check() const {
+  RequireIn(texel_size, 0.0, kLarge, true, "chart texel size");
+  RequireIn(max_extent_texels, 1.0, kLarge, false, "largest chart side (texels)");
+  RequireIn(max_normal_angle_deg, 0.0, 180.0, true, "chart normal angle (degrees)");
+  if (gutter < 0) throw OptionError("chart gutter must be >= 0 texels");
+}
+
+void ConformalChartOptions::Check() const {
+  RequireIn(texel_size, 0.0, kLarge, true, "chart texel size");
+  RequireIn(max_side_texels, 0.0, kLarge, true, "conformal chart side (texels)");
+  RequireIn(max_normal_angle_deg, 0.0, 180.0, true, "chart normal angle (degrees)");
+  RequireIn(max_stretch, 1.0, kLarge, true, "chart stretch");
+  RequireIn(max_extent_texels, 0.0, kLarge, true, "largest chart side (texels)");
+}
+
+void StripChartOptions::Check() const {
+  RequireIn(texel_size, 0.0, kLarge, true, "chart texel size");
+  RequireIn(max_stretch, 1.0, kLarge, true, "chart stretch");
+  RequireIn(max_length_texels, 0.0, kLarge, true, "longest strip (texels)");
+  RequireIn(max_normal_angle_deg, 0.0, 180.0, true, "chart normal angle (degrees)");
+  if (min_fan_faces != 0 && min_fan_faces < 3)
+    throw OptionError("fans need at least 3 faces (or 0: no fans)");
+  RequireIn(max_stack_texels, 0.0, kLarge, false, "stack height (texels)");
+  RequireIn(min_stack_cover, 0.0, 1.0, true, "stack cover");
+  if (std::isnan(max_stack_overhang_texels))
+    throw OptionError("stack overhang must be a number (< 0: no limit)");
+  if (gutter < 0) throw OptionError("chart gutter must be >= 0 texels");
+}
+
 std::vector<std::vector<ChartFace>> MakeRigidCharts(
     const sfm::TriangleMesh& mesh, const std::vector<TrianglePatch>& patches,
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const RigidChartOptions& options) {
+  options.Check();
   const std::size_t num_faces = mesh.faces.size();
-  if (patches.size() != num_faces || unfoldings.size() != num_faces)
-    throw OptionError("charts: patches and unfoldings must have one entry per face");
+  TEXLUME_CHECK(patches.size() == num_faces && unfoldings.size() == num_faces,
+                "charts need one patch and one unfolding per face");
   const double t = options.texel_size;
   const int gutter = options.gutter;
   std::vector<std::vector<ChartFace>> charts;
@@ -410,12 +455,9 @@ std::vector<std::vector<ChartFace>> MakeConformalCharts(
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const ConformalChartOptions& options,
     ConformalChartStats* stats) {
   const std::size_t num_faces = mesh.faces.size();
-  if (patches.size() != num_faces || unfoldings.size() != num_faces)
-    throw OptionError("charts: patches and unfoldings must have one entry per face");
-  if (!(options.texel_size > 0.0) || !(options.max_side_texels > 0.0) ||
-      !(options.max_stretch > 1.0) || !(options.max_extent_texels > 0.0) ||
-      !(options.max_normal_angle_deg > 0.0 && options.max_normal_angle_deg <= 180.0))
-    throw OptionError("charts: bad options");
+  TEXLUME_CHECK(patches.size() == num_faces && unfoldings.size() == num_faces,
+                "charts need one patch and one unfolding per face");
+  options.Check();
   const double t = options.texel_size;
   ConformalChartStats local_stats;
   ConformalChartStats& st = stats ? *stats : local_stats;
@@ -825,15 +867,9 @@ std::vector<std::vector<ChartFace>> MakeStripCharts(
     const std::vector<std::array<Unfolding, 3>>& unfoldings, const StripChartOptions& options,
     StripChartStats* stats) {
   const std::size_t num_faces = mesh.faces.size();
-  if (patches.size() != num_faces || unfoldings.size() != num_faces)
-    throw OptionError("charts: patches and unfoldings must have one entry per face");
-  if (!(options.texel_size > 0.0) || !(options.max_stretch > 1.0) ||
-      !(options.max_length_texels > 0.0) ||
-      (options.min_fan_faces != 0 && options.min_fan_faces < 3) || options.gutter < 0 ||
-      !(options.max_stack_texels >= 0.0) || std::isnan(options.max_stack_overhang_texels) ||
-      !(options.min_stack_cover > 0.0 && options.min_stack_cover <= 1.0) ||
-      !(options.max_normal_angle_deg > 0.0 && options.max_normal_angle_deg <= 180.0))
-    throw OptionError("charts: bad options");
+  TEXLUME_CHECK(patches.size() == num_faces && unfoldings.size() == num_faces,
+                "charts need one patch and one unfolding per face");
+  options.Check();
   const double t = options.texel_size;
   StripChartStats local_stats;
   StripChartStats& st = stats ? *stats : local_stats;

@@ -20,10 +20,13 @@ struct ChartFace {
 
 /// Settings of MakeRigidCharts.
 struct RigidChartOptions {
-  double texel_size = 1.0;           ///< world units
-  double max_extent_texels = 188.0;  ///< largest chart side
-  double max_normal_angle_deg = 180.0;
-  int gutter = 2;  ///< texels; faces that do not share a vertex keep 2 gutters + 1 apart
+  double texel_size = 1.0;              ///< world units, > 0
+  double max_extent_texels = 188.0;     ///< largest chart side, >= 1
+  double max_normal_angle_deg = 180.0;  ///< (0, 180]
+  int gutter = 2;  ///< texels, >= 0; faces that do not share a vertex keep 2 gutters + 1 apart
+
+  /// Throws OptionError naming the first setting out of range.
+  void Check() const;
 };
 
 /// Charts unfolded edge to edge without distortion: from seeds in breadth-first
@@ -48,6 +51,9 @@ struct ConformalChartOptions {
   double max_stretch = 1.25;
   /// Largest chart side in texels (an atlas less its gutters); larger charts are split.
   double max_extent_texels = 2044.0;
+
+  /// Throws OptionError naming the first setting out of range.
+  void Check() const;
 };
 
 /// What MakeConformalCharts did.
@@ -105,6 +111,9 @@ struct StripChartOptions {
   /// that the rung's similarity would stretch beyond the bound takes its apex
   /// at the least-stretching place on either line instead of ending the band.
   bool fit_irregular_faces = false;
+
+  /// Throws OptionError naming the first setting out of range.
+  void Check() const;
 };
 
 /// What MakeStripCharts did.

@@ -179,12 +179,26 @@ void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int s
   inputs.seconds_visibility = Since(t);
 }
 
-SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress) {
-  options.synthesis.Check();
-  options.atlas.Check();
-  options.visibility.Check();
-  if (options.max_subdivisions < 0 || options.max_subdivisions > 6)
+void SynthJobOptions::CheckInputsAndLayout() const {
+  for (const auto& [path, what] :
+       {std::pair{&model_dir, "COLMAP model folder"}, std::pair{&images_dir, "images folder"},
+        std::pair{&lights_file, "lights file"}, std::pair{&mesh_file, "mesh"},
+        std::pair{&out_dir, "output folder"}})
+    if (path->empty()) throw OptionError(std::string("synth needs a ") + what);
+  atlas.Check();
+  visibility.Check();
+  if (max_subdivisions < 0 || max_subdivisions > 6)
     throw OptionError("max subdivisions must be in [0, 6]");
+}
+
+void SynthJobOptions::Check() const {
+  CheckInputsAndLayout();
+  if (sample_file.empty()) throw OptionError("synth needs a sample");
+  synthesis.Check();
+}
+
+SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress) {
+  options.Check();
   const auto start = std::chrono::steady_clock::now();
   SynthJobSummary summary;
   if (fs::exists(options.out_dir) &&
@@ -400,12 +414,21 @@ ModelBaselines ReadModelBaselines(const fs::path& model_folder, const TexturedMo
   return out;
 }
 
+void RenderJobOptions::Check() const {
+  for (const auto& [path, what] :
+       {std::pair{&model_folder, "model folder"}, std::pair{&cameras_dir, "COLMAP model folder"},
+        std::pair{&lights_file, "lights file"}, std::pair{&out_dir, "output folder"}})
+    if (path->empty()) throw OptionError(std::string("render needs a ") + what);
+  if (samples_per_axis < 1 || samples_per_axis > 8) throw OptionError("samples must be in [1, 8]");
+  if (reduced_factor < 1 || reduced_factor > 16)
+    throw OptionError("reduced factor must be in [1, 16]");
+  if (!truth_masks_dir.empty() && truth_images_dir.empty())
+    throw OptionError("truth masks need truth images");
+}
+
 RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
-  if (options.samples_per_axis < 1 || options.samples_per_axis > 8)
-    throw OptionError("samples must be in [1, 8]");
-  if (options.reduced_factor < 1 || options.reduced_factor > 16)
-    throw OptionError("reduced factor must be in [1, 16]");
+  options.Check();
   RenderJobSummary summary;
   const TexturedModel model = ReadModelFolder(options.model_folder);
   ModelRenderer renderer(model);
@@ -449,7 +472,7 @@ RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCal
       const fs::path mask_path =
           options.truth_masks_dir.empty() ? fs::path() : options.truth_masks_dir / image.name;
       if (!mask_path.empty() && fs::exists(mask_path)) {
-        truth_mask = cv::imread(mask_path.string(), cv::IMREAD_GRAYSCALE);
+        truth_mask = ReadImageGrey(mask_path) > 0.5f;
         if (truth_mask.size() != truth.size())
           throw InputError(mask_path.string(), "does not match its image's size");
       } else {

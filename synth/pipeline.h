@@ -33,6 +33,11 @@ struct SynthJobOptions {
   /// the photos, the model from photo views beside the photos and the
   /// baselines, a light sweep, the atlases, timings (synth/report.h).
   bool write_report = true;
+
+  /// Throws OptionError when a path is missing or a setting is out of range.
+  void Check() const;
+  /// The same, but for the synthesis settings (the BTF job checks its own).
+  void CheckInputsAndLayout() const;
 };
 
 /// What the job did (also written to manifest.json).
@@ -104,6 +109,9 @@ struct RenderJobOptions {
   /// Also compare after reducing both by this factor (the constraint photos'
   /// resolution when the views are rendered finer); 1 = off.
   int reduced_factor = 1;
+
+  /// Throws OptionError when a path is missing or a setting is out of range.
+  void Check() const;
 };
 
 struct ViewMetrics {

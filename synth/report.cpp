@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "core/check.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 
@@ -145,7 +146,7 @@ std::vector<double> AtlasOccupancies(const TexturedModel& model) {
 
 ReportSummary WriteReport(const fs::path& dir, const ReportInputs& in,
                           const ProgressCallback& progress) {
-  if (!in.model) throw OptionError("the report needs a model");
+  TEXLUME_CHECK(in.model != nullptr, "the report needs a model");
   if (in.picture_width < 32 || in.picture_width > 4096)
     throw OptionError("report picture width must be in [32, 4096]");
   if (in.max_views < 0 || in.max_photos < 0 || in.sweep_frames < 0 || in.sweep_frames > 64)
@@ -279,7 +280,7 @@ ReportSummary WriteReport(const fs::path& dir, const ReportInputs& in,
                      cv::Size(static_cast<int>(camera.width), static_cast<int>(camera.height)), 0,
                      0, cv::INTER_AREA);
           if (!v.reference_mask.empty()) {
-            const cv::Mat mask = cv::imread(v.reference_mask.string(), cv::IMREAD_GRAYSCALE);
+            const cv::Mat mask = ReadImageGrey(v.reference_mask) > 0.5f;
             if (mask.size() != full.size())
               throw InputError(v.reference_mask.string(), "does not match its image's size");
             cv::resize(mask, inside, reference.size(), 0, 0, cv::INTER_NEAREST);

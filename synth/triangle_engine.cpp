@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "core/check.h"
 #include "core/errors.h"
 #include "core/image_io.h"
 #include "synth/tangent_field.h"
@@ -66,8 +67,8 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
   options_.Check();
   const auto start = std::chrono::steady_clock::now();
   const std::size_t num_faces = mesh_.faces.size();
-  if (visibility_.triangles.size() != num_faces)
-    throw InputError("visibility", "does not match the mesh's face count");
+  TEXLUME_CHECK(visibility_.triangles.size() == num_faces,
+                "visibility is computed for the engine's mesh");
   const double t = options_.sample_texel_size;
   result_.texel_size = t;
   score_margin_ = sample_.Blendable() ? 0.5 * options_.strip * t : 0.0;

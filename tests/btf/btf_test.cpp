@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
+#include "btf/btf_model.h"
 #include "core/errors.h"
 #include "synth/mesh_synthesis.h"
 #include "tests/test_util.h"
@@ -230,6 +231,26 @@ TEST(Btf, BadCapturesAndOptionsAreClearErrors) {
     EXPECT_NE(std::string(e.what()).find("[1, 60]"), std::string::npos) << e.what();
   }
   EXPECT_THROW(FactoriseBtf(capture, 0), OptionError);
+}
+
+TEST(BtfSynthJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
+  BtfSynthJobOptions o;
+  o.job.model_dir = "sparse";
+  o.job.images_dir = "images";
+  o.job.lights_file = "lights.json";
+  o.job.mesh_file = "mesh.ply";
+  o.job.out_dir = "model";
+  o.btf = "btf";
+  EXPECT_NO_THROW(o.Check());  // texel size 0: the capture's
+  o.components = 0;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.components = 40;
+  o.synthesis.seam_band = 40;  // wider than the strip
+  EXPECT_THROW(o.Check(), OptionError);
+  o.synthesis.seam_band = 4;
+  o.btf.clear();
+  EXPECT_THROW(o.Check(), OptionError);
+  EXPECT_THROW(RunBtfSynthJob(o), OptionError);
 }
 
 }  // namespace

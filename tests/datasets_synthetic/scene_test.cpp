@@ -325,5 +325,32 @@ TEST(SceneOptions, BadSettingsAreRefused) {
   EXPECT_THROW(o.Check(), std::invalid_argument);
 }
 
+TEST(ShadingOptions, OutOfRangeSettingsAreRefused) {
+  ShadingOptions o;
+  EXPECT_NO_THROW(o.Check());
+  o.ambient = 1.5;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.ambient = 0.1;
+  o.exposure = 0.0;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.exposure = 1.0;
+  o.samples_per_axis = 9;
+  EXPECT_THROW(o.Check(), OptionError);
+}
+
+TEST(PlanarSurfaceOptions, ScaleMustDivideTheSizeAndNestedSettingsBeValid) {
+  PlanarSurfaceOptions o;
+  EXPECT_NO_THROW(o.Check());
+  o.scale = 3;  // 256 is not a multiple of 3
+  EXPECT_THROW(o.Check(), OptionError);
+  o.scale = 2;
+  o.offset = -1;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.offset = 0;
+  o.shading.samples_per_axis = 0;
+  EXPECT_THROW(o.Check(), OptionError);
+  EXPECT_THROW(RenderPlanarSurface(o, {}, {}), OptionError);
+}
+
 }  // namespace
 }  // namespace texlume::datasets

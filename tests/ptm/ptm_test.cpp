@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <random>
 
+#include "core/errors.h"
 #include "ptm/coefficient_space.h"
 
 namespace texlume::ptm {
@@ -112,6 +113,22 @@ TEST(CoefficientSpace, FrameRotationMatchesDirectEvaluation) {
     EXPECT_TRUE((FrameRotation(-angle) * m).isIdentity(1e-12));
   }
   EXPECT_TRUE((FrameRotation(0.4) * FrameRotation(0.5)).isApprox(FrameRotation(0.9), 1e-12));
+}
+
+TEST(EnhancementOptions, OutOfRangeSettingsAreRefused) {
+  EnhancementOptions o;
+  EXPECT_NO_THROW(o.Check());
+  o.diffuse_gain = 0.5;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.diffuse_gain = 2.0;
+  o.specular = 11.0;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.specular = 1.0;
+  o.specular_exponent = 0.0;
+  EXPECT_THROW(o.Check(), OptionError);
+  Ptm ptm;
+  ptm.Resize(PtmFormat::kLrgb, 2, 2);
+  EXPECT_THROW(Relight(ptm, Eigen::Vector3d::UnitZ(), o), OptionError);
 }
 
 }  // namespace

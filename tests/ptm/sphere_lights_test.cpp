@@ -4,6 +4,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "core/errors.h"
 #include "datasets_synthetic/renderer.h"
 #include "datasets_synthetic/scene.h"
 #include "tests/test_util.h"
@@ -73,6 +74,17 @@ TEST(SphereLights, MirrorGeometryKnownAnswers) {
   EXPECT_TRUE(LightFromHighlight(c, {50 + off, 50}).isApprox(Eigen::Vector3d::UnitX(), 1e-9));
   // Up in the image is +y in the light frame.
   EXPECT_GT(LightFromHighlight(c, {50, 45}).y(), 0.5);
+}
+
+TEST(HighlightOptions, OutOfRangeFractionsAreRefused) {
+  HighlightOptions o;
+  EXPECT_NO_THROW(o.Check());
+  o.threshold_fraction = 0.0;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.threshold_fraction = 0.9;
+  o.search_radius_fraction = 1.5;
+  EXPECT_THROW(o.Check(), OptionError);
+  EXPECT_THROW(LightsFromSphere({}, std::nullopt, o), OptionError);
 }
 
 }  // namespace

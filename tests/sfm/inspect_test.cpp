@@ -61,5 +61,15 @@ TEST(Inspect, LpLightsForUnknownImagesAreRefused) {
   }
 }
 
+TEST(InspectOptions, AMissingModelFolderOrBadNestedSettingIsRefused) {
+  InspectOptions o;
+  EXPECT_THROW(o.Check(), OptionError);  // no model folder
+  o.model_dir = "model";
+  EXPECT_NO_THROW(o.Check());
+  o.visibility.edge_samples = 100;
+  EXPECT_THROW(o.Check(), OptionError);
+  EXPECT_THROW(RunInspect(o), OptionError);
+}
+
 }  // namespace
 }  // namespace texlume::sfm

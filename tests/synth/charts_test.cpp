@@ -9,6 +9,7 @@
 #include <random>
 #include <set>
 
+#include "core/check.h"
 #include "core/errors.h"
 #include "datasets_synthetic/shapes.h"
 #include "synth/atlas.h"
@@ -664,6 +665,27 @@ TEST(Charts, BadChartOptionsAreRefused) {
   strips.min_stack_cover = 0.75;
   strips.max_stack_overhang_texels = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), OptionError);
+  RigidChartOptions rigid;
+  EXPECT_NO_THROW(rigid.Check());
+  rigid.gutter = -1;
+  EXPECT_THROW(MakeRigidCharts(mesh, g.patches, g.unfoldings, rigid), OptionError);
+  rigid.gutter = 2;
+  rigid.max_normal_angle_deg = 0.0;
+  EXPECT_THROW(rigid.Check(), OptionError);
+  ConformalChartOptions conformal;
+  EXPECT_NO_THROW(conformal.Check());
+  conformal.max_stretch = 1.0;
+  EXPECT_THROW(MakeConformalCharts(mesh, g.patches, g.unfoldings, conformal), OptionError);
+}
+
+// Patches and unfoldings that do not belong to the mesh are a programming error.
+TEST(Charts, PatchesOfAnotherMeshAreAnInternalError) {
+  const sfm::TriangleMesh mesh = datasets::MakeGridPlane(2, 0.5);
+  PatchGeometry g = Geometry(mesh);
+  g.patches.pop_back();
+  StripChartOptions strips;
+  strips.texel_size = kTexel;
+  EXPECT_THROW(MakeStripCharts(mesh, g.patches, g.unfoldings, strips), InternalError);
 }
 
 }  // namespace
