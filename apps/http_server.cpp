@@ -1,114 +1,18 @@
 #include "apps/http_server.h"
 
 #include <arpa/inet.h>
-#include <netinet/in.h>
-#include <poll.h>
-#include <sys/socket.h>
-#include <sys/time.h>
-#include <unistd.h>
+#include <httplib.h>
 
-#include <cerrno>
-#include <condition_variable>
+#include <chrono>
 #include <cstring>
-#include <mutex>
-#include <sstream>
 #include <stdexcept>
 #include <thread>
 
 namespace texlume::apps {
-namespace {
 
-constexpr std::size_t kMaxRequestBytes = 16384;
-
-bool SendAll(int fd, const void* data, std::size_t size) {
-  const char* p = static_cast<const char*>(data);
-  while (size > 0) {
-    const ssize_t n = ::send(fd, p, size, MSG_NOSIGNAL);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    p += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
-std::string PercentDecode(const std::string& s) {
-  std::string out;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '%' && i + 2 < s.size() && std::isxdigit(static_cast<unsigned char>(s[i + 1])) &&
-        std::isxdigit(static_cast<unsigned char>(s[i + 2]))) {
-      out.push_back(static_cast<char>(std::stoi(s.substr(i + 1, 2), nullptr, 16)));
-      i += 2;
-    } else {
-      out.push_back(s[i]);
-    }
-  }
-  return out;
-}
-
-const char* Reason(int status) {
-  switch (status) {
-    case 200:
-      return "OK";
-    case 400:
-      return "Bad Request";
-    case 404:
-      return "Not Found";
-    case 405:
-      return "Method Not Allowed";
-    default:
-      return "Internal Server Error";
-  }
-}
-
-void Answer(int fd, const HttpHandler& handler) {
-  timeval timeout{5, 0};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
-  ::setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &timeout, sizeof timeout);
-  std::string request;
-  char buffer[4096];
-  while (request.find("\r\n\r\n") == std::string::npos && request.size() < kMaxRequestBytes) {
-    const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return;
-    request.append(buffer, static_cast<std::size_t>(n));
-  }
-  std::istringstream line(request.substr(0, request.find("\r\n")));
-  std::string method, target, version;
-  line >> method >> target >> version;
-  HttpResponse response;
-  if (version.rfind("HTTP/1.", 0) != 0 || target.empty() || target[0] != '/') {
-    response = {400, "text/plain", {}};
-  } else if (method != "GET" && method != "HEAD") {
-    response = {405, "text/plain", {}};
-  } else {
-    const std::string path = PercentDecode(target.substr(0, target.find_first_of("?#")));
-    try {
-      response = handler(path);
-    } catch (const std::exception& e) {
-      const std::string what = e.what();
-      response = {500, "text/plain",
-                  std::make_shared<const std::vector<unsigned char>>(what.begin(), what.end())};
-    }
-  }
-  if (!response.body || (response.status != 200 && response.body->empty())) {
-    const std::string text = response.status == 200
-                                 ? std::string()
-                                 : std::to_string(response.status) + " " + Reason(response.status);
-    response.body = std::make_shared<const std::vector<unsigned char>>(text.begin(), text.end());
-    if (response.status != 200) response.content_type = "text/plain";
-  }
-  std::ostringstream head;
-  head << "HTTP/1.1 " << response.status << " " << Reason(response.status) << "\r\n"
-       << "Content-Type: " << response.content_type << "\r\n"
-       << "Content-Length: " << response.body->size() << "\r\n"
-       << "Cache-Control: no-store\r\nConnection: close\r\n\r\n";
-  const std::string h = head.str();
-  if (!SendAll(fd, h.data(), h.size())) return;
-  if (method != "HEAD") SendAll(fd, response.body->data(), response.body->size());
-}
-
-}  // namespace
+struct HttpServer::Impl {
+  httplib::Server server;
+};
 
 std::string ContentTypeOf(const std::string& name) {
   auto ends = [&](const char* ext) {
@@ -124,76 +28,44 @@ std::string ContentTypeOf(const std::string& name) {
   return "application/octet-stream";
 }
 
-HttpServer::HttpServer(const std::string& host, int port) {
+HttpServer::HttpServer(const std::string& host, int port) : impl_(std::make_unique<Impl>()) {
   const std::string address = host + ":" + std::to_string(port);
   if (port < 0 || port > 65535) throw std::runtime_error("port must be in [0, 65535]: " + address);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<std::uint16_t>(port));
-  if (::inet_pton(AF_INET, host.c_str(), &addr.sin_addr) != 1)
+  in_addr parsed{};
+  if (::inet_pton(AF_INET, host.c_str(), &parsed) != 1)
     throw std::runtime_error("not an IPv4 address: " + host);
-  socket_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (socket_ < 0)
-    throw std::runtime_error(std::string("cannot open a socket: ") + strerror(errno));
-  const int yes = 1;
-  ::setsockopt(socket_, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-  if (::bind(socket_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 ||
-      ::listen(socket_, 64) != 0) {
-    const std::string why = strerror(errno);
-    ::close(socket_);
-    throw std::runtime_error("cannot listen on " + address + ": " + why);
-  }
-  socklen_t len = sizeof addr;
-  ::getsockname(socket_, reinterpret_cast<sockaddr*>(&addr), &len);
-  port_ = ntohs(addr.sin_port);
+  httplib::Server& server = impl_->server;
+  // Requests are paths only; at most kMaxConnections answered at a time.
+  server.set_payload_max_length(16384);
+  server.new_task_queue = [] { return new httplib::ThreadPool(kMaxConnections); };
+  port_ = port == 0 ? server.bind_to_any_port(host) : (server.bind_to_port(host, port) ? port : -1);
+  if (port_ <= 0) throw std::runtime_error("cannot listen on " + address + ": " + strerror(errno));
 }
 
-HttpServer::~HttpServer() {
-  if (socket_ >= 0) ::close(socket_);
-}
+HttpServer::~HttpServer() = default;
 
 void HttpServer::Serve(const HttpHandler& handler, const std::atomic<bool>& stop) {
-  struct Connection {
-    std::thread thread;
-    std::shared_ptr<std::atomic<bool>> answered;
-  };
-  std::mutex mutex;
-  std::condition_variable answered_one;
-  int active = 0;
-  std::vector<Connection> connections;
-  while (!stop.load()) {
-    pollfd p{socket_, POLLIN, 0};
-    if (::poll(&p, 1, 200) <= 0) continue;
-    {
-      std::unique_lock lock(mutex);
-      answered_one.wait(lock, [&] { return active < kMaxConnections; });
-      ++active;
+  httplib::Server& server = impl_->server;
+  // GET (and HEAD, which cpp-httplib answers from the GET handler); bodies are
+  // shared with the handler's caller and streamed without a copy.
+  server.Get(".*", [&handler](const httplib::Request& request, httplib::Response& response) {
+    const HttpResponse answer = handler(request.path);
+    response.status = answer.status;
+    if (!answer.body) {
+      response.set_content("", answer.content_type);
+      return;
     }
-    const int fd = ::accept4(socket_, nullptr, nullptr, SOCK_CLOEXEC);
-    if (fd < 0) {
-      std::lock_guard lock(mutex);
-      --active;
-      continue;
-    }
-    // Join the threads that have answered, so the list stays short.
-    std::erase_if(connections, [](Connection& c) {
-      if (!c.answered->load()) return false;
-      c.thread.join();
-      return true;
-    });
-    auto answered = std::make_shared<std::atomic<bool>>(false);
-    connections.push_back({std::thread([fd, answered, &handler, &mutex, &answered_one, &active] {
-                             Answer(fd, handler);
-                             ::shutdown(fd, SHUT_WR);
-                             ::close(fd);
-                             answered->store(true);
-                             std::lock_guard lock(mutex);
-                             --active;
-                             answered_one.notify_all();
-                           }),
-                           answered});
-  }
-  for (Connection& c : connections) c.thread.join();
+    const std::shared_ptr<const std::vector<unsigned char>> body = answer.body;
+    response.set_content_provider(
+        body->size(), answer.content_type,
+        [body](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+          return sink.write(reinterpret_cast<const char*>(body->data()) + offset, length);
+        });
+  });
+  std::thread listener([&server] { server.listen_after_bind(); });
+  while (!stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  server.stop();
+  listener.join();
 }
 
 }  // namespace texlume::apps

@@ -19,11 +19,10 @@ struct HttpResponse {
 /// Request path (no query string, percent-decoded) -> response.
 using HttpHandler = std::function<HttpResponse(const std::string& path)>;
 
-/// A small HTTP/1.1 server for local previews: GET and HEAD only, one request
-/// per connection (Connection: close). Connections are answered concurrently,
-/// each on its own thread (at most kMaxConnections at a time), so that a large
-/// file does not hold up the scripts a page loads beside it; the handler must
-/// be safe to call from several threads.
+/// A small HTTP/1.1 server for local previews (cpp-httplib): GET and HEAD only.
+/// Connections are answered concurrently by a pool of kMaxConnections threads,
+/// so that a large file does not hold up the scripts a page loads beside it;
+/// the handler must be safe to call from several threads.
 class HttpServer {
  public:
   /// Binds to host:port (port 0: any free port). Throws std::runtime_error
@@ -39,7 +38,8 @@ class HttpServer {
   void Serve(const HttpHandler& handler, const std::atomic<bool>& stop);
 
  private:
-  int socket_ = -1;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
   int port_ = 0;
 };
 

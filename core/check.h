@@ -21,8 +21,7 @@ class InternalError : public std::logic_error {
 
 /// Checks an internal invariant (a precondition a caller inside texlume must
 /// meet): TEXLUME_CHECK(planes.size() == names.size(), "one name per plane").
-#define TEXLUME_CHECK(condition, message)                                  \
-  do {                                                                     \
-    if (!(condition)) ::texlume::FailCheck(#condition, __FILE__, __LINE__, \
-                                           (message));                     \
+#define TEXLUME_CHECK(condition, message)                                              \
+  do {                                                                                 \
+    if (!(condition)) ::texlume::FailCheck(#condition, __FILE__, __LINE__, (message)); \
   } while (false)

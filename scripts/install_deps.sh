@@ -9,6 +9,8 @@ PACKAGES=(
   # libraries (see DESIGN.md, "Modules")
   libeigen3-dev libopenmesh-dev libopencv-dev libceres-dev libopenimageio-dev
   nlohmann-json3-dev libembree-dev
+  libcli11-dev  # the command line (BSD)
+  libcpp-httplib-dev  # the viewer's local HTTP server (MIT)
   openimageio-tools  # its CMake package config refers to the OIIO tools
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -60,6 +60,30 @@ TEST_F(CliTest, UsageErrorsExitWithTwo) {
   EXPECT_EQ(Texlume("--help", &out), 0);
 }
 
+// Every subcommand has its own help, listing each option with its default;
+// typos get the nearest name.
+TEST(Cli, HelpListsEveryOptionAndTyposGetTheNearestName) {
+  std::string out;
+  for (const char* sub : {"inspect", "fit", "btf", "relight", "lights-from-sphere", "synth2d",
+                          "synth", "render", "view", "scene", "demo"}) {
+    EXPECT_EQ(Texlume(std::string(sub) + " --help", &out), 0) << sub << "\n" << out;
+    EXPECT_NE(out.find("Usage: texlume " + std::string(sub)), std::string::npos) << out;
+  }
+  ASSERT_EQ(Texlume("synth --help", &out), 0);
+  for (const char* option : {"--btf", "--chart-flattening", "--correction-prior-shrink",
+                             "--seam-band", "--no-detail-transfer", "--tangent-field"})
+    EXPECT_NE(out.find(option), std::string::npos) << option << "\n" << out;
+  EXPECT_NE(out.find("--chart-stretch FLOAT=1.25"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("help", &out), 0);
+  EXPECT_NE(out.find("lights-from-sphere"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth --modle x --images b", &out), 2);
+  EXPECT_NE(out.find("did you mean --model?"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("inspct --model x", &out), 2);
+  EXPECT_NE(out.find("did you mean 'inspect'?"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("render --model m --cameras c --lights l --out r --samples=9", &out), 2);
+  EXPECT_NE(out.find("samples must be in [1, 8]"), std::string::npos) << out;
+}
+
 TEST_F(CliTest, TruncatedBinaryModelIsACleanErrorNamingTheFile) {
   Corrupt("sparse/points3D.bin", 100);
   std::string out;

@@ -1,8 +1,8 @@
 #include "core/image_io.h"
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
-#include <OpenImageIO/imageio.h>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <vector>
@@ -21,7 +21,8 @@ fs::path WriteJpegWithOrientation6(const fs::path& path) {
   const int w = 16, h = 8;
   std::vector<unsigned char> rgb(static_cast<std::size_t>(w * h * 3), 0);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) rgb[static_cast<std::size_t>((y * w + x) * 3 + (x < w / 2 ? 0 : 2))] = 255;
+    for (int x = 0; x < w; ++x)
+      rgb[static_cast<std::size_t>((y * w + x) * 3 + (x < w / 2 ? 0 : 2))] = 255;
   OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("Orientation", 6);
   spec.attribute("CompressionQuality", 100);
@@ -62,7 +63,8 @@ TEST(ImageIo, IntegersAreScaledToUnitAndChannelsMadeRgb) {
   TempDir tmp;
   // 16-bit grey: each value v becomes v / 65535 in all three channels.
   cv::Mat grey16(2, 3, CV_16UC1);
-  for (int i = 0; i < 6; ++i) grey16.at<std::uint16_t>(i / 3, i % 3) = static_cast<std::uint16_t>(i * 13107);
+  for (int i = 0; i < 6; ++i)
+    grey16.at<std::uint16_t>(i / 3, i % 3) = static_cast<std::uint16_t>(i * 13107);
   ASSERT_TRUE(cv::imwrite((tmp.path() / "g16.png").string(), grey16));
   const cv::Mat rgb = ReadPhotoRgb(tmp.path() / "g16.png");
   ASSERT_EQ(rgb.type(), CV_32FC3);
@@ -71,7 +73,7 @@ TEST(ImageIo, IntegersAreScaledToUnitAndChannelsMadeRgb) {
       EXPECT_FLOAT_EQ(rgb.at<cv::Vec3f>(i / 3, i % 3)[c], i * 13107 / 65535.0f);
   // 8-bit BGRA as OpenCV writes it: RGB in order, alpha dropped; grey is the Rec. 601 luma.
   cv::Mat bgra(1, 2, CV_8UC4, cv::Scalar(0, 0, 0, 0));
-  bgra.at<cv::Vec4b>(0, 0) = cv::Vec4b(30, 60, 90, 10);   // B G R A
+  bgra.at<cv::Vec4b>(0, 0) = cv::Vec4b(30, 60, 90, 10);  // B G R A
   bgra.at<cv::Vec4b>(0, 1) = cv::Vec4b(255, 255, 255, 255);
   ASSERT_TRUE(cv::imwrite((tmp.path() / "c8.png").string(), bgra));
   const cv::Mat c8 = ReadPhotoRgb(tmp.path() / "c8.png");

@@ -1,0 +1,256 @@
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "apps/cli.h"
+#include "apps/commands.h"
+#include "apps/progress_bar.h"
+#include "pipeline/jobs.h"
+
+namespace texlume::apps {
+namespace {
+
+// What the synth command reads besides the Options it binds directly.
+struct SynthWords {
+  std::string tangent_frame, prior_shrink;
+  std::vector<double> tangent_field;
+  bool best_view_only = false, no_additive = false, no_channel = false, no_detail = false,
+       no_report = false;
+};
+
+void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o) {
+  synth::SynthJobOptions& j = o.job;
+  sub->add_option("--model", j.model_dir, "COLMAP model folder")->required();
+  sub->add_option("--images", j.images_dir, "the object photos")->required();
+  sub->add_option("--lights", j.lights_file, "object-lights JSON (docs/lights.md)")->required();
+  sub->add_option("--mesh", j.mesh_file, "coarse mesh in the model's frame")->required();
+  sub->add_option("--out", j.out_dir, "the model folder to write")->required();
+  auto* sample = sub->add_option("--sample", j.sample_file, "sample PTM (.ptm or .exr)");
+  sub->add_option("--btf", o.btf, "BTF capture or factorisation folder (instead of --sample)")
+      ->excludes(sample);
+  sub->add_option("--components", o.components, "BTF components kept when factorising a capture")
+      ->capture_default_str();
+  sub->add_option("--sample-texel-size", j.synthesis.sample_texel_size,
+                  "world units per sample texel (required with --sample; BTF: the capture's)");
+  sub->add_option("--seam-band", o.seam_band,
+                  "BTF graph-cut band half-width in texels [min(4, "
+                  "strip)]");
+  sub->add_option("--max-subdivisions", j.max_subdivisions,
+                  "1-to-4 splits allowed so that every patch fits the sample")
+      ->capture_default_str();
+  sub->add_option("--max-buffer-size", j.visibility.max_buffer_dimension,
+                  "largest z-buffer side in pixels (0: full resolution)")
+      ->capture_default_str();
+}
+
+void BindEngine(CLI::App* sub, synth::MeshSynthesisOptions& s, SynthWords& w) {
+  sub->add_option("--strip", s.strip, "W_e: texels of strip around each triangle [2, 32]")
+      ->capture_default_str();
+  sub->add_option("--top-k", s.top_k, "candidates kept by the image score")->capture_default_str();
+  sub->add_flag("--best-view-only", w.best_view_only, "constrain by the best view alone");
+  sub->add_option("--max-views", s.max_views, "most photos constraining a triangle")
+      ->capture_default_str();
+  sub->add_option("--seed", s.seed, "random seed")->capture_default_str();
+  auto* frame =
+      sub->add_option("--tangent-frame", w.tangent_frame,
+                      "each face's frame: auto, photos or first-edge")
+          ->check(OneOf({"auto", "photos", "first-edge"}, "give first-edge, photos or auto"))
+          ->default_str("auto");
+  sub->add_option("--tangent-field", w.tangent_field,
+                  "a world direction x,y,z laid on every face (instead of --tangent-frame)")
+      ->delimiter(',')
+      ->expected(3)
+      ->excludes(frame);
+}
+
+void BindCorrection(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords& w) {
+  synth::MeshSynthesisOptions& s = o.job.synthesis;
+  sub->add_option("--correction-iterations", s.correction_iterations,
+                  "photo-consistency rounds [0, 5] (0: off, also for a BTF)")
+      ->capture_default_str();
+  sub->add_option("--correction-noise", o.correction_noise,
+                  "photo noise of the pass (PTM 0.1, BTF 0.05)");
+  sub->add_option("--correction-sigma", o.correction_sigma,
+                  "smoothing of the per-channel factors, photo pixels (PTM 2, BTF 0.35)");
+  sub->add_option("--correction-prior-shrink", w.prior_shrink,
+                  "auto, or the share in [0, 1] of the way to the sample's mean")
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            if (v == "auto") return "";
+            try {
+              std::size_t used = 0;
+              const double x = std::stod(v, &used);
+              if (used == v.size() && x >= 0.0 && x <= 1.0) return "";
+            } catch (const std::exception&) {
+            }
+            return "give auto or a number in [0, 1]";
+          },
+          "auto|W"))
+      ->default_str("auto");
+  sub->add_flag("--no-additive-correction", w.no_additive, "no change of the luminance");
+  sub->add_flag("--no-channel-correction", w.no_channel, "no per-channel factors");
+  sub->add_flag("--no-detail-transfer", w.no_detail, "keep the quilted patch's own detail");
+}
+
+void BindAtlas(CLI::App* sub, synth::AtlasOptions& a, SynthWords& w) {
+  sub->add_option("--atlas", a.mode, "charts or per-triangle")
+      ->transform(Choice(std::map<std::string, synth::AtlasMode>{
+          {"charts", synth::AtlasMode::kCharts}, {"per-triangle", synth::AtlasMode::kPerTriangle}}))
+      ->default_str("charts");
+  sub->add_option("--atlas-size", a.atlas_size, "atlas side in texels")->capture_default_str();
+  sub->add_option("--gutter", a.gutter, "texels around every chart")->capture_default_str();
+  sub->add_option("--chart-angle", a.max_chart_normal_angle_deg,
+                  "largest normal angle within a chart, degrees")
+      ->capture_default_str();
+  sub->add_option("--chart-size", a.max_chart_size, "largest chart side in texels (0: any)")
+      ->capture_default_str();
+  sub->add_option("--chart-flattening", a.flattening, "auto, strips, rigid or conformal")
+      ->transform(Choice(std::map<std::string, synth::ChartFlattening>{
+          {"auto", synth::ChartFlattening::kAuto},
+          {"strips", synth::ChartFlattening::kStrips},
+          {"rigid", synth::ChartFlattening::kRigid},
+          {"conformal", synth::ChartFlattening::kConformal}}))
+      ->default_str("auto");
+  sub->add_option("--chart-stretch", a.max_chart_stretch, "texel stretch bound of a chart")
+      ->capture_default_str();
+  sub->add_flag("--no-report", w.no_report, "do not write report.html");
+}
+
+// The words and flags into the job's Options.
+void Resolve(const CLI::App* sub, const SynthWords& w, pipeline::SynthCommandOptions& o) {
+  synth::MeshSynthesisOptions& s = o.job.synthesis;
+  if (o.btf.empty() && sub->count("--sample-texel-size") == 0)
+    throw UsageError(
+        "--sample-texel-size: give the sample's texel size in world units of the model");
+  s.all_views = !w.best_view_only;
+  s.additive_correction = !w.no_additive;
+  s.channel_correction = !w.no_channel;
+  s.detail_transfer = !w.no_detail;
+  if (!w.prior_shrink.empty() && w.prior_shrink != "auto")
+    s.correction_prior_shrink = std::stod(w.prior_shrink);
+  if (w.tangent_frame == "first-edge") s.tangent_frame = synth::TangentFrame::kFirstEdge;
+  if (w.tangent_frame == "photos") s.tangent_frame = synth::TangentFrame::kPhotos;
+  if (!w.tangent_field.empty()) {
+    s.tangent_frame = synth::TangentFrame::kSmoothField;
+    s.field_direction_in_world =
+        Eigen::Vector3d(w.tangent_field[0], w.tangent_field[1], w.tangent_field[2]);
+  }
+  o.job.atlas.blend_strip = s.strip;
+  o.job.write_report = !w.no_report;
+}
+
+}  // namespace
+
+void AddSynthCommand(CLI::App& app, CommandRunners& run) {
+  auto* sub = app.add_subcommand(
+      "synth",
+      "The relightable model: per-triangle image-constrained synthesis on the mesh (paper 003 "
+      "Algorithm 2) from a PTM (--sample) or BTF (--btf) sample, packed into atlases, exported, "
+      "with report.html (docs/synth.md).");
+  auto o = std::make_shared<pipeline::SynthCommandOptions>();
+  auto w = std::make_shared<SynthWords>();
+  BindSynthInputs(sub, *o);
+  BindEngine(sub, o->job.synthesis, *w);
+  BindCorrection(sub, *o, *w);
+  BindAtlas(sub, o->job.atlas, *w);
+  run[sub] = [sub, o, w](std::ostream& out, std::ostream& err) {
+    Resolve(sub, *w, *o);
+    ProgressBar bar;
+    pipeline::RunSynthCommandJob(*o, out, err, bar.Callback());
+    return 0;
+  };
+}
+
+void AddRenderCommand(CLI::App& app, CommandRunners& run) {
+  auto* sub = app.add_subcommand(
+      "render", "Render a model folder for every image of a COLMAP model under its light(s).");
+  auto o = std::make_shared<synth::RenderJobOptions>();
+  sub->add_option("--model", o->model_folder, "model folder written by texlume synth")->required();
+  sub->add_option("--cameras", o->cameras_dir, "COLMAP model of the views")->required();
+  sub->add_option("--lights", o->lights_file, "object-lights JSON of those views")->required();
+  sub->add_option("--out", o->out_dir, "the folder to write")->required();
+  auto* baseline = sub->add_option("--baseline", o->mode, "flat, baked or ptm (a BTF's preview)")
+                       ->transform(Choice(std::map<std::string, synth::RenderMode>{
+                           {"flat", synth::RenderMode::kFlat},
+                           {"baked", synth::RenderMode::kBaked},
+                           {"ptm", synth::RenderMode::kPtm}}));
+  sub->add_option("--samples", o->samples_per_axis, "samples per pixel along each axis [1, 8]")
+      ->capture_default_str();
+  sub->add_option("--truth", o->truth_images_dir, "ground-truth images: PSNR and SSIM");
+  sub->add_option("--truth-masks", o->truth_masks_dir, "their masks");
+  sub->add_option("--reduced-factor", o->reduced_factor,
+                  "also compare after reducing both by this factor")
+      ->capture_default_str();
+  run[sub] = [o, baseline](std::ostream& out, std::ostream& err) {
+    ProgressBar bar;
+    pipeline::RunRenderCommandJob(*o, baseline->count() > 0, out, err, bar.Callback());
+    return 0;
+  };
+}
+
+namespace {
+
+void BindSceneCapture(CLI::App* sub, datasets::SceneOptions& s) {
+  sub->add_option("--capture-size", s.capture_size, "RTI capture side in texels")
+      ->capture_default_str();
+  sub->add_option("--capture-lights", s.num_capture_lights, "RTI capture lights")
+      ->capture_default_str();
+  sub->add_option("--held-out-lights", s.num_held_out_capture_lights,
+                  "held-out lights of the capture")
+      ->capture_default_str();
+  sub->add_option("--held-out-views", s.num_held_out_views, "held-out views of the object")
+      ->capture_default_str();
+  sub->add_option("--held-out-scale", s.held_out_scale, "held-out views' resolution factor")
+      ->capture_default_str();
+  sub->add_option("--texel-size", s.material.texel_size, "world units per material texel")
+      ->capture_default_str();
+  sub->add_option("--relief", s.material.relief_height, "relief height, world units")
+      ->capture_default_str();
+  sub->add_option("--specular", s.material.specular, "specular strength")->capture_default_str();
+  sub->add_option("--samples", s.shading.samples_per_axis, "samples per pixel along each axis")
+      ->capture_default_str();
+  sub->add_option("--mesh-resolution", s.mesh_resolution, "coarse mesh resolution [0, 7]")
+      ->capture_default_str();
+  sub->add_option("--btf-size", s.btf_size, "BTF capture side in texels")->capture_default_str();
+  sub->add_option("--btf-views", s.btf_view_count, "BTF capture views")->capture_default_str();
+  sub->add_option("--btf-lights", s.btf_light_count, "BTF capture lights")->capture_default_str();
+}
+
+}  // namespace
+
+void AddSceneCommand(CLI::App& app, CommandRunners& run) {
+  auto* sub = app.add_subcommand(
+      "scene", "Write a synthetic heritage scene with ground truth (docs/synthetic_scenes.md).");
+  auto s = std::make_shared<datasets::SceneOptions>();
+  auto out_dir = std::make_shared<std::filesystem::path>();
+  auto flags = std::make_shared<std::pair<bool, bool>>(false, false);  // no BTF, fixed exposure
+  sub->add_option("--out", *out_dir, "the folder to write")->required();
+  sub->add_option("--kind", s->shape, "sphere, cylinder, plane or torus")
+      ->transform(Choice(ShapeWords()))
+      ->default_str("sphere");
+  sub->add_option("--material", s->material.kind, "stone, brick or grooves")
+      ->transform(Choice(MaterialWords()))
+      ->default_str("stone");
+  sub->add_option("--seed", s->seed, "random seed (scene and material)")->capture_default_str();
+  sub->add_option("--images", s->num_images, "object photos")->capture_default_str();
+  sub->add_option("--camera-model", s->camera_model, "pinhole or opencv")
+      ->transform(Choice(std::map<std::string, sfm::CameraModelId>{
+          {"pinhole", sfm::CameraModelId::kPinhole}, {"opencv", sfm::CameraModelId::kOpenCV}}))
+      ->default_str("pinhole");
+  sub->add_option("--width", s->image_width, "photo width in pixels")->capture_default_str();
+  sub->add_option("--height", s->image_height, "photo height in pixels")->capture_default_str();
+  BindSceneCapture(sub, *s);
+  sub->add_flag("--no-btf", flags->first, "no BTF capture");
+  sub->add_flag("--fixed-exposure", flags->second, "every photo at one exposure");
+  run[sub] = [s, out_dir, flags](std::ostream& out, std::ostream&) {
+    s->material.seed = s->seed;
+    s->focal_px *= s->image_width / 640.0;
+    s->write_btf = !flags->first;
+    s->vary_exposure = !flags->second;
+    ProgressBar bar;
+    pipeline::RunSceneJob(*s, *out_dir, out, bar.Callback());
+    return 0;
+  };
+}
+
+}  // namespace texlume::apps
