@@ -25,7 +25,9 @@ void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o) {
   sub->add_option("--lights", j.lights_file, "object-lights JSON (docs/lights.md)")->required();
   sub->add_option("--mesh", j.mesh_file, "coarse mesh in the model's frame")->required();
   sub->add_option("--out", j.out_dir, "the model folder to write")->required();
-  auto* sample = sub->add_option("--sample", j.sample_file, "sample PTM (.ptm or .exr)");
+  auto* sample =
+      sub->add_option("--sample", j.sample_file,
+                      "sample: a PTM (.ptm, .exr) or a colour photo (.png, .jpg, .tif, RGB .exr)");
   sub->add_option("--btf", o.btf, "BTF capture or factorisation folder (instead of --sample)")
       ->excludes(sample);
   sub->add_option("--components", o.components, "BTF components kept when factorising a capture")

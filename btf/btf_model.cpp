@@ -252,199 +252,263 @@ void BtfSynthJobOptions::Check() const {
   resolved.Check();
 }
 
-BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
-                                  const ProgressCallback& progress) {
-  const auto start = std::chrono::steady_clock::now();
-  options.Check();
-  const synth::SynthJobOptions& job = options.job;
-  if (fs::exists(job.out_dir) &&
-      (!fs::is_directory(job.out_dir) ||
-       (!fs::exists(job.out_dir / "manifest.json") && !fs::is_empty(job.out_dir)))) {
-    throw InputError(job.out_dir.string(),
-                     "exists and is not a texlume model folder; not replacing it");
-  }
-  BtfSynthJobSummary summary;
+namespace {
 
-  synth::SynthInputs inputs = synth::LoadSynthInputs(job);
-  // The sample: a factorisation as it is, or a capture factorised here.
-  auto t = std::chrono::steady_clock::now();
-  BtfFactorisation sample;
-  std::vector<SvdError> errors;
-  if (fs::exists(options.btf / "btf_svd.json")) {
-    sample = ReadBtfFactorisation(options.btf);
-  } else {
-    const BtfCapture capture = ReadBtfCapture(options.btf);
-    sample = FactoriseBtf(capture, options.components, progress);
+// The BTF job's steps, each a method (RunBtfSynthJob).
+class BtfSynthJob {
+ public:
+  BtfSynthJob(const BtfSynthJobOptions& options, const ProgressCallback& progress)
+      : options_(options), job_(options.job), progress_(progress) {}
+
+  BtfSynthJobSummary Run() {
+    const auto start = std::chrono::steady_clock::now();
+    RefuseAForeignOutputFolder();
+    inputs_ = synth::LoadSynthInputs(job_);
+    LoadSample();
+    Synthesize();
+    LayOut();
+    nlohmann::json record = Record();
+    // The geometry maps baked per atlas texel, for export (docs/btf.md).
+    const auto t = std::chrono::steady_clock::now();
+    record["btf"]["geometry_atlases"] = EncodeGeometryAtlases();
+    summary_.seconds_export = Since(t);
+    record["timings_s"]["export_geometry"] = summary_.seconds_export;
+    synth::WriteModelFolder(job_.out_dir, model_, record, extra_images_,
+                            [this](const fs::path& folder) { WriteBtfFiles(folder); });
+    summary_.seconds_total = Since(start);
+    return summary_;
   }
-  {
+
+ private:
+  void RefuseAForeignOutputFolder() const {
+    const fs::path& out = job_.out_dir;
+    if (fs::exists(out) && (!fs::is_directory(out) ||
+                            (!fs::exists(out / "manifest.json") && !fs::is_empty(out))))
+      throw InputError(out.string(), "exists and is not a texlume model folder; not replacing it");
+  }
+
+  // The sample: a factorisation as it is, or a capture factorised here; its
+  // error table; the synthesis settings with its texel size; the mesh.
+  void LoadSample() {
+    const auto t = std::chrono::steady_clock::now();
+    if (fs::exists(options_.btf / "btf_svd.json")) {
+      sample_ = ReadBtfFactorisation(options_.btf);
+    } else {
+      const BtfCapture capture = ReadBtfCapture(options_.btf);
+      sample_ = FactoriseBtf(capture, options_.components, progress_);
+    }
     std::vector<int> ns;
-    for (int k = 1; k < sample.Components(); k *= 2) ns.push_back(k);
-    ns.push_back(sample.Components());
-    errors = SvdErrorTable(sample, ns);
+    for (int k = 1; k < sample_.Components(); k *= 2) ns.push_back(k);
+    ns.push_back(sample_.Components());
+    errors_ = SvdErrorTable(sample_, ns);
+    summary_.seconds_factorise = Since(t);
+    so_ = options_.synthesis;
+    if (so_.sample_texel_size == 0.0) so_.sample_texel_size = sample_.texel_size;
+    so_.Check();
+    synth::PrepareSynthMesh(inputs_, job_, std::min(sample_.width, sample_.height),
+                            so_.sample_texel_size, so_.strip, progress_);
+    summary_.warnings = inputs_.warnings;
+    summary_.photos_used = inputs_.photos.size();
+    summary_.subdivisions = inputs_.subdivisions;
+    summary_.faces = inputs_.mesh.faces.size();
   }
-  summary.seconds_factorise = Since(t);
-  synth::BtfMeshSynthesisOptions so = options.synthesis;
-  if (so.sample_texel_size == 0.0) so.sample_texel_size = sample.texel_size;
-  so.Check();
 
-  synth::PrepareSynthMesh(inputs, job, std::min(sample.width, sample.height), so.sample_texel_size,
-                          so.strip, progress);
-  summary.warnings = inputs.warnings;
-  summary.photos_used = inputs.photos.size();
-  summary.subdivisions = inputs.subdivisions;
-  summary.faces = inputs.mesh.faces.size();
-
-  const synth::BtfMeshSynthesis synthesis = synth::SynthesizeMeshBtf(
-      inputs.mesh, inputs.reconstruction, inputs.visibility, inputs.photos, sample, so, progress);
-  summary.seconds_synthesis = synthesis.seconds_synthesis;
-  summary.seconds_seams = synthesis.seconds_seams;
-  summary.from_photos = synthesis.num_from_photos;
-  summary.from_neighbours = synthesis.num_from_neighbours;
-  summary.random = synthesis.num_random;
-  summary.seam_edges = synthesis.seam_edges;
-  summary.seam_cost_per_link = synthesis.seam_cost_per_link;
-  summary.edge_cost_per_link = synthesis.edge_cost_per_link;
-
-  t = std::chrono::steady_clock::now();
-  const BtfAtlases atlases = BuildBtfAtlases(inputs.mesh, synthesis, sample, job.atlas, progress);
-  summary.seconds_atlas = Since(t);
-  summary.atlases = atlases.geometry.size();
-  summary.charts = static_cast<std::size_t>(atlases.layout.num_charts);
-  summary.chart_flattening = job.atlas.mode == synth::AtlasMode::kCharts
-                                 ? synth::ChartFlatteningName(atlases.layout.flattening)
-                                 : "none";
-  summary.occupancy = atlases.occupancy;
-  t = std::chrono::steady_clock::now();
-  synth::TexturedModel model;
-  model.mesh = inputs.mesh;
-  model.atlases = PreviewPtms(atlases, sample, progress);
-  for (const synth::FacePlacement& fp : atlases.layout.faces) {
-    model.face_atlas.push_back(fp.atlas);
-    model.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
-                               fp.corners_px[2].cast<float>()});
+  void Synthesize() {
+    synthesis_ = synth::SynthesizeMeshBtf(inputs_.mesh, inputs_.reconstruction,
+                                          inputs_.visibility, inputs_.photos, sample_, so_,
+                                          progress_);
+    summary_.seconds_synthesis = synthesis_.seconds_synthesis;
+    summary_.seconds_seams = synthesis_.seconds_seams;
+    summary_.from_photos = synthesis_.num_from_photos;
+    summary_.from_neighbours = synthesis_.num_from_neighbours;
+    summary_.random = synthesis_.num_random;
+    summary_.seam_edges = synthesis_.seam_edges;
+    summary_.seam_cost_per_link = synthesis_.seam_cost_per_link;
+    summary_.edge_cost_per_link = synthesis_.edge_cost_per_link;
   }
-  summary.seconds_preview = Since(t);
 
-  // The baselines `texlume render` draws, as for PTM models.
-  const std::vector<cv::Mat> baked = synth::BakePhotoTextures(
-      model, inputs.reconstruction, inputs.visibility, inputs.photos, synthesis.photo_gains);
-  const Eigen::Vector3f flat_albedo = synth::MeanAlbedoFromPhotos(
-      inputs.mesh, inputs.reconstruction, inputs.visibility, inputs.photos, synthesis.photo_gains);
+  // The atlases, the PTM preview as the model's atlases, and the baselines
+  // `texlume render` draws, as for PTM models.
+  void LayOut() {
+    auto t = std::chrono::steady_clock::now();
+    atlases_ = BuildBtfAtlases(inputs_.mesh, synthesis_, sample_, job_.atlas, progress_);
+    summary_.seconds_atlas = Since(t);
+    summary_.atlases = atlases_.geometry.size();
+    summary_.charts = static_cast<std::size_t>(atlases_.layout.num_charts);
+    summary_.chart_flattening = job_.atlas.mode == synth::AtlasMode::kCharts
+                                    ? synth::ChartFlatteningName(atlases_.layout.flattening)
+                                    : "none";
+    summary_.occupancy = atlases_.occupancy;
+    t = std::chrono::steady_clock::now();
+    model_.mesh = inputs_.mesh;
+    model_.atlases = PreviewPtms(atlases_, sample_, progress_);
+    for (const synth::FacePlacement& fp : atlases_.layout.faces) {
+      model_.face_atlas.push_back(fp.atlas);
+      model_.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
+                                  fp.corners_px[2].cast<float>()});
+    }
+    summary_.seconds_preview = Since(t);
+    baked_ = synth::BakePhotoTextures(model_, inputs_.reconstruction, inputs_.visibility,
+                                      inputs_.photos, synthesis_.photo_gains);
+    flat_albedo_ = synth::MeanAlbedoFromPhotos(inputs_.mesh, inputs_.reconstruction,
+                                               inputs_.visibility, inputs_.photos,
+                                               synthesis_.photo_gains);
+  }
 
-  nlohmann::json record;
-  record["command"] = "synth --btf";
-  record["inputs"] = {{"model", job.model_dir.string()},
-                      {"images", job.images_dir.string()},
-                      {"lights", job.lights_file.string()},
-                      {"mesh", job.mesh_file.string()},
-                      {"btf", options.btf.string()}};
-  record["settings"] = {{"sample_texel_size", so.sample_texel_size},
-                        {"components", sample.Components()},
-                        {"strip", so.strip},
-                        {"seam_band", so.seam_band},
-                        {"top_k", so.top_k},
-                        {"max_views", so.max_views},
-                        {"tangent_frame", synth::TangentFrameName(so.tangent_frame)},
-                        {"tolerance", so.tolerance},
-                        {"photo_correction", so.photo_correction},
-                        {"correction_noise", so.correction_noise},
-                        {"correction_sigma", so.correction_sigma},
-                        {"seed", so.seed},
-                        {"horizon_elevation_deg", synth::kHorizonElevationDeg}};
-  record["settings"].update(synth::AtlasSettingsJson(job.atlas));
-  record["summary"] = {{"photos_used", summary.photos_used},
-                       {"faces", summary.faces},
-                       {"subdivisions", summary.subdivisions},
-                       {"from_photos", summary.from_photos},
-                       {"from_neighbours_only", summary.from_neighbours},
-                       {"random", summary.random},
-                       {"atlases", summary.atlases},
-                       {"charts", summary.charts},
-                       {"chart_flattening", summary.chart_flattening},
-                       {"occupancy", summary.occupancy},
-                       {"seam_edges", summary.seam_edges},
-                       {"seam_cost_per_link", summary.seam_cost_per_link},
-                       {"straight_edge_cost_per_link", summary.edge_cost_per_link},
-                       {"photo_rms_quilted", synthesis.photo_rms_quilted},
-                       {"photo_rms_corrected", synthesis.photo_rms_corrected},
-                       {"photo_gains", synthesis.photo_gains},
-                       {"tangent_frame", synth::TangentFrameName(synthesis.tangent_frame)},
-                       {"sample_coherence", synthesis.sample_coherence >= 0.0
-                                                ? nlohmann::json(synthesis.sample_coherence)
-                                                : nlohmann::json(nullptr)}};
-  record["warnings"] = summary.warnings;
-  std::vector<std::pair<std::string, cv::Mat>> extra =
-      synth::RecordBaselines(flat_albedo, baked, record);
-  nlohmann::json btf_files = nlohmann::json::array();
-  for (std::size_t a = 0; a < atlases.geometry.size(); ++a) btf_files.push_back(AtlasFileName(a));
-  record["btf"] = {
-      {"format", "texlume-btf-model-1"},
-      {"factorisation", "btf/btf_svd.json"},
-      {"atlases", btf_files},
-      {"atlas_channels", "sample_x, sample_y, angle, gain_r, gain_g, gain_b (docs/btf.md)"},
-      {"ptm_atlases", "a preview: the BTF seen head-on, fitted per texel"}};
-  record["timings_s"] = {
-      {"load", inputs.seconds_load},
-      {"visibility", inputs.seconds_visibility},
-      {"factorise", summary.seconds_factorise},
-      {"synthesis", summary.seconds_synthesis},
-      {"seams", summary.seconds_seams},
-      {"atlas", summary.seconds_atlas},
-      {"ptm_preview", summary.seconds_preview},
-      {"synthesis_per_triangle", (summary.seconds_synthesis + summary.seconds_seams) /
-                                     static_cast<double>(std::max<std::size_t>(1, summary.faces))}};
-  // The geometry maps baked per atlas texel, for export: 8 bits per component
-  // with a scale and bias each, four components per RGBA PNG (docs/btf.md).
-  t = std::chrono::steady_clock::now();
-  std::vector<std::pair<std::string, std::vector<unsigned char>>> geometry_png;
-  nlohmann::json geometry_json = nlohmann::json::array();
-  for (std::size_t a = 0; a < atlases.geometry.size(); ++a) {
-    const auto& planes = atlases.geometry[a];
-    const int w = planes[0].cols, h = planes[0].rows;
-    std::vector<synth::QuantisedPlane> quantised(planes.size());
+  nlohmann::json Settings() const {
+    nlohmann::json settings = {{"sample_texel_size", so_.sample_texel_size},
+                               {"components", sample_.Components()},
+                               {"strip", so_.strip},
+                               {"seam_band", so_.seam_band},
+                               {"top_k", so_.top_k},
+                               {"max_views", so_.max_views},
+                               {"tangent_frame", synth::TangentFrameName(so_.tangent_frame)},
+                               {"tolerance", so_.tolerance},
+                               {"photo_correction", so_.photo_correction},
+                               {"correction_noise", so_.correction_noise},
+                               {"correction_sigma", so_.correction_sigma},
+                               {"seed", so_.seed},
+                               {"horizon_elevation_deg", synth::kHorizonElevationDeg}};
+    settings.update(synth::AtlasSettingsJson(job_.atlas));
+    return settings;
+  }
+
+  nlohmann::json Summary() const {
+    const BtfSynthJobSummary& s = summary_;
+    return {{"photos_used", s.photos_used},
+            {"faces", s.faces},
+            {"subdivisions", s.subdivisions},
+            {"from_photos", s.from_photos},
+            {"from_neighbours_only", s.from_neighbours},
+            {"random", s.random},
+            {"atlases", s.atlases},
+            {"charts", s.charts},
+            {"chart_flattening", s.chart_flattening},
+            {"occupancy", s.occupancy},
+            {"seam_edges", s.seam_edges},
+            {"seam_cost_per_link", s.seam_cost_per_link},
+            {"straight_edge_cost_per_link", s.edge_cost_per_link},
+            {"photo_rms_quilted", synthesis_.photo_rms_quilted},
+            {"photo_rms_corrected", synthesis_.photo_rms_corrected},
+            {"photo_gains", synthesis_.photo_gains},
+            {"tangent_frame", synth::TangentFrameName(synthesis_.tangent_frame)},
+            {"sample_coherence", synthesis_.sample_coherence >= 0.0
+                                     ? nlohmann::json(synthesis_.sample_coherence)
+                                     : nlohmann::json(nullptr)}};
+  }
+
+  nlohmann::json Record() {
+    nlohmann::json record;
+    record["command"] = "synth --btf";
+    record["inputs"] = {{"model", job_.model_dir.string()},
+                        {"images", job_.images_dir.string()},
+                        {"lights", job_.lights_file.string()},
+                        {"mesh", job_.mesh_file.string()},
+                        {"btf", options_.btf.string()}};
+    record["settings"] = Settings();
+    record["summary"] = Summary();
+    record["warnings"] = summary_.warnings;
+    extra_images_ = synth::RecordBaselines(flat_albedo_, baked_, record);
+    nlohmann::json btf_files = nlohmann::json::array();
+    for (std::size_t a = 0; a < atlases_.geometry.size(); ++a)
+      btf_files.push_back(AtlasFileName(a));
+    record["btf"] = {
+        {"format", "texlume-btf-model-1"},
+        {"factorisation", "btf/btf_svd.json"},
+        {"atlases", btf_files},
+        {"atlas_channels", "sample_x, sample_y, angle, gain_r, gain_g, gain_b (docs/btf.md)"},
+        {"ptm_atlases", "a preview: the BTF seen head-on, fitted per texel"}};
+    const BtfSynthJobSummary& s = summary_;
+    record["timings_s"] = {{"load", inputs_.seconds_load},
+                           {"visibility", inputs_.seconds_visibility},
+                           {"factorise", s.seconds_factorise},
+                           {"synthesis", s.seconds_synthesis},
+                           {"seams", s.seconds_seams},
+                           {"atlas", s.seconds_atlas},
+                           {"ptm_preview", s.seconds_preview},
+                           {"synthesis_per_triangle",
+                            (s.seconds_synthesis + s.seconds_seams) /
+                                static_cast<double>(std::max<std::size_t>(1, s.faces))}};
+    return record;
+  }
+
+  // 8 bits per component with a scale and bias each, four components per RGBA
+  // PNG (docs/btf.md); the PNGs go into geometry_png_, the manifest's entries
+  // are returned.
+  nlohmann::json EncodeGeometryAtlases() {
+    nlohmann::json geometry_json = nlohmann::json::array();
+    for (std::size_t a = 0; a < atlases_.geometry.size(); ++a) {
+      const auto& planes = atlases_.geometry[a];
+      const int w = planes[0].cols, h = planes[0].rows;
+      std::vector<synth::QuantisedPlane> quantised(planes.size());
 #pragma omp parallel for schedule(dynamic, 1)
-    for (std::size_t i = 0; i < planes.size(); ++i) {
-      const cv::Mat flat = planes[i].reshape(1, 1);
-      quantised[i] =
-          synth::QuantisePlane(std::vector<float>(flat.begin<float>(), flat.end<float>()));
-    }
-    nlohmann::json files = nlohmann::json::array();
-    geometry_png.resize(geometry_png.size() + (planes.size() + 3) / 4);
-    const std::size_t first = geometry_png.size() - (planes.size() + 3) / 4;
+      for (std::size_t i = 0; i < planes.size(); ++i) {
+        const cv::Mat flat = planes[i].reshape(1, 1);
+        quantised[i] =
+            synth::QuantisePlane(std::vector<float>(flat.begin<float>(), flat.end<float>()));
+      }
+      const std::size_t parts = (planes.size() + 3) / 4;
+      geometry_png_.resize(geometry_png_.size() + parts);
+      const std::size_t first = geometry_png_.size() - parts;
 #pragma omp parallel for schedule(dynamic, 1)
-    for (std::size_t part = 0; part < (planes.size() + 3) / 4; ++part) {
-      std::vector<const synth::QuantisedPlane*> group;
-      for (std::size_t i = part * 4; i < std::min(planes.size(), part * 4 + 4); ++i)
-        group.push_back(&quantised[i]);
-      const std::string name = GeometryFileName(a, part);
-      geometry_png[first + part] = {name, synth::PlanesPng(group, w, h, name)};
+      for (std::size_t part = 0; part < parts; ++part) {
+        std::vector<const synth::QuantisedPlane*> group;
+        for (std::size_t i = part * 4; i < std::min(planes.size(), part * 4 + 4); ++i)
+          group.push_back(&quantised[i]);
+        const std::string name = GeometryFileName(a, part);
+        geometry_png_[first + part] = {name, synth::PlanesPng(group, w, h, name)};
+      }
+      nlohmann::json files = nlohmann::json::array();
+      for (std::size_t part = 0; part < parts; ++part) {
+        nlohmann::json scale = nlohmann::json::array(), bias = nlohmann::json::array();
+        for (std::size_t i = part * 4; i < std::min(planes.size(), part * 4 + 4); ++i)
+          scale.push_back(quantised[i].scale), bias.push_back(quantised[i].bias);
+        files.push_back({{"file", GeometryFileName(a, part)}, {"scale", scale}, {"bias", bias}});
+      }
+      geometry_json.push_back(files);
     }
-    for (std::size_t part = 0; part < (planes.size() + 3) / 4; ++part) {
-      nlohmann::json scale = nlohmann::json::array(), bias = nlohmann::json::array();
-      for (std::size_t i = part * 4; i < std::min(planes.size(), part * 4 + 4); ++i)
-        scale.push_back(quantised[i].scale), bias.push_back(quantised[i].bias);
-      files.push_back({{"file", GeometryFileName(a, part)}, {"scale", scale}, {"bias", bias}});
-    }
-    geometry_json.push_back(files);
+    return geometry_json;
   }
-  record["btf"]["geometry_atlases"] = geometry_json;
-  summary.seconds_export = Since(t);
-  record["timings_s"]["export_geometry"] = summary.seconds_export;
-  synth::WriteModelFolder(job.out_dir, model, record, extra, [&](const fs::path& folder) {
-    WriteBtfFactorisation(sample, errors, folder / "btf");
-    for (std::size_t a = 0; a < atlases.sample_coords.size(); ++a) {
+
+  // The factorisation, the per-texel sample coordinates and factors, and the
+  // geometry-map PNGs, into the model folder being written.
+  void WriteBtfFiles(const fs::path& folder) const {
+    WriteBtfFactorisation(sample_, errors_, folder / "btf");
+    for (std::size_t a = 0; a < atlases_.sample_coords.size(); ++a) {
       std::vector<cv::Mat> planes, gain;
-      cv::split(atlases.sample_coords[a], planes);
-      cv::split(atlases.colour_gain[a], gain);
+      cv::split(atlases_.sample_coords[a], planes);
+      cv::split(atlases_.colour_gain[a], gain);
       planes.insert(planes.end(), gain.begin(), gain.end());
       std::vector<std::string> names = kCoordinateChannels;
       names.insert(names.end(), kGainChannels.begin(), kGainChannels.end());
       ptm::WriteExr(folder / AtlasFileName(a), planes, names);
     }
-    for (const auto& [name, bytes] : geometry_png) WriteBytesAtomically(folder / name, bytes);
-  });
-  summary.seconds_total = Since(start);
-  return summary;
+    for (const auto& [name, bytes] : geometry_png_) WriteBytesAtomically(folder / name, bytes);
+  }
+
+  const BtfSynthJobOptions& options_;
+  const synth::SynthJobOptions& job_;
+  const ProgressCallback& progress_;
+  BtfSynthJobSummary summary_;
+  synth::SynthInputs inputs_;
+  BtfFactorisation sample_;
+  std::vector<SvdError> errors_;
+  synth::BtfMeshSynthesisOptions so_;
+  synth::BtfMeshSynthesis synthesis_;
+  BtfAtlases atlases_;
+  synth::TexturedModel model_;
+  std::vector<cv::Mat> baked_;
+  Eigen::Vector3f flat_albedo_ = Eigen::Vector3f::Constant(0.5f);
+  std::vector<std::pair<std::string, cv::Mat>> extra_images_;
+  std::vector<std::pair<std::string, std::vector<unsigned char>>> geometry_png_;
+};
+
+}  // namespace
+
+BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
+                                  const ProgressCallback& progress) {
+  options.Check();
+  return BtfSynthJob(options, progress).Run();
 }
 
 }  // namespace texlume::btf

@@ -1,5 +1,6 @@
 #include "synth/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <map>
@@ -13,6 +14,7 @@
 #include "sfm/colmap_io.h"
 #include "sfm/lights.h"
 #include "sfm/mesh.h"
+#include "synth/colour_sample.h"
 #include "synth/report.h"
 
 namespace texlume::synth {
@@ -42,7 +44,38 @@ nlohmann::json MeanPriorShrink(const MeshSynthesis& synthesis) {
   return n ? nlohmann::json(sum / n) : nlohmann::json(nullptr);
 }
 
+// The colour engine's settings from the PTM job's: the engine's, and the
+// per-channel factors (off with --correction-iterations 0, as the PTM pass).
+ColourSynthesisOptions ColourOptions(const MeshSynthesisOptions& ptm) {
+  ColourSynthesisOptions colour;
+  static_cast<TriangleEngineOptions&>(colour) = ptm;
+  colour.photo_correction = ptm.correction_iterations > 0;
+  colour.correction_noise = ptm.correction_noise;
+  colour.correction_sigma = ptm.correction_sigma;
+  return colour;
+}
+
 }  // namespace
+
+bool IsColourImage(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".ptm") return false;
+  if (ext == ".exr") return ImageReader(path).channels() <= 4;  // a PTM EXR has 9 or 18
+  return true;
+}
+
+Sample ReadSample(const fs::path& path) {
+  Sample sample;
+  if (!IsColourImage(path)) {
+    sample.ptm = ptm::ReadPtmAnyFormat(path);
+    return sample;
+  }
+  sample.colour = ReadPhotoRgb(path);
+  sample.ptm = LambertianPtm(sample.colour);
+  return sample;
+}
 
 sfm::TriangleMesh SubdivideMidpoint(const sfm::TriangleMesh& mesh) {
   sfm::TriangleMesh out;
@@ -197,182 +230,250 @@ void SynthJobOptions::Check() const {
   synthesis.Check();
 }
 
+namespace {
+
+// The main job's steps, each a method, sharing the inputs, the synthesis and
+// the model they build (RunSynthJob).
+class SynthJob {
+ public:
+  SynthJob(const SynthJobOptions& options, const ProgressCallback& progress)
+      : options_(options), progress_(progress) {}
+
+  SynthJobSummary Run() {
+    const auto start = std::chrono::steady_clock::now();
+    RefuseAForeignOutputFolder();
+    Load();
+    Synthesize();
+    LayOut();
+    Baselines();
+    const auto t = std::chrono::steady_clock::now();
+    std::function<void(const fs::path&)> write_report;
+    if (options_.write_report)
+      write_report = [this](const fs::path& folder) { WriteModelReport(folder); };
+    WriteModelFolder(options_.out_dir, model_, Record(), extra_images_, write_report);
+    summary_.seconds_export = Since(t) - summary_.seconds_report;
+    summary_.seconds_total = Since(start);
+    return summary_;
+  }
+
+ private:
+  void RefuseAForeignOutputFolder() const {
+    const fs::path& out = options_.out_dir;
+    if (fs::exists(out) && (!fs::is_directory(out) ||
+                            (!fs::exists(out / "manifest.json") && !fs::is_empty(out))))
+      throw InputError(out.string(), "exists and is not a texlume model folder; not replacing it");
+  }
+
+  void Load() {
+    inputs_ = LoadSynthInputs(options_);
+    sample_ = ReadSample(options_.sample_file);
+    PrepareSynthMesh(inputs_, options_, std::min(sample_.ptm.width, sample_.ptm.height),
+                     options_.synthesis.sample_texel_size, options_.synthesis.strip, progress_);
+    summary_.warnings = inputs_.warnings;
+    summary_.photos_used = inputs_.photos.size();
+    summary_.subdivisions = inputs_.subdivisions;
+    summary_.faces = inputs_.mesh.faces.size();
+    summary_.seconds_load = inputs_.seconds_load;
+    summary_.seconds_visibility = inputs_.seconds_visibility;
+  }
+
+  // Synthesis (Algorithm 2) with the sample's kind.
+  void Synthesize() {
+    const auto t = std::chrono::steady_clock::now();
+    const SynthInputs& in = inputs_;
+    synthesis_ = sample_.colour.empty()
+                     ? SynthesizeMeshPtm(in.mesh, in.reconstruction, in.visibility, in.photos,
+                                         sample_.ptm, options_.synthesis, progress_)
+                     : SynthesizeMeshColour(in.mesh, in.reconstruction, in.visibility, in.photos,
+                                            sample_.colour, ColourOptions(options_.synthesis),
+                                            progress_);
+    summary_.seconds_synthesis = Since(t);
+    summary_.from_photos = synthesis_.num_from_photos;
+    summary_.from_neighbours = synthesis_.num_from_neighbours;
+    summary_.random = synthesis_.num_random;
+  }
+
+  // Blending and atlases: the textured model.
+  void LayOut() {
+    const auto t = std::chrono::steady_clock::now();
+    Atlases atlases = BuildAtlases(inputs_.mesh, synthesis_, options_.atlas, progress_);
+    summary_.seconds_atlas = Since(t);
+    summary_.atlases = atlases.ptms.size();
+    summary_.charts = static_cast<std::size_t>(atlases.num_charts);
+    summary_.chart_flattening = options_.atlas.mode == AtlasMode::kCharts
+                                    ? ChartFlatteningName(atlases.flattening)
+                                    : "none";
+    summary_.occupancy = atlases.occupancy;
+    summary_.stretch = atlases.stretch;
+    model_.mesh = inputs_.mesh;
+    model_.atlases = std::move(atlases.ptms);
+    for (const FacePlacement& fp : atlases.faces) {
+      model_.face_atlas.push_back(fp.atlas);
+      model_.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
+                                  fp.corners_px[2].cast<float>()});
+    }
+  }
+
+  // The baselines `texlume render --baseline` draws.
+  void Baselines() {
+    const auto t = std::chrono::steady_clock::now();
+    const SynthInputs& in = inputs_;
+    baked_ = BakePhotoTextures(model_, in.reconstruction, in.visibility, in.photos,
+                               synthesis_.photo_gains);
+    flat_albedo_ = MeanAlbedoFromPhotos(in.mesh, in.reconstruction, in.visibility, in.photos,
+                                        synthesis_.photo_gains);
+    summary_.seconds_baselines = Since(t);
+  }
+
+  nlohmann::json Settings() const {
+    const MeshSynthesisOptions& so = options_.synthesis;
+    nlohmann::json settings = {
+        {"sample_texel_size", so.sample_texel_size},
+        {"output_texel_size", so.sample_texel_size},
+        {"strip", so.strip},
+        {"top_k", so.top_k},
+        {"all_views", so.all_views},
+        {"max_views", so.max_views},
+        {"tangent_frame", TangentFrameName(so.tangent_frame)},
+        {"correction_iterations", so.correction_iterations},
+        {"additive_correction", so.additive_correction},
+        {"correction_noise", so.correction_noise},
+        {"channel_correction", so.channel_correction},
+        {"detail_transfer", so.detail_transfer},
+        {"correction_prior_shrink", so.correction_prior_shrink < 0.0
+                                        ? nlohmann::json("auto")
+                                        : nlohmann::json(so.correction_prior_shrink)},
+        {"correction_sigma", so.correction_sigma},
+        {"horizon_elevation_deg", kHorizonElevationDeg},
+        {"seed", so.seed},
+        {"sample_kind", sample_.colour.empty() ? "PTM" : "colour"}};
+    settings.update(AtlasSettingsJson(options_.atlas));
+    return settings;
+  }
+
+  nlohmann::json Summary() const {
+    const SynthJobSummary& s = summary_;
+    return {{"photos_used", s.photos_used},
+            {"faces", s.faces},
+            {"subdivisions", s.subdivisions},
+            {"from_photos", s.from_photos},
+            {"from_neighbours_only", s.from_neighbours},
+            {"random", s.random},
+            {"atlases", s.atlases},
+            {"charts", s.charts},
+            {"chart_flattening", s.chart_flattening},
+            {"occupancy", s.occupancy},
+            {"texel_stretch",
+             {{"mean", s.stretch.mean}, {"min", s.stretch.min}, {"max", s.stretch.max}}},
+            {"photo_gains", synthesis_.photo_gains},
+            {"mean_prior_shrink", MeanPriorShrink(synthesis_)},
+            {"tangent_frame", TangentFrameName(synthesis_.tangent_frame)},
+            {"sample_coherence", synthesis_.sample_coherence >= 0.0
+                                     ? nlohmann::json(synthesis_.sample_coherence)
+                                     : nlohmann::json(nullptr)}};
+  }
+
+  // The manifest's record: inputs, settings, summary, warnings, baselines, timings.
+  nlohmann::json Record() {
+    nlohmann::json record;
+    record["command"] = "synth";
+    record["inputs"] = {{"model", options_.model_dir.string()},
+                        {"images", options_.images_dir.string()},
+                        {"lights", options_.lights_file.string()},
+                        {"mesh", options_.mesh_file.string()},
+                        {"sample", options_.sample_file.string()}};
+    record["settings"] = Settings();
+    record["summary"] = Summary();
+    record["warnings"] = summary_.warnings;
+    extra_images_ = RecordBaselines(flat_albedo_, baked_, record);
+    const SynthJobSummary& s = summary_;
+    record["timings_s"] = {
+        {"load", s.seconds_load},
+        {"visibility", s.seconds_visibility},
+        {"synthesis", s.seconds_synthesis},
+        {"atlas", s.seconds_atlas},
+        {"baselines", s.seconds_baselines},
+        {"synthesis_per_triangle", s.seconds_synthesis / std::max<std::size_t>(1, s.faces)}};
+    return record;
+  }
+
+  // The photos and their views (under their lights, beside the photo divided by its gain).
+  void AddPhotoViews(ReportInputs& report) const {
+    const std::vector<MeshPhoto>& photos = inputs_.photos;
+    for (std::size_t i = 0; i < photos.size(); ++i) {
+      const MeshPhoto& p = photos[i];
+      const sfm::Image& image = inputs_.reconstruction.images.at(p.image_id);
+      report.photos.push_back({p.name, options_.images_dir / p.name, p.lights, p.image});
+      ReportView view;
+      view.name = p.name;
+      view.camera = inputs_.reconstruction.cameras.at(image.camera_id);
+      view.cam_from_world = image.cam_from_world;
+      view.lights = p.lights;
+      view.reference_image = options_.images_dir / p.name;
+      view.reference = p.image;
+      view.reference_gain =
+          i < synthesis_.photo_gains.size() ? synthesis_.photo_gains[i] : 1.0;
+      report.views.push_back(std::move(view));
+    }
+    report.views_heading = "Photo views under the photos' lights";
+  }
+
+  void WriteModelReport(const fs::path& folder) {
+    const SynthJobSummary& s = summary_;
+    ReportInputs report;
+    report.title = "texlume synth: " + options_.mesh_file.filename().string();
+    report.intro =
+        "The relightable model texlume synthesised from the photos and the material sample: "
+        "the mesh covered with PTM atlases whose detail comes from the sample, chosen triangle "
+        "by triangle to agree with the photos under their lights. Below, the model is drawn "
+        "from some of the photos' own views under their lights beside the photo (divided by "
+        "its estimated exposure) and the two baselines; texlume render measures it on "
+        "held-out views.";
+    report.model = &model_;
+    report.flat_albedo = flat_albedo_;
+    report.baked = baked_;
+    report.sample = &sample_.ptm;
+    AddPhotoViews(report);
+    report.occupancy = s.occupancy;
+    report.facts = {
+        {"triangles", std::to_string(s.faces) + " (" + std::to_string(s.from_photos) +
+                          " constrained by photos, " + std::to_string(s.from_neighbours) +
+                          " by neighbours only)"},
+        {"photos used", std::to_string(s.photos_used)},
+        {"sample texel size",
+         std::to_string(options_.synthesis.sample_texel_size) + " world units"},
+        {"atlases", std::to_string(s.atlases) + " of " +
+                        std::to_string(options_.atlas.atlas_size) + " texels, " +
+                        std::to_string(s.charts) + " charts"}};
+    for (const std::string& w : s.warnings) report.facts.emplace_back("warning", w);
+    report.timings_s = {{"load", s.seconds_load},
+                        {"visibility", s.seconds_visibility},
+                        {"synthesis", s.seconds_synthesis},
+                        {"atlas", s.seconds_atlas},
+                        {"baselines", s.seconds_baselines}};
+    report.links = {{"model.glb", "model.glb"},
+                    {"model.obj", "model.obj"},
+                    {"manifest.json", "manifest.json"}};
+    summary_.seconds_report = WriteReport(folder, report, progress_).seconds;
+  }
+
+  const SynthJobOptions& options_;
+  const ProgressCallback& progress_;
+  SynthJobSummary summary_;
+  SynthInputs inputs_;
+  Sample sample_;
+  MeshSynthesis synthesis_;
+  TexturedModel model_;
+  std::vector<cv::Mat> baked_;
+  Eigen::Vector3f flat_albedo_ = Eigen::Vector3f::Constant(0.5f);
+  std::vector<std::pair<std::string, cv::Mat>> extra_images_;
+};
+
+}  // namespace
+
 SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress) {
   options.Check();
-  const auto start = std::chrono::steady_clock::now();
-  SynthJobSummary summary;
-  if (fs::exists(options.out_dir) &&
-      (!fs::is_directory(options.out_dir) ||
-       (!fs::exists(options.out_dir / "manifest.json") && !fs::is_empty(options.out_dir)))) {
-    throw InputError(options.out_dir.string(),
-                     "exists and is not a texlume model folder; not replacing it");
-  }
-
-  SynthInputs inputs = LoadSynthInputs(options);
-  const ptm::Ptm sample = ptm::ReadPtmAnyFormat(options.sample_file);
-  PrepareSynthMesh(inputs, options, std::min(sample.width, sample.height),
-                   options.synthesis.sample_texel_size, options.synthesis.strip, progress);
-  const sfm::Reconstruction& reconstruction = inputs.reconstruction;
-  const sfm::TriangleMesh& mesh = inputs.mesh;
-  const std::vector<MeshPhoto>& photos = inputs.photos;
-  const sfm::VisibilityResult& visibility = inputs.visibility;
-  summary.warnings = inputs.warnings;
-  summary.photos_used = photos.size();
-  summary.subdivisions = inputs.subdivisions;
-  summary.faces = mesh.faces.size();
-  summary.seconds_load = inputs.seconds_load;
-  summary.seconds_visibility = inputs.seconds_visibility;
-
-  // Synthesis (Algorithm 2), blending and atlases.
-  auto t = std::chrono::steady_clock::now();
-  const MeshSynthesis synthesis = SynthesizeMeshPtm(mesh, reconstruction, visibility, photos,
-                                                    sample, options.synthesis, progress);
-  summary.seconds_synthesis = Since(t);
-  summary.from_photos = synthesis.num_from_photos;
-  summary.from_neighbours = synthesis.num_from_neighbours;
-  summary.random = synthesis.num_random;
-  t = std::chrono::steady_clock::now();
-  Atlases atlases = BuildAtlases(mesh, synthesis, options.atlas, progress);
-  summary.seconds_atlas = Since(t);
-  summary.atlases = atlases.ptms.size();
-  summary.charts = static_cast<std::size_t>(atlases.num_charts);
-  summary.chart_flattening =
-      options.atlas.mode == AtlasMode::kCharts ? ChartFlatteningName(atlases.flattening) : "none";
-  summary.occupancy = atlases.occupancy;
-  summary.stretch = atlases.stretch;
-
-  TexturedModel model;
-  model.mesh = mesh;
-  model.atlases = std::move(atlases.ptms);
-  for (const FacePlacement& fp : atlases.faces) {
-    model.face_atlas.push_back(fp.atlas);
-    model.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
-                               fp.corners_px[2].cast<float>()});
-  }
-
-  // Baselines for `texlume render --baseline`.
-  t = std::chrono::steady_clock::now();
-  const std::vector<cv::Mat> baked =
-      BakePhotoTextures(model, reconstruction, visibility, photos, synthesis.photo_gains);
-  const Eigen::Vector3f flat_albedo =
-      MeanAlbedoFromPhotos(mesh, reconstruction, visibility, photos, synthesis.photo_gains);
-  summary.seconds_baselines = Since(t);
-
-  t = std::chrono::steady_clock::now();
-  nlohmann::json record;
-  record["command"] = "synth";
-  record["inputs"] = {{"model", options.model_dir.string()},
-                      {"images", options.images_dir.string()},
-                      {"lights", options.lights_file.string()},
-                      {"mesh", options.mesh_file.string()},
-                      {"sample", options.sample_file.string()}};
-  const MeshSynthesisOptions& so = options.synthesis;
-  record["settings"] = {
-      {"sample_texel_size", so.sample_texel_size},
-      {"output_texel_size", so.sample_texel_size},
-      {"strip", so.strip},
-      {"top_k", so.top_k},
-      {"all_views", so.all_views},
-      {"max_views", so.max_views},
-      {"tangent_frame", TangentFrameName(so.tangent_frame)},
-      {"correction_iterations", so.correction_iterations},
-      {"additive_correction", so.additive_correction},
-      {"correction_noise", so.correction_noise},
-      {"channel_correction", so.channel_correction},
-      {"detail_transfer", so.detail_transfer},
-      {"correction_prior_shrink", so.correction_prior_shrink < 0.0
-                                      ? nlohmann::json("auto")
-                                      : nlohmann::json(so.correction_prior_shrink)},
-      {"correction_sigma", so.correction_sigma},
-      {"horizon_elevation_deg", kHorizonElevationDeg},
-      {"seed", so.seed}};
-  record["settings"].update(AtlasSettingsJson(options.atlas));
-  record["summary"] = {{"photos_used", summary.photos_used},
-                       {"faces", summary.faces},
-                       {"subdivisions", summary.subdivisions},
-                       {"from_photos", summary.from_photos},
-                       {"from_neighbours_only", summary.from_neighbours},
-                       {"random", summary.random},
-                       {"atlases", summary.atlases},
-                       {"charts", summary.charts},
-                       {"chart_flattening", summary.chart_flattening},
-                       {"occupancy", summary.occupancy},
-                       {"texel_stretch",
-                        {{"mean", summary.stretch.mean},
-                         {"min", summary.stretch.min},
-                         {"max", summary.stretch.max}}},
-                       {"photo_gains", synthesis.photo_gains},
-                       {"mean_prior_shrink", MeanPriorShrink(synthesis)},
-                       {"tangent_frame", TangentFrameName(synthesis.tangent_frame)},
-                       {"sample_coherence", synthesis.sample_coherence >= 0.0
-                                                ? nlohmann::json(synthesis.sample_coherence)
-                                                : nlohmann::json(nullptr)}};
-  record["warnings"] = summary.warnings;
-  std::vector<std::pair<std::string, cv::Mat>> extra = RecordBaselines(flat_albedo, baked, record);
-  record["timings_s"] = {{"load", summary.seconds_load},
-                         {"visibility", summary.seconds_visibility},
-                         {"synthesis", summary.seconds_synthesis},
-                         {"atlas", summary.seconds_atlas},
-                         {"baselines", summary.seconds_baselines},
-                         {"synthesis_per_triangle",
-                          summary.seconds_synthesis / std::max<std::size_t>(1, summary.faces)}};
-  std::function<void(const fs::path&)> write_report;
-  if (options.write_report) {
-    write_report = [&](const fs::path& folder) {
-      ReportInputs report;
-      report.title = "texlume synth: " + options.mesh_file.filename().string();
-      report.intro =
-          "The relightable model texlume synthesised from the photos and the material sample: "
-          "the mesh covered with PTM atlases whose detail comes from the sample, chosen triangle "
-          "by triangle to agree with the photos under their lights. Below, the model is drawn "
-          "from some of the photos' own views under their lights beside the photo (divided by "
-          "its estimated exposure) and the two baselines; texlume render measures it on "
-          "held-out views.";
-      report.model = &model;
-      report.flat_albedo = flat_albedo;
-      report.baked = baked;
-      report.sample = &sample;
-      for (std::size_t i = 0; i < photos.size(); ++i) {
-        const MeshPhoto& p = photos[i];
-        const sfm::Image& image = reconstruction.images.at(p.image_id);
-        report.photos.push_back({p.name, options.images_dir / p.name, p.lights, p.image});
-        ReportView view;
-        view.name = p.name;
-        view.camera = reconstruction.cameras.at(image.camera_id);
-        view.cam_from_world = image.cam_from_world;
-        view.lights = p.lights;
-        view.reference_image = options.images_dir / p.name;
-        view.reference = p.image;
-        view.reference_gain = i < synthesis.photo_gains.size() ? synthesis.photo_gains[i] : 1.0;
-        report.views.push_back(std::move(view));
-      }
-      report.views_heading = "Photo views under the photos' lights";
-      report.occupancy = summary.occupancy;
-      report.facts = {
-          {"triangles", std::to_string(summary.faces) + " (" + std::to_string(summary.from_photos) +
-                            " constrained by photos, " + std::to_string(summary.from_neighbours) +
-                            " by neighbours only)"},
-          {"photos used", std::to_string(summary.photos_used)},
-          {"sample texel size", std::to_string(so.sample_texel_size) + " world units"},
-          {"atlases", std::to_string(summary.atlases) + " of " +
-                          std::to_string(options.atlas.atlas_size) + " texels, " +
-                          std::to_string(summary.charts) + " charts"}};
-      for (const std::string& w : summary.warnings) report.facts.emplace_back("warning", w);
-      report.timings_s = {{"load", summary.seconds_load},
-                          {"visibility", summary.seconds_visibility},
-                          {"synthesis", summary.seconds_synthesis},
-                          {"atlas", summary.seconds_atlas},
-                          {"baselines", summary.seconds_baselines}};
-      report.links = {{"model.glb", "model.glb"},
-                      {"model.obj", "model.obj"},
-                      {"manifest.json", "manifest.json"}};
-      summary.seconds_report = WriteReport(folder, report, progress).seconds;
-    };
-  }
-  WriteModelFolder(options.out_dir, model, record, extra, write_report);
-  summary.seconds_export = Since(t) - summary.seconds_report;
-  summary.seconds_total = Since(start);
-  return summary;
+  return SynthJob(options, progress).Run();
 }
 
 std::vector<std::pair<std::string, cv::Mat>> RecordBaselines(const Eigen::Vector3f& flat_albedo,

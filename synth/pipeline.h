@@ -21,7 +21,7 @@ struct SynthJobOptions {
   std::filesystem::path images_dir;   ///< the object photos, by the model's image names
   std::filesystem::path lights_file;  ///< object-lights JSON (docs/lights.md)
   std::filesystem::path mesh_file;    ///< coarse mesh in the model's frame
-  std::filesystem::path sample_file;  ///< sample PTM (.ptm or .exr)
+  std::filesystem::path sample_file;  ///< sample: PTM (.ptm, .exr) or colour photo (ReadSample)
   std::filesystem::path out_dir;      ///< the model folder written
   MeshSynthesisOptions synthesis;     ///< sample_texel_size required
   AtlasOptions atlas;
@@ -53,6 +53,19 @@ struct SynthJobSummary {
   double seconds_load = 0, seconds_visibility = 0, seconds_synthesis = 0, seconds_atlas = 0,
          seconds_baselines = 0, seconds_report = 0, seconds_export = 0, seconds_total = 0;
 };
+
+/// The material sample of the main job: a PTM (.ptm, or an EXR of PTM
+/// channels), or an ordinary photo of the material (PNG, JPEG, TIFF, or an EXR
+/// of at most 4 channels), which is quilted as a colour sample and baked as
+/// its LambertianPtm.
+struct Sample {
+  ptm::Ptm ptm;    ///< the PTM, or the colour sample's LambertianPtm
+  cv::Mat colour;  ///< CV_32FC3 display RGB for a colour sample; empty for a PTM
+};
+/// Whether a sample file is a colour image (by extension, and channel count for EXR).
+bool IsColourImage(const std::filesystem::path& path);
+/// Reads a sample file. Throws InputError naming it when it is unreadable.
+Sample ReadSample(const std::filesystem::path& path);
 
 /// The main job's inputs, read and checked (shared with the BTF job, btf/).
 struct SynthInputs {

@@ -494,5 +494,50 @@ TEST(Cli, SynthWithABtfSampleRendersAsABtfAndRefusesBadInput) {
   EXPECT_FALSE(std::filesystem::exists(tmp / "x"));
 }
 
+// The main job with a colour sample (an ordinary photo of the material): a
+// model folder of PTM atlases that `texlume render` draws; a sample that is no
+// image is an input error naming it.
+TEST(Cli, SynthWithAColourSampleWritesAModelThatRenders) {
+  TempDir tmp;
+  datasets::SceneOptions options = SmallBtfScene(8, 96, 40);
+  options.write_btf = false;
+  options.capture_size = 64;
+  options.focal_px = 90;
+  options.num_held_out_views = 1;
+  options.held_out_lights_per_view = 1;
+  options.material.texel_size = 0.01;
+  datasets::GenerateScene(options, tmp.path() / "scene");
+  const std::string scene = (tmp / "scene").string();
+  const std::string inputs = " --model " + scene + "/object/sparse --images " + scene +
+                             "/object/images --lights " + scene + "/object/lights.json --mesh " +
+                             scene + "/object/mesh.ply --atlas-size 512 --no-report" +
+                             " --sample-texel-size 0.01";
+  std::string out;
+  ASSERT_EQ(Texlume("synth" + inputs + " --sample " + scene +
+                        "/material/capture/rti_005.png --out " + (tmp / "model").string(),
+                    &out),
+            0)
+      << out;
+  const nlohmann::json manifest =
+      nlohmann::json::parse(testing::ReadText(tmp / "model/manifest.json"));
+  EXPECT_EQ(manifest["settings"]["sample_kind"], "colour");
+  const std::string held = scene + "/object/held_out";
+  ASSERT_EQ(Texlume("render --model " + (tmp / "model").string() + " --cameras " + held +
+                        "/sparse --lights " + held + "/lights.json --truth " + held +
+                        "/images --truth-masks " + held + "/masks --out " + (tmp / "r").string(),
+                    &out),
+            0)
+      << out;
+  const nlohmann::json render = nlohmann::json::parse(testing::ReadText(tmp / "r/render.json"));
+  EXPECT_GT(render["metrics"]["mean_psnr_db"].get<double>(), 10.0);
+  testing::WriteText(tmp / "not_an_image.png", "plain text");
+  EXPECT_EQ(Texlume("synth" + inputs + " --sample " + (tmp / "not_an_image.png").string() +
+                        " --out " + (tmp / "bad").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("not_an_image.png"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
+}
+
 }  // namespace
 }  // namespace texlume
