@@ -262,7 +262,7 @@ class BtfSynthJob {
 
   BtfSynthJobSummary Run() {
     const auto start = std::chrono::steady_clock::now();
-    RefuseAForeignOutputFolder();
+    synth::RefuseForeignModelFolder(job_.out_dir);
     inputs_ = synth::LoadSynthInputs(job_);
     LoadSample();
     Synthesize();
@@ -280,13 +280,6 @@ class BtfSynthJob {
   }
 
  private:
-  void RefuseAForeignOutputFolder() const {
-    const fs::path& out = job_.out_dir;
-    if (fs::exists(out) && (!fs::is_directory(out) ||
-                            (!fs::exists(out / "manifest.json") && !fs::is_empty(out))))
-      throw InputError(out.string(), "exists and is not a texlume model folder; not replacing it");
-  }
-
   // The sample: a factorisation as it is, or a capture factorised here; its
   // error table; the synthesis settings with its texel size; the mesh.
   void LoadSample() {
@@ -314,9 +307,8 @@ class BtfSynthJob {
   }
 
   void Synthesize() {
-    synthesis_ = synth::SynthesizeMeshBtf(inputs_.mesh, inputs_.reconstruction,
-                                          inputs_.visibility, inputs_.photos, sample_, so_,
-                                          progress_);
+    synthesis_ = synth::SynthesizeMeshBtf(inputs_.mesh, inputs_.reconstruction, inputs_.visibility,
+                                          inputs_.photos, sample_, so_, progress_);
     summary_.seconds_synthesis = synthesis_.seconds_synthesis;
     summary_.seconds_seams = synthesis_.seconds_seams;
     summary_.from_photos = synthesis_.num_from_photos;
@@ -340,19 +332,14 @@ class BtfSynthJob {
                                     : "none";
     summary_.occupancy = atlases_.occupancy;
     t = std::chrono::steady_clock::now();
-    model_.mesh = inputs_.mesh;
-    model_.atlases = PreviewPtms(atlases_, sample_, progress_);
-    for (const synth::FacePlacement& fp : atlases_.layout.faces) {
-      model_.face_atlas.push_back(fp.atlas);
-      model_.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
-                                  fp.corners_px[2].cast<float>()});
-    }
+    model_ = synth::TexturedModelOf(inputs_.mesh, PreviewPtms(atlases_, sample_, progress_),
+                                    atlases_.layout.faces);
     summary_.seconds_preview = Since(t);
     baked_ = synth::BakePhotoTextures(model_, inputs_.reconstruction, inputs_.visibility,
                                       inputs_.photos, synthesis_.photo_gains);
-    flat_albedo_ = synth::MeanAlbedoFromPhotos(inputs_.mesh, inputs_.reconstruction,
-                                               inputs_.visibility, inputs_.photos,
-                                               synthesis_.photo_gains);
+    flat_albedo_ =
+        synth::MeanAlbedoFromPhotos(inputs_.mesh, inputs_.reconstruction, inputs_.visibility,
+                                    inputs_.photos, synthesis_.photo_gains);
   }
 
   nlohmann::json Settings() const {
@@ -419,16 +406,16 @@ class BtfSynthJob {
         {"atlas_channels", "sample_x, sample_y, angle, gain_r, gain_g, gain_b (docs/btf.md)"},
         {"ptm_atlases", "a preview: the BTF seen head-on, fitted per texel"}};
     const BtfSynthJobSummary& s = summary_;
-    record["timings_s"] = {{"load", inputs_.seconds_load},
-                           {"visibility", inputs_.seconds_visibility},
-                           {"factorise", s.seconds_factorise},
-                           {"synthesis", s.seconds_synthesis},
-                           {"seams", s.seconds_seams},
-                           {"atlas", s.seconds_atlas},
-                           {"ptm_preview", s.seconds_preview},
-                           {"synthesis_per_triangle",
-                            (s.seconds_synthesis + s.seconds_seams) /
-                                static_cast<double>(std::max<std::size_t>(1, s.faces))}};
+    record["timings_s"] = {
+        {"load", inputs_.seconds_load},
+        {"visibility", inputs_.seconds_visibility},
+        {"factorise", s.seconds_factorise},
+        {"synthesis", s.seconds_synthesis},
+        {"seams", s.seconds_seams},
+        {"atlas", s.seconds_atlas},
+        {"ptm_preview", s.seconds_preview},
+        {"synthesis_per_triangle", (s.seconds_synthesis + s.seconds_seams) /
+                                       static_cast<double>(std::max<std::size_t>(1, s.faces))}};
     return record;
   }
 

@@ -42,17 +42,6 @@ BtfSample::BtfSample(const btf::BtfFactorisation& btf)
       energy_(PlaneEnergy(geometry_)),
       mean_g_(btf.geometry.colwise().mean().transpose()) {}
 
-bool BtfSample::PatchFeatures(const TrianglePatch& patch, double t, const Eigen::Vector2d& p,
-                              float* out) const {
-  const double sx = patch.sample_x + (p.x() - patch.x_min) / t;
-  const double sy = patch.sample_y + (patch.y_max - p.y()) / t;
-  if (sx < patch.sample_x || sy < patch.sample_y || sx > patch.sample_x + patch.width ||
-      sy > patch.sample_y + patch.height)
-    return false;
-  SampleGeometry(btf_, Eigen::Vector2d(sx, sy), out);
-  return true;
-}
-
 void BtfSample::FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const {
   SampleGeometry(btf_, sample_px, out);
 }

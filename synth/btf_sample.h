@@ -23,8 +23,6 @@ class BtfSample : public MaterialSample {
   int Height() const override { return btf_.height; }
   const std::vector<cv::Mat>& FeaturePlanes() const override { return geometry_; }
   const cv::Mat& FeatureEnergy() const override { return energy_; }
-  bool PatchFeatures(const TrianglePatch& patch, double texel_size,
-                     const Eigen::Vector2d& p_in_frame, float* out) const override;
   void FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const override;
   void TurnFeatures(const Unfolding&, float*) const override {}
   bool Blendable() const override { return false; }

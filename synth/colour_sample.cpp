@@ -66,17 +66,6 @@ ColourSample::ColourSample(const cv::Mat& display_rgb) {
   mean_linear_sum_ = sum / static_cast<double>(display_rgb.total());
 }
 
-bool ColourSample::PatchFeatures(const TrianglePatch& patch, double t, const Eigen::Vector2d& p,
-                                 float* out) const {
-  const double sx = patch.sample_x + (p.x() - patch.x_min) / t;
-  const double sy = patch.sample_y + (patch.y_max - p.y()) / t;
-  if (sx < patch.sample_x || sy < patch.sample_y || sx > patch.sample_x + patch.width ||
-      sy > patch.sample_y + patch.height)
-    return false;
-  FeaturesAt(Eigen::Vector2d(sx, sy), out);
-  return true;
-}
-
 void ColourSample::FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const {
   for (std::size_t c = 0; c < 3; ++c)
     out[c] =

@@ -28,8 +28,6 @@ class ColourSample : public MaterialSample {
   int Height() const override { return display_[0].rows; }
   const std::vector<cv::Mat>& FeaturePlanes() const override { return display_; }
   const cv::Mat& FeatureEnergy() const override { return energy_; }
-  bool PatchFeatures(const TrianglePatch& patch, double texel_size,
-                     const Eigen::Vector2d& p_in_frame, float* out) const override;
   void FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const override;
   void TurnFeatures(const Unfolding&, float*) const override {}
   bool Blendable() const override { return true; }

@@ -117,6 +117,17 @@ const ReducedPlanes& MaterialSample::Reduced(int level) const {
   return reduced_.emplace(level, ReduceToDensityLevel(RelightPlanes(), level)).first->second;
 }
 
+bool MaterialSample::PatchFeatures(const TrianglePatch& patch, double t, const Eigen::Vector2d& p,
+                                   float* out) const {
+  const double sx = patch.sample_x + (p.x() - patch.x_min) / t;
+  const double sy = patch.sample_y + (patch.y_max - p.y()) / t;
+  if (sx < patch.sample_x || sy < patch.sample_y || sx > patch.sample_x + patch.width ||
+      sy > patch.sample_y + patch.height)
+    return false;
+  FeaturesAt(Eigen::Vector2d(sx, sy), out);
+  return true;
+}
+
 double BilinearClamped(const cv::Mat& m, double x, double y) {
   x = std::clamp(x, 0.0, m.cols - 1.0);
   y = std::clamp(y, 0.0, m.rows - 1.0);

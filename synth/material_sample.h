@@ -54,8 +54,10 @@ class MaterialSample {
   /// The features a placed patch shows at a point of its face's frame (world
   /// units), with whatever the photo-consistency pass changed in them;
   /// false outside the patch rectangle. `out` holds NumFeatures() values.
+  /// By default FeaturesAt the point's sample position (a pass that changes no
+  /// feature).
   virtual bool PatchFeatures(const TrianglePatch& patch, double texel_size,
-                             const Eigen::Vector2d& p_in_frame, float* out) const = 0;
+                             const Eigen::Vector2d& p_in_frame, float* out) const;
   /// The features at a continuous sample position (texels, x right, y down,
   /// centres at +0.5), bilinear, clamped to the sample.
   virtual void FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const = 0;

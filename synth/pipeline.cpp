@@ -230,6 +230,25 @@ void SynthJobOptions::Check() const {
   synthesis.Check();
 }
 
+void RefuseForeignModelFolder(const fs::path& out) {
+  if (fs::exists(out) &&
+      (!fs::is_directory(out) || (!fs::exists(out / "manifest.json") && !fs::is_empty(out))))
+    throw InputError(out.string(), "exists and is not a texlume model folder; not replacing it");
+}
+
+TexturedModel TexturedModelOf(const sfm::TriangleMesh& mesh, std::vector<ptm::Ptm> atlases,
+                              const std::vector<FacePlacement>& faces) {
+  TexturedModel model;
+  model.mesh = mesh;
+  model.atlases = std::move(atlases);
+  for (const FacePlacement& fp : faces) {
+    model.face_atlas.push_back(fp.atlas);
+    model.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
+                               fp.corners_px[2].cast<float>()});
+  }
+  return model;
+}
+
 namespace {
 
 // The main job's steps, each a method, sharing the inputs, the synthesis and
@@ -241,7 +260,7 @@ class SynthJob {
 
   SynthJobSummary Run() {
     const auto start = std::chrono::steady_clock::now();
-    RefuseAForeignOutputFolder();
+    RefuseForeignModelFolder(options_.out_dir);
     Load();
     Synthesize();
     LayOut();
@@ -257,13 +276,6 @@ class SynthJob {
   }
 
  private:
-  void RefuseAForeignOutputFolder() const {
-    const fs::path& out = options_.out_dir;
-    if (fs::exists(out) && (!fs::is_directory(out) ||
-                            (!fs::exists(out / "manifest.json") && !fs::is_empty(out))))
-      throw InputError(out.string(), "exists and is not a texlume model folder; not replacing it");
-  }
-
   void Load() {
     inputs_ = LoadSynthInputs(options_);
     sample_ = ReadSample(options_.sample_file);
@@ -281,12 +293,12 @@ class SynthJob {
   void Synthesize() {
     const auto t = std::chrono::steady_clock::now();
     const SynthInputs& in = inputs_;
-    synthesis_ = sample_.colour.empty()
-                     ? SynthesizeMeshPtm(in.mesh, in.reconstruction, in.visibility, in.photos,
-                                         sample_.ptm, options_.synthesis, progress_)
-                     : SynthesizeMeshColour(in.mesh, in.reconstruction, in.visibility, in.photos,
-                                            sample_.colour, ColourOptions(options_.synthesis),
-                                            progress_);
+    synthesis_ =
+        sample_.colour.empty()
+            ? SynthesizeMeshPtm(in.mesh, in.reconstruction, in.visibility, in.photos, sample_.ptm,
+                                options_.synthesis, progress_)
+            : SynthesizeMeshColour(in.mesh, in.reconstruction, in.visibility, in.photos,
+                                   sample_.colour, ColourOptions(options_.synthesis), progress_);
     summary_.seconds_synthesis = Since(t);
     summary_.from_photos = synthesis_.num_from_photos;
     summary_.from_neighbours = synthesis_.num_from_neighbours;
@@ -305,13 +317,7 @@ class SynthJob {
                                     : "none";
     summary_.occupancy = atlases.occupancy;
     summary_.stretch = atlases.stretch;
-    model_.mesh = inputs_.mesh;
-    model_.atlases = std::move(atlases.ptms);
-    for (const FacePlacement& fp : atlases.faces) {
-      model_.face_atlas.push_back(fp.atlas);
-      model_.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
-                                  fp.corners_px[2].cast<float>()});
-    }
+    model_ = TexturedModelOf(inputs_.mesh, std::move(atlases.ptms), atlases.faces);
   }
 
   // The baselines `texlume render --baseline` draws.
@@ -411,8 +417,7 @@ class SynthJob {
       view.lights = p.lights;
       view.reference_image = options_.images_dir / p.name;
       view.reference = p.image;
-      view.reference_gain =
-          i < synthesis_.photo_gains.size() ? synthesis_.photo_gains[i] : 1.0;
+      view.reference_gain = i < synthesis_.photo_gains.size() ? synthesis_.photo_gains[i] : 1.0;
       report.views.push_back(std::move(view));
     }
     report.views_heading = "Photo views under the photos' lights";
@@ -442,18 +447,16 @@ class SynthJob {
         {"photos used", std::to_string(s.photos_used)},
         {"sample texel size",
          std::to_string(options_.synthesis.sample_texel_size) + " world units"},
-        {"atlases", std::to_string(s.atlases) + " of " +
-                        std::to_string(options_.atlas.atlas_size) + " texels, " +
-                        std::to_string(s.charts) + " charts"}};
+        {"atlases", std::to_string(s.atlases) + " of " + std::to_string(options_.atlas.atlas_size) +
+                        " texels, " + std::to_string(s.charts) + " charts"}};
     for (const std::string& w : s.warnings) report.facts.emplace_back("warning", w);
     report.timings_s = {{"load", s.seconds_load},
                         {"visibility", s.seconds_visibility},
                         {"synthesis", s.seconds_synthesis},
                         {"atlas", s.seconds_atlas},
                         {"baselines", s.seconds_baselines}};
-    report.links = {{"model.glb", "model.glb"},
-                    {"model.obj", "model.obj"},
-                    {"manifest.json", "manifest.json"}};
+    report.links = {
+        {"model.glb", "model.glb"}, {"model.obj", "model.obj"}, {"manifest.json", "manifest.json"}};
     summary_.seconds_report = WriteReport(folder, report, progress_).seconds;
   }
 

@@ -89,6 +89,15 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options);
 void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int sample_side,
                       double sample_texel_size, int strip, const ProgressCallback& progress = {});
 
+/// Refuses an output folder that exists and is not a texlume model folder
+/// (InputError naming it): a job never replaces anything else.
+void RefuseForeignModelFolder(const std::filesystem::path& out_dir);
+
+/// The textured model of a layout: the mesh, and per face its atlas and its
+/// corners' texture coordinates (FacePlacement), with the atlases.
+TexturedModel TexturedModelOf(const sfm::TriangleMesh& mesh, std::vector<ptm::Ptm> atlases,
+                              const std::vector<FacePlacement>& faces);
+
 /// Runs the whole job: reads and checks the inputs, visibility and best views,
 /// per-triangle synthesis (Algorithm 2), blending, atlases, and the model folder
 /// (WriteModelFolder, plus the baselines `texlume render` draws: baked_K.png
