@@ -300,10 +300,7 @@ class BtfSynthJob {
     so_.Check();
     synth::PrepareSynthMesh(inputs_, job_, std::min(sample_.width, sample_.height),
                             so_.sample_texel_size, so_.strip, progress_);
-    summary_.warnings = inputs_.warnings;
-    summary_.photos_used = inputs_.photos.size();
-    summary_.subdivisions = inputs_.subdivisions;
-    summary_.faces = inputs_.mesh.faces.size();
+    summary_.CountInputs(inputs_);
   }
 
   void Synthesize() {
@@ -362,26 +359,18 @@ class BtfSynthJob {
 
   nlohmann::json Summary() const {
     const BtfSynthJobSummary& s = summary_;
-    return {{"photos_used", s.photos_used},
-            {"faces", s.faces},
-            {"subdivisions", s.subdivisions},
-            {"from_photos", s.from_photos},
-            {"from_neighbours_only", s.from_neighbours},
-            {"random", s.random},
-            {"atlases", s.atlases},
-            {"charts", s.charts},
-            {"chart_flattening", s.chart_flattening},
-            {"occupancy", s.occupancy},
-            {"seam_edges", s.seam_edges},
-            {"seam_cost_per_link", s.seam_cost_per_link},
-            {"straight_edge_cost_per_link", s.edge_cost_per_link},
-            {"photo_rms_quilted", synthesis_.photo_rms_quilted},
-            {"photo_rms_corrected", synthesis_.photo_rms_corrected},
-            {"photo_gains", synthesis_.photo_gains},
-            {"tangent_frame", synth::TangentFrameName(synthesis_.tangent_frame)},
-            {"sample_coherence", synthesis_.sample_coherence >= 0.0
-                                     ? nlohmann::json(synthesis_.sample_coherence)
-                                     : nlohmann::json(nullptr)}};
+    nlohmann::json summary = s.ToJson();
+    summary.update({{"seam_edges", s.seam_edges},
+                    {"seam_cost_per_link", s.seam_cost_per_link},
+                    {"straight_edge_cost_per_link", s.edge_cost_per_link},
+                    {"photo_rms_quilted", synthesis_.photo_rms_quilted},
+                    {"photo_rms_corrected", synthesis_.photo_rms_corrected},
+                    {"photo_gains", synthesis_.photo_gains},
+                    {"tangent_frame", synth::TangentFrameName(synthesis_.tangent_frame)},
+                    {"sample_coherence", synthesis_.sample_coherence >= 0.0
+                                             ? nlohmann::json(synthesis_.sample_coherence)
+                                             : nlohmann::json(nullptr)}});
+    return summary;
   }
 
   nlohmann::json Record() {

@@ -88,13 +88,9 @@ struct BtfSynthJobOptions {
   void Check() const;
 };
 
-struct BtfSynthJobSummary {
-  std::size_t photos_used = 0, faces = 0, subdivisions = 0;
-  std::size_t from_photos = 0, from_neighbours = 0, random = 0;
-  std::size_t atlases = 0, charts = 0, seam_edges = 0;
-  std::string chart_flattening;  ///< the one used ("auto" resolves to "strips" or "rigid")
-  double occupancy = 0, seam_cost_per_link = 0, edge_cost_per_link = 0;
-  std::vector<std::string> warnings;
+struct BtfSynthJobSummary : synth::SynthCounts {
+  std::size_t seam_edges = 0;
+  double seam_cost_per_link = 0, edge_cost_per_link = 0;
   double seconds_factorise = 0, seconds_synthesis = 0, seconds_seams = 0, seconds_atlas = 0,
          seconds_preview = 0, seconds_export = 0, seconds_total = 0;
 };

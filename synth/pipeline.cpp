@@ -230,6 +230,26 @@ void SynthJobOptions::Check() const {
   synthesis.Check();
 }
 
+nlohmann::json SynthCounts::ToJson() const {
+  return {{"photos_used", photos_used},
+          {"faces", faces},
+          {"subdivisions", subdivisions},
+          {"from_photos", from_photos},
+          {"from_neighbours_only", from_neighbours},
+          {"random", random},
+          {"atlases", atlases},
+          {"charts", charts},
+          {"chart_flattening", chart_flattening},
+          {"occupancy", occupancy}};
+}
+
+void SynthCounts::CountInputs(const SynthInputs& inputs) {
+  warnings = inputs.warnings;
+  photos_used = inputs.photos.size();
+  subdivisions = inputs.subdivisions;
+  faces = inputs.mesh.faces.size();
+}
+
 void RefuseForeignModelFolder(const fs::path& out) {
   if (fs::exists(out) &&
       (!fs::is_directory(out) || (!fs::exists(out / "manifest.json") && !fs::is_empty(out))))
@@ -281,10 +301,7 @@ class SynthJob {
     sample_ = ReadSample(options_.sample_file);
     PrepareSynthMesh(inputs_, options_, std::min(sample_.ptm.width, sample_.ptm.height),
                      options_.synthesis.sample_texel_size, options_.synthesis.strip, progress_);
-    summary_.warnings = inputs_.warnings;
-    summary_.photos_used = inputs_.photos.size();
-    summary_.subdivisions = inputs_.subdivisions;
-    summary_.faces = inputs_.mesh.faces.size();
+    summary_.CountInputs(inputs_);
     summary_.seconds_load = inputs_.seconds_load;
     summary_.seconds_visibility = inputs_.seconds_visibility;
   }
@@ -359,24 +376,16 @@ class SynthJob {
 
   nlohmann::json Summary() const {
     const SynthJobSummary& s = summary_;
-    return {{"photos_used", s.photos_used},
-            {"faces", s.faces},
-            {"subdivisions", s.subdivisions},
-            {"from_photos", s.from_photos},
-            {"from_neighbours_only", s.from_neighbours},
-            {"random", s.random},
-            {"atlases", s.atlases},
-            {"charts", s.charts},
-            {"chart_flattening", s.chart_flattening},
-            {"occupancy", s.occupancy},
-            {"texel_stretch",
-             {{"mean", s.stretch.mean}, {"min", s.stretch.min}, {"max", s.stretch.max}}},
-            {"photo_gains", synthesis_.photo_gains},
-            {"mean_prior_shrink", MeanPriorShrink(synthesis_)},
-            {"tangent_frame", TangentFrameName(synthesis_.tangent_frame)},
-            {"sample_coherence", synthesis_.sample_coherence >= 0.0
-                                     ? nlohmann::json(synthesis_.sample_coherence)
-                                     : nlohmann::json(nullptr)}};
+    nlohmann::json summary = s.ToJson();
+    summary.update({{"texel_stretch",
+                     {{"mean", s.stretch.mean}, {"min", s.stretch.min}, {"max", s.stretch.max}}},
+                    {"photo_gains", synthesis_.photo_gains},
+                    {"mean_prior_shrink", MeanPriorShrink(synthesis_)},
+                    {"tangent_frame", TangentFrameName(synthesis_.tangent_frame)},
+                    {"sample_coherence", synthesis_.sample_coherence >= 0.0
+                                             ? nlohmann::json(synthesis_.sample_coherence)
+                                             : nlohmann::json(nullptr)}});
+    return summary;
   }
 
   // The manifest's record: inputs, settings, summary, warnings, baselines, timings.

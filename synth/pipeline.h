@@ -41,14 +41,23 @@ struct SynthJobOptions {
 };
 
 /// What the job did (also written to manifest.json).
-struct SynthJobSummary {
-  std::size_t photos_used = 0;
-  std::vector<std::string> warnings;  ///< skipped photos, repaired faces, subdivisions
-  std::size_t faces = 0, subdivisions = 0;
+struct SynthInputs;
+
+/// What every synth job counts, with any sample (its manifest's summary).
+struct SynthCounts {
+  std::size_t photos_used = 0, faces = 0, subdivisions = 0;
   std::size_t from_photos = 0, from_neighbours = 0, random = 0;
   std::size_t atlases = 0, charts = 0;
   std::string chart_flattening;  ///< the one used ("auto" resolves to "strips" or "rigid")
   double occupancy = 0.0;
+  std::vector<std::string> warnings;  ///< skipped photos, repaired faces, subdivisions
+  /// The counts as the manifest's "summary" names them.
+  nlohmann::json ToJson() const;
+  /// Takes the counts of the inputs (photos, faces, subdivisions, warnings).
+  void CountInputs(const SynthInputs& inputs);
+};
+
+struct SynthJobSummary : SynthCounts {
   AtlasStretch stretch;
   double seconds_load = 0, seconds_visibility = 0, seconds_synthesis = 0, seconds_atlas = 0,
          seconds_baselines = 0, seconds_report = 0, seconds_export = 0, seconds_total = 0;
