@@ -364,23 +364,16 @@ class BtfSynthJob {
                     {"seam_cost_per_link", s.seam_cost_per_link},
                     {"straight_edge_cost_per_link", s.edge_cost_per_link},
                     {"photo_rms_quilted", synthesis_.photo_rms_quilted},
-                    {"photo_rms_corrected", synthesis_.photo_rms_corrected},
-                    {"photo_gains", synthesis_.photo_gains},
-                    {"tangent_frame", synth::TangentFrameName(synthesis_.tangent_frame)},
-                    {"sample_coherence", synthesis_.sample_coherence >= 0.0
-                                             ? nlohmann::json(synthesis_.sample_coherence)
-                                             : nlohmann::json(nullptr)}});
+                    {"photo_rms_corrected", synthesis_.photo_rms_corrected}});
+    summary.update(synth::EngineSummaryJson(synthesis_));
     return summary;
   }
 
   nlohmann::json Record() {
     nlohmann::json record;
     record["command"] = "synth --btf";
-    record["inputs"] = {{"model", job_.model_dir.string()},
-                        {"images", job_.images_dir.string()},
-                        {"lights", job_.lights_file.string()},
-                        {"mesh", job_.mesh_file.string()},
-                        {"btf", options_.btf.string()}};
+    record["inputs"] = job_.InputsJson();
+    record["inputs"]["btf"] = options_.btf.string();
     record["settings"] = Settings();
     record["summary"] = Summary();
     record["warnings"] = summary_.warnings;

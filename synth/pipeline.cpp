@@ -224,6 +224,13 @@ void SynthJobOptions::CheckInputsAndLayout() const {
     throw OptionError("max subdivisions must be in [0, 6]");
 }
 
+nlohmann::json SynthJobOptions::InputsJson() const {
+  return {{"model", model_dir.string()},
+          {"images", images_dir.string()},
+          {"lights", lights_file.string()},
+          {"mesh", mesh_file.string()}};
+}
+
 void SynthJobOptions::Check() const {
   CheckInputsAndLayout();
   if (sample_file.empty()) throw OptionError("synth needs a sample");
@@ -248,6 +255,14 @@ void SynthCounts::CountInputs(const SynthInputs& inputs) {
   photos_used = inputs.photos.size();
   subdivisions = inputs.subdivisions;
   faces = inputs.mesh.faces.size();
+}
+
+nlohmann::json EngineSummaryJson(const TriangleSynthesis& synthesis) {
+  return {{"photo_gains", synthesis.photo_gains},
+          {"tangent_frame", TangentFrameName(synthesis.tangent_frame)},
+          {"sample_coherence", synthesis.sample_coherence >= 0.0
+                                   ? nlohmann::json(synthesis.sample_coherence)
+                                   : nlohmann::json(nullptr)}};
 }
 
 void RefuseForeignModelFolder(const fs::path& out) {
@@ -379,12 +394,8 @@ class SynthJob {
     nlohmann::json summary = s.ToJson();
     summary.update({{"texel_stretch",
                      {{"mean", s.stretch.mean}, {"min", s.stretch.min}, {"max", s.stretch.max}}},
-                    {"photo_gains", synthesis_.photo_gains},
-                    {"mean_prior_shrink", MeanPriorShrink(synthesis_)},
-                    {"tangent_frame", TangentFrameName(synthesis_.tangent_frame)},
-                    {"sample_coherence", synthesis_.sample_coherence >= 0.0
-                                             ? nlohmann::json(synthesis_.sample_coherence)
-                                             : nlohmann::json(nullptr)}});
+                    {"mean_prior_shrink", MeanPriorShrink(synthesis_)}});
+    summary.update(EngineSummaryJson(synthesis_));
     return summary;
   }
 
@@ -392,11 +403,8 @@ class SynthJob {
   nlohmann::json Record() {
     nlohmann::json record;
     record["command"] = "synth";
-    record["inputs"] = {{"model", options_.model_dir.string()},
-                        {"images", options_.images_dir.string()},
-                        {"lights", options_.lights_file.string()},
-                        {"mesh", options_.mesh_file.string()},
-                        {"sample", options_.sample_file.string()}};
+    record["inputs"] = options_.InputsJson();
+    record["inputs"]["sample"] = options_.sample_file.string();
     record["settings"] = Settings();
     record["summary"] = Summary();
     record["warnings"] = summary_.warnings;

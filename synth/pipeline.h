@@ -38,6 +38,8 @@ struct SynthJobOptions {
   void Check() const;
   /// The same, but for the synthesis settings (the BTF job checks its own).
   void CheckInputsAndLayout() const;
+  /// The input paths as the manifest's "inputs" names them (the sample's left out).
+  nlohmann::json InputsJson() const;
 };
 
 /// What the job did (also written to manifest.json).
@@ -97,6 +99,11 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options);
 /// seen by no usable photo (a mesh in another frame).
 void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int sample_side,
                       double sample_texel_size, int strip, const ProgressCallback& progress = {});
+
+/// What the engine decided, as the manifests' summaries name it: the photo
+/// gains, the frames (kAuto resolved) and the sample's coherence (null when
+/// not measured).
+nlohmann::json EngineSummaryJson(const TriangleSynthesis& synthesis);
 
 /// Refuses an output folder that exists and is not a texlume model folder
 /// (InputError naming it): a job never replaces anything else.
