@@ -35,12 +35,10 @@ ChannelFactorCorrection::OnGrid ChannelFactorCorrection::ToGrid(const TrianglePa
 }
 
 cv::Mat ChannelFactorCorrection::ChannelFactors(const cv::Mat& num, const cv::Mat& den,
-                                                const cv::Mat& observed,
-                                                double observed_sum) const {
+                                                const cv::Mat& observed, double observed_sum,
+                                                const cv::Mat& weight,
+                                                const cv::Mat& wide_weight) const {
   const double sigma = options_.sigma;
-  cv::Mat weight, wide_weight;
-  cv::GaussianBlur(observed, weight, cv::Size(), sigma);
-  cv::GaussianBlur(observed, wide_weight, cv::Size(), 4.0 * sigma);
   const double mu = cv::sum(den)[0] / observed_sum;  // mean m^2 per observation
   const double prior = options_.noise * std::max(mu, 1e-12);
   cv::Mat raw;
@@ -91,9 +89,13 @@ void ChannelFactorCorrection::Correct(TriangleEngine& engine, std::size_t face,
   }
   const double observed_sum = cv::sum(observed)[0];
   if (!(observed_sum > 0.0)) return;
+  // The observed cells smoothed once for the three channels.
+  cv::Mat weight, wide_weight;
+  cv::GaussianBlur(observed, weight, cv::Size(), options_.sigma);
+  cv::GaussianBlur(observed, wide_weight, cv::Size(), 4.0 * options_.sigma);
   std::vector<cv::Mat> k(3);
   for (std::size_t ch = 0; ch < 3; ++ch)
-    k[ch] = ChannelFactors(num[ch], den[ch], observed, observed_sum);
+    k[ch] = ChannelFactors(num[ch], den[ch], observed, observed_sum, weight, wide_weight);
   for (const OnGrid& g : on_grid)
     for (std::size_t ch = 0; ch < 3; ++ch) {
       const cv::Mat before = g.model[ch] - g.photo[ch];

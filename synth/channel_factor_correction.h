@@ -56,9 +56,11 @@ class ChannelFactorCorrection : public PhotoCorrection {
   OnGrid ToGrid(const TrianglePatch& patch, const RectifiedView& view, const ReducedPlanes& reduced,
                 const std::vector<cv::Mat>& relit, cv::Size grid) const;
   // The factors of one channel from the summed products (num = sum m p,
-  // den = sum m^2) over the observed cells.
+  // den = sum m^2) over the observed cells, and the observed cells smoothed
+  // by sigma (`weight`) and 4 sigma (`wide_weight`).
   cv::Mat ChannelFactors(const cv::Mat& num, const cv::Mat& den, const cv::Mat& observed,
-                         double observed_sum) const;
+                         double observed_sum, const cv::Mat& weight,
+                         const cv::Mat& wide_weight) const;
 
   Options options_;
   std::vector<cv::Mat> factors_;
