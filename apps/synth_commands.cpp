@@ -19,7 +19,7 @@ struct SynthWords {
 };
 
 void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o) {
-  synth::SynthJobOptions& j = o.job;
+  pipeline::SynthJobOptions& j = o.job;
   sub->add_option("--model", j.model_dir, "COLMAP model folder")->required();
   sub->add_option("--images", j.images_dir, "the object photos")->required();
   sub->add_option("--lights", j.lights_file, "object-lights JSON (docs/lights.md)")->required();
@@ -94,10 +94,10 @@ void BindCorrection(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords&
   sub->add_flag("--no-detail-transfer", w.no_detail, "keep the quilted patch's own detail");
 }
 
-void BindAtlas(CLI::App* sub, synth::AtlasOptions& a, SynthWords& w) {
+void BindAtlas(CLI::App* sub, atlas::AtlasOptions& a, SynthWords& w) {
   sub->add_option("--atlas", a.mode, "charts or per-triangle")
-      ->transform(Choice(std::map<std::string, synth::AtlasMode>{
-          {"charts", synth::AtlasMode::kCharts}, {"per-triangle", synth::AtlasMode::kPerTriangle}}))
+      ->transform(Choice(std::map<std::string, atlas::AtlasMode>{
+          {"charts", atlas::AtlasMode::kCharts}, {"per-triangle", atlas::AtlasMode::kPerTriangle}}))
       ->default_str("charts");
   sub->add_option("--atlas-size", a.atlas_size, "atlas side in texels")->capture_default_str();
   sub->add_option("--gutter", a.gutter, "texels around every chart")->capture_default_str();
@@ -107,11 +107,11 @@ void BindAtlas(CLI::App* sub, synth::AtlasOptions& a, SynthWords& w) {
   sub->add_option("--chart-size", a.max_chart_size, "largest chart side in texels (0: any)")
       ->capture_default_str();
   sub->add_option("--chart-flattening", a.flattening, "auto, strips, rigid or conformal")
-      ->transform(Choice(std::map<std::string, synth::ChartFlattening>{
-          {"auto", synth::ChartFlattening::kAuto},
-          {"strips", synth::ChartFlattening::kStrips},
-          {"rigid", synth::ChartFlattening::kRigid},
-          {"conformal", synth::ChartFlattening::kConformal}}))
+      ->transform(Choice(std::map<std::string, atlas::ChartFlattening>{
+          {"auto", atlas::ChartFlattening::kAuto},
+          {"strips", atlas::ChartFlattening::kStrips},
+          {"rigid", atlas::ChartFlattening::kRigid},
+          {"conformal", atlas::ChartFlattening::kConformal}}))
       ->default_str("auto");
   sub->add_option("--chart-stretch", a.max_chart_stretch, "texel stretch bound of a chart")
       ->capture_default_str();
@@ -166,16 +166,16 @@ void AddSynthCommand(CLI::App& app, CommandRunners& run) {
 void AddRenderCommand(CLI::App& app, CommandRunners& run) {
   auto* sub = app.add_subcommand(
       "render", "Render a model folder for every image of a COLMAP model under its light(s).");
-  auto o = std::make_shared<synth::RenderJobOptions>();
+  auto o = std::make_shared<pipeline::RenderJobOptions>();
   sub->add_option("--model", o->model_folder, "model folder written by texlume synth")->required();
   sub->add_option("--cameras", o->cameras_dir, "COLMAP model of the views")->required();
   sub->add_option("--lights", o->lights_file, "object-lights JSON of those views")->required();
   sub->add_option("--out", o->out_dir, "the folder to write")->required();
   auto* baseline = sub->add_option("--baseline", o->mode, "flat, baked or ptm (a BTF's preview)")
-                       ->transform(Choice(std::map<std::string, synth::RenderMode>{
-                           {"flat", synth::RenderMode::kFlat},
-                           {"baked", synth::RenderMode::kBaked},
-                           {"ptm", synth::RenderMode::kPtm}}));
+                       ->transform(Choice(std::map<std::string, render::RenderMode>{
+                           {"flat", render::RenderMode::kFlat},
+                           {"baked", render::RenderMode::kBaked},
+                           {"ptm", render::RenderMode::kPtm}}));
   sub->add_option("--samples", o->samples_per_axis, "samples per pixel along each axis [1, 8]")
       ->capture_default_str();
   sub->add_option("--truth", o->truth_images_dir, "ground-truth images: PSNR and SSIM");

@@ -12,7 +12,7 @@
 
 #include "apps/http_server.h"
 #include "core/errors.h"
-#include "synth/web_model.h"
+#include "model/web_model.h"
 
 namespace texlume::apps {
 namespace fs = std::filesystem;
@@ -89,7 +89,7 @@ void ServeViewer(const ViewOptions& options, std::ostream& out, std::ostream& er
   const fs::path web = WebDir();
   CheckViewerBundle(web);
   const auto t0 = std::chrono::steady_clock::now();
-  synth::WebModel model = synth::BuildWebModel(options.model_dir);
+  model::WebModel model = model::BuildWebModel(options.model_dir);
   const double prepare_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // Served without a copy per request.

@@ -27,9 +27,9 @@
 
 #include "datasets_synthetic/material.h"
 #include "datasets_synthetic/shapes.h"
-#include "synth/atlas.h"
+#include "atlas/atlas.h"
 #include "synth/mesh_synthesis.h"
-#include "synth/pipeline.h"
+#include "pipeline/synth_job.h"
 
 using namespace texlume;
 
@@ -40,7 +40,7 @@ cv::Mat Thumbnail(const cv::Mat& coverage) {
   cv::resize(coverage, small, cv::Size(), 0.25, 0.25, cv::INTER_AREA);
   return small;
 }
-sfm::TriangleMesh Jittered(sfm::TriangleMesh mesh) {
+mesh::TriangleMesh Jittered(mesh::TriangleMesh mesh) {
   double edge = 0;
   for (std::size_t f = 0; f < mesh.faces.size(); ++f)
     edge += (mesh.Corner(f, 1) - mesh.Corner(f, 0)).norm();
@@ -64,7 +64,7 @@ sfm::TriangleMesh Jittered(sfm::TriangleMesh mesh) {
 /// A fine mesh of the shape decimated by quadric edge collapses (OpenMesh) to
 /// `num_faces`: irregular triangles of varying size and valence, as a
 /// photogrammetry mesh decimated for texturing has.
-sfm::TriangleMesh Decimated(const sfm::TriangleMesh& fine, std::size_t num_faces) {
+mesh::TriangleMesh Decimated(const mesh::TriangleMesh& fine, std::size_t num_faces) {
   struct Traits : OpenMesh::DefaultTraits {
     using Point = OpenMesh::Vec3d;
   };
@@ -82,7 +82,7 @@ sfm::TriangleMesh Decimated(const sfm::TriangleMesh& fine, std::size_t num_faces
   decimater.initialize();
   decimater.decimate_to_faces(0, num_faces);
   om.garbage_collection();
-  sfm::TriangleMesh mesh;
+  mesh::TriangleMesh mesh;
   for (const auto& vh : om.vertices()) {
     const auto& p = om.point(vh);
     mesh.vertices.emplace_back(p[0], p[1], p[2]);
@@ -98,7 +98,7 @@ sfm::TriangleMesh Decimated(const sfm::TriangleMesh& fine, std::size_t num_faces
 
 /// The shape at 2^`doublings` times the coarse mesh's resolution along each
 /// direction (icosphere 3, cylinder 48 x 12, torus 48 x 20), on the surface.
-sfm::TriangleMesh FinerMesh(datasets::SceneShape shape, int doublings) {
+mesh::TriangleMesh FinerMesh(datasets::SceneShape shape, int doublings) {
   const int k = 1 << doublings;
   switch (shape) {
     case datasets::SceneShape::kSphere:
@@ -112,17 +112,17 @@ sfm::TriangleMesh FinerMesh(datasets::SceneShape shape, int doublings) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  synth::AtlasOptions charts;
+  atlas::AtlasOptions charts;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--gutter")) charts.gutter = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--chart-size")) charts.max_chart_size = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--max-stretch")) charts.max_chart_stretch = std::atof(argv[i + 1]);
   }
-  synth::AtlasOptions boxes = charts, conformal = charts, strips = charts;
-  charts.flattening = synth::ChartFlattening::kRigid;
-  boxes.mode = synth::AtlasMode::kPerTriangle;
-  conformal.flattening = synth::ChartFlattening::kConformal;
-  strips.flattening = synth::ChartFlattening::kStrips;
+  atlas::AtlasOptions boxes = charts, conformal = charts, strips = charts;
+  charts.flattening = atlas::ChartFlattening::kRigid;
+  boxes.mode = atlas::AtlasMode::kPerTriangle;
+  conformal.flattening = atlas::ChartFlattening::kConformal;
+  strips.flattening = atlas::ChartFlattening::kStrips;
   // Strips are as long as an atlas row allows, whatever --chart-size says.
   strips.max_chart_size = 0;
   const double texel_size = datasets::MaterialOptions{}.texel_size;
@@ -132,10 +132,10 @@ int main(int argc, char** argv) {
     // The coarse mesh, split 1-to-4, and the coarse mesh with every vertex moved
     // along the surface by up to a third of the mean edge (irregular triangles,
     // as decimated photogrammetry meshes have), normals kept.
-    const sfm::TriangleMesh coarse = datasets::CoarseMesh(shape);
-    std::vector<std::pair<std::string, sfm::TriangleMesh>> meshes = {
+    const mesh::TriangleMesh coarse = datasets::CoarseMesh(shape);
+    std::vector<std::pair<std::string, mesh::TriangleMesh>> meshes = {
         {"", coarse},
-        {"", synth::SubdivideMidpoint(coarse)},
+        {"", mesh::SubdivideMidpoint(coarse)},
         {" dense", FinerMesh(shape, 2)},  // 16 times the triangles
         {" jittered", Jittered(coarse)},
         {" decimated", Decimated(FinerMesh(shape, 3), coarse.faces.size())}};
@@ -144,35 +144,35 @@ int main(int argc, char** argv) {
     for (const auto& [label, mesh] : meshes) {
       const synth::PatchGeometry geometry = synth::MakePatchGeometry(
           mesh, texel_size, 8, synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
-      for (const synth::AtlasOptions& options : {charts, conformal, strips, boxes}) {
+      for (const atlas::AtlasOptions& options : {charts, conformal, strips, boxes}) {
         const auto t0 = std::chrono::steady_clock::now();
-        const synth::AtlasLayout layout =
-            synth::LayoutAtlases(mesh, geometry.patches, geometry.unfoldings, texel_size, options);
+        const atlas::AtlasLayout layout =
+            atlas::LayoutAtlases(mesh, geometry.patches, geometry.unfoldings, texel_size, options);
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const synth::AtlasCoverage coverage = synth::VisitAtlasTexels(
+        const atlas::AtlasCoverage coverage = atlas::VisitAtlasTexels(
             layout, texel_size, options.gutter, [](int, int, int, int, const Eigen::Vector2d&) {});
         if (const char* dump = std::getenv("ATLAS_BENCH_DUMP"))
           for (std::size_t a = 0; a < coverage.coverage.size(); ++a)
             cv::imwrite(std::string(dump) + "/" + std::string(datasets::SceneShapeName(shape)) +
                             std::to_string(mesh.faces.size()) +
                             (label.empty() ? "" : label.substr(1)) + "_" +
-                            (options.mode == synth::AtlasMode::kPerTriangle
+                            (options.mode == atlas::AtlasMode::kPerTriangle
                                  ? std::string("boxes")
-                                 : std::string(synth::ChartFlatteningName(options.flattening))) +
+                                 : std::string(atlas::ChartFlatteningName(options.flattening))) +
                             std::to_string(a) + ".png",
                         Thumbnail(coverage.coverage[a]));
         double texels = 0, written = 0;
         for (const cv::Mat& c : coverage.coverage) written += cv::countNonZero(c);
         for (const cv::Size& s : layout.atlas_sizes) texels += static_cast<double>(s.area());
-        const synth::AtlasStretch stretch = synth::MeasureStretch(geometry.patches, layout);
+        const atlas::AtlasStretch stretch = atlas::MeasureStretch(geometry.patches, layout);
         std::printf(
             "%-17s %6zu faces %-12s occupancy %.3f  charts %4d  atlases %zu (last %dx%d)  "
             "%.2f s  inside/outline %.3f  packing %.3f  stretch mean %.3f  min %.3f  max %.3f\n",
             (std::string(datasets::SceneShapeName(shape)) + label).c_str(), mesh.faces.size(),
-            options.mode == synth::AtlasMode::kPerTriangle
+            options.mode == atlas::AtlasMode::kPerTriangle
                 ? "per-triangle"
-                : synth::ChartFlatteningName(options.flattening),
+                : atlas::ChartFlatteningName(options.flattening),
             static_cast<double>(coverage.inside_texels) / texels, layout.num_charts,
             layout.atlas_sizes.size(), layout.atlas_sizes.back().width,
             layout.atlas_sizes.back().height, seconds,

@@ -14,11 +14,11 @@
 #include "ptm/fit.h"
 #include "sfm/colmap_io.h"
 #include "sfm/lights.h"
-#include "sfm/mesh.h"
+#include "mesh/mesh.h"
 #include "sfm/visibility.h"
-#include "synth/atlas.h"
+#include "atlas/atlas.h"
 #include "synth/mesh_synthesis.h"
-#include "synth/pipeline.h"
+#include "pipeline/synth_job.h"
 
 using namespace texlume;
 namespace fs = std::filesystem;
@@ -47,11 +47,11 @@ int main(int argc, char** argv) {
     p.lights = lights.at(image.name);
     photos.push_back(p);
   }
-  sfm::TriangleMesh mesh = sfm::LoadMesh(work / "object/mesh.ply").mesh;
+  mesh::TriangleMesh mesh = mesh::LoadMesh(work / "object/mesh.ply").mesh;
   double base_synthesis = 0;
   for (int level = 0; level < levels; ++level) {
     if (level > 0) {
-      mesh = synth::SubdivideMidpoint(mesh);
+      mesh = mesh::SubdivideMidpoint(mesh);
       for (auto& v : mesh.vertices) v.normalize();  // back on the unit sphere
     }
     auto t0 = std::chrono::steady_clock::now();
@@ -63,10 +63,10 @@ int main(int argc, char** argv) {
     const synth::MeshSynthesis s =
         synth::SynthesizeMeshPtm(mesh, reconstruction, visibility, photos, sample, o);
     if (level == 0) base_synthesis = s.seconds_synthesis;
-    synth::AtlasOptions charts, boxes;
-    boxes.mode = synth::AtlasMode::kPerTriangle;
-    const synth::Atlases a_charts = synth::BuildAtlases(mesh, s, charts);
-    const synth::Atlases a_boxes = synth::BuildAtlases(mesh, s, boxes);
+    atlas::AtlasOptions charts, boxes;
+    boxes.mode = atlas::AtlasMode::kPerTriangle;
+    const atlas::Atlases a_charts = atlas::BuildAtlases(mesh, s, charts);
+    const atlas::Atlases a_boxes = atlas::BuildAtlases(mesh, s, boxes);
     std::printf(
         "%6zu triangles: visibility %.2f s, synthesis %.2f s (%.2f ms per triangle, %.2fx the "
         "1280-triangle time), atlas %.2f s (charts) / %.2f s (boxes); occupancy charts %.3f in "

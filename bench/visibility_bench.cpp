@@ -16,7 +16,7 @@ namespace {
 using namespace texlume;
 
 struct Scene {
-  sfm::TriangleMesh mesh;
+  mesh::TriangleMesh mesh;
   sfm::Reconstruction reconstruction;
 };
 
@@ -25,7 +25,7 @@ const Scene& BenchScene() {
     Scene s;
     // Icosphere (81,920 faces) and a column in front of it (20,480 faces): 102,400.
     s.mesh = datasets::MakeIcosphere(6, 1.0);
-    const sfm::TriangleMesh column = datasets::MakeCylinder(160, 64, 0.25, 2.5);
+    const mesh::TriangleMesh column = datasets::MakeCylinder(160, 64, 0.25, 2.5);
     const int offset = static_cast<int>(s.mesh.NumVertices());
     for (const auto& v : column.vertices) s.mesh.vertices.push_back(v + Eigen::Vector3d(1.6, 0, 0));
     for (const auto& f : column.faces) {

@@ -131,7 +131,7 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
 
   // Sparse points on the surface, observed where their face is fully visible.
   if (options.num_points > 0) {
-    const auto areas = sfm::FaceAreas(scene.mesh);
+    const auto areas = mesh::FaceAreas(scene.mesh);
     std::discrete_distribution<std::size_t> pick_face(areas.begin(), areas.end());
     sfm::VisibilityOptions vis_options;
     vis_options.max_buffer_dimension = 256;
@@ -177,7 +177,7 @@ void WriteObjectScene(const ObjectScene& scene, const std::filesystem::path& dir
   std::filesystem::create_directories(dir);
   sfm::WriteModel(scene.reconstruction, dir / "sparse", sfm::ModelFormat::kBinary);
   sfm::WriteModel(scene.reconstruction, dir / "sparse_txt", sfm::ModelFormat::kText);
-  sfm::SaveMesh(scene.mesh, dir / "mesh.ply");
+  mesh::SaveMesh(scene.mesh, dir / "mesh.ply");
   sfm::WriteObjectLightsFile(scene.lights, dir / "lights.json");
 }
 

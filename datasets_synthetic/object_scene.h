@@ -6,7 +6,7 @@
 #include "datasets_synthetic/shapes.h"
 #include "sfm/camera_models.h"
 #include "sfm/lights.h"
-#include "sfm/mesh.h"
+#include "mesh/mesh.h"
 #include "sfm/reconstruction.h"
 
 namespace texlume::datasets {
@@ -41,7 +41,7 @@ struct ObjectSceneOptions {
 /// A synthetic object: its coarse mesh, a COLMAP model of its photos (cameras,
 /// poses, sparse points with tracks) and one directional light per photo.
 struct ObjectScene {
-  sfm::TriangleMesh mesh;
+  mesh::TriangleMesh mesh;
   sfm::Reconstruction reconstruction;
   sfm::ObjectLights lights;
 };

@@ -144,7 +144,7 @@ std::vector<SurfacePatch> ShapePatches(SceneShape shape) {
   return patches;
 }
 
-sfm::TriangleMesh CoarseMesh(SceneShape shape) {
+mesh::TriangleMesh CoarseMesh(SceneShape shape) {
   switch (shape) {
     case SceneShape::kSphere:
       return MakeIcosphere(3, kSphereRadius);
@@ -158,8 +158,8 @@ sfm::TriangleMesh CoarseMesh(SceneShape shape) {
   return {};
 }
 
-sfm::TriangleMesh MakeTorus(int around, int tube, double major, double minor) {
-  sfm::TriangleMesh mesh;
+mesh::TriangleMesh MakeTorus(int around, int tube, double major, double minor) {
+  mesh::TriangleMesh mesh;
   for (int j = 0; j < tube; ++j) {
     const double theta = 2 * kPi * j / tube;
     for (int i = 0; i < around; ++i) {
@@ -179,9 +179,9 @@ sfm::TriangleMesh MakeTorus(int around, int tube, double major, double minor) {
   return mesh;
 }
 
-sfm::TriangleMesh MakeIcosphere(int subdivisions, double radius) {
+mesh::TriangleMesh MakeIcosphere(int subdivisions, double radius) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  sfm::TriangleMesh mesh;
+  mesh::TriangleMesh mesh;
   mesh.vertices = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
   mesh.faces = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
@@ -215,8 +215,8 @@ sfm::TriangleMesh MakeIcosphere(int subdivisions, double radius) {
   return mesh;
 }
 
-sfm::TriangleMesh MakeCylinder(int around, int along, double radius, double height) {
-  sfm::TriangleMesh mesh;
+mesh::TriangleMesh MakeCylinder(int around, int along, double radius, double height) {
+  mesh::TriangleMesh mesh;
   for (int j = 0; j <= along; ++j) {
     const double z = -height / 2 + height * j / along;
     for (int i = 0; i < around; ++i) {
@@ -242,8 +242,8 @@ sfm::TriangleMesh MakeCylinder(int around, int along, double radius, double heig
   return mesh;
 }
 
-sfm::TriangleMesh MakeGridPlane(int segments, double size) {
-  sfm::TriangleMesh mesh;
+mesh::TriangleMesh MakeGridPlane(int segments, double size) {
+  mesh::TriangleMesh mesh;
   for (int j = 0; j <= segments; ++j) {
     for (int i = 0; i <= segments; ++i) {
       mesh.vertices.emplace_back(-size / 2 + size * i / segments, -size / 2 + size * j / segments,

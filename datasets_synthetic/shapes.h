@@ -6,7 +6,7 @@
 #include <string_view>
 #include <vector>
 
-#include "sfm/mesh.h"
+#include "mesh/mesh.h"
 
 namespace texlume::datasets {
 
@@ -44,14 +44,14 @@ struct SurfacePatch {
 std::vector<SurfacePatch> ShapePatches(SceneShape shape);
 
 /// The coarse, undisplaced, low-poly mesh of a shape (what a mesher would give).
-sfm::TriangleMesh CoarseMesh(SceneShape shape);
+mesh::TriangleMesh CoarseMesh(SceneShape shape);
 
 /// Mesh generators (outward normals), also used by tests.
-sfm::TriangleMesh MakeIcosphere(int subdivisions, double radius);
-sfm::TriangleMesh MakeCylinder(int segments_around, int segments_along, double radius,
+mesh::TriangleMesh MakeIcosphere(int subdivisions, double radius);
+mesh::TriangleMesh MakeCylinder(int segments_around, int segments_along, double radius,
                                double height);
-sfm::TriangleMesh MakeGridPlane(int segments, double size);
-sfm::TriangleMesh MakeTorus(int segments_around, int segments_tube, double major_radius,
+mesh::TriangleMesh MakeGridPlane(int segments, double size);
+mesh::TriangleMesh MakeTorus(int segments_around, int segments_tube, double major_radius,
                             double minor_radius);
 
 }  // namespace texlume::datasets

@@ -4,20 +4,18 @@
 
 #include "core/errors.h"
 #include "core/file_util.h"
+#include "core/timing.h"
 #include "pipeline/jobs.h"
 #include "ptm/ptm_io.h"
 #include "sfm/colmap_io.h"
 #include "sfm/lights.h"
-#include "synth/model_io.h"
-#include "synth/report.h"
+#include "model/baselines.h"
+#include "model/model_io.h"
+#include "report/report.h"
 
 namespace texlume::pipeline {
 namespace fs = std::filesystem;
 namespace {
-
-double Since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 // The demo's steps, each a method, sharing the scene's folders and the timings.
 class DemoJob {
@@ -49,7 +47,7 @@ class DemoJob {
     Timed("synth", [&] { Synthesise(); });
     Timed("render", [&] { RenderHeldOut(); });
     Timed("report", [&] { WriteDemoReport(); });
-    seconds_["total"] = Since(start);
+    seconds_["total"] = SecondsSince(start);
     WriteRecord();
     out_ << "\nReport: " << (options_.out_dir / "report.html").string()
          << " (run.json: settings, timings)\n";
@@ -60,7 +58,7 @@ class DemoJob {
   void Timed(const std::string& name, const Step& step) {
     const auto t = std::chrono::steady_clock::now();
     step();
-    seconds_[name] = Since(t);
+    seconds_[name] = SecondsSince(t);
   }
 
   void MakeScene() {
@@ -109,15 +107,15 @@ class DemoJob {
          << job_.mesh_file.string() << " --sample " << job_.sample_file.string()
          << " --sample-texel-size " << job_.synthesis.sample_texel_size << " --out "
          << job_.out_dir.string() << "\n";
-    synthesis_ = synth::RunSynthJob(job_, progress_);
+    synthesis_ = pipeline::RunSynthJob(job_, progress_);
     for (const std::string& w : synthesis_.warnings) err_ << "warning: " << w << "\n";
     out_ << "   " << synthesis_.faces << " triangles (" << synthesis_.from_photos
          << " from photos), " << synthesis_.atlases << " atlas(es), occupancy "
          << synthesis_.occupancy << ", " << synthesis_.seconds_total << " s\n";
   }
 
-  synth::RenderJobSummary Render(synth::RenderMode mode, const std::string& name) {
-    synth::RenderJobOptions r;
+  pipeline::RenderJobSummary Render(render::RenderMode mode, const std::string& name) {
+    pipeline::RenderJobOptions r;
     r.model_folder = job_.out_dir;
     r.cameras_dir = held_ / "sparse";
     r.lights_file = held_ / "lights.json";
@@ -131,7 +129,7 @@ class DemoJob {
          << r.out_dir.string() << (name == "texlume" ? "" : " --baseline " + name) << " --truth "
          << r.truth_images_dir.string() << " --truth-masks " << r.truth_masks_dir.string()
          << " --reduced-factor " << r.reduced_factor << "\n";
-    const synth::RenderJobSummary s = synth::RunRenderJob(r, progress_);
+    const pipeline::RenderJobSummary s = pipeline::RunRenderJob(r, progress_);
     out_ << "   held-out views under held-out lights, inside the masks: PSNR " << s.mean_psnr
          << " dB, SSIM " << s.mean_ssim << " at full resolution; " << s.mean_psnr_reduced << " dB, "
          << s.mean_ssim_reduced << " at the photos' resolution\n";
@@ -139,13 +137,13 @@ class DemoJob {
   }
 
   void RenderHeldOut() {
-    ours_ = Render(synth::RenderMode::kPtm, "texlume");
-    flat_ = Render(synth::RenderMode::kFlat, "flat");
-    baked_ = Render(synth::RenderMode::kBaked, "baked");
+    ours_ = Render(render::RenderMode::kPtm, "texlume");
+    flat_ = Render(render::RenderMode::kFlat, "flat");
+    baked_ = Render(render::RenderMode::kBaked, "baked");
   }
 
   // The photos and the held-out views (with truth and masks) the report shows.
-  void AddReportViews(synth::ReportInputs& rep) const {
+  void AddReportViews(report::ReportInputs& rep) const {
     const sfm::LoadedModel photos_model = sfm::ReadModel(job_.model_dir);
     const sfm::ObjectLights photo_lights = sfm::ReadObjectLightsFile(job_.lights_file);
     for (const auto& [id, image] : photos_model.reconstruction.images)
@@ -156,7 +154,7 @@ class DemoJob {
     for (const auto& [id, image] : held_model.reconstruction.images) {
       const auto it = held_lights.find(image.name);
       if (it == held_lights.end()) continue;
-      synth::ReportView view;
+      report::ReportView view;
       view.name = image.name;
       view.camera = held_model.reconstruction.cameras.at(image.camera_id);
       view.cam_from_world = image.cam_from_world;
@@ -168,13 +166,18 @@ class DemoJob {
     rep.views_heading = "Held-out views under held-out lights";
   }
 
+  static report::ReportMetrics MetricsOf(const std::string& label,
+                                         const pipeline::RenderJobSummary& s) {
+    return {label, s.metrics, s.mean_psnr, s.mean_ssim, s.mean_psnr_reduced, s.mean_ssim_reduced};
+  }
+
   // The sample, the photos, held-out views beside the truth and the baselines,
   // error maps, a light sweep, the atlases, metrics and timings.
   void WriteDemoReport() {
     out_ << "\n6. The report\n";
-    const synth::TexturedModel model = synth::ReadModelFolder(job_.out_dir);
-    const synth::ModelBaselines baselines = synth::ReadModelBaselines(job_.out_dir, model);
-    synth::ReportInputs rep;
+    const model::TexturedModel model = model::ReadModelFolder(job_.out_dir);
+    const model::ModelBaselines baselines = model::ReadModelBaselines(job_.out_dir, model);
+    report::ReportInputs rep;
     rep.title = "texlume demo: a " + material_ + " " + shape_;
     rep.intro =
         "A synthetic heritage scene with ground truth: the " + material_ + " " + shape_ +
@@ -188,8 +191,8 @@ class DemoJob {
     rep.baked = baselines.baked;
     rep.sample = &sample_;
     AddReportViews(rep);
-    rep.metrics = {
-        {"texlume (PTM atlases)", ours_}, {"flat baseline", flat_}, {"baked baseline", baked_}};
+    rep.metrics = {MetricsOf("texlume (PTM atlases)", ours_), MetricsOf("flat baseline", flat_),
+                   MetricsOf("baked baseline", baked_)};
     rep.occupancy = synthesis_.occupancy;
     rep.facts = {
         {"triangles", std::to_string(synthesis_.faces) + " (" +
@@ -207,7 +210,7 @@ class DemoJob {
                  {"manifest.json", "model/manifest.json"},
                  {"the model's own report (photo views)", "model/report.html"},
                  {"run.json", "run.json"}};
-    synth::WriteReport(options_.out_dir, rep, progress_);
+    report::WriteReport(options_.out_dir, rep, progress_);
   }
 
   void WriteRecord() const {
@@ -218,7 +221,7 @@ class DemoJob {
         {{"num_images", scene_.num_images}, {"held_out_scale", scene_.held_out_scale}});
     run["timings_s"] = seconds_;
     run["inspect"] = nlohmann::json::parse(sfm::InspectReportToJson(inspect_report_));
-    auto metrics = [](const synth::RenderJobSummary& s) {
+    auto metrics = [](const pipeline::RenderJobSummary& s) {
       return nlohmann::json{{"psnr_db", s.mean_psnr},
                             {"ssim", s.mean_ssim},
                             {"psnr_db_photo_resolution", s.mean_psnr_reduced},
@@ -241,9 +244,9 @@ class DemoJob {
   std::string shape_, material_;
   sfm::InspectReport inspect_report_;
   ptm::Ptm sample_;
-  synth::SynthJobOptions job_;
-  synth::SynthJobSummary synthesis_;
-  synth::RenderJobSummary ours_, flat_, baked_;
+  pipeline::SynthJobOptions job_;
+  pipeline::SynthJobSummary synthesis_;
+  pipeline::RenderJobSummary ours_, flat_, baked_;
   std::map<std::string, double> seconds_;
 };
 

@@ -8,21 +8,18 @@
 #include <opencv2/imgproc.hpp>
 
 #include "btf/btf.h"
-#include "btf/btf_model.h"
+#include "pipeline/btf_synth_job.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/timing.h"
 #include "ptm/ptm_io.h"
 #include "sfm/lights.h"
-#include "synth/model_io.h"
+#include "model/model_io.h"
 
 namespace texlume::pipeline {
 namespace fs = std::filesystem;
 namespace {
-
-double Since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 void WriteJson(const fs::path& path, const nlohmann::json& record) {
   WriteFileAtomically(
@@ -111,7 +108,7 @@ void RunFitJob(const FitJobOptions& options, std::ostream& out, const ProgressCa
   ptm::WritePtmFile(result.ptm, options.out_file);
   if (!options.exr_file.empty()) ptm::WritePtmExr(result.ptm, options.exr_file);
   if (!options.web_dir.empty()) ptm::WriteRelightWeb(result.ptm, options.web_dir);
-  const double write_seconds = Since(t0);
+  const double write_seconds = SecondsSince(t0);
   out << "Fitted a " << result.ptm.width << "x" << result.ptm.height << " "
       << (options.fit.format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB") << " PTM to "
       << result.num_images << " images in " << result.seconds << " s"
@@ -145,10 +142,10 @@ void RunBtfJob(const BtfJobOptions& options, std::ostream& out, const ProgressCa
   options.Check();
   const auto t0 = std::chrono::steady_clock::now();
   const btf::BtfCapture capture = btf::ReadBtfCapture(options.capture_dir);
-  const double read_seconds = Since(t0);
+  const double read_seconds = SecondsSince(t0);
   const auto t1 = std::chrono::steady_clock::now();
   const btf::BtfFactorisation f = btf::FactoriseBtf(capture, options.components, progress);
-  const double factorise_seconds = Since(t1);
+  const double factorise_seconds = SecondsSince(t1);
   const auto t2 = std::chrono::steady_clock::now();
   // The error table: powers of two up to the rank, the chosen n included.
   std::vector<int> counts;
@@ -170,7 +167,7 @@ void RunBtfJob(const BtfJobOptions& options, std::ostream& out, const ProgressCa
   record["command"] = "btf";
   record["settings"] = options.ToJson();
   record["timings_s"] = {
-      {"read", read_seconds}, {"factorise", factorise_seconds}, {"write", Since(t2)}};
+      {"read", read_seconds}, {"factorise", factorise_seconds}, {"write", SecondsSince(t2)}};
   WriteJson(options.out_dir / "run.json", record);
 }
 
@@ -362,8 +359,8 @@ namespace {
 
 // The BTF job's options from the command's: its paths, layout and the
 // synthesis settings both samples share.
-btf::BtfSynthJobOptions BtfJobFrom(const SynthCommandOptions& c) {
-  btf::BtfSynthJobOptions b;
+pipeline::BtfSynthJobOptions BtfJobFrom(const SynthCommandOptions& c) {
+  pipeline::BtfSynthJobOptions b;
   b.btf = c.btf;
   b.components = c.components;
   const synth::MeshSynthesisOptions& ptm = c.job.synthesis;
@@ -389,8 +386,8 @@ void RunSynthCommandJob(const SynthCommandOptions& options, std::ostream& out, s
                         const ProgressCallback& progress) {
   options.Check();
   if (!options.btf.empty()) {
-    const btf::BtfSynthJobOptions b = BtfJobFrom(options);
-    const btf::BtfSynthJobSummary s = btf::RunBtfSynthJob(b, progress);
+    const pipeline::BtfSynthJobOptions b = BtfJobFrom(options);
+    const pipeline::BtfSynthJobSummary s = pipeline::RunBtfSynthJob(b, progress);
     for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
     out << "Synthesised a BTF over " << s.faces << " triangles (" << s.from_photos
         << " from photos, " << s.from_neighbours << " from neighbours only, " << s.random
@@ -401,12 +398,12 @@ void RunSynthCommandJob(const SynthCommandOptions& options, std::ostream& out, s
         << " s: " << b.job.out_dir.string() << " (see manifest.json)\n";
     return;
   }
-  synth::SynthJobOptions job = options.job;
+  pipeline::SynthJobOptions job = options.job;
   job.synthesis.correction_noise =
       options.correction_noise.value_or(job.synthesis.correction_noise);
   job.synthesis.correction_sigma =
       options.correction_sigma.value_or(job.synthesis.correction_sigma);
-  const synth::SynthJobSummary s = synth::RunSynthJob(job, progress);
+  const pipeline::SynthJobSummary s = pipeline::RunSynthJob(job, progress);
   for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
   out << "Synthesised " << s.faces << " triangles (" << s.from_photos << " from photos, "
       << s.from_neighbours << " from neighbours only, " << s.random << " seeds) from "
@@ -416,27 +413,11 @@ void RunSynthCommandJob(const SynthCommandOptions& options, std::ostream& out, s
       << (job.write_report ? " and report.html" : "") << ")\n";
 }
 
-void RunRenderCommandJob(synth::RenderJobOptions o, bool baseline_asked, std::ostream& out,
+void RunRenderCommandJob(pipeline::RenderJobOptions o, bool baseline_asked, std::ostream& out,
                          std::ostream& err, const ProgressCallback& progress) {
   o.Check();
-  // A BTF model (texlume synth --btf) is drawn as a BTF unless a baseline is asked for.
-  std::shared_ptr<btf::BtfModel> btf_model;
-  if (!baseline_asked && synth::ReadModelManifest(o.model_folder).contains("btf")) {
-    o.renderer_name = "btf";
-    const fs::path folder = o.model_folder;
-    const int samples = o.samples_per_axis;
-    o.renderer = [&btf_model, folder, samples](
-                     const synth::ModelRenderer& renderer, const synth::TexturedModel& model,
-                     const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
-                     const std::vector<sfm::ObjectLight>& lights) {
-      if (!btf_model) btf_model = std::make_shared<btf::BtfModel>(btf::ReadBtfModel(folder, model));
-      return renderer.RenderWith(camera, cam_from_world, samples,
-                                 [&](const synth::ModelRenderer::SurfaceSample& s) {
-                                   return btf::ShadeBtf(*btf_model, s, lights);
-                                 });
-    };
-  }
-  const synth::RenderJobSummary s = synth::RunRenderJob(o, progress);
+  o.btf_as_btf = !baseline_asked;
+  const pipeline::RenderJobSummary s = pipeline::RunRenderJob(o, progress);
   for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
   out << "Rendered " << s.rendered << " views into " << o.out_dir.string() << " in " << s.seconds
       << " s";

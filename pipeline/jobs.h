@@ -14,7 +14,8 @@
 #include "ptm/ptm.h"
 #include "ptm/sphere_lights.h"
 #include "sfm/inspect.h"
-#include "synth/pipeline.h"
+#include "pipeline/render_job.h"
+#include "pipeline/synth_job.h"
 #include "synth/planar_synthesis.h"
 
 // The jobs the texlume program runs that are not in synth/pipeline.h: each an
@@ -90,7 +91,7 @@ void RunSynth2dJob(const Synth2dJobOptions& options, std::ostream& out);
 /// `texlume synth`: the main job with a PTM sample, or with a BTF sample when `btf`
 /// is set (the BTF job takes the PTM job's paths, layout and shared synthesis settings).
 struct SynthCommandOptions {
-  synth::SynthJobOptions job;
+  pipeline::SynthJobOptions job;
   std::filesystem::path btf;  ///< a BTF capture or factorisation folder; empty: a PTM sample
   int components = 40;
   std::optional<int> seam_band;                              ///< none: min(4, strip)
@@ -100,9 +101,9 @@ struct SynthCommandOptions {
 void RunSynthCommandJob(const SynthCommandOptions& options, std::ostream& out, std::ostream& err,
                         const ProgressCallback& progress = {});
 
-/// `texlume render`: synth::RunRenderJob, drawing a BTF model folder as a BTF
+/// `texlume render`: pipeline::RunRenderJob, drawing a BTF model folder as a BTF
 /// unless a baseline is asked for.
-void RunRenderCommandJob(synth::RenderJobOptions options, bool baseline_asked, std::ostream& out,
+void RunRenderCommandJob(pipeline::RenderJobOptions options, bool baseline_asked, std::ostream& out,
                          std::ostream& err, const ProgressCallback& progress = {});
 
 /// `texlume scene`: a synthetic heritage scene with ground truth.

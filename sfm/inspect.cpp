@@ -76,8 +76,8 @@ InspectReport RunInspect(const InspectOptions& options, const ProgressCallback& 
   }
 
   if (options.mesh) {
-    LoadedMesh loaded = LoadMesh(*options.mesh, options.mesh_clean);
-    report.mesh_stats = ComputeMeshStats(loaded.mesh);
+    mesh::LoadedMesh loaded = mesh::LoadMesh(*options.mesh, options.mesh_clean);
+    report.mesh_stats = mesh::ComputeMeshStats(loaded.mesh);
     report.mesh_report = loaded.report;
     const VisibilityResult vis = ComputeVisibility(loaded.mesh, r, options.visibility, progress);
     report.triangles_fully_seen = vis.num_fully_seen;
@@ -112,7 +112,7 @@ std::string FormatInspectReport(const InspectReport& rep) {
   out << "Mean observations per image: " << rep.mean_observations_per_image << "\n";
   out << "Mean reprojection error: " << rep.mean_reprojection_error_px << "px\n";
   if (rep.mesh_stats) {
-    const MeshStats& s = *rep.mesh_stats;
+    const mesh::MeshStats& s = *rep.mesh_stats;
     out << std::setprecision(4);
     out << "Mesh: " << s.vertices << " vertices, " << s.faces << " faces, " << s.edges << " edges, "
         << s.boundary_edges << " boundary edges, " << s.components << " components\n";

@@ -8,7 +8,7 @@
 
 #include "core/progress.h"
 #include "sfm/colmap_io.h"
-#include "sfm/mesh.h"
+#include "mesh/mesh.h"
 #include "sfm/visibility.h"
 
 namespace texlume::sfm {
@@ -19,7 +19,7 @@ struct InspectOptions {
   std::optional<std::filesystem::path> mesh;        ///< coarse mesh in the model's frame
   std::optional<std::filesystem::path> images_dir;  ///< folder the image names are relative to
   std::optional<std::filesystem::path> lights;      ///< object-lights .json or an .lp file
-  MeshCleanOptions mesh_clean;
+  mesh::MeshCleanOptions mesh_clean;
   VisibilityOptions visibility;
 
   /// Throws OptionError when no model folder is given or a nested setting is out of range.
@@ -40,8 +40,8 @@ struct InspectReport {
   double mean_reprojection_error_px = 0.0;
   std::map<std::string, std::size_t> camera_models;  ///< model name -> cameras
 
-  std::optional<MeshStats> mesh_stats;
-  std::optional<MeshReport> mesh_report;
+  std::optional<mesh::MeshStats> mesh_stats;
+  std::optional<mesh::MeshReport> mesh_report;
 
   std::optional<std::size_t> triangles_fully_seen;      ///< by at least one photo
   std::optional<std::size_t> triangles_partially_seen;  ///< partly, never fully

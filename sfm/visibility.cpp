@@ -74,7 +74,7 @@ struct ImageViews {
   std::vector<std::pair<int, TriangleView>> records;
 };
 
-ImageViews ComputeImageViews(const TriangleMesh& mesh, const std::vector<Eigen::Vector3d>& normals,
+ImageViews ComputeImageViews(const mesh::TriangleMesh& mesh, const std::vector<Eigen::Vector3d>& normals,
                              const std::vector<Eigen::Vector3d>& centroids, const Image& image,
                              const Camera& camera, const VisibilityOptions& options) {
   const double full_w = static_cast<double>(camera.width);
@@ -209,12 +209,12 @@ std::vector<ImageId> TriangleVisibility::FullyVisibleViews() const {
   return ids;
 }
 
-VisibilityResult ComputeVisibility(const TriangleMesh& mesh, const Reconstruction& reconstruction,
+VisibilityResult ComputeVisibility(const mesh::TriangleMesh& mesh, const Reconstruction& reconstruction,
                                    const VisibilityOptions& options,
                                    const ProgressCallback& progress) {
   options.Check();
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<Eigen::Vector3d> normals = FaceNormals(mesh);
+  const std::vector<Eigen::Vector3d> normals = mesh::FaceNormals(mesh);
   std::vector<Eigen::Vector3d> centroids(mesh.faces.size());
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     centroids[f] = (mesh.Corner(f, 0) + mesh.Corner(f, 1) + mesh.Corner(f, 2)) / 3.0;

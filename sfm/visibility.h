@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "sfm/mesh.h"
+#include "mesh/mesh.h"
 #include "sfm/reconstruction.h"
 
 namespace texlume::sfm {
@@ -79,8 +79,8 @@ struct VisibilityResult {
 /// rasterising every mesh face (front and back facing) at the photo's distorted
 /// projection, so partial occlusion of a triangle is detected, not only of its
 /// corners. Images run in parallel (OpenMP). The mesh must be in the model's
-/// world frame with outward-facing normals (LoadMesh makes closed meshes so).
-VisibilityResult ComputeVisibility(const TriangleMesh& mesh, const Reconstruction& reconstruction,
+/// world frame with outward-facing normals (mesh::LoadMesh makes closed meshes so).
+VisibilityResult ComputeVisibility(const mesh::TriangleMesh& mesh, const Reconstruction& reconstruction,
                                    const VisibilityOptions& options = {},
                                    const ProgressCallback& progress = {});
 

@@ -50,9 +50,4 @@ class BtfSample : public MaterialSample {
   Eigen::VectorXf mean_g_;
 };
 
-/// The geometry-map vector (n values) of the sample at a continuous texel
-/// position (x right, y down, centres at +0.5), bilinear, clamped to the sample.
-void SampleGeometry(const btf::BtfFactorisation& sample, const Eigen::Vector2d& sample_px,
-                    float* out);
-
 }  // namespace texlume::synth

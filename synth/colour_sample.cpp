@@ -17,12 +17,12 @@ namespace {
 
 // The luminance polynomial of a Lambertian texel in the display domain: the
 // least-squares fit of l_z^(1/2.2) over light directions on a grid of
-// azimuths and elevations from kHorizonElevationDeg to 90 degrees.
+// azimuths and elevations from ptm::kHorizonElevationDeg to 90 degrees.
 std::array<float, 6> LambertianLuminance() {
   std::vector<std::array<double, 6>> rows;
   std::vector<double> values;
   for (int e = 0; e <= 15; ++e) {
-    const double elevation = (kHorizonElevationDeg + (90.0 - kHorizonElevationDeg) * e / 15.0) *
+    const double elevation = (ptm::kHorizonElevationDeg + (90.0 - ptm::kHorizonElevationDeg) * e / 15.0) *
                              std::numbers::pi / 180.0;
     for (int a = 0; a < 36; ++a) {
       const double azimuth = 2.0 * std::numbers::pi * a / 36.0;
@@ -131,7 +131,7 @@ void FactorsAsChannelGains(const cv::Mat& factors, const Eigen::Vector2d& densit
 
 }  // namespace
 
-MeshSynthesis SynthesizeMeshColour(const sfm::TriangleMesh& mesh,
+MeshSynthesis SynthesizeMeshColour(const mesh::TriangleMesh& mesh,
                                    const sfm::Reconstruction& reconstruction,
                                    const sfm::VisibilityResult& visibility,
                                    const std::vector<MeshPhoto>& photos, const cv::Mat& display_rgb,

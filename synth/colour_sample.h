@@ -73,7 +73,7 @@ struct ColourSynthesisOptions : TriangleEngineOptions {
 /// baked into atlases and exported as PTM models are: each corrected face
 /// carries its factors (display domain, lin^(1/2.2)) as the per-channel gains
 /// of MeshSynthesis. Throws as SynthesizeMeshPtm.
-MeshSynthesis SynthesizeMeshColour(const sfm::TriangleMesh& mesh,
+MeshSynthesis SynthesizeMeshColour(const mesh::TriangleMesh& mesh,
                                    const sfm::Reconstruction& reconstruction,
                                    const sfm::VisibilityResult& visibility,
                                    const std::vector<MeshPhoto>& photos, const cv::Mat& display_rgb,

@@ -34,7 +34,7 @@ int NearestEdge(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& 
   int best = 0;
   double best_d = std::numeric_limits<double>::max();
   for (std::size_t k = 0; k < 3; ++k) {
-    const double d = DistanceToSegment(c[k], c[(k + 1) % 3], p);
+    const double d = mesh::DistanceToSegment(c[k], c[(k + 1) % 3], p);
     if (d < best_d) best_d = d, best = static_cast<int>(k);
   }
   return best;
@@ -74,7 +74,7 @@ class EdgeCut {
         const Eigen::Vector2d p = Centre(i, j);
         const bool on_f = Cross(p) * own_sign_ >= 0;
         side_[static_cast<std::size_t>(j * w + i)] = on_f ? 1 : -1;
-        if (DistanceToSegment(a_, b_, p) > band_) continue;
+        if (mesh::DistanceToSegment(a_, b_, p) > band_) continue;
         const Eigen::Vector2d q = u_.rotation * p + u_.translation;
         if (on_f ? NearestEdge(patch_.corners_in_frame, p) != k_
                  : NearestEdge(other_.corners_in_frame, q) != kh_)
@@ -154,7 +154,7 @@ class EdgeCut {
       for (int i = 0; i < other_.width; ++i) {
         const Eigen::Vector2d q(other_.x_min + (i + 0.5) * t_, other_.y_max - (j + 0.5) * t_);
         const Eigen::Vector2d p = back * (q - u_.translation);
-        if (DistanceToSegment(a_, b_, p) > band_ + t_) continue;
+        if (mesh::DistanceToSegment(a_, b_, p) > band_ + t_) continue;
         const int ci = static_cast<int>(std::floor((p.x() - patch_.x_min) / t_));
         const int cj = static_cast<int>(std::floor((patch_.y_max - p.y()) / t_));
         if (ci < 0 || cj < 0 || ci >= w || cj >= hgt) continue;

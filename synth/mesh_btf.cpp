@@ -64,7 +64,7 @@ BtfSampleLookup BtfMeshSynthesis::Lookup(int face, const Eigen::Vector2d& p) con
   return own(u.face, u.rotation * p + u.translation, AngleOf(u.rotation));
 }
 
-BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
+BtfMeshSynthesis SynthesizeMeshBtf(const mesh::TriangleMesh& mesh,
                                    const sfm::Reconstruction& reconstruction,
                                    const sfm::VisibilityResult& visibility,
                                    const std::vector<MeshPhoto>& photos,

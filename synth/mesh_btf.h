@@ -8,7 +8,7 @@
 
 #include "btf/btf.h"
 #include "core/progress.h"
-#include "sfm/mesh.h"
+#include "mesh/mesh.h"
 #include "sfm/reconstruction.h"
 #include "sfm/visibility.h"
 #include "synth/btf_sample.h"
@@ -81,7 +81,7 @@ struct BtfMeshSynthesis : TriangleSynthesis {
 /// seam_band texels on both sides of every shared edge.
 /// Throws OptionError for bad options and InputError when a patch does not fit
 /// the sample or the patches exceed max_texels.
-BtfMeshSynthesis SynthesizeMeshBtf(const sfm::TriangleMesh& mesh,
+BtfMeshSynthesis SynthesizeMeshBtf(const mesh::TriangleMesh& mesh,
                                    const sfm::Reconstruction& reconstruction,
                                    const sfm::VisibilityResult& visibility,
                                    const std::vector<MeshPhoto>& photos,

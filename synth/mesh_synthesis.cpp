@@ -40,7 +40,7 @@ void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip,
     if (u.face < 0) continue;
     const Eigen::Vector2d& a = patch.corners_in_frame[static_cast<std::size_t>(k)];
     const Eigen::Vector2d& b = patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)];
-    const double d = DistanceToSegment(a, b, p);
+    const double d = mesh::DistanceToSegment(a, b, p);
     if (d >= half_width) continue;
     if (!SamplePatch(u.face, u.rotation * p + u.translation, other.data())) continue;
     const double w = 0.5 * (1.0 - d / half_width);  // 1/2 at the edge, 0 at W_e / 2
@@ -57,7 +57,7 @@ void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip,
   for (std::size_t c = 0; c < n; ++c) out[c] = static_cast<float>(own_weight * own[c] + sum[c]);
 }
 
-MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
+MeshSynthesis SynthesizeMeshPtm(const mesh::TriangleMesh& mesh,
                                 const sfm::Reconstruction& reconstruction,
                                 const sfm::VisibilityResult& visibility,
                                 const std::vector<MeshPhoto>& photos, const ptm::Ptm& ptm,

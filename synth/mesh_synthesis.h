@@ -9,7 +9,7 @@
 
 #include "core/progress.h"
 #include "ptm/ptm.h"
-#include "sfm/mesh.h"
+#include "mesh/mesh.h"
 #include "sfm/reconstruction.h"
 #include "sfm/visibility.h"
 #include "synth/triangle_engine.h"
@@ -83,7 +83,7 @@ struct MeshSynthesis : TriangleSynthesis {
 /// `photos` the usable photos (each image_id in the reconstruction). Throws
 /// OptionError for bad options and InputError when the patches would not fit the
 /// sample or would exceed max_texels (with the estimate).
-MeshSynthesis SynthesizeMeshPtm(const sfm::TriangleMesh& mesh,
+MeshSynthesis SynthesizeMeshPtm(const mesh::TriangleMesh& mesh,
                                 const sfm::Reconstruction& reconstruction,
                                 const sfm::VisibilityResult& visibility,
                                 const std::vector<MeshPhoto>& photos, const ptm::Ptm& sample,

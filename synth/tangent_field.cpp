@@ -64,7 +64,7 @@ Eigen::Matrix2d SampleStructureTensor(
   return tensor;
 }
 
-PhotoTangentField PhotoAlignedTangents(const std::vector<TriangleFrame>& frames,
+PhotoTangentField PhotoAlignedTangents(const std::vector<mesh::TriangleFrame>& frames,
                                        const std::vector<std::array<Unfolding, 3>>& unfoldings,
                                        const std::vector<Eigen::Matrix2d>& photo_tensors,
                                        const Eigen::Matrix2d& sample_tensor, double smoothness) {
@@ -157,7 +157,7 @@ FrameChoice ChoosePhotoFrames(
   if (requested == TangentFrame::kAuto && choice.sample_coherence < kAnisotropicSampleCoherence)
     return choice;
   std::vector<Eigen::Matrix2d> photo_tensors(patches.size(), Eigen::Matrix2d::Zero());
-  std::vector<TriangleFrame> frames(patches.size());
+  std::vector<mesh::TriangleFrame> frames(patches.size());
   for (std::size_t f = 0; f < patches.size(); ++f) {
     frames[f] = patches[f].frame;
     if (face_levels[f] >= 0) photo_tensors[f] = photo_tensor(f);

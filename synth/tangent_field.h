@@ -6,7 +6,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "synth/triangle_frame.h"
+#include "mesh/triangle_frame.h"
 #include "synth/triangle_parts.h"
 
 namespace texlume::synth {
@@ -62,7 +62,7 @@ inline constexpr double kPhotoFieldSmoothness = 1.0;
 /// unfolding's rotation), by a sparse Cholesky solve; turn_f = arg(u_f) / 2.
 /// Faces and components with no photo follow their neighbours, or keep their
 /// frame. `frames` and `unfoldings` are per face (MakePatchGeometry's).
-PhotoTangentField PhotoAlignedTangents(const std::vector<TriangleFrame>& frames,
+PhotoTangentField PhotoAlignedTangents(const std::vector<mesh::TriangleFrame>& frames,
                                        const std::vector<std::array<Unfolding, 3>>& unfoldings,
                                        const std::vector<Eigen::Matrix2d>& photo_tensors,
                                        const Eigen::Matrix2d& sample_tensor,

@@ -9,15 +9,12 @@
 #include "core/check.h"
 #include "core/errors.h"
 #include "core/image_io.h"
+#include "core/timing.h"
 #include "synth/tangent_field.h"
 #include "synth/template_match.h"
 
 namespace texlume::synth {
 namespace {
-
-double Since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 // The photo's sum over a view's masked cells and R, G, B, in the linear domain.
 double PhotoLinearSum(const RectifiedView& r, PhotoDomain domain) {
@@ -48,7 +45,7 @@ void TriangleEngineOptions::Check() const {
     throw OptionError("field direction must be nonzero");
 }
 
-TriangleEngine::TriangleEngine(const sfm::TriangleMesh& mesh,
+TriangleEngine::TriangleEngine(const mesh::TriangleMesh& mesh,
                                const sfm::Reconstruction& reconstruction,
                                const sfm::VisibilityResult& visibility,
                                const std::vector<MeshPhoto>& photos, const MaterialSample& sample,
@@ -79,7 +76,7 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
 
   // Breadth first from the best-seen face (Algorithm 2, step 2).
   const std::vector<int> order =
-      sfm::BreadthFirstFaceOrder(mesh_, sfm::FaceNeighbours(mesh_), BestSeenFace(visibility_));
+      mesh::BreadthFirstFaceOrder(mesh_, mesh::FaceNeighbours(mesh_), BestSeenFace(visibility_));
   done_.assign(num_faces, 0);
   std::mt19937_64 rng(options_.seed);
   std::size_t processed = 0;
@@ -91,7 +88,7 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
       progress("synthesis", processed, num_faces);
   }
   if (correction_) correction_->Finish(*this, progress);
-  result_.seconds_synthesis = Since(start);
+  result_.seconds_synthesis = SecondsSince(start);
   return std::move(result_);
 }
 
@@ -276,7 +273,7 @@ TriangleEngine::OverlapTargets TriangleEngine::CollectOverlapTargets(std::size_t
         const Unfolding& u = result_.unfoldings[f][k];
         if (u.face < 0 || !done_[static_cast<std::size_t>(u.face)]) continue;
         const double d =
-            DistanceToSegment(patch.corners_in_frame[k], patch.corners_in_frame[(k + 1) % 3], p);
+            mesh::DistanceToSegment(patch.corners_in_frame[k], patch.corners_in_frame[(k + 1) % 3], p);
         if (d > options_.strip * t) continue;
         const TrianglePatch& other = result_.patches[static_cast<std::size_t>(u.face)];
         if (!sample_.PatchFeatures(other, t, u.rotation * p + u.translation, value.data()))

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "sfm/mesh.h"
+#include "mesh/mesh.h"
 #include "sfm/reconstruction.h"
 #include "sfm/visibility.h"
 #include "synth/material_sample.h"
@@ -121,7 +121,7 @@ class PhotoCorrection {
 class TriangleEngine {
  public:
   /// All references must outlive the engine. `correction` may be null (no pass).
-  TriangleEngine(const sfm::TriangleMesh& mesh, const sfm::Reconstruction& reconstruction,
+  TriangleEngine(const mesh::TriangleMesh& mesh, const sfm::Reconstruction& reconstruction,
                  const sfm::VisibilityResult& visibility, const std::vector<MeshPhoto>& photos,
                  const MaterialSample& sample, const TriangleEngineOptions& options,
                  PhotoCorrection* correction);
@@ -169,7 +169,7 @@ class TriangleEngine {
   void PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap,
                          std::mt19937_64& rng) const;
 
-  const sfm::TriangleMesh& mesh_;
+  const mesh::TriangleMesh& mesh_;
   const sfm::Reconstruction& reconstruction_;
   const sfm::VisibilityResult& visibility_;
   const std::vector<MeshPhoto>& photos_;

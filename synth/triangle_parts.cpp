@@ -18,10 +18,10 @@ using LightList = std::vector<std::pair<Eigen::Vector3d, double>>;  // (tangent-
 Eigen::Vector3f RelightMixture(const float* coefficients, const float* colour,
                                ptm::PtmFormat format, const LightList& lights, double gain) {
   Eigen::Vector3f linear = Eigen::Vector3f::Zero();
-  static const double z_horizon = std::sin(kHorizonElevationDeg * std::numbers::pi / 180.0);
+  static const double z_horizon = std::sin(ptm::kHorizonElevationDeg * std::numbers::pi / 180.0);
   for (const auto& [l_in, intensity] : lights) {
     if (l_in.z() <= 0.0) continue;
-    // Below kHorizonElevationDeg the biquadratic is extrapolated beyond any
+    // Below ptm::kHorizonElevationDeg the biquadratic is extrapolated beyond any
     // capture light and overshoots: take its value at that elevation (same
     // azimuth) fading linearly with l_z to 0 at the horizon.
     Eigen::Vector3d l = l_in;
@@ -102,7 +102,7 @@ int RectificationMaps(const TrianglePatch& patch, double t, double rx, double ry
       const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(cam);
       map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
       map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
-      if (px && SignedDistanceToTriangle(patch.corners_in_frame, p) <= mask_margin &&
+      if (px && mesh::SignedDistanceToTriangle(patch.corners_in_frame, p) <= mask_margin &&
           px->x() >= 0.5 && px->y() >= 0.5 && px->x() <= image_size.width - 0.5 &&
           px->y() <= image_size.height - 0.5) {
         mask.at<float>(j, i) = 1.0f;
@@ -212,7 +212,7 @@ void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& can
   }
 }
 
-PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int strip,
+PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double t, int strip,
                                 TangentFrame tangent_frame,
                                 const Eigen::Vector3d& field_direction_in_world) {
   std::vector<Eigen::Vector3d> tangents(mesh.faces.size());
@@ -234,7 +234,7 @@ PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int str
   return MakePatchGeometry(mesh, t, strip, tangents);
 }
 
-PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int strip,
+PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double t, int strip,
                                 const std::vector<Eigen::Vector3d>& tangents_in_world) {
   const std::size_t num_faces = mesh.faces.size();
   PatchGeometry result;
@@ -244,7 +244,7 @@ PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int str
   result.patches.resize(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f) {
     TrianglePatch& patch = result.patches[f];
-    patch.frame = MakeTriangleFrame(mesh, f, tangents_in_world[f]);
+    patch.frame = mesh::MakeTriangleFrame(mesh, f, tangents_in_world[f]);
     Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
     Eigen::Vector2d hi = -lo;
     for (int k = 0; k < 3; ++k) {
@@ -269,7 +269,7 @@ PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double t, int str
     total_texels += static_cast<std::int64_t>(patch.width) * patch.height;
   }
   // Unfoldings across every shared edge.
-  const std::vector<std::array<int, 3>> neighbours = sfm::FaceNeighbours(mesh);
+  const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(mesh);
   result.unfoldings.resize(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f) {
     for (int k = 0; k < 3; ++k) {

@@ -12,10 +12,10 @@
 #include "core/image_io.h"
 #include "ptm/ptm.h"
 #include "sfm/lights.h"
-#include "sfm/mesh.h"
+#include "mesh/mesh.h"
 #include "sfm/reconstruction.h"
 #include "sfm/visibility.h"
-#include "synth/triangle_frame.h"
+#include "mesh/triangle_frame.h"
 
 // The parts of paper 003 Algorithm 2 that every per-triangle engine shares: the
 // photos, each face's frame and patch rectangle, the unfoldings across its
@@ -61,7 +61,7 @@ enum class PatchSource {
 /// (x_min + (i + 0.5) t, y_max - (j + 0.5) t), t the texel size. The rectangle is
 /// the triangle's bounding box plus W_e texels of strip on every side.
 struct TrianglePatch {
-  TriangleFrame frame;
+  mesh::TriangleFrame frame;
   std::array<Eigen::Vector2d, 3> corners_in_frame;  ///< world units
   double x_min = 0.0, y_max = 0.0;                  ///< world units, frame coordinates
   int width = 0, height = 0;                        ///< texels
@@ -109,13 +109,13 @@ struct PatchGeometry {
   std::int64_t total_texels = 0;
   int widest = 0, tallest = 0;  ///< largest patch sides, texels
 };
-PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double texel_size, int strip,
+PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double texel_size, int strip,
                                 TangentFrame tangent_frame,
                                 const Eigen::Vector3d& field_direction_in_world);
 /// The same with each face's frame x axis along its tangent (projected onto the
 /// face; v0 -> v1 where it is nearly the normal). kPhotos and kAuto above give
 /// first-edge frames, the start that SynthesizeMeshPtm turns.
-PatchGeometry MakePatchGeometry(const sfm::TriangleMesh& mesh, double texel_size, int strip,
+PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double texel_size, int strip,
                                 const std::vector<Eigen::Vector3d>& tangents_in_world);
 
 /// Helpers of Algorithm 2 shared by the PTM and BTF synthesis.
@@ -170,16 +170,10 @@ void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& can
                              const std::function<double(int, int)>& overlap_error,
                              TrianglePatch& patch);
 
-/// Lights lower than this (degrees above the tangent plane) are evaluated at this
-/// elevation and faded linearly in l_z to 0 at the horizon (RelightMixture): RTI
-/// domes rarely light below it, and the biquadratic overshoots there. Recorded in
-/// the model's manifest and glTF extras so that viewers do the same.
-inline constexpr double kHorizonElevationDeg = 15.0;
-
 /// The display value of a PTM texel under several lights (tangent frame) with
 /// intensities, times a gain: the sum is taken in the linear domain,
 /// srgb(gain * sum_i I_i lin(clamp(f(l_i)))). Lights below the horizon add 0;
-/// lights below kHorizonElevationDeg fade (see there).
+/// lights below ptm::kHorizonElevationDeg fade (see there).
 Eigen::Vector3f RelightMixture(const float* coefficients_or_l, const float* colour,
                                ptm::PtmFormat format,
                                const std::vector<std::pair<Eigen::Vector3d, double>>& lights,

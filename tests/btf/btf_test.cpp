@@ -9,7 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
-#include "btf/btf_model.h"
+#include "pipeline/btf_synth_job.h"
 #include "core/errors.h"
 #include "synth/mesh_synthesis.h"
 #include "tests/test_util.h"
@@ -234,7 +234,7 @@ TEST(Btf, BadCapturesAndOptionsAreClearErrors) {
 }
 
 TEST(BtfSynthJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
-  BtfSynthJobOptions o;
+  pipeline::BtfSynthJobOptions o;
   o.job.model_dir = "sparse";
   o.job.images_dir = "images";
   o.job.lights_file = "lights.json";
@@ -250,7 +250,7 @@ TEST(BtfSynthJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
   o.synthesis.seam_band = 4;
   o.btf.clear();
   EXPECT_THROW(o.Check(), OptionError);
-  EXPECT_THROW(RunBtfSynthJob(o), OptionError);
+  EXPECT_THROW(pipeline::RunBtfSynthJob(o), OptionError);
 }
 
 }  // namespace

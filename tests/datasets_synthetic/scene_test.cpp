@@ -10,7 +10,7 @@
 #include "ptm/exr_io.h"
 #include "sfm/colmap_io.h"
 #include "sfm/lights.h"
-#include "sfm/mesh.h"
+#include "mesh/mesh.h"
 #include "tests/test_util.h"
 
 namespace texlume::datasets {
@@ -41,7 +41,7 @@ SceneOptions SmallScene(SceneShape shape, MaterialKind kind) {
 }
 
 // The coarse mesh projected with a COLMAP camera: the object mask it predicts.
-cv::Mat ProjectMesh(const sfm::TriangleMesh& mesh, const sfm::Camera& camera,
+cv::Mat ProjectMesh(const mesh::TriangleMesh& mesh, const sfm::Camera& camera,
                     const sfm::Image& image) {
   cv::Mat mask(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC1,
                cv::Scalar(0));
@@ -70,7 +70,7 @@ double IoU(const cv::Mat& a, const cv::Mat& b) {
 void ExpectMasksMatchTheCoarseMesh(const fs::path& object_dir, const std::string& model,
                                    const std::string& masks) {
   const sfm::LoadedModel loaded = sfm::ReadModel(object_dir / model);
-  const sfm::LoadedMesh mesh = sfm::LoadMesh(object_dir / "mesh.ply");
+  const mesh::LoadedMesh mesh = mesh::LoadMesh(object_dir / "mesh.ply");
   for (const auto& [id, image] : loaded.reconstruction.images) {
     const cv::Mat rendered =
         cv::imread((object_dir / masks / image.name).string(), cv::IMREAD_GRAYSCALE);

@@ -32,7 +32,7 @@ Reconstruction CamerasLookingAtOrigin(const std::vector<Eigen::Vector3d>& center
 }
 
 // Does the triangle overlap the open square |x|,|y| < h (separating axis test)?
-bool OverlapsSquare(const TriangleMesh& m, std::size_t f, double h) {
+bool OverlapsSquare(const mesh::TriangleMesh& m, std::size_t f, double h) {
   std::vector<Eigen::Vector2d> p = {m.Corner(f, 0).head<2>(), m.Corner(f, 1).head<2>(),
                                     m.Corner(f, 2).head<2>()};
   std::vector<Eigen::Vector2d> square = {{-h, -h}, {h, -h}, {h, h}, {-h, h}};
@@ -54,7 +54,7 @@ bool OverlapsSquare(const TriangleMesh& m, std::size_t f, double h) {
 TEST(Visibility, KnownOccluderHidesExactlyTheTrianglesBehindItPartlyOrWholly) {
   // A 2x2 plane of 512 triangles at z = 0 and a 0.4x0.4 occluder at z = 1 facing
   // the camera at z = 3: its shadow on the plane is the square |x|,|y| < 0.3.
-  TriangleMesh mesh = datasets::MakeGridPlane(16, 2.0);
+  mesh::TriangleMesh mesh = datasets::MakeGridPlane(16, 2.0);
   const std::size_t plane_faces = mesh.NumFaces();
   const int base = static_cast<int>(mesh.NumVertices());
   for (const auto& v : std::vector<Eigen::Vector3d>{
@@ -86,7 +86,7 @@ TEST(Visibility, KnownOccluderHidesExactlyTheTrianglesBehindItPartlyOrWholly) {
 
 TEST(Visibility, OccluderInsideATriangleWithAllCornersVisibleIsDetected) {
   // One big triangle; a tiny occluder in front of its middle hides no corner.
-  TriangleMesh mesh;
+  mesh::TriangleMesh mesh;
   mesh.vertices = {{-1, -1, 0},         {1, -1, 0},         {0, 1, 0},
                    {-0.05, -0.05, 0.5}, {0.05, -0.05, 0.5}, {0, 0.05, 0.5}};
   mesh.faces = {{0, 1, 2}, {3, 4, 5}};
@@ -99,7 +99,7 @@ TEST(Visibility, OccluderInsideATriangleWithAllCornersVisibleIsDetected) {
 }
 
 TEST(Visibility, BestViewIsTheSmallestAngleAmongFullyVisibleViews) {
-  const TriangleMesh mesh = datasets::MakeGridPlane(4, 0.5);
+  const mesh::TriangleMesh mesh = datasets::MakeGridPlane(4, 0.5);
   const Reconstruction r = CamerasLookingAtOrigin({{3, 0, 2}, {0.3, 0, 4}, {-2, 0, 2}, {0, 0, -3}});
   const VisibilityResult vis = ComputeVisibility(mesh, r);
   for (const TriangleVisibility& t : vis.triangles) {
@@ -116,7 +116,7 @@ TEST(Visibility, BestViewIsTheSmallestAngleAmongFullyVisibleViews) {
 }
 
 TEST(Visibility, ProjectedAreaMatchesTheHeadOnScale) {
-  const TriangleMesh mesh = datasets::MakeGridPlane(2, 0.2);
+  const mesh::TriangleMesh mesh = datasets::MakeGridPlane(2, 0.2);
   const VisibilityResult vis = ComputeVisibility(mesh, CamerasLookingAtOrigin({{0, 0, 3}}));
   double area_px = 0;
   for (const auto& t : vis.triangles) area_px += t.views.at(0).projected_area_px;
@@ -127,7 +127,7 @@ TEST(Visibility, ProjectedAreaMatchesTheHeadOnScale) {
 
 TEST(Visibility, TrianglesLeavingTheImageFallBackToTheirMostVisibleView) {
   // A plane wider than the field of view: outer triangles are only partly inside.
-  const TriangleMesh mesh = datasets::MakeGridPlane(8, 8.0);
+  const mesh::TriangleMesh mesh = datasets::MakeGridPlane(8, 8.0);
   const VisibilityResult vis =
       ComputeVisibility(mesh, CamerasLookingAtOrigin({{0, 0, 3}}, CameraModelId::kOpenCV));
   EXPECT_GT(vis.num_fully_seen, 0u);

@@ -10,7 +10,7 @@
 
 #include "datasets_synthetic/shapes.h"
 #include "synth/mesh_synthesis.h"
-#include "synth/pipeline.h"
+#include "pipeline/synth_job.h"
 #include "tests/small_scene.h"
 #include "tests/test_util.h"
 
@@ -81,7 +81,7 @@ TEST(LuminanceStructureTensor, IgnoresCellsOutsideTheMaskAndNoiseIsIsotropic) {
 // `sample_angle` in its texel axes) is laid on the surface with its x axis along
 // `x_in_world`: the gradient in the world, taken into the face's frame, plus
 // some isotropic texture (coherence about 0.6) and a little angular noise.
-Eigen::Matrix2d PhotoTensor(const TriangleFrame& frame, const Eigen::Vector3d& x_in_world,
+Eigen::Matrix2d PhotoTensor(const mesh::TriangleFrame& frame, const Eigen::Vector3d& x_in_world,
                             double sample_angle, std::mt19937& rng) {
   const Eigen::Vector3d x = (x_in_world - frame.z_axis * frame.z_axis.dot(x_in_world)).normalized();
   const Eigen::Vector3d y = frame.z_axis.cross(x);
@@ -93,11 +93,11 @@ Eigen::Matrix2d PhotoTensor(const TriangleFrame& frame, const Eigen::Vector3d& x
 }
 
 // A mesh's first-edge patch geometry (texels of 0.01, strip 4).
-PatchGeometry FirstEdgeGeometry(const sfm::TriangleMesh& mesh) {
+PatchGeometry FirstEdgeGeometry(const mesh::TriangleMesh& mesh) {
   return MakePatchGeometry(mesh, 0.01, 4, TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
 }
-std::vector<TriangleFrame> FramesOf(const PatchGeometry& geometry) {
-  std::vector<TriangleFrame> frames;
+std::vector<mesh::TriangleFrame> FramesOf(const PatchGeometry& geometry) {
+  std::vector<mesh::TriangleFrame> frames;
   for (const TrianglePatch& p : geometry.patches) frames.push_back(p.frame);
   return frames;
 }
@@ -109,7 +109,7 @@ Eigen::Matrix2d SampleTensor(double angle) {
 
 TEST(PhotoAlignedTangents, ALineFieldOnAPlaneFollowsThePhotosWhereverTheyAre) {
   const PatchGeometry geometry = FirstEdgeGeometry(datasets::MakeGridPlane(12, 1.2));
-  const std::vector<TriangleFrame> frames = FramesOf(geometry);
+  const std::vector<mesh::TriangleFrame> frames = FramesOf(geometry);
   const Eigen::Vector3d truth(std::cos(0.5), std::sin(0.5), 0.0);  // the texture's x axis
   const double sample_angle = kPi / 2;  // horizontal stripes: gradients along y
   std::mt19937 rng(3);
@@ -140,7 +140,7 @@ TEST(PhotoAlignedTangents, ALineFieldOnAPlaneFollowsThePhotosWhereverTheyAre) {
 
 TEST(PhotoAlignedTangents, ACylindersFieldRunsAroundItAcrossCurvedEdges) {
   const PatchGeometry geometry = FirstEdgeGeometry(datasets::MakeCylinder(24, 8, 0.6, 1.6));
-  const std::vector<TriangleFrame> frames = FramesOf(geometry);
+  const std::vector<mesh::TriangleFrame> frames = FramesOf(geometry);
   std::mt19937 rng(5);
   // The way around: horizontal in the face's plane.
   auto around = [&](std::size_t f) {
@@ -171,7 +171,7 @@ TEST(PhotoAlignedTangents, ACylindersFieldRunsAroundItAcrossCurvedEdges) {
 
 TEST(ChoosePhotoFrames, AutoTurnsFramesOnlyForAnAnisotropicSample) {
   const PatchGeometry geometry = FirstEdgeGeometry(datasets::MakeGridPlane(4, 1.0));
-  const std::vector<TriangleFrame> frames = FramesOf(geometry);
+  const std::vector<mesh::TriangleFrame> frames = FramesOf(geometry);
   std::vector<int> levels(frames.size(), 3);
   levels[0] = -1;  // seen in no photo
   int sample_level = -1;
@@ -223,7 +223,7 @@ TEST(PhotoFrames, BricksOnAColumnRunAroundItAndMatchThePhotosBetter) {
   o.num_held_out_views = 0;
   datasets::GenerateScene(o, tmp.path() / "scene");
   const ptm::Ptm sample = testing::FitSceneSample(tmp.path() / "scene");
-  SynthJobOptions job;
+  pipeline::SynthJobOptions job;
   const std::filesystem::path object = tmp.path() / "scene/object";
   job.model_dir = object / "sparse";
   job.images_dir = object / "images";
@@ -232,8 +232,8 @@ TEST(PhotoFrames, BricksOnAColumnRunAroundItAndMatchThePhotosBetter) {
   job.synthesis.sample_texel_size = 0.004;
   job.synthesis.correction_iterations = 0;  // the quilting alone
   job.synthesis.detail_transfer = false;
-  SynthInputs inputs = LoadSynthInputs(job);
-  PrepareSynthMesh(inputs, job, std::min(sample.width, sample.height), 0.004, job.synthesis.strip);
+  pipeline::SynthInputs inputs = pipeline::LoadSynthInputs(job);
+  pipeline::PrepareSynthMesh(inputs, job, std::min(sample.width, sample.height), 0.004, job.synthesis.strip);
   auto synthesise = [&](TangentFrame frame) {
     job.synthesis.tangent_frame = frame;
     return SynthesizeMeshPtm(inputs.mesh, inputs.reconstruction, inputs.visibility, inputs.photos,

@@ -1,0 +1,364 @@
+#include "atlas/chart_packing.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <unordered_map>
+
+#include "core/check.h"
+#include "core/errors.h"
+#include "ptm/coefficient_space.h"
+#include "atlas/charts.h"
+#include "synth/planar_synthesis.h"
+
+namespace texlume::atlas::chart_packing {
+
+std::pair<int, int> TexelColumns(const std::pair<double, double>& span, int width) {
+  if (span.first > span.second) return {0, -1};
+  const double first = std::ceil(span.first - 0.5), last = std::floor(span.second - 0.5);
+  return {static_cast<int>(std::max(0.0, first)),
+          static_cast<int>(std::min(static_cast<double>(width - 1), last))};
+}
+
+ChartOutline Box(const std::vector<ChartFace>& chart, double angle,
+                 const std::vector<synth::TrianglePatch>& patches, double t, int gutter,
+                 std::vector<std::array<Eigen::Vector2d, 3>>* corners) {
+  ChartOutline o;
+  o.angle = angle;
+  const Eigen::Matrix2d turn = Eigen::Rotation2Dd(angle).toRotationMatrix();
+  Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
+  Eigen::Vector2d hi = -lo;
+  for (const ChartFace& cf : chart) {
+    std::array<Eigen::Vector2d, 3> c;
+    for (std::size_t k = 0; k < 3; ++k) {
+      c[k] = turn *
+             (cf.linear * patches[static_cast<std::size_t>(cf.face)].corners_in_frame[k] +
+              cf.translation) /
+             t;
+      lo = lo.cwiseMin(c[k]);
+      hi = hi.cwiseMax(c[k]);
+    }
+    if (corners) corners->push_back(c);
+  }
+  // Texels i whose centre i + 0.5 is within gutter + 0.5 (and a hair) of the corners' box.
+  constexpr double kHair = 1e-6;
+  o.lo = Eigen::Vector2i(static_cast<int>(std::ceil(lo.x() - gutter - 1 - kHair)),
+                         static_cast<int>(std::ceil(lo.y() - gutter - 1 - kHair)));
+  o.hi = Eigen::Vector2i(static_cast<int>(std::floor(hi.x() + gutter + kHair)) + 1,
+                         static_cast<int>(std::floor(hi.y() + gutter + kHair)) + 1);
+  return o;
+}
+
+ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
+                     const std::vector<synth::TrianglePatch>& patches, double t, int gutter) {
+  std::vector<std::array<Eigen::Vector2d, 3>> corners;  // texels, chart frame
+  ChartOutline o = Box(chart, angle, patches, t, gutter, &corners);
+  const int w = o.Width(), h = o.Height();
+  cv::Mat mask = cv::Mat::zeros(h, w, CV_8UC1);
+  for (auto c : corners) {
+    for (auto& p : c) p = Eigen::Vector2d(p.x() - o.lo.x(), o.hi.y() - p.y());  // box, y down
+    Eigen::Vector2d clo = c[0], chi = clo;
+    for (const auto& p : c) clo = clo.cwiseMin(p), chi = chi.cwiseMax(p);
+    // Texels the bake writes for this face: centre within gutter + 0.5 of it
+    // (and a hair more, so rounding in the bake cannot write beyond the outline).
+    const double reach = gutter + 0.5 + 1e-6;
+    for (int y = std::max(0, static_cast<int>(clo.y()) - gutter - 1);
+         y <= std::min(h - 1, static_cast<int>(chi.y()) + gutter + 1); ++y) {
+      const auto [x_first, x_last] = TexelColumns(mesh::TriangleRowSpan(c, y + 0.5, reach), w);
+      for (int x = x_first; x <= x_last; ++x)
+        if (mesh::SignedDistanceToTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5)) <= reach)
+          mask.at<std::uint8_t>(y, x) = 1;
+    }
+  }
+  o.row_first_x.assign(static_cast<std::size_t>(h), std::numeric_limits<int>::max());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w;) {
+      if (!mask.at<std::uint8_t>(y, x)) {
+        ++x;
+        continue;
+      }
+      int end = x;
+      while (end < w && mask.at<std::uint8_t>(y, end)) ++end;
+      o.runs.push_back({y, x, end - x});
+      int& first = o.row_first_x[static_cast<std::size_t>(y)];
+      first = std::min(first, x);
+      o.area += end - x;
+      x = end;
+    }
+  // Longest runs first: they reject a blocked position soonest.
+  std::stable_sort(
+      o.runs.begin(), o.runs.end(),
+      [](const ChartOutline::Run& a, const ChartOutline::Run& b) { return a.length > b.length; });
+  return o;
+}
+
+double UprightBoxAngle(const std::vector<ChartFace>& chart,
+                       const std::vector<synth::TrianglePatch>& patches) {
+  std::vector<Eigen::Vector2d> points;
+  for (const ChartFace& cf : chart)
+    for (const auto& c : patches[static_cast<std::size_t>(cf.face)].corners_in_frame)
+      points.push_back(cf.linear * c + cf.translation);
+  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() != b.x() ? a.x() < b.x() : a.y() < b.y();
+  });
+  // Monotone chain (Andrew 1979).
+  std::vector<Eigen::Vector2d> hull(2 * points.size());
+  std::size_t k = 0;
+  auto turn_left = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a,
+                      const Eigen::Vector2d& b) {
+    return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x() > 0;
+  };
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && !turn_left(hull[k - 2], hull[k - 1], points[i])) --k;
+    hull[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && !turn_left(hull[k - 2], hull[k - 1], points[i])) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k > 1 ? k - 1 : k);
+  double best_area = std::numeric_limits<double>::max(), best_angle = 0.0;
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const Eigen::Vector2d e = hull[(i + 1) % hull.size()] - hull[i];
+    if (e.squaredNorm() == 0.0) continue;
+    const double angle = -std::atan2(e.y(), e.x());
+    const Eigen::Matrix2d r = Eigen::Rotation2Dd(angle).toRotationMatrix();
+    Eigen::Vector2d lo = r * hull[0], hi = lo;
+    for (const auto& p : hull) lo = lo.cwiseMin(r * p), hi = hi.cwiseMax(r * p);
+    const double area = (hi - lo).prod();
+    if (area < best_area - 1e-12 * std::abs(best_area)) best_area = area, best_angle = angle;
+  }
+  return best_angle;
+}
+
+/// Bottom-left packing of outlines (texel-exact, so charts fill each other's
+/// concavities and holes): charts go in `order`, each into the first atlas
+/// where it fits, at the rotation and position `rule` prefers.
+/// `placed` is called after each chart.
+OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlines,
+                            const std::vector<std::size_t>& order, int bin_size, DropRule rule,
+                            const std::function<void()>& placed) {
+  OutlinePacking packing;
+  packing.drops.resize(outlines.size());
+  std::vector<PackingBin> bins;
+  for (const std::size_t c : order) {
+    for (std::size_t bin = 0;; ++bin) {
+      if (bin == bins.size()) bins.emplace_back(bin_size);
+      const std::size_t num_rotations = outlines[c].size();
+      std::vector<std::pair<int, int>> fit(num_rotations);
+#pragma omp parallel for schedule(dynamic, 1)
+      for (std::size_t r = 0; r < num_rotations; ++r)
+        fit[r] = bins[bin].FirstFit(outlines[c][r], bin_size);
+      int best = -1;
+      auto key = [&](std::size_t r) {
+        const int y = fit[r].second;
+        return std::make_tuple(rule == DropRule::kLowestBottom ? y + outlines[c][r].Height() : y,
+                               fit[r].first, y);
+      };
+      for (std::size_t r = 0; r < num_rotations; ++r)
+        if (fit[r].first >= 0 && (best < 0 || key(r) < key(static_cast<std::size_t>(best))))
+          best = static_cast<int>(r);
+      if (best < 0) continue;
+      const auto [x, y] = fit[static_cast<std::size_t>(best)];
+      bins[bin].Take(outlines[c][static_cast<std::size_t>(best)], x, y);
+      packing.drops[c] = {static_cast<int>(bin), best, x, y};
+      break;
+    }
+    if (placed) placed();
+  }
+  for (std::size_t bin = 0; bin < bins.size(); ++bin)
+    packing.texels += static_cast<std::int64_t>(bin_size) *
+                      (bin + 1 < bins.size() ? bin_size : bins[bin].used_rows);
+  return packing;
+}
+
+RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
+                            const std::vector<synth::TrianglePatch>& patches, double t, int gutter,
+                            int atlas_size, const ProgressCallback& progress) {
+  // Band x of a face (texels): the centroid of its corners in the chart frame.
+  auto band_x = [&](const ChartFace& cf) {
+    double x = 0;
+    for (const auto& c : patches[static_cast<std::size_t>(cf.face)].corners_in_frame)
+      x += (cf.linear * c + cf.translation).x();
+    return x / (3.0 * t);
+  };
+  std::vector<std::vector<ChartFace>> queue;
+  std::vector<int> height;  // texels, outline box at turn 0
+  for (const auto& chart : charts) {
+    std::vector<ChartFace> sorted = chart;
+    std::stable_sort(sorted.begin(), sorted.end(),
+                     [&](const ChartFace& a, const ChartFace& b) { return band_x(a) < band_x(b); });
+    queue.push_back(std::move(sorted));
+    height.push_back(Box(chart, 0.0, patches, t, gutter, nullptr).Height());
+  }
+  std::vector<std::size_t> order(queue.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return height[a] != height[b] ? height[a] > height[b] : queue[a].size() > queue[b].size();
+  });
+
+  RowPacking out;
+  int atlas = 0, row_y = 0, row_height = 0;
+  std::vector<int> right_edge;  // per row of the current band row: first free x
+  auto new_row = [&](int h) {
+    row_y += row_height;
+    if (row_y + h > atlas_size) ++atlas, row_y = 0;
+    row_height = h;
+    right_edge.assign(static_cast<std::size_t>(h), 0);
+  };
+  // Where `o` slides to in the current row: the smallest x where no run
+  // overlaps the row's used texels.
+  auto slide = [&](const ChartOutline& o, int dy) {
+    int x = 0;
+    for (const ChartOutline::Run& r : o.runs)
+      x = std::max(x, right_edge[static_cast<std::size_t>(r.row + dy)] - r.x);
+    return x;
+  };
+  // Texels left empty between the row's right edge and outline `o` slid to
+  // x at dy, per row of the outline: the gap its left end leaves.
+  auto gap_per_row = [&](const ChartOutline& o, int x, int dy) {
+    double gap = 0.0;
+    int rows = 0;
+    for (int row = 0; row < o.Height(); ++row) {
+      const int first = o.row_first_x[static_cast<std::size_t>(row)];
+      if (first == std::numeric_limits<int>::max()) continue;
+      gap += x + first - right_edge[static_cast<std::size_t>(row + dy)];
+      ++rows;
+    }
+    return rows > 0 ? gap / rows : 0.0;
+  };
+  // Whole charts' outlines at 0 and 180 degrees, made when first needed.
+  std::vector<std::array<std::optional<ChartOutline>, 2>> whole(queue.size());
+  auto whole_outline = [&](std::size_t c, int turn) -> const ChartOutline& {
+    auto& o = whole[c][static_cast<std::size_t>(turn)];
+    if (!o) o = Outline(queue[c], turn * kPi, patches, t, gutter);
+    return *o;
+  };
+  std::vector<char> pending(order.size(), 1);  // per position in `order`
+  std::size_t first_pending = 0;
+  std::size_t done = 0;
+  while (done < order.size()) {
+    while (!pending[first_pending]) ++first_pending;
+    std::size_t pick = first_pending;
+    // Best fit: in a started row, the whole chart (of the next
+    // kBestFitCandidates of the row's height) whose left end leaves the least
+    // gap, so slanted ends nest instead of leaving triangles empty.
+    if (row_height > 0 &&
+        std::any_of(right_edge.begin(), right_edge.end(), [](int e) { return e > 0; })) {
+      double best_gap = std::numeric_limits<double>::max();
+      int tried = 0;
+      for (std::size_t i = first_pending; i < order.size() && tried < kBestFitCandidates; ++i) {
+        if (!pending[i] || height[order[i]] != row_height) continue;
+        ++tried;
+        for (int turn = 0; turn < 2; ++turn) {
+          const ChartOutline& o = whole_outline(order[i], turn);
+          for (int dy = 0; dy + o.Height() <= row_height; ++dy) {
+            const int x = slide(o, dy);
+            if (x + o.Width() > atlas_size) continue;
+            const double gap = gap_per_row(o, x, dy);
+            if (gap < best_gap) best_gap = gap, pick = i;
+          }
+        }
+      }
+    }
+    pending[pick] = 0;
+    const std::size_t c = order[pick];
+    if (height[c] > atlas_size)
+      throw OptionError("a strip chart of " + std::to_string(height[c]) +
+                        " texels' height does not fit an atlas of " + std::to_string(atlas_size));
+    std::vector<ChartFace> rest = queue[c];
+    // The `count` faces at the front of the band (turn 0, placed from the left)
+    // or at its back (turned by 180 degrees, the back comes first).
+    auto end_of_rest = [&](int turn, std::size_t count) {
+      const auto n = static_cast<std::ptrdiff_t>(count);
+      return turn == 0 ? std::make_pair(rest.begin(), rest.begin() + n)
+                       : std::make_pair(rest.end() - n, rest.end());
+    };
+    while (!rest.empty()) {
+      if (row_height == 0) new_row(height[c]);
+      // The longest prefix of `rest` (in the turned order) that fits this row.
+      bool placed = false;
+      if (height[c] <= row_height) {
+        // The best slide of the `count` faces at the chosen end, over both
+        // turns and, for pieces shorter than the row, every height in it.
+        struct Slide {
+          int turn = -1, x = 0, dy = 0;
+          double gap = 0.0;
+          ChartOutline outline;
+        };
+        auto best_slide = [&](std::size_t count) {
+          Slide best;
+          for (int turn = 0; turn < 2; ++turn) {
+            const auto [first, last] = end_of_rest(turn, count);
+            ChartOutline o =
+                Outline(std::vector<ChartFace>(first, last), turn * kPi, patches, t, gutter);
+            // Shorter pieces may sit lower in the row, under others.
+            for (int dy = 0; dy + o.Height() <= row_height; ++dy) {
+              const int x = slide(o, dy);
+              if (x + o.Width() > atlas_size) continue;
+              const double gap = gap_per_row(o, x, dy);
+              if (best.turn < 0 || gap < best.gap ||
+                  (gap == best.gap && x + o.Width() < best.x + best.outline.Width()))
+                best = Slide{turn, x, dy, gap, o};
+            }
+          }
+          return best;
+        };
+        std::size_t count = rest.size();
+        Slide best = best_slide(count);
+        if (best.turn < 0) {
+          // The most faces that fit, by bisection (fewer faces never fit worse).
+          std::size_t fits = 0, fails = count;
+          while (fails - fits > 1) {
+            const std::size_t mid = fits + (fails - fits) / 2;
+            Slide s = best_slide(mid);
+            if (s.turn >= 0) {
+              fits = mid;
+              best = std::move(s);
+            } else {
+              fails = mid;
+            }
+          }
+          count = fits;
+        }
+        if (count > 0 && best.turn >= 0) {
+          const auto [first, last] = end_of_rest(best.turn, count);
+          std::vector<ChartFace> piece(first, last);
+          rest.erase(first, last);
+          for (const ChartOutline::Run& r : best.outline.runs) {
+            int& edge = right_edge[static_cast<std::size_t>(r.row + best.dy)];
+            edge = std::max(edge, best.x + r.x + r.length);
+          }
+          out.pieces.push_back(std::move(piece));
+          out.outlines.push_back(std::move(best.outline));
+          out.drops.push_back({atlas, best.x, row_y + best.dy});
+          placed = true;
+        }
+      }
+      if (!placed) {
+        if (std::all_of(right_edge.begin(), right_edge.end(), [](int e) { return e == 0; }))
+          throw OptionError("a strip chart does not fit an atlas of " + std::to_string(atlas_size));
+        new_row(height[c]);
+      }
+    }
+    ++done;
+    if (progress && (done % 8 == 0 || done == order.size()))
+      progress("packing", done, order.size());
+  }
+  std::vector<int> used_rows(static_cast<std::size_t>(atlas) + 1, 0);
+  for (std::size_t p = 0; p < out.pieces.size(); ++p) {
+    int& rows = used_rows[static_cast<std::size_t>(out.drops[p][0])];
+    rows = std::max(rows, out.drops[p][2] + out.outlines[p].Height());
+  }
+  for (std::size_t a = 0; a < used_rows.size(); ++a)
+    out.texels += static_cast<std::int64_t>(atlas_size) *
+                  (a + 1 < used_rows.size() ? atlas_size : used_rows[a]);
+  return out;
+}
+
+}  // namespace texlume::atlas::chart_packing

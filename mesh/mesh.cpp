@@ -1,0 +1,570 @@
+#include "mesh/mesh.h"
+
+#include <unistd.h>
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
+#include <OpenMesh/Core/System/omstream.hh>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <queue>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "core/errors.h"
+
+namespace texlume::mesh {
+namespace {
+
+struct OmTraits : public OpenMesh::DefaultTraits {
+  using Point = OpenMesh::Vec3d;
+  using Normal = OpenMesh::Vec3d;
+};
+using OmPolyMesh = OpenMesh::PolyMesh_ArrayKernelT<OmTraits>;
+
+// OpenMesh prints complaints about the files it reads to its own streams; texlume
+// reports problems itself, so those streams are silenced once.
+void SilenceOpenMesh() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    omerr().disable();
+    omlog().disable();
+    omout().disable();
+  });
+}
+
+// Captures the polygon soup exactly as the OpenMesh reader delivers it, before
+// OpenMesh's own handling of non-manifold faces changes anything.
+class SoupImporter : public OpenMesh::IO::ImporterT<OmPolyMesh> {
+ public:
+  using Base = OpenMesh::IO::ImporterT<OmPolyMesh>;
+  explicit SoupImporter(OmPolyMesh& mesh) : Base(mesh) {}
+
+  OpenMesh::VertexHandle add_vertex(const OpenMesh::Vec3f& p) override {
+    return Record(Base::add_vertex(p), Eigen::Vector3d(p[0], p[1], p[2]));
+  }
+  OpenMesh::VertexHandle add_vertex(const OpenMesh::Vec3d& p) override {
+    return Record(Base::add_vertex(p), Eigen::Vector3d(p[0], p[1], p[2]));
+  }
+  OpenMesh::VertexHandle add_vertex() override {
+    return Record(Base::add_vertex(), Eigen::Vector3d::Zero());
+  }
+  // Readers that add vertices first and place them later (PLY) call this.
+  void set_point(OpenMesh::VertexHandle vh, const OpenMesh::Vec3f& p) override {
+    Base::set_point(vh, p);
+    const auto it = soup_index_.find(vh.idx());
+    if (it != soup_index_.end()) {
+      vertices[static_cast<std::size_t>(it->second)] = Eigen::Vector3d(p[0], p[1], p[2]);
+    }
+  }
+  OpenMesh::FaceHandle add_face(const VHandles& indices) override {
+    std::vector<int> polygon;
+    polygon.reserve(indices.size());
+    for (const auto& vh : indices) {
+      const auto it = soup_index_.find(vh.idx());
+      polygon.push_back(it == soup_index_.end() ? -1 : it->second);
+    }
+    polygons.push_back(std::move(polygon));
+    return Base::add_face(indices);
+  }
+
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::vector<int>> polygons;
+
+ private:
+  OpenMesh::VertexHandle Record(OpenMesh::VertexHandle vh, const Eigen::Vector3d& p) {
+    soup_index_[vh.idx()] = static_cast<int>(vertices.size());
+    vertices.push_back(p);
+    return vh;
+  }
+  std::unordered_map<int, int> soup_index_;
+};
+
+std::uint64_t EdgeKey(int a, int b) {
+  const auto lo = static_cast<std::uint32_t>(std::min(a, b));
+  const auto hi = static_cast<std::uint32_t>(std::max(a, b));
+  return (static_cast<std::uint64_t>(lo) << 32) | hi;
+}
+
+// For every undirected edge, the faces using it and the corner at which each
+// face starts the edge.
+struct EdgeUse {
+  int face;
+  int corner;  // the edge is (corner, corner+1 mod 3) of the face
+};
+std::unordered_map<std::uint64_t, std::vector<EdgeUse>> EdgeUses(
+    const std::vector<std::array<int, 3>>& faces) {
+  std::unordered_map<std::uint64_t, std::vector<EdgeUse>> uses;
+  uses.reserve(faces.size() * 2);
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = faces[f][static_cast<std::size_t>(k)];
+      const int b = faces[f][static_cast<std::size_t>((k + 1) % 3)];
+      uses[EdgeKey(a, b)].push_back({static_cast<int>(f), k});
+    }
+  }
+  return uses;
+}
+
+// True when two faces traverse their shared edge in the same direction.
+bool SameDirection(const std::vector<std::array<int, 3>>& faces, const EdgeUse& u,
+                   const EdgeUse& w) {
+  const auto& fu = faces[static_cast<std::size_t>(u.face)];
+  const auto& fw = faces[static_cast<std::size_t>(w.face)];
+  return fu[static_cast<std::size_t>(u.corner)] == fw[static_cast<std::size_t>(w.corner)];
+}
+
+double SignedVolume(const std::vector<Eigen::Vector3d>& v, const std::array<int, 3>& f) {
+  return v[static_cast<std::size_t>(f[0])].dot(
+             v[static_cast<std::size_t>(f[1])].cross(v[static_cast<std::size_t>(f[2])])) /
+         6.0;
+}
+
+}  // namespace
+
+void MeshCleanOptions::Check() const {
+  if (!(weld_relative_tolerance >= 0.0 && weld_relative_tolerance <= 1e-2)) {
+    throw OptionError("weld_relative_tolerance must be in [0, 1e-2]");
+  }
+  if (!(degenerate_relative_area >= 0.0 && degenerate_relative_area <= 1e-3)) {
+    throw OptionError("degenerate_relative_area must be in [0, 1e-3]");
+  }
+}
+
+std::vector<std::string> MeshReport::Problems() const {
+  std::vector<std::string> out;
+  auto add = [&](std::size_t n, const std::string& what) {
+    if (n > 0) out.push_back(std::to_string(n) + " " + what);
+  };
+  add(duplicate_vertices_merged, "duplicate vertices merged");
+  add(degenerate_faces_removed, "degenerate faces removed");
+  add(duplicate_faces_removed, "duplicate faces removed");
+  add(unused_vertices_removed, "unused vertices removed");
+  add(non_manifold_edges, "non-manifold edges (kept; treated as boundaries)");
+  add(inconsistently_oriented_edges, "inconsistently oriented edges");
+  add(faces_flipped, "faces flipped to a consistent outward orientation");
+  add(non_orientable_components, "non-orientable components");
+  return out;
+}
+
+LoadedMesh CleanMesh(const std::vector<Eigen::Vector3d>& vertices,
+                     const std::vector<std::vector<int>>& polygons, const MeshCleanOptions& options,
+                     const std::string& label) {
+  options.Check();
+  LoadedMesh result;
+  MeshReport& report = result.report;
+  report.input_vertices = vertices.size();
+  report.input_faces = polygons.size();
+
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    if (!vertices[i].allFinite()) {
+      throw InputError(label, "vertex " + std::to_string(i) + " has a non-finite coordinate");
+    }
+    lo = lo.cwiseMin(vertices[i]);
+    hi = hi.cwiseMax(vertices[i]);
+  }
+  const double diagonal = vertices.empty() ? 0.0 : (hi - lo).norm();
+
+  // 1. Weld duplicate vertices on a hash grid (cells of the tolerance size,
+  //    neighbouring cells searched so no pair within tolerance is missed).
+  std::vector<int> representative(vertices.size());
+  {
+    const double tol = options.weld_relative_tolerance * diagonal;
+    const double cell = tol > 0.0 ? tol : 1.0;
+    struct KeyHash {
+      std::size_t operator()(const std::array<std::int64_t, 3>& k) const {
+        return static_cast<std::size_t>(k[0] * 73856093 ^ k[1] * 19349663 ^ k[2] * 83492791);
+      }
+    };
+    std::unordered_map<std::array<std::int64_t, 3>, std::vector<int>, KeyHash> grid;
+    std::unordered_map<std::array<double, 3>, int, decltype([](const std::array<double, 3>& p) {
+                         return std::hash<double>()(p[0]) ^ (std::hash<double>()(p[1]) << 1) ^
+                                (std::hash<double>()(p[2]) << 2);
+                       })>
+        exact;
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+      const Eigen::Vector3d& p = vertices[i];
+      int found = -1;
+      if (tol > 0.0) {
+        std::array<std::int64_t, 3> key;
+        for (int c = 0; c < 3; ++c)
+          key[c] = static_cast<std::int64_t>(std::floor((p[c] - lo[c]) / cell));
+        for (int dx = -1; dx <= 1 && found < 0; ++dx)
+          for (int dy = -1; dy <= 1 && found < 0; ++dy)
+            for (int dz = -1; dz <= 1 && found < 0; ++dz) {
+              const auto it = grid.find({key[0] + dx, key[1] + dy, key[2] + dz});
+              if (it == grid.end()) continue;
+              for (int j : it->second) {
+                if ((vertices[static_cast<std::size_t>(j)] - p).norm() <= tol) {
+                  found = j;
+                  break;
+                }
+              }
+            }
+        if (found < 0) grid[key].push_back(static_cast<int>(i));
+      } else {
+        const auto [it, inserted] =
+            exact.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<int>(i));
+        if (!inserted) found = it->second;
+      }
+      representative[i] = found < 0 ? static_cast<int>(i) : found;
+      if (found >= 0) ++report.duplicate_vertices_merged;
+    }
+  }
+
+  // 2. Triangulate (fan), map to representatives, drop degenerate and duplicate faces.
+  std::vector<std::array<int, 3>> faces;
+  std::vector<std::size_t> source;
+  faces.reserve(polygons.size());
+  const double min_area = options.degenerate_relative_area * diagonal * diagonal;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> seen;  // min vertex -> faces
+  for (std::size_t pi = 0; pi < polygons.size(); ++pi) {
+    const auto& polygon = polygons[pi];
+    if (polygon.size() < 3) {
+      ++report.degenerate_faces_removed;
+      continue;
+    }
+    for (int idx : polygon) {
+      if (idx < 0 || static_cast<std::size_t>(idx) >= vertices.size()) {
+        throw InputError(label, "face " + std::to_string(pi) + " refers to vertex " +
+                                    std::to_string(idx) + " but the mesh has " +
+                                    std::to_string(vertices.size()) + " vertices");
+      }
+    }
+    if (polygon.size() > 3) ++report.polygons_triangulated;
+    for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
+      const std::array<int, 3> f = {representative[static_cast<std::size_t>(polygon[0])],
+                                    representative[static_cast<std::size_t>(polygon[k])],
+                                    representative[static_cast<std::size_t>(polygon[k + 1])]};
+      const Eigen::Vector3d& a = vertices[static_cast<std::size_t>(f[0])];
+      const double area = 0.5 * (vertices[static_cast<std::size_t>(f[1])] - a)
+                                    .cross(vertices[static_cast<std::size_t>(f[2])] - a)
+                                    .norm();
+      if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2] || !(area > min_area)) {
+        ++report.degenerate_faces_removed;
+        continue;
+      }
+      std::array<int, 3> sorted = f;
+      std::sort(sorted.begin(), sorted.end());
+      const std::uint64_t key = static_cast<std::uint64_t>(sorted[0]);
+      bool duplicate = false;
+      for (std::size_t other : seen[key]) {
+        std::array<int, 3> s = faces[other];
+        std::sort(s.begin(), s.end());
+        if (s == sorted) {
+          duplicate = true;
+          break;
+        }
+      }
+      if (duplicate) {
+        ++report.duplicate_faces_removed;
+        continue;
+      }
+      seen[key].push_back(faces.size());
+      faces.push_back(f);
+      source.push_back(pi);
+    }
+  }
+  if (faces.empty()) throw InputError(label, "the mesh has no usable faces");
+
+  // 3. Non-manifold edges and orientation.
+  auto uses = EdgeUses(faces);
+  for (const auto& [key, list] : uses) {
+    if (list.size() > 2) ++report.non_manifold_edges;
+    if (list.size() == 2 && SameDirection(faces, list[0], list[1])) {
+      ++report.inconsistently_oriented_edges;
+    }
+  }
+  if (options.fix_orientation) {
+    // Breadth-first over manifold edges: a face reached through an edge it
+    // traverses in the same direction as its parent gets flipped.
+    std::vector<int> flip(faces.size(), -1);  // -1 unvisited, 0 keep, 1 flip
+    for (std::size_t seed = 0; seed < faces.size(); ++seed) {
+      if (flip[seed] >= 0) continue;
+      std::vector<std::size_t> component;
+      bool orientable = true;
+      std::queue<std::size_t> queue;
+      flip[seed] = 0;
+      queue.push(seed);
+      while (!queue.empty()) {
+        const std::size_t f = queue.front();
+        queue.pop();
+        component.push_back(f);
+        for (int k = 0; k < 3; ++k) {
+          const int a = faces[f][static_cast<std::size_t>(k)];
+          const int b = faces[f][static_cast<std::size_t>((k + 1) % 3)];
+          const auto& list = uses[EdgeKey(a, b)];
+          if (list.size() != 2) continue;
+          const EdgeUse& mine = list[0].face == static_cast<int>(f) ? list[0] : list[1];
+          const EdgeUse& other = list[0].face == static_cast<int>(f) ? list[1] : list[0];
+          const int relation = SameDirection(faces, mine, other) ? 1 : 0;  // 1: must differ
+          const int wanted = flip[f] ^ relation;
+          const auto g = static_cast<std::size_t>(other.face);
+          if (flip[g] < 0) {
+            flip[g] = wanted;
+            queue.push(g);
+          } else if (flip[g] != wanted) {
+            orientable = false;
+          }
+        }
+      }
+      if (!orientable) ++report.non_orientable_components;
+      // Closed components face outwards (positive signed volume); open ones keep
+      // the orientation of the majority of their faces.
+      double volume = 0.0;
+      std::size_t flipped = 0;
+      bool closed = true;
+      for (std::size_t f : component) {
+        std::array<int, 3> face = faces[f];
+        if (flip[f] == 1) std::swap(face[1], face[2]);
+        volume += SignedVolume(vertices, face);
+        flipped += static_cast<std::size_t>(flip[f]);
+        for (int k = 0; k < 3 && closed; ++k) {
+          closed = uses[EdgeKey(face[static_cast<std::size_t>(k)],
+                                face[static_cast<std::size_t>((k + 1) % 3)])]
+                       .size() == 2;
+        }
+      }
+      const bool invert = closed ? volume < 0.0 : 2 * flipped > component.size();
+      for (std::size_t f : component) {
+        if (invert) flip[f] ^= 1;
+        if (flip[f] == 1) {
+          std::swap(faces[f][1], faces[f][2]);
+          ++report.faces_flipped;
+        }
+      }
+    }
+  }
+
+  // 4. Compact vertices: keep those used by a face, in their original order.
+  std::vector<int> new_index(vertices.size(), -1);
+  for (const auto& f : faces)
+    for (int v : f) new_index[static_cast<std::size_t>(v)] = 0;
+  int next = 0;
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    if (new_index[i] == 0) {
+      new_index[i] = next++;
+      result.mesh.vertices.push_back(vertices[i]);
+    } else if (representative[i] == static_cast<int>(i)) {
+      ++report.unused_vertices_removed;
+    }
+  }
+  for (auto& f : faces)
+    for (int& v : f) v = new_index[static_cast<std::size_t>(v)];
+  result.mesh.faces = std::move(faces);
+  result.source_face = std::move(source);
+  return result;
+}
+
+LoadedMesh LoadMesh(const std::filesystem::path& path, const MeshCleanOptions& options) {
+  SilenceOpenMesh();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw InputError(path.string(), "mesh file not found");
+  }
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (ext != ".ply" && ext != ".obj" && ext != ".off" && ext != ".stl") {
+    throw InputError(path.string(), "unsupported mesh format '" + ext +
+                                        "' (texlume reads .ply, .obj, .off, .stl)");
+  }
+  OmPolyMesh om_mesh;
+  SoupImporter importer(om_mesh);
+  OpenMesh::IO::Options read_options;
+  bool ok = false;
+  try {
+    ok = OpenMesh::IO::IOManager().read(path.string(), importer, read_options);
+  } catch (const std::exception& e) {
+    throw InputError(path.string(), std::string("cannot parse mesh: ") + e.what());
+  }
+  if (!ok) throw InputError(path.string(), "cannot parse mesh (OpenMesh rejected the file)");
+  for (std::size_t i = 0; i < importer.polygons.size(); ++i) {
+    for (int idx : importer.polygons[i]) {
+      if (idx < 0) {
+        throw InputError(path.string(),
+                         "face " + std::to_string(i) + " refers to a vertex that does not exist");
+      }
+    }
+  }
+  if (importer.polygons.empty()) throw InputError(path.string(), "the mesh has no faces");
+  return CleanMesh(importer.vertices, importer.polygons, options, path.string());
+}
+
+void SaveMesh(const TriangleMesh& mesh, const std::filesystem::path& path) {
+  SilenceOpenMesh();
+  OmPolyMesh om;
+  std::vector<OpenMesh::VertexHandle> handles;
+  handles.reserve(mesh.vertices.size());
+  for (const auto& v : mesh.vertices) handles.push_back(om.add_vertex({v.x(), v.y(), v.z()}));
+  for (const auto& f : mesh.faces) {
+    std::vector<OpenMesh::VertexHandle> fh = {handles[static_cast<std::size_t>(f[0])],
+                                              handles[static_cast<std::size_t>(f[1])],
+                                              handles[static_cast<std::size_t>(f[2])]};
+    if (!om.add_face(fh).is_valid()) {
+      // A face OpenMesh cannot attach (non-manifold) is written with its own copies
+      // of its vertices, as OpenMesh's importer does.
+      for (auto& h : fh) h = om.add_vertex(om.point(h));
+      om.add_face(fh);
+    }
+  }
+  std::filesystem::path tmp =
+      path.parent_path() /
+      (path.stem().string() + ".tmp-" + std::to_string(::getpid()) + path.extension().string());
+  OpenMesh::IO::Options write_options = OpenMesh::IO::Options::Binary;
+  if (path.extension() == ".obj" || path.extension() == ".off") write_options = {};
+  if (!OpenMesh::IO::write_mesh(om, tmp.string(), write_options, 17)) {
+    std::error_code remove_error;
+    std::filesystem::remove(tmp, remove_error);
+    throw std::runtime_error(path.string() + ": cannot write mesh");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+std::vector<Eigen::Vector3d> FaceNormals(const TriangleMesh& mesh) {
+  std::vector<Eigen::Vector3d> normals(mesh.faces.size());
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const Eigen::Vector3d n =
+        (mesh.Corner(f, 1) - mesh.Corner(f, 0)).cross(mesh.Corner(f, 2) - mesh.Corner(f, 0));
+    const double len = n.norm();
+    normals[f] = len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
+  }
+  return normals;
+}
+
+std::vector<double> FaceAreas(const TriangleMesh& mesh) {
+  std::vector<double> areas(mesh.faces.size());
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    areas[f] =
+        0.5 *
+        (mesh.Corner(f, 1) - mesh.Corner(f, 0)).cross(mesh.Corner(f, 2) - mesh.Corner(f, 0)).norm();
+  }
+  return areas;
+}
+
+std::vector<std::array<int, 3>> FaceNeighbours(const TriangleMesh& mesh) {
+  std::vector<std::array<int, 3>> neighbours(mesh.faces.size(), {-1, -1, -1});
+  const auto uses = EdgeUses(mesh.faces);
+  for (const auto& [key, list] : uses) {
+    if (list.size() != 2) continue;
+    neighbours[static_cast<std::size_t>(list[0].face)][static_cast<std::size_t>(list[0].corner)] =
+        list[1].face;
+    neighbours[static_cast<std::size_t>(list[1].face)][static_cast<std::size_t>(list[1].corner)] =
+        list[0].face;
+  }
+  return neighbours;
+}
+
+std::vector<int> BreadthFirstFaceOrder(const TriangleMesh& mesh,
+                                       const std::vector<std::array<int, 3>>& neighbours,
+                                       int seed_face) {
+  const int n = static_cast<int>(mesh.faces.size());
+  if (seed_face < 0 || seed_face >= n) {
+    throw std::out_of_range("seed face " + std::to_string(seed_face) + " is not a face index");
+  }
+  std::vector<char> visited(static_cast<std::size_t>(n), 0);
+  std::vector<int> order;
+  order.reserve(static_cast<std::size_t>(n));
+  auto run = [&](int start) {
+    std::size_t head = order.size();
+    visited[static_cast<std::size_t>(start)] = 1;
+    order.push_back(start);
+    while (head < order.size()) {
+      const int f = order[head++];
+      for (int g : neighbours[static_cast<std::size_t>(f)]) {
+        if (g >= 0 && !visited[static_cast<std::size_t>(g)]) {
+          visited[static_cast<std::size_t>(g)] = 1;
+          order.push_back(g);
+        }
+      }
+    }
+  };
+  run(seed_face);
+  for (int f = 0; f < n; ++f) {
+    if (!visited[static_cast<std::size_t>(f)]) run(f);
+  }
+  return order;
+}
+
+MeshStats ComputeMeshStats(const TriangleMesh& mesh) {
+  MeshStats s;
+  s.vertices = mesh.vertices.size();
+  s.faces = mesh.faces.size();
+  const auto uses = EdgeUses(mesh.faces);
+  s.edges = uses.size();
+  double edge_length_sum = 0.0;
+  for (const auto& [key, list] : uses) {
+    if (list.size() == 1) ++s.boundary_edges;
+    const auto& f = mesh.faces[static_cast<std::size_t>(list[0].face)];
+    edge_length_sum +=
+        (mesh.vertices[static_cast<std::size_t>(f[static_cast<std::size_t>(list[0].corner)])] -
+         mesh.vertices[static_cast<std::size_t>(
+             f[static_cast<std::size_t>((list[0].corner + 1) % 3)])])
+            .norm();
+  }
+  s.mean_edge_length = s.edges ? edge_length_sum / static_cast<double>(s.edges) : 0.0;
+  for (double a : FaceAreas(mesh)) s.surface_area += a;
+  if (!mesh.vertices.empty()) {
+    s.bbox_min = s.bbox_max = mesh.vertices[0];
+    for (const auto& v : mesh.vertices) {
+      s.bbox_min = s.bbox_min.cwiseMin(v);
+      s.bbox_max = s.bbox_max.cwiseMax(v);
+    }
+  }
+  if (!mesh.faces.empty()) {
+    const auto neighbours = FaceNeighbours(mesh);
+    const auto order = BreadthFirstFaceOrder(mesh, neighbours, 0);
+    // Count component starts: a face whose BFS predecessor set is empty starts one.
+    std::vector<char> seen(mesh.faces.size(), 0);
+    for (int f : order) {
+      bool connected = false;
+      for (int g : neighbours[static_cast<std::size_t>(f)]) {
+        connected = connected || (g >= 0 && seen[static_cast<std::size_t>(g)]);
+      }
+      if (!connected) ++s.components;
+      seen[static_cast<std::size_t>(f)] = 1;
+    }
+  }
+  return s;
+}
+
+std::vector<Eigen::Vector3d> VertexNormals(const TriangleMesh& mesh) {
+  std::vector<Eigen::Vector3d> n(mesh.vertices.size(), Eigen::Vector3d::Zero());
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const Eigen::Vector3d a =
+        (mesh.Corner(f, 1) - mesh.Corner(f, 0)).cross(mesh.Corner(f, 2) - mesh.Corner(f, 0));
+    for (int v : mesh.faces[f]) n[static_cast<std::size_t>(v)] += a;
+  }
+  for (auto& v : n) v = v.norm() > 0 ? v.normalized() : Eigen::Vector3d::UnitZ();
+  return n;
+}
+
+TriangleMesh SubdivideMidpoint(const TriangleMesh& mesh) {
+  TriangleMesh out;
+  out.vertices = mesh.vertices;
+  std::map<std::pair<int, int>, int> midpoint;
+  auto mid = [&](int a, int b) {
+    const std::pair<int, int> key(std::min(a, b), std::max(a, b));
+    const auto it = midpoint.find(key);
+    if (it != midpoint.end()) return it->second;
+    out.vertices.push_back(0.5 * (mesh.vertices[static_cast<std::size_t>(a)] +
+                                  mesh.vertices[static_cast<std::size_t>(b)]));
+    const int id = static_cast<int>(out.vertices.size() - 1);
+    midpoint.emplace(key, id);
+    return id;
+  };
+  for (const auto& f : mesh.faces) {
+    const int a = mid(f[0], f[1]), b = mid(f[1], f[2]), c = mid(f[2], f[0]);
+    out.faces.push_back({f[0], a, c});
+    out.faces.push_back({a, f[1], b});
+    out.faces.push_back({c, b, f[2]});
+    out.faces.push_back({a, b, c});
+  }
+  return out;
+}
+
+}  // namespace texlume::mesh

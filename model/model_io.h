@@ -1,0 +1,72 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "core/image_io.h"
+#include "core/json_io.h"
+#include "ptm/ptm.h"
+#include "mesh/mesh.h"
+
+namespace texlume::model {
+
+/// A relightable model: the mesh, texture coordinates per face corner in atlas
+/// pixels (x right, y down, pixel centres at +0.5), the atlas of each face, and
+/// the PTM atlases. Each atlas texel's coefficients are in the tangent frame of
+/// the texture coordinates: x = dP/du, y = dP/dv with v up, z = face normal.
+struct TexturedModel {
+  mesh::TriangleMesh mesh;
+  std::vector<std::array<Eigen::Vector2f, 3>> corner_px;
+  std::vector<int> face_atlas;
+  std::vector<ptm::Ptm> atlases;
+};
+
+/// Writes the model into `dir` (created; an existing texlume model folder there
+/// is replaced, anything else is an error): model.obj + model.mtl with
+/// base_colour_K.png (the PTM at a head-on light) and albedo_K.png; the PTM
+/// atlases as ptm_atlas_K.ptm and lossless ptm_atlas_K.exr; model.glb (glTF
+/// 2.0 binary, base colour, the PTM atlases described in the material's
+/// `extras`); manifest.json listing every file with `record` (settings, timings)
+/// merged in. Everything is written under a temporary name first and renamed
+/// into place, so a failure leaves no half-written folder.
+/// `extra_images`: further PNGs to include (name -> 8-bit BGR image);
+/// `write_more`, when set, writes further files into the temporary folder it
+/// is given (listed in the manifest too, by their paths relative to `dir`).
+void WriteModelFolder(const std::filesystem::path& dir, const TexturedModel& model,
+                      const nlohmann::json& record,
+                      const std::vector<std::pair<std::string, cv::Mat>>& extra_images = {},
+                      const std::function<void(const std::filesystem::path&)>& write_more = {});
+
+/// Reads and checks a model folder's manifest.json (format "texlume-model", an
+/// "atlases" array). Throws InputError naming the file otherwise.
+nlohmann::json ReadModelManifest(const std::filesystem::path& dir);
+
+/// The frame face f's atlas coefficients are in, as columns in world
+/// coordinates: x = dP/du made orthogonal to the normal, y = n x x (dP/dv
+/// direction, v up), z = the face normal (x = the first edge without texture
+/// coordinates).
+Eigen::Matrix3d AtlasFaceFrame(const TexturedModel& model, std::size_t f);
+
+/// Reads a model folder written by WriteModelFolder (its manifest, OBJ and EXR
+/// atlases). Throws InputError naming the file on anything malformed.
+TexturedModel ReadModelFolder(const std::filesystem::path& dir);
+
+/// The PTM relit at a head-on light (base colour) and the Lambertian albedo
+/// (head-on value over the PTM normal's z, linear domain), as 8-bit BGR images.
+cv::Mat BaseColourImage(const ptm::Ptm& ptm);
+cv::Mat AlbedoImage(const ptm::Ptm& ptm);
+
+/// Writes a glTF 2.0 binary: positions, smooth normals, TEXCOORD_0 (glTF's v
+/// down), one primitive and material per atlas with its base-colour PNG
+/// embedded; `material_extras[k]` goes into material k's extras.
+void WriteGlb(const std::filesystem::path& path, const TexturedModel& model,
+              const std::vector<std::vector<unsigned char>>& base_colour_png,
+              const std::vector<nlohmann::json>& material_extras);
+
+}  // namespace texlume::model

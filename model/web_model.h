@@ -1,0 +1,43 @@
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "model/model_io.h"
+
+namespace texlume::model {
+
+/// A model folder prepared for the browser viewer (docs/viewer.md): a scene
+/// description, the geometry as float32 vertex streams, and the PTM atlases as
+/// 8-bit channels with a scale and bias each, four per RGBA PNG.
+struct WebModel {
+  nlohmann::json scene;                                     ///< "scene.json"
+  std::map<std::string, std::vector<unsigned char>> files;  ///< name -> bytes, scene.json included
+};
+
+/// Charts of a model: faces are in one chart when they share a mesh edge whose
+/// two corners have the same texture coordinates on both sides (within 1e-3
+/// texels) in the same atlas. Returns the chart id of every face (0-based).
+std::vector<int> ChartsOfModel(const TexturedModel& model);
+
+/// Quantises one channel (a plane of PTM values) to 8 bits: value = byte / 255 * scale + bias,
+/// bias = the plane's minimum, scale = its range (1 when the plane is constant).
+struct QuantisedPlane {
+  std::vector<unsigned char> bytes;
+  double scale = 1.0, bias = 0.0;
+};
+QuantisedPlane QuantisePlane(const std::vector<float>& values);
+/// PNG bytes (8-bit RGBA) of up to four quantised planes of `width` x `height`
+/// (R, G, B, A; missing planes are 0). Throws InputError(label) on failure.
+std::vector<unsigned char> PlanesPng(const std::vector<const QuantisedPlane*>& planes, int width,
+                                     int height, const std::string& label);
+
+/// Builds the web model of a model folder written by WriteModelFolder (reads
+/// its manifest, OBJ, EXR atlases and baked textures). Throws InputError naming
+/// the file on anything malformed.
+WebModel BuildWebModel(const std::filesystem::path& model_dir);
+
+}  // namespace texlume::model

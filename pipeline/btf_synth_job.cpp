@@ -1,0 +1,264 @@
+#include "pipeline/btf_synth_job.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "core/errors.h"
+#include "core/timing.h"
+#include "ptm/coefficient_space.h"
+#include "ptm/exr_io.h"
+#include "model/baselines.h"
+#include "model/model_io.h"
+#include "model/btf_model.h"
+#include "model/web_model.h"
+#include "render/model_render.h"
+
+namespace texlume::pipeline {
+namespace fs = std::filesystem;
+namespace {
+
+
+std::string GeometryFileName(std::size_t atlas, std::size_t part) {
+  return "btf_geometry_" + std::to_string(atlas) + "_" + std::to_string(part) + ".png";
+}
+
+}  // namespace
+
+void BtfSynthJobOptions::Check() const {
+  job.CheckInputsAndLayout();
+  if (btf.empty()) throw OptionError("synth --btf needs a BTF capture or factorisation folder");
+  if (components < 1) throw OptionError("components must be >= 1");
+  if (!(synthesis.sample_texel_size >= 0.0))
+    throw OptionError("sample texel size must be >= 0 (0: the capture's)");
+  synth::BtfMeshSynthesisOptions resolved = synthesis;
+  if (resolved.sample_texel_size == 0.0) resolved.sample_texel_size = 1.0;  // any valid size
+  resolved.Check();
+}
+
+namespace {
+
+// The BTF job's steps, each a method (RunBtfSynthJob).
+class BtfSynthJob {
+ public:
+  BtfSynthJob(const BtfSynthJobOptions& options, const ProgressCallback& progress)
+      : options_(options), job_(options.job), progress_(progress) {}
+
+  BtfSynthJobSummary Run() {
+    const auto start = std::chrono::steady_clock::now();
+    pipeline::RefuseForeignModelFolder(job_.out_dir);
+    inputs_ = pipeline::LoadSynthInputs(job_);
+    LoadSample();
+    Synthesize();
+    LayOut();
+    nlohmann::json record = Record();
+    // The geometry maps baked per atlas texel, for export (docs/btf.md).
+    const auto t = std::chrono::steady_clock::now();
+    record["btf"]["geometry_atlases"] = EncodeGeometryAtlases();
+    summary_.seconds_export = SecondsSince(t);
+    record["timings_s"]["export_geometry"] = summary_.seconds_export;
+    model::WriteModelFolder(job_.out_dir, model_, record, extra_images_,
+                            [this](const fs::path& folder) { WriteBtfFiles(folder); });
+    summary_.seconds_total = SecondsSince(start);
+    return summary_;
+  }
+
+ private:
+  // The sample: a factorisation as it is, or a capture factorised here; its
+  // error table; the synthesis settings with its texel size; the mesh.
+  void LoadSample() {
+    const auto t = std::chrono::steady_clock::now();
+    if (fs::exists(options_.btf / "btf_svd.json")) {
+      sample_ = btf::ReadBtfFactorisation(options_.btf);
+    } else {
+      const btf::BtfCapture capture = btf::ReadBtfCapture(options_.btf);
+      sample_ = btf::FactoriseBtf(capture, options_.components, progress_);
+    }
+    std::vector<int> ns;
+    for (int k = 1; k < sample_.Components(); k *= 2) ns.push_back(k);
+    ns.push_back(sample_.Components());
+    errors_ = btf::SvdErrorTable(sample_, ns);
+    summary_.seconds_factorise = SecondsSince(t);
+    so_ = options_.synthesis;
+    if (so_.sample_texel_size == 0.0) so_.sample_texel_size = sample_.texel_size;
+    so_.Check();
+    pipeline::PrepareSynthMesh(inputs_, job_, std::min(sample_.width, sample_.height),
+                            so_.sample_texel_size, so_.strip, progress_);
+    summary_.CountInputs(inputs_);
+  }
+
+  void Synthesize() {
+    synthesis_ = synth::SynthesizeMeshBtf(inputs_.mesh, inputs_.reconstruction, inputs_.visibility,
+                                          inputs_.photos, sample_, so_, progress_);
+    summary_.seconds_synthesis = synthesis_.seconds_synthesis;
+    summary_.seconds_seams = synthesis_.seconds_seams;
+    summary_.from_photos = synthesis_.num_from_photos;
+    summary_.from_neighbours = synthesis_.num_from_neighbours;
+    summary_.random = synthesis_.num_random;
+    summary_.seam_edges = synthesis_.seam_edges;
+    summary_.seam_cost_per_link = synthesis_.seam_cost_per_link;
+    summary_.edge_cost_per_link = synthesis_.edge_cost_per_link;
+  }
+
+  // The atlases, the PTM preview as the model's atlases, and the baselines
+  // `texlume render` draws, as for PTM models.
+  void LayOut() {
+    auto t = std::chrono::steady_clock::now();
+    atlases_ = atlas::BuildBtfAtlases(inputs_.mesh, synthesis_, sample_, job_.atlas, progress_);
+    summary_.seconds_atlas = SecondsSince(t);
+    summary_.atlases = atlases_.geometry.size();
+    summary_.charts = static_cast<std::size_t>(atlases_.layout.num_charts);
+    summary_.chart_flattening = job_.atlas.mode == atlas::AtlasMode::kCharts
+                                    ? atlas::ChartFlatteningName(atlases_.layout.flattening)
+                                    : "none";
+    summary_.occupancy = atlases_.occupancy;
+    t = std::chrono::steady_clock::now();
+    model_ = pipeline::TexturedModelOf(inputs_.mesh, atlas::PreviewPtms(atlases_, sample_, progress_),
+                                    atlases_.layout.faces);
+    summary_.seconds_preview = SecondsSince(t);
+    baked_ = render::BakePhotoTextures(model_, inputs_.reconstruction, inputs_.visibility,
+                                      inputs_.photos, synthesis_.photo_gains);
+    flat_albedo_ =
+        render::MeanAlbedoFromPhotos(inputs_.mesh, inputs_.reconstruction, inputs_.visibility,
+                                    inputs_.photos, synthesis_.photo_gains);
+  }
+
+  nlohmann::json Settings() const {
+    nlohmann::json settings = {{"sample_texel_size", so_.sample_texel_size},
+                               {"components", sample_.Components()},
+                               {"strip", so_.strip},
+                               {"seam_band", so_.seam_band},
+                               {"top_k", so_.top_k},
+                               {"max_views", so_.max_views},
+                               {"tangent_frame", synth::TangentFrameName(so_.tangent_frame)},
+                               {"tolerance", so_.tolerance},
+                               {"photo_correction", so_.photo_correction},
+                               {"correction_noise", so_.correction_noise},
+                               {"correction_sigma", so_.correction_sigma},
+                               {"seed", so_.seed},
+                               {"horizon_elevation_deg", ptm::kHorizonElevationDeg}};
+    settings.update(pipeline::AtlasSettingsJson(job_.atlas));
+    return settings;
+  }
+
+  nlohmann::json Summary() const {
+    const BtfSynthJobSummary& s = summary_;
+    nlohmann::json summary = s.ToJson();
+    summary.update({{"seam_edges", s.seam_edges},
+                    {"seam_cost_per_link", s.seam_cost_per_link},
+                    {"straight_edge_cost_per_link", s.edge_cost_per_link},
+                    {"photo_rms_quilted", synthesis_.photo_rms_quilted},
+                    {"photo_rms_corrected", synthesis_.photo_rms_corrected}});
+    summary.update(pipeline::EngineSummaryJson(synthesis_));
+    return summary;
+  }
+
+  nlohmann::json Record() {
+    nlohmann::json record;
+    record["command"] = "synth --btf";
+    record["inputs"] = job_.InputsJson();
+    record["inputs"]["btf"] = options_.btf.string();
+    record["settings"] = Settings();
+    record["summary"] = Summary();
+    record["warnings"] = summary_.warnings;
+    extra_images_ = model::RecordBaselines(flat_albedo_, baked_, record);
+    nlohmann::json btf_files = nlohmann::json::array();
+    for (std::size_t a = 0; a < atlases_.geometry.size(); ++a)
+      btf_files.push_back(model::BtfAtlasFileName(a));
+    record["btf"] = {
+        {"format", "texlume-btf-model-1"},
+        {"factorisation", "btf/btf_svd.json"},
+        {"atlases", btf_files},
+        {"atlas_channels", "sample_x, sample_y, angle, gain_r, gain_g, gain_b (docs/btf.md)"},
+        {"ptm_atlases", "a preview: the BTF seen head-on, fitted per texel"}};
+    const BtfSynthJobSummary& s = summary_;
+    record["timings_s"] = {
+        {"load", inputs_.seconds_load},
+        {"visibility", inputs_.seconds_visibility},
+        {"factorise", s.seconds_factorise},
+        {"synthesis", s.seconds_synthesis},
+        {"seams", s.seconds_seams},
+        {"atlas", s.seconds_atlas},
+        {"ptm_preview", s.seconds_preview},
+        {"synthesis_per_triangle", (s.seconds_synthesis + s.seconds_seams) /
+                                       static_cast<double>(std::max<std::size_t>(1, s.faces))}};
+    return record;
+  }
+
+  // 8 bits per component with a scale and bias each, four components per RGBA
+  // PNG (docs/btf.md); the PNGs go into geometry_png_, the manifest's entries
+  // are returned.
+  nlohmann::json EncodeGeometryAtlases() {
+    nlohmann::json geometry_json = nlohmann::json::array();
+    for (std::size_t a = 0; a < atlases_.geometry.size(); ++a) {
+      const auto& planes = atlases_.geometry[a];
+      const int w = planes[0].cols, h = planes[0].rows;
+      std::vector<model::QuantisedPlane> quantised(planes.size());
+#pragma omp parallel for schedule(dynamic, 1)
+      for (std::size_t i = 0; i < planes.size(); ++i) {
+        const cv::Mat flat = planes[i].reshape(1, 1);
+        quantised[i] =
+            model::QuantisePlane(std::vector<float>(flat.begin<float>(), flat.end<float>()));
+      }
+      const std::size_t parts = (planes.size() + 3) / 4;
+      geometry_png_.resize(geometry_png_.size() + parts);
+      const std::size_t first = geometry_png_.size() - parts;
+#pragma omp parallel for schedule(dynamic, 1)
+      for (std::size_t part = 0; part < parts; ++part) {
+        std::vector<const model::QuantisedPlane*> group;
+        for (std::size_t i = part * 4; i < std::min(planes.size(), part * 4 + 4); ++i)
+          group.push_back(&quantised[i]);
+        const std::string name = GeometryFileName(a, part);
+        geometry_png_[first + part] = {name, model::PlanesPng(group, w, h, name)};
+      }
+      nlohmann::json files = nlohmann::json::array();
+      for (std::size_t part = 0; part < parts; ++part) {
+        nlohmann::json scale = nlohmann::json::array(), bias = nlohmann::json::array();
+        for (std::size_t i = part * 4; i < std::min(planes.size(), part * 4 + 4); ++i)
+          scale.push_back(quantised[i].scale), bias.push_back(quantised[i].bias);
+        files.push_back({{"file", GeometryFileName(a, part)}, {"scale", scale}, {"bias", bias}});
+      }
+      geometry_json.push_back(files);
+    }
+    return geometry_json;
+  }
+
+  // The factorisation, the per-texel sample coordinates and factors, and the
+  // geometry-map PNGs, into the model folder being written.
+  void WriteBtfFiles(const fs::path& folder) const {
+    btf::WriteBtfFactorisation(sample_, errors_, folder / "btf");
+    for (std::size_t a = 0; a < atlases_.sample_coords.size(); ++a)
+      model::WriteBtfAtlas(folder / model::BtfAtlasFileName(a), atlases_.sample_coords[a],
+                           atlases_.colour_gain[a]);
+    for (const auto& [name, bytes] : geometry_png_) WriteBytesAtomically(folder / name, bytes);
+  }
+
+  const BtfSynthJobOptions& options_;
+  const pipeline::SynthJobOptions& job_;
+  const ProgressCallback& progress_;
+  BtfSynthJobSummary summary_;
+  pipeline::SynthInputs inputs_;
+  btf::BtfFactorisation sample_;
+  std::vector<btf::SvdError> errors_;
+  synth::BtfMeshSynthesisOptions so_;
+  synth::BtfMeshSynthesis synthesis_;
+  atlas::BtfAtlases atlases_;
+  model::TexturedModel model_;
+  std::vector<cv::Mat> baked_;
+  Eigen::Vector3f flat_albedo_ = Eigen::Vector3f::Constant(0.5f);
+  std::vector<std::pair<std::string, cv::Mat>> extra_images_;
+  std::vector<std::pair<std::string, std::vector<unsigned char>>> geometry_png_;
+};
+
+}  // namespace
+
+BtfSynthJobSummary RunBtfSynthJob(const BtfSynthJobOptions& options,
+                                  const ProgressCallback& progress) {
+  options.Check();
+  return BtfSynthJob(options, progress).Run();
+}
+
+}  // namespace texlume::pipeline

@@ -1,0 +1,464 @@
+#include "pipeline/synth_job.h"
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/errors.h"
+#include "core/file_util.h"
+#include "core/timing.h"
+#include "ptm/ptm_io.h"
+#include "sfm/colmap_io.h"
+#include "sfm/lights.h"
+#include "mesh/mesh.h"
+#include "synth/colour_sample.h"
+#include "model/baselines.h"
+#include "render/model_render.h"
+#include "report/report.h"
+
+namespace texlume::pipeline {
+namespace fs = std::filesystem;
+namespace {
+
+// Mean prior shrink over the photo-corrected patches (null when none was).
+nlohmann::json MeanPriorShrink(const synth::MeshSynthesis& synthesis) {
+  double sum = 0.0;
+  int n = 0;
+  for (const synth::TrianglePatch& p : synthesis.patches)
+    if (p.prior_shrink >= 0.0) sum += p.prior_shrink, ++n;
+  return n ? nlohmann::json(sum / n) : nlohmann::json(nullptr);
+}
+
+// The colour engine's settings from the PTM job's: the engine's, and the
+// per-channel factors (off with --correction-iterations 0, as the PTM pass).
+synth::ColourSynthesisOptions ColourOptions(const synth::MeshSynthesisOptions& ptm) {
+  synth::ColourSynthesisOptions colour;
+  static_cast<synth::TriangleEngineOptions&>(colour) = ptm;
+  colour.photo_correction = ptm.correction_iterations > 0;
+  colour.correction_noise = ptm.correction_noise;
+  colour.correction_sigma = ptm.correction_sigma;
+  return colour;
+}
+
+}  // namespace
+
+bool IsColourImage(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".ptm") return false;
+  if (ext == ".exr") return ImageReader(path).channels() <= 4;  // a PTM EXR has 9 or 18
+  return true;
+}
+
+Sample ReadSample(const fs::path& path) {
+  Sample sample;
+  if (!IsColourImage(path)) {
+    sample.ptm = ptm::ReadPtmAnyFormat(path);
+    return sample;
+  }
+  sample.colour = ReadPhotoRgb(path);
+  sample.ptm = synth::LambertianPtm(sample.colour);
+  return sample;
+}
+
+SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SynthInputs inputs;
+  // Inputs.
+  inputs.reconstruction = sfm::ReadModel(options.model_dir).reconstruction;
+  const sfm::Reconstruction& reconstruction = inputs.reconstruction;
+  const sfm::ObjectLights lights = sfm::ReadObjectLightsFile(options.lights_file);
+  const std::vector<std::string> unlit =
+      sfm::CheckLightsAgainstModel(lights, reconstruction, options.lights_file.string());
+  for (const std::string& name : unlit)
+    inputs.warnings.push_back("skipping " + name + ": no light for it in " +
+                              options.lights_file.string());
+  mesh::LoadedMesh loaded_mesh = mesh::LoadMesh(options.mesh_file);
+  for (const std::string& problem : loaded_mesh.report.Problems())
+    inputs.warnings.push_back(options.mesh_file.string() + ": " + problem);
+  mesh::TriangleMesh& mesh = inputs.mesh;
+  mesh = std::move(loaded_mesh.mesh);
+
+  std::vector<synth::MeshPhoto>& photos = inputs.photos;
+  for (const auto& [id, image] : reconstruction.images) {
+    const auto it = lights.find(image.name);
+    if (it == lights.end()) continue;
+    const fs::path file = options.images_dir / image.name;
+    if (!fs::exists(file)) {
+      inputs.warnings.push_back("skipping " + image.name + ": no file " + file.string());
+      continue;
+    }
+    synth::MeshPhoto photo;
+    photo.image_id = id;
+    photo.name = image.name;
+    photo.image = ReadPhotoRgb(file);
+    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
+    if (photo.image.cols != static_cast<int>(camera.width) ||
+        photo.image.rows != static_cast<int>(camera.height)) {
+      throw InputError(file.string(), "is " + std::to_string(photo.image.cols) + "x" +
+                                          std::to_string(photo.image.rows) + " but its camera is " +
+                                          std::to_string(camera.width) + "x" +
+                                          std::to_string(camera.height));
+    }
+    photo.lights = it->second;
+    photos.push_back(std::move(photo));
+  }
+  if (photos.empty()) {
+    throw InputError(options.images_dir.string(),
+                     "no usable photo: every image of the model lacks a light or a file");
+  }
+  inputs.seconds_load = SecondsSince(start);
+  return inputs;
+}
+
+nlohmann::json AtlasSettingsJson(const atlas::AtlasOptions& atlas) {
+  return {{"atlas_mode", atlas.mode == atlas::AtlasMode::kCharts ? "charts" : "per_triangle"},
+          {"atlas_size", atlas.atlas_size},
+          {"gutter", atlas.gutter},
+          {"chart_flattening", atlas::ChartFlatteningName(atlas.flattening)},
+          {"chart_size", atlas.max_chart_size},
+          {"chart_angle_deg", atlas.max_chart_normal_angle_deg},
+          {"chart_stretch", atlas.max_chart_stretch}};
+}
+
+void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int sample_side,
+                      double sample_texel_size, int strip, const ProgressCallback& progress) {
+  const sfm::Reconstruction& reconstruction = inputs.reconstruction;
+  const std::vector<synth::MeshPhoto>& photos = inputs.photos;
+  mesh::TriangleMesh& mesh = inputs.mesh;
+  // Visibility (and subdivision while the largest triangle does not fit the sample).
+  auto t = std::chrono::steady_clock::now();
+  auto largest_patch = [&](const mesh::TriangleMesh& m) {
+    double widest = 0;
+    for (std::size_t f = 0; f < m.faces.size(); ++f) {
+      double longest = 0;
+      for (int k = 0; k < 3; ++k)
+        longest = std::max(longest, (m.Corner(f, (k + 1) % 3) - m.Corner(f, k)).norm());
+      widest = std::max(widest, longest);
+    }
+    return widest / sample_texel_size + 2 * strip + 2;
+  };
+  while (largest_patch(mesh) > sample_side &&
+         inputs.subdivisions < static_cast<std::size_t>(options.max_subdivisions)) {
+    mesh = mesh::SubdivideMidpoint(mesh);
+    ++inputs.subdivisions;
+  }
+  if (inputs.subdivisions) {
+    inputs.warnings.push_back("subdivided the mesh " + std::to_string(inputs.subdivisions) +
+                              " time(s) so that every triangle's patch fits the sample");
+  }
+  inputs.visibility = sfm::ComputeVisibility(mesh, reconstruction, options.visibility, progress);
+  // Photos used here only (visibility saw every image of the model).
+  std::size_t seen_by_usable = 0;
+  {
+    std::map<sfm::ImageId, bool> usable;
+    for (const synth::MeshPhoto& p : photos) usable[p.image_id] = true;
+    for (const auto& tv : inputs.visibility.triangles) {
+      bool seen = false;
+      for (const auto& v : tv.views)
+        seen = seen || (usable.count(v.image_id) && v.visible_fraction > 0);
+      seen_by_usable += seen;
+    }
+  }
+  if (seen_by_usable * 2 < mesh.faces.size()) {
+    throw InputError(options.mesh_file.string(),
+                     std::to_string(mesh.faces.size() - seen_by_usable) + " of " +
+                         std::to_string(mesh.faces.size()) +
+                         " triangles project outside every usable photo or face away from it: is "
+                         "the mesh in the "
+                         "frame of the COLMAP model " +
+                         options.model_dir.string() + "?");
+  }
+  inputs.seconds_visibility = SecondsSince(t);
+}
+
+void SynthJobOptions::CheckInputsAndLayout() const {
+  for (const auto& [path, what] :
+       {std::pair{&model_dir, "COLMAP model folder"}, std::pair{&images_dir, "images folder"},
+        std::pair{&lights_file, "lights file"}, std::pair{&mesh_file, "mesh"},
+        std::pair{&out_dir, "output folder"}})
+    if (path->empty()) throw OptionError(std::string("synth needs a ") + what);
+  atlas.Check();
+  visibility.Check();
+  if (max_subdivisions < 0 || max_subdivisions > 6)
+    throw OptionError("max subdivisions must be in [0, 6]");
+}
+
+nlohmann::json SynthJobOptions::InputsJson() const {
+  return {{"model", model_dir.string()},
+          {"images", images_dir.string()},
+          {"lights", lights_file.string()},
+          {"mesh", mesh_file.string()}};
+}
+
+void SynthJobOptions::Check() const {
+  CheckInputsAndLayout();
+  if (sample_file.empty()) throw OptionError("synth needs a sample");
+  synthesis.Check();
+}
+
+nlohmann::json SynthCounts::ToJson() const {
+  return {{"photos_used", photos_used},
+          {"faces", faces},
+          {"subdivisions", subdivisions},
+          {"from_photos", from_photos},
+          {"from_neighbours_only", from_neighbours},
+          {"random", random},
+          {"atlases", atlases},
+          {"charts", charts},
+          {"chart_flattening", chart_flattening},
+          {"occupancy", occupancy}};
+}
+
+void SynthCounts::CountInputs(const SynthInputs& inputs) {
+  warnings = inputs.warnings;
+  photos_used = inputs.photos.size();
+  subdivisions = inputs.subdivisions;
+  faces = inputs.mesh.faces.size();
+}
+
+nlohmann::json EngineSummaryJson(const synth::TriangleSynthesis& synthesis) {
+  return {{"photo_gains", synthesis.photo_gains},
+          {"tangent_frame", synth::TangentFrameName(synthesis.tangent_frame)},
+          {"sample_coherence", synthesis.sample_coherence >= 0.0
+                                   ? nlohmann::json(synthesis.sample_coherence)
+                                   : nlohmann::json(nullptr)}};
+}
+
+void RefuseForeignModelFolder(const fs::path& out) {
+  if (fs::exists(out) &&
+      (!fs::is_directory(out) || (!fs::exists(out / "manifest.json") && !fs::is_empty(out))))
+    throw InputError(out.string(), "exists and is not a texlume model folder; not replacing it");
+}
+
+model::TexturedModel TexturedModelOf(const mesh::TriangleMesh& mesh, std::vector<ptm::Ptm> atlases,
+                              const std::vector<atlas::FacePlacement>& faces) {
+  model::TexturedModel model;
+  model.mesh = mesh;
+  model.atlases = std::move(atlases);
+  for (const atlas::FacePlacement& fp : faces) {
+    model.face_atlas.push_back(fp.atlas);
+    model.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
+                               fp.corners_px[2].cast<float>()});
+  }
+  return model;
+}
+
+namespace {
+
+// The main job's steps, each a method, sharing the inputs, the synthesis and
+// the model they build (RunSynthJob).
+class SynthJob {
+ public:
+  SynthJob(const SynthJobOptions& options, const ProgressCallback& progress)
+      : options_(options), progress_(progress) {}
+
+  SynthJobSummary Run() {
+    const auto start = std::chrono::steady_clock::now();
+    RefuseForeignModelFolder(options_.out_dir);
+    Load();
+    Synthesize();
+    LayOut();
+    Baselines();
+    const auto t = std::chrono::steady_clock::now();
+    std::function<void(const fs::path&)> write_report;
+    if (options_.write_report)
+      write_report = [this](const fs::path& folder) { WriteModelReport(folder); };
+    model::WriteModelFolder(options_.out_dir, model_, Record(), extra_images_, write_report);
+    summary_.seconds_export = SecondsSince(t) - summary_.seconds_report;
+    summary_.seconds_total = SecondsSince(start);
+    return summary_;
+  }
+
+ private:
+  void Load() {
+    inputs_ = LoadSynthInputs(options_);
+    sample_ = ReadSample(options_.sample_file);
+    PrepareSynthMesh(inputs_, options_, std::min(sample_.ptm.width, sample_.ptm.height),
+                     options_.synthesis.sample_texel_size, options_.synthesis.strip, progress_);
+    summary_.CountInputs(inputs_);
+    summary_.seconds_load = inputs_.seconds_load;
+    summary_.seconds_visibility = inputs_.seconds_visibility;
+  }
+
+  // Synthesis (Algorithm 2) with the sample's kind.
+  void Synthesize() {
+    const auto t = std::chrono::steady_clock::now();
+    const SynthInputs& in = inputs_;
+    synthesis_ =
+        sample_.colour.empty()
+            ? synth::SynthesizeMeshPtm(in.mesh, in.reconstruction, in.visibility, in.photos, sample_.ptm,
+                                options_.synthesis, progress_)
+            : synth::SynthesizeMeshColour(in.mesh, in.reconstruction, in.visibility, in.photos,
+                                   sample_.colour, ColourOptions(options_.synthesis), progress_);
+    summary_.seconds_synthesis = SecondsSince(t);
+    summary_.from_photos = synthesis_.num_from_photos;
+    summary_.from_neighbours = synthesis_.num_from_neighbours;
+    summary_.random = synthesis_.num_random;
+  }
+
+  // Blending and atlases: the textured model.
+  void LayOut() {
+    const auto t = std::chrono::steady_clock::now();
+    atlas::Atlases atlases = atlas::BuildAtlases(inputs_.mesh, synthesis_, options_.atlas, progress_);
+    summary_.seconds_atlas = SecondsSince(t);
+    summary_.atlases = atlases.ptms.size();
+    summary_.charts = static_cast<std::size_t>(atlases.num_charts);
+    summary_.chart_flattening = options_.atlas.mode == atlas::AtlasMode::kCharts
+                                    ? atlas::ChartFlatteningName(atlases.flattening)
+                                    : "none";
+    summary_.occupancy = atlases.occupancy;
+    summary_.stretch = atlases.stretch;
+    model_ = TexturedModelOf(inputs_.mesh, std::move(atlases.ptms), atlases.faces);
+  }
+
+  // The baselines `texlume render --baseline` draws.
+  void Baselines() {
+    const auto t = std::chrono::steady_clock::now();
+    const SynthInputs& in = inputs_;
+    baked_ = render::BakePhotoTextures(model_, in.reconstruction, in.visibility, in.photos,
+                               synthesis_.photo_gains);
+    flat_albedo_ = render::MeanAlbedoFromPhotos(in.mesh, in.reconstruction, in.visibility, in.photos,
+                                        synthesis_.photo_gains);
+    summary_.seconds_baselines = SecondsSince(t);
+  }
+
+  nlohmann::json Settings() const {
+    const synth::MeshSynthesisOptions& so = options_.synthesis;
+    nlohmann::json settings = {
+        {"sample_texel_size", so.sample_texel_size},
+        {"output_texel_size", so.sample_texel_size},
+        {"strip", so.strip},
+        {"top_k", so.top_k},
+        {"all_views", so.all_views},
+        {"max_views", so.max_views},
+        {"tangent_frame", synth::TangentFrameName(so.tangent_frame)},
+        {"correction_iterations", so.correction_iterations},
+        {"additive_correction", so.additive_correction},
+        {"correction_noise", so.correction_noise},
+        {"channel_correction", so.channel_correction},
+        {"detail_transfer", so.detail_transfer},
+        {"correction_prior_shrink", so.correction_prior_shrink < 0.0
+                                        ? nlohmann::json("auto")
+                                        : nlohmann::json(so.correction_prior_shrink)},
+        {"correction_sigma", so.correction_sigma},
+        {"horizon_elevation_deg", ptm::kHorizonElevationDeg},
+        {"seed", so.seed},
+        {"sample_kind", sample_.colour.empty() ? "PTM" : "colour"}};
+    settings.update(AtlasSettingsJson(options_.atlas));
+    return settings;
+  }
+
+  nlohmann::json Summary() const {
+    const SynthJobSummary& s = summary_;
+    nlohmann::json summary = s.ToJson();
+    summary.update({{"texel_stretch",
+                     {{"mean", s.stretch.mean}, {"min", s.stretch.min}, {"max", s.stretch.max}}},
+                    {"mean_prior_shrink", MeanPriorShrink(synthesis_)}});
+    summary.update(EngineSummaryJson(synthesis_));
+    return summary;
+  }
+
+  // The manifest's record: inputs, settings, summary, warnings, baselines, timings.
+  nlohmann::json Record() {
+    nlohmann::json record;
+    record["command"] = "synth";
+    record["inputs"] = options_.InputsJson();
+    record["inputs"]["sample"] = options_.sample_file.string();
+    record["settings"] = Settings();
+    record["summary"] = Summary();
+    record["warnings"] = summary_.warnings;
+    extra_images_ = model::RecordBaselines(flat_albedo_, baked_, record);
+    const SynthJobSummary& s = summary_;
+    record["timings_s"] = {
+        {"load", s.seconds_load},
+        {"visibility", s.seconds_visibility},
+        {"synthesis", s.seconds_synthesis},
+        {"atlas", s.seconds_atlas},
+        {"baselines", s.seconds_baselines},
+        {"synthesis_per_triangle", s.seconds_synthesis / std::max<std::size_t>(1, s.faces)}};
+    return record;
+  }
+
+  // The photos and their views (under their lights, beside the photo divided by its gain).
+  void AddPhotoViews(report::ReportInputs& report) const {
+    const std::vector<synth::MeshPhoto>& photos = inputs_.photos;
+    for (std::size_t i = 0; i < photos.size(); ++i) {
+      const synth::MeshPhoto& p = photos[i];
+      const sfm::Image& image = inputs_.reconstruction.images.at(p.image_id);
+      report.photos.push_back({p.name, options_.images_dir / p.name, p.lights, p.image});
+      report::ReportView view;
+      view.name = p.name;
+      view.camera = inputs_.reconstruction.cameras.at(image.camera_id);
+      view.cam_from_world = image.cam_from_world;
+      view.lights = p.lights;
+      view.reference_image = options_.images_dir / p.name;
+      view.reference = p.image;
+      view.reference_gain = i < synthesis_.photo_gains.size() ? synthesis_.photo_gains[i] : 1.0;
+      report.views.push_back(std::move(view));
+    }
+    report.views_heading = "Photo views under the photos' lights";
+  }
+
+  void WriteModelReport(const fs::path& folder) {
+    const SynthJobSummary& s = summary_;
+    report::ReportInputs report;
+    report.title = "texlume synth: " + options_.mesh_file.filename().string();
+    report.intro =
+        "The relightable model texlume synthesised from the photos and the material sample: "
+        "the mesh covered with PTM atlases whose detail comes from the sample, chosen triangle "
+        "by triangle to agree with the photos under their lights. Below, the model is drawn "
+        "from some of the photos' own views under their lights beside the photo (divided by "
+        "its estimated exposure) and the two baselines; texlume render measures it on "
+        "held-out views.";
+    report.model = &model_;
+    report.flat_albedo = flat_albedo_;
+    report.baked = baked_;
+    report.sample = &sample_.ptm;
+    AddPhotoViews(report);
+    report.occupancy = s.occupancy;
+    report.facts = {
+        {"triangles", std::to_string(s.faces) + " (" + std::to_string(s.from_photos) +
+                          " constrained by photos, " + std::to_string(s.from_neighbours) +
+                          " by neighbours only)"},
+        {"photos used", std::to_string(s.photos_used)},
+        {"sample texel size",
+         std::to_string(options_.synthesis.sample_texel_size) + " world units"},
+        {"atlases", std::to_string(s.atlases) + " of " + std::to_string(options_.atlas.atlas_size) +
+                        " texels, " + std::to_string(s.charts) + " charts"}};
+    for (const std::string& w : s.warnings) report.facts.emplace_back("warning", w);
+    report.timings_s = {{"load", s.seconds_load},
+                        {"visibility", s.seconds_visibility},
+                        {"synthesis", s.seconds_synthesis},
+                        {"atlas", s.seconds_atlas},
+                        {"baselines", s.seconds_baselines}};
+    report.links = {
+        {"model.glb", "model.glb"}, {"model.obj", "model.obj"}, {"manifest.json", "manifest.json"}};
+    summary_.seconds_report = report::WriteReport(folder, report, progress_).seconds;
+  }
+
+  const SynthJobOptions& options_;
+  const ProgressCallback& progress_;
+  SynthJobSummary summary_;
+  SynthInputs inputs_;
+  Sample sample_;
+  synth::MeshSynthesis synthesis_;
+  model::TexturedModel model_;
+  std::vector<cv::Mat> baked_;
+  Eigen::Vector3f flat_albedo_ = Eigen::Vector3f::Constant(0.5f);
+  std::vector<std::pair<std::string, cv::Mat>> extra_images_;
+};
+
+}  // namespace
+
+SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress) {
+  options.Check();
+  return SynthJob(options, progress).Run();
+}
+
+}  // namespace texlume::pipeline

@@ -1,0 +1,129 @@
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/image_io.h"
+#include "core/progress.h"
+#include "sfm/visibility.h"
+#include "atlas/atlas.h"
+#include "synth/mesh_synthesis.h"
+#include "render/model_render.h"
+
+namespace texlume::pipeline {
+
+/// Inputs and settings of the main job (`texlume synth`).
+struct SynthJobOptions {
+  std::filesystem::path model_dir;    ///< COLMAP model (.bin or .txt)
+  std::filesystem::path images_dir;   ///< the object photos, by the model's image names
+  std::filesystem::path lights_file;  ///< object-lights JSON (docs/lights.md)
+  std::filesystem::path mesh_file;    ///< coarse mesh in the model's frame
+  std::filesystem::path sample_file;  ///< sample: PTM (.ptm, .exr) or colour photo (ReadSample)
+  std::filesystem::path out_dir;      ///< the model folder written
+  synth::MeshSynthesisOptions synthesis;     ///< sample_texel_size required
+  atlas::AtlasOptions atlas;
+  sfm::VisibilityOptions visibility;
+  /// Split every triangle in four (midpoints) up to this many times while the
+  /// largest patch does not fit the sample. [0, 6].
+  int max_subdivisions = 4;
+  /// Also write report.html (and report/) into the model folder: the sample,
+  /// the photos, the model from photo views beside the photos and the
+  /// baselines, a light sweep, the atlases, timings (synth/report.h).
+  bool write_report = true;
+
+  /// Throws OptionError when a path is missing or a setting is out of range.
+  void Check() const;
+  /// The same, but for the synthesis settings (the BTF job checks its own).
+  void CheckInputsAndLayout() const;
+  /// The input paths as the manifest's "inputs" names them (the sample's left out).
+  nlohmann::json InputsJson() const;
+};
+
+/// What the job did (also written to manifest.json).
+struct SynthInputs;
+
+/// What every synth job counts, with any sample (its manifest's summary).
+struct SynthCounts {
+  std::size_t photos_used = 0, faces = 0, subdivisions = 0;
+  std::size_t from_photos = 0, from_neighbours = 0, random = 0;
+  std::size_t atlases = 0, charts = 0;
+  std::string chart_flattening;  ///< the one used ("auto" resolves to "strips" or "rigid")
+  double occupancy = 0.0;
+  std::vector<std::string> warnings;  ///< skipped photos, repaired faces, subdivisions
+  /// The counts as the manifest's "summary" names them.
+  nlohmann::json ToJson() const;
+  /// Takes the counts of the inputs (photos, faces, subdivisions, warnings).
+  void CountInputs(const SynthInputs& inputs);
+};
+
+struct SynthJobSummary : SynthCounts {
+  atlas::AtlasStretch stretch;
+  double seconds_load = 0, seconds_visibility = 0, seconds_synthesis = 0, seconds_atlas = 0,
+         seconds_baselines = 0, seconds_report = 0, seconds_export = 0, seconds_total = 0;
+};
+
+/// The material sample of the main job: a PTM (.ptm, or an EXR of PTM
+/// channels), or an ordinary photo of the material (PNG, JPEG, TIFF, or an EXR
+/// of at most 4 channels), which is quilted as a colour sample and baked as
+/// its LambertianPtm.
+struct Sample {
+  ptm::Ptm ptm;    ///< the PTM, or the colour sample's LambertianPtm
+  cv::Mat colour;  ///< CV_32FC3 display RGB for a colour sample; empty for a PTM
+};
+/// Whether a sample file is a colour image (by extension, and channel count for EXR).
+bool IsColourImage(const std::filesystem::path& path);
+/// Reads a sample file. Throws InputError naming it when it is unreadable.
+Sample ReadSample(const std::filesystem::path& path);
+
+/// The main job's inputs, read and checked (shared with the BTF job, btf/).
+struct SynthInputs {
+  sfm::Reconstruction reconstruction;
+  mesh::TriangleMesh mesh;         ///< subdivided as needed
+  std::vector<synth::MeshPhoto> photos;  ///< those with a light and a file
+  sfm::VisibilityResult visibility;
+  std::vector<std::string> warnings;
+  std::size_t subdivisions = 0;
+  double seconds_load = 0, seconds_visibility = 0;
+};
+
+/// Reads the COLMAP model, object lights, mesh and photos named in `options`
+/// (sample and out_dir are not touched). Throws InputError as RunSynthJob describes.
+SynthInputs LoadSynthInputs(const SynthJobOptions& options);
+
+/// Splits the mesh while its largest patch (longest edge / sample_texel_size +
+/// 2 strip texels) exceeds `sample_side` texels (up to options.max_subdivisions
+/// times) and computes visibility. Throws InputError when most triangles are
+/// seen by no usable photo (a mesh in another frame).
+void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int sample_side,
+                      double sample_texel_size, int strip, const ProgressCallback& progress = {});
+
+/// What the engine decided, as the manifests' summaries name it: the photo
+/// gains, the frames (kAuto resolved) and the sample's coherence (null when
+/// not measured).
+nlohmann::json EngineSummaryJson(const synth::TriangleSynthesis& synthesis);
+
+/// Refuses an output folder that exists and is not a texlume model folder
+/// (InputError naming it): a job never replaces anything else.
+void RefuseForeignModelFolder(const std::filesystem::path& out_dir);
+
+/// The textured model of a layout: the mesh, and per face its atlas and its
+/// corners' texture coordinates (FacePlacement), with the atlases.
+model::TexturedModel TexturedModelOf(const mesh::TriangleMesh& mesh, std::vector<ptm::Ptm> atlases,
+                              const std::vector<atlas::FacePlacement>& faces);
+
+/// Runs the whole job: reads and checks the inputs, visibility and best views,
+/// per-triangle synthesis (Algorithm 2), blending, atlases, and the model folder
+/// (WriteModelFolder, plus the baselines `texlume render` draws: baked_K.png
+/// and the flat albedo). Photos in the model without a light or a file are
+/// skipped with a warning; it is an InputError when none remains, when most
+/// triangles are seen by no photo (a mesh in another frame), or when the
+/// patches would not fit in memory. Nothing is written on error.
+SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress = {});
+
+/// The atlas settings as the manifests record them (shared by the PTM and BTF jobs).
+nlohmann::json AtlasSettingsJson(const atlas::AtlasOptions& atlas);
+
+}  // namespace texlume::pipeline

@@ -1,0 +1,27 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+namespace texlume::render {
+
+/// PSNR (dB, peak 1) and SSIM (Gaussian window 11, sigma 1.5, on each channel,
+/// averaged) of two CV_32FC3 images over the pixels where `mask` (CV_8UC1) is set.
+double MaskedPsnr(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask);
+double MaskedSsim(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask);
+
+
+/// A rendered view against its ground truth, inside a mask; also reduced by an
+/// integer factor (area averaging; the mask nearest) when it is over 1.
+struct ViewMetrics {
+  std::string name;
+  double psnr = 0, ssim = 0, psnr_reduced = 0, ssim_reduced = 0;
+};
+
+/// Measures `rendered` against `truth` (CV_32FC3 display RGB, one size) inside
+/// `inside` (CV_8UC1), at full resolution and, for `reduced_factor` > 1,
+/// reduced by it.
+ViewMetrics MeasureView(const std::string& name, const cv::Mat& rendered, const cv::Mat& truth,
+                        const cv::Mat& inside, int reduced_factor);
+
+}  // namespace texlume::render

@@ -1,0 +1,64 @@
+#include <gtest/gtest.h>
+
+#include "core/errors.h"
+#include "model/baselines.h"
+#include "pipeline/render_job.h"
+#include "pipeline/synth_job.h"
+
+namespace texlume::synth {
+namespace {
+
+pipeline::SynthJobOptions CompleteSynthJob() {
+  pipeline::SynthJobOptions o;
+  o.model_dir = "sparse";
+  o.images_dir = "images";
+  o.lights_file = "lights.json";
+  o.mesh_file = "mesh.ply";
+  o.sample_file = "sample.ptm";
+  o.out_dir = "model";
+  o.synthesis.sample_texel_size = 0.002;
+  return o;
+}
+
+TEST(SynthJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
+  pipeline::SynthJobOptions o = CompleteSynthJob();
+  EXPECT_NO_THROW(o.Check());
+  o.sample_file.clear();
+  EXPECT_THROW(o.Check(), OptionError);
+  EXPECT_NO_THROW(o.CheckInputsAndLayout());  // the BTF job has no sample file
+  o = CompleteSynthJob();
+  o.mesh_file.clear();
+  EXPECT_THROW(o.CheckInputsAndLayout(), OptionError);
+  o = CompleteSynthJob();
+  o.max_subdivisions = 7;
+  EXPECT_THROW(o.Check(), OptionError);
+  o = CompleteSynthJob();
+  o.synthesis.sample_texel_size = 0.0;
+  EXPECT_THROW(o.Check(), OptionError);
+  o = CompleteSynthJob();
+  o.atlas.gutter = 0;
+  EXPECT_THROW(o.Check(), OptionError);
+  EXPECT_THROW(pipeline::RunSynthJob(o), OptionError);
+}
+
+TEST(RenderJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
+  pipeline::RenderJobOptions o;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.model_folder = "model";
+  o.cameras_dir = "sparse";
+  o.lights_file = "lights.json";
+  o.out_dir = "render";
+  EXPECT_NO_THROW(o.Check());
+  o.samples_per_axis = 9;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.samples_per_axis = 2;
+  o.reduced_factor = 0;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.reduced_factor = 1;
+  o.truth_masks_dir = "masks";  // masks without images
+  EXPECT_THROW(o.Check(), OptionError);
+  EXPECT_THROW(pipeline::RunRenderJob(o), OptionError);
+}
+
+}  // namespace
+}  // namespace texlume::synth
