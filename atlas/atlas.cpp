@@ -146,7 +146,319 @@ std::vector<std::array<int, 3>> PackSkyline(const std::vector<std::pair<int, int
   return out;
 }
 
-AtlasLayout LayoutAtlases(const mesh::TriangleMesh& mesh, const std::vector<synth::TrianglePatch>& patches,
+namespace {
+
+// Lays out the faces of a mesh in atlases with one flattening (not kAuto): the charts, their
+// outlines, the packing of the charts into atlases, each face's placement, the atlas sizes.
+class AtlasLayouter {
+ public:
+  AtlasLayouter(const mesh::TriangleMesh& mesh, const std::vector<synth::TrianglePatch>& patches,
+                const std::vector<std::array<synth::Unfolding, 3>>& unfoldings, double texel_size,
+                const AtlasOptions& options, const ProgressCallback& progress)
+      : mesh_(mesh),
+        patches_(patches),
+        unfoldings_(unfoldings),
+        t_(texel_size),
+        gutter_(options.gutter),
+        options_(options),
+        progress_(progress),
+        num_faces_(mesh.faces.size()) {}
+
+  // Runs the stages in turn.
+  AtlasLayout Run();
+
+ private:
+  // 1. Charts by the chosen flattening (strip charts are made while packing).
+  void MakeCharts();
+  // One chart per face, turned to the minimal bounding box of its triangle.
+  void MakePerTriangleCharts();
+  // 2. Chart boxes in texels (with gutters), packed.
+  void Pack();
+  // Per triangle: the charts' boxes, skyline-packed.
+  void PackPerTriangle();
+  // Strip charts in every variant, packed in rows; the fewest atlas texels win.
+  void PackStrips();
+  // Charts packed by their outlines, at both drop rules; the fewest atlas texels win.
+  void PackByOutlines();
+  // Each chart's outlines at its packing rotations, and the largest outline area per chart.
+  std::vector<std::vector<ChartOutline>> OutlineCharts(std::vector<double>& area);
+  // Throws when a chart fits an atlas at none of its rotations.
+  void CheckOutlinesFit(const std::vector<std::vector<ChartOutline>>& outlines) const;
+  // Records a packed chart, turned to its outline's rotation, at (atlas, x, y).
+  void DropChart(std::vector<ChartFace>& chart, const ChartOutline& o,
+                 const std::array<int, 3>& at);
+  // 3. Each face's placement in its atlas.
+  void PlaceFaces();
+  // 4. The atlases' sizes, each cropped to the rows it uses.
+  void SizeAtlases();
+
+  const mesh::TriangleMesh& mesh_;
+  const std::vector<synth::TrianglePatch>& patches_;
+  const std::vector<std::array<synth::Unfolding, 3>>& unfoldings_;
+  const double t_;  // texel size, world units
+  const int gutter_;
+  const AtlasOptions& options_;
+  const ProgressCallback& progress_;
+  const std::size_t num_faces_;
+
+  std::vector<std::vector<ChartFace>> charts_;
+  std::vector<std::pair<int, int>> sizes_;
+  std::vector<Eigen::Vector2i> chart_lo_, chart_hi_;
+  std::vector<std::array<int, 3>> packed_;
+  AtlasLayout layout_;
+  int num_atlases_ = 0;
+  std::vector<int> used_height_;
+};
+
+AtlasLayout AtlasLayouter::Run() {
+  MakeCharts();
+  Pack();
+  PlaceFaces();
+  SizeAtlases();
+  return std::move(layout_);
+}
+
+void AtlasLayouter::MakeCharts() {
+  // 1. Charts: faces with their rigid placement in the chart plane.
+  if (options_.mode == AtlasMode::kPerTriangle) {
+    MakePerTriangleCharts();
+  } else if (options_.flattening == ChartFlattening::kRigid) {
+    RigidChartOptions ro;
+    ro.texel_size = t_;
+    ro.max_extent_texels =
+        (options_.max_chart_size > 0 ? std::min(options_.max_chart_size, options_.atlas_size)
+                                     : options_.atlas_size) -
+        2 * gutter_ - 2;
+    ro.max_normal_angle_deg = options_.max_chart_normal_angle_deg;
+    ro.gutter = gutter_;
+    charts_ = MakeRigidCharts(mesh_, patches_, unfoldings_, ro);
+  } else if (options_.flattening == ChartFlattening::kStrips) {
+    // Laid out below, with the packing.
+  } else {
+    ConformalChartOptions co;
+    co.texel_size = t_;
+    co.max_side_texels =
+        options_.max_chart_size > 0 ? options_.max_chart_size : options_.atlas_size;
+    co.max_normal_angle_deg = options_.max_chart_normal_angle_deg;
+    co.max_stretch = options_.max_chart_stretch;
+    co.max_extent_texels = options_.atlas_size - 2 * gutter_ - 2;
+    charts_ = MakeConformalCharts(mesh_, patches_, unfoldings_, co);
+  }
+}
+
+void AtlasLayouter::MakePerTriangleCharts() {
+  const double t = t_;
+  for (std::size_t f = 0; f < num_faces_; ++f) {
+    // The minimal bounding box of a triangle has a side along one of its edges.
+    const auto& c = patches_[f].corners_in_frame;
+    double best_area = std::numeric_limits<double>::max();
+    Eigen::Matrix2d best = Eigen::Matrix2d::Identity();
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d e =
+          c[static_cast<std::size_t>((k + 1) % 3)] - c[static_cast<std::size_t>(k)];
+      const Eigen::Matrix2d r = Eigen::Rotation2Dd(-std::atan2(e.y(), e.x())).toRotationMatrix();
+      Eigen::Vector2d lo = r * c[0], hi = lo;
+      for (const auto& p : c) lo = lo.cwiseMin(r * p), hi = hi.cwiseMax(r * p);
+      const double area = (std::ceil((hi.x() - lo.x()) / t) + 2 * gutter_) *
+                          (std::ceil((hi.y() - lo.y()) / t) + 2 * gutter_);
+      if (area < best_area) best_area = area, best = r;
+    }
+    charts_.push_back({{static_cast<int>(f), best, Eigen::Vector2d::Zero()}});
+  }
+}
+
+void AtlasLayouter::Pack() {
+  // 2. Chart boxes in texels (with gutters), packed.
+  if (options_.mode == AtlasMode::kPerTriangle) {
+    PackPerTriangle();
+  } else if (options_.flattening == ChartFlattening::kStrips) {
+    PackStrips();
+  } else {
+    PackByOutlines();
+  }
+}
+
+void AtlasLayouter::PackPerTriangle() {
+  for (const auto& chart : charts_) {
+    const ChartOutline outline = Box(chart, 0.0, patches_, t_, gutter_, nullptr);
+    chart_lo_.push_back(outline.lo);
+    chart_hi_.push_back(outline.hi);
+    sizes_.emplace_back(outline.Width(), outline.Height());
+  }
+  packed_ = PackSkyline(sizes_, options_.atlas_size, options_.atlas_size);
+}
+
+void AtlasLayouter::PackStrips() {
+  // Strips (after fans) from each seed-side rule, unstacked; stacked up to
+  // a seventh of the atlas or up to the whole (which wins on developable
+  // surfaces such as a cylinder's side); and in stacks of 4 or 8 bands of
+  // the preferred height, each band within half a band of the ends of the one
+  // below (near-rectangles: on curved surfaces, where bands of small faces
+  // lose most to gutters, but stacks of many bands turn into triangles).
+  // Each is packed in rows; the layout with the fewest atlas texels wins.
+  StripChartOptions so;
+  so.texel_size = t_;
+  so.max_stretch = options_.max_chart_stretch;
+  so.max_length_texels = options_.atlas_size - 2 * gutter_ - 2;  // a whole row (rows cut them)
+  so.max_normal_angle_deg = options_.max_chart_normal_angle_deg;
+  so.gutter = gutter_;
+  const double atlas_rows = so.max_length_texels;
+  const double band = PreferredBandHeight(patches_, t_);
+  struct Variant {
+    StripSide side;
+    double max_stack_texels, max_stack_overhang_texels;
+  };
+  const Variant variants[] = {{StripSide::kTallest, 0.0, -1.0},
+                              {StripSide::kNearestPreferred, 0.0, -1.0},
+                              {StripSide::kTallest, atlas_rows / 7.0, -1.0},
+                              {StripSide::kTallest, atlas_rows, -1.0},
+                              {StripSide::kTallest, 4.0 * band + 0.5, 0.5 * band},
+                              {StripSide::kTallest, 8.0 * band + 0.5, 0.5 * band}};
+  RowPacking best;
+  std::int64_t best_texels = 0;
+  // Every variant as it is and fitted to irregular faces (synth/charts.h).
+  for (const bool fit_irregular_faces : {false, true})
+    for (const Variant& variant : variants) {
+      so.side = variant.side;
+      so.max_stack_texels = variant.max_stack_texels;
+      so.max_stack_overhang_texels = variant.max_stack_overhang_texels;
+      so.fit_irregular_faces = fit_irregular_faces;
+      RowPacking rows = PackStripsInRows(MakeStripCharts(mesh_, patches_, unfoldings_, so),
+                                         patches_, t_, gutter_, options_.atlas_size, progress_);
+      if (best.pieces.empty() || rows.texels < best_texels)
+        best_texels = rows.texels, best = std::move(rows);
+    }
+  charts_ = std::move(best.pieces);
+  for (std::size_t c = 0; c < charts_.size(); ++c)
+    DropChart(charts_[c], best.outlines[c], best.drops[c]);
+}
+
+void AtlasLayouter::PackByOutlines() {
+  // Charts are packed by their outlines (the texels the bake writes), largest
+  // first, each at the best of kPackingRotations turns and the first position
+  // where it overlaps nothing, so charts nest in each other's concavities.
+  std::vector<double> area(charts_.size(), 0.0);
+  const std::vector<std::vector<ChartOutline>> outlines = OutlineCharts(area);
+  std::vector<std::size_t> order(charts_.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return area[a] > area[b]; });
+  CheckOutlinesFit(outlines);
+  // Both drop rules; the layout with fewer atlas texels wins.
+  OutlinePacking best_packing;
+  std::size_t placed = 0;
+  const std::size_t to_place = 2 * charts_.size();
+  const auto count_placed = [&] {
+    ++placed;
+    if (progress_ && (placed % 8 == 0 || placed == to_place))
+      progress_("packing", placed, to_place);
+  };
+  for (const DropRule rule : {DropRule::kLowestBottom, DropRule::kLowestPosition}) {
+    OutlinePacking packing = PackOutlines(outlines, order, options_.atlas_size, rule, count_placed);
+    if (best_packing.drops.empty() || packing.texels < best_packing.texels)
+      best_packing = std::move(packing);
+  }
+  for (std::size_t c = 0; c < charts_.size(); ++c) {
+    const OutlineDrop& drop = best_packing.drops[c];
+    DropChart(charts_[c], outlines[c][static_cast<std::size_t>(drop.rotation)],
+              {drop.bin, drop.x, drop.y});
+  }
+}
+
+std::vector<std::vector<ChartOutline>> AtlasLayouter::OutlineCharts(std::vector<double>& area) {
+  const double t = t_;
+  const int gutter = gutter_;
+  std::vector<std::vector<ChartOutline>> outlines(charts_.size());
+  std::size_t outlined = 0;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::size_t c = 0; c < charts_.size(); ++c) {
+    const double upright = UprightBoxAngle(charts_[c], patches_);
+    outlines[c].push_back(Outline(charts_[c], upright, patches_, t, gutter));
+    // A long thin chart (a run of slivers) is tried at quarter turns only:
+    // turned by less, its outline is a tall diagonal that never packs better
+    // and is slow to place.
+    const ChartOutline& upright_outline = outlines[c][0];
+    const int long_side = std::max(upright_outline.Width(), upright_outline.Height());
+    const int short_side = std::min(upright_outline.Width(), upright_outline.Height());
+    const bool thin = long_side >= kThinChartAspect * short_side;
+    for (int r = 1; r < kPackingRotations; ++r)
+      if (!thin || r % (kPackingRotations / 4) == 0)
+        outlines[c].push_back(
+            Outline(charts_[c], upright + 2.0 * kPi * r / kPackingRotations, patches_, t, gutter));
+    for (const auto& o : outlines[c]) area[c] = std::max(area[c], o.area);
+#pragma omp critical(texlume_chart_outlines)
+    {
+      ++outlined;
+      if (progress_ && (outlined % 8 == 0 || outlined == charts_.size()))
+        progress_("chart outlines", outlined, charts_.size());
+    }
+  }
+  return outlines;
+}
+
+void AtlasLayouter::CheckOutlinesFit(const std::vector<std::vector<ChartOutline>>& outlines) const {
+  for (const auto& chart_outlines : outlines) {
+    bool fits = false;
+    for (const auto& o : chart_outlines)
+      fits = fits || (o.Width() <= options_.atlas_size && o.Height() <= options_.atlas_size);
+    if (!fits)
+      throw OptionError("a chart of " + std::to_string(chart_outlines[0].Width()) + " x " +
+                        std::to_string(chart_outlines[0].Height()) +
+                        " texels does not fit an atlas of " + std::to_string(options_.atlas_size));
+  }
+}
+
+void AtlasLayouter::DropChart(std::vector<ChartFace>& chart, const ChartOutline& o,
+                              const std::array<int, 3>& at) {
+  const Eigen::Matrix2d turn = Eigen::Rotation2Dd(o.angle).toRotationMatrix();
+  for (ChartFace& cf : chart) {
+    cf.linear = turn * cf.linear;
+    cf.translation = turn * cf.translation;
+  }
+  chart_lo_.push_back(o.lo);
+  chart_hi_.push_back(o.hi);
+  sizes_.emplace_back(o.Width(), o.Height());
+  packed_.push_back(at);
+}
+
+void AtlasLayouter::PlaceFaces() {
+  const double t = t_;
+  layout_.num_charts = static_cast<int>(charts_.size());
+  layout_.flattening = options_.flattening;
+  layout_.faces.resize(num_faces_);
+  for (std::size_t c = 0; c < charts_.size(); ++c) {
+    const auto [bin, x0, y0] = packed_[c];
+    num_atlases_ = std::max(num_atlases_, bin + 1);
+    used_height_.resize(static_cast<std::size_t>(num_atlases_), 0);
+    used_height_[static_cast<std::size_t>(bin)] =
+        std::max(used_height_[static_cast<std::size_t>(bin)], y0 + sizes_[c].second);
+    for (const ChartFace& cf : charts_[c]) {
+      FacePlacement& fp = layout_.faces[static_cast<std::size_t>(cf.face)];
+      fp.atlas = bin;
+      fp.chart = static_cast<int>(c);
+      fp.linear = cf.linear;
+      fp.offset = Eigen::Vector2d(x0 + cf.translation.x() / t - chart_lo_[c].x(),
+                                  y0 + chart_hi_[c].y() - cf.translation.y() / t);
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2d q = cf.linear * patches_[static_cast<std::size_t>(cf.face)]
+                                                  .corners_in_frame[static_cast<std::size_t>(k)];
+        fp.corners_px[static_cast<std::size_t>(k)] =
+            Eigen::Vector2d(fp.offset.x() + q.x() / t, fp.offset.y() - q.y() / t);
+      }
+    }
+  }
+}
+
+void AtlasLayouter::SizeAtlases() {
+  for (int a = 0; a < num_atlases_; ++a)
+    layout_.atlas_sizes.emplace_back(options_.atlas_size,
+                                     std::max(1, used_height_[static_cast<std::size_t>(a)]));
+}
+
+}  // namespace
+
+AtlasLayout LayoutAtlases(const mesh::TriangleMesh& mesh,
+                          const std::vector<synth::TrianglePatch>& patches,
                           const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
                           double texel_size, const AtlasOptions& options,
                           const ProgressCallback& progress) {
@@ -166,215 +478,7 @@ AtlasLayout LayoutAtlases(const mesh::TriangleMesh& mesh, const std::vector<synt
     AtlasLayout other = LayoutAtlases(mesh, patches, unfoldings, texel_size, rigid, progress);
     return other.Texels() < best.Texels() ? other : best;
   }
-  const double t = texel_size;
-  const int gutter = options.gutter;
-
-  // 1. Charts: faces with their rigid placement in the chart plane.
-  std::vector<std::vector<ChartFace>> charts;
-  if (options.mode == AtlasMode::kPerTriangle) {
-    for (std::size_t f = 0; f < num_faces; ++f) {
-      // The minimal bounding box of a triangle has a side along one of its edges.
-      const auto& c = patches[f].corners_in_frame;
-      double best_area = std::numeric_limits<double>::max();
-      Eigen::Matrix2d best = Eigen::Matrix2d::Identity();
-      for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector2d e =
-            c[static_cast<std::size_t>((k + 1) % 3)] - c[static_cast<std::size_t>(k)];
-        const Eigen::Matrix2d r = Eigen::Rotation2Dd(-std::atan2(e.y(), e.x())).toRotationMatrix();
-        Eigen::Vector2d lo = r * c[0], hi = lo;
-        for (const auto& p : c) lo = lo.cwiseMin(r * p), hi = hi.cwiseMax(r * p);
-        const double area = (std::ceil((hi.x() - lo.x()) / t) + 2 * gutter) *
-                            (std::ceil((hi.y() - lo.y()) / t) + 2 * gutter);
-        if (area < best_area) best_area = area, best = r;
-      }
-      charts.push_back({{static_cast<int>(f), best, Eigen::Vector2d::Zero()}});
-    }
-  } else if (options.flattening == ChartFlattening::kRigid) {
-    RigidChartOptions ro;
-    ro.texel_size = t;
-    ro.max_extent_texels =
-        (options.max_chart_size > 0 ? std::min(options.max_chart_size, options.atlas_size)
-                                    : options.atlas_size) -
-        2 * gutter - 2;
-    ro.max_normal_angle_deg = options.max_chart_normal_angle_deg;
-    ro.gutter = gutter;
-    charts = MakeRigidCharts(mesh, patches, unfoldings, ro);
-  } else if (options.flattening == ChartFlattening::kStrips) {
-    // Laid out below, with the packing.
-  } else {
-    ConformalChartOptions co;
-    co.texel_size = t;
-    co.max_side_texels = options.max_chart_size > 0 ? options.max_chart_size : options.atlas_size;
-    co.max_normal_angle_deg = options.max_chart_normal_angle_deg;
-    co.max_stretch = options.max_chart_stretch;
-    co.max_extent_texels = options.atlas_size - 2 * gutter - 2;
-    charts = MakeConformalCharts(mesh, patches, unfoldings, co);
-  }
-
-  // 2. Chart boxes in texels (with gutters), packed.
-  std::vector<std::pair<int, int>> sizes;
-  std::vector<Eigen::Vector2i> chart_lo, chart_hi;
-  std::vector<std::array<int, 3>> packed;
-  // Records a packed chart, turned to its outline's rotation, at (atlas, x, y).
-  auto drop_chart = [&](std::vector<ChartFace>& chart, const ChartOutline& o,
-                        const std::array<int, 3>& at) {
-    const Eigen::Matrix2d turn = Eigen::Rotation2Dd(o.angle).toRotationMatrix();
-    for (ChartFace& cf : chart) {
-      cf.linear = turn * cf.linear;
-      cf.translation = turn * cf.translation;
-    }
-    chart_lo.push_back(o.lo);
-    chart_hi.push_back(o.hi);
-    sizes.emplace_back(o.Width(), o.Height());
-    packed.push_back(at);
-  };
-  if (options.mode == AtlasMode::kPerTriangle) {
-    for (const auto& chart : charts) {
-      const ChartOutline outline = Box(chart, 0.0, patches, t, gutter, nullptr);
-      chart_lo.push_back(outline.lo);
-      chart_hi.push_back(outline.hi);
-      sizes.emplace_back(outline.Width(), outline.Height());
-    }
-    packed = PackSkyline(sizes, options.atlas_size, options.atlas_size);
-  } else if (options.flattening == ChartFlattening::kStrips) {
-    // Strips (after fans) from each seed-side rule, unstacked; stacked up to
-    // a seventh of the atlas or up to the whole (which wins on developable
-    // surfaces such as a cylinder's side); and in stacks of 4 or 8 bands of
-    // the preferred height, each band within half a band of the ends of the one
-    // below (near-rectangles: on curved surfaces, where bands of small faces
-    // lose most to gutters, but stacks of many bands turn into triangles).
-    // Each is packed in rows; the layout with the fewest atlas texels wins.
-    StripChartOptions so;
-    so.texel_size = t;
-    so.max_stretch = options.max_chart_stretch;
-    so.max_length_texels = options.atlas_size - 2 * gutter - 2;  // a whole row (rows cut them)
-    so.max_normal_angle_deg = options.max_chart_normal_angle_deg;
-    so.gutter = gutter;
-    const double atlas_rows = so.max_length_texels;
-    const double band = PreferredBandHeight(patches, t);
-    struct Variant {
-      StripSide side;
-      double max_stack_texels, max_stack_overhang_texels;
-    };
-    const Variant variants[] = {{StripSide::kTallest, 0.0, -1.0},
-                                {StripSide::kNearestPreferred, 0.0, -1.0},
-                                {StripSide::kTallest, atlas_rows / 7.0, -1.0},
-                                {StripSide::kTallest, atlas_rows, -1.0},
-                                {StripSide::kTallest, 4.0 * band + 0.5, 0.5 * band},
-                                {StripSide::kTallest, 8.0 * band + 0.5, 0.5 * band}};
-    RowPacking best;
-    std::int64_t best_texels = 0;
-    // Every variant as it is and fitted to irregular faces (synth/charts.h).
-    for (const bool fit_irregular_faces : {false, true})
-      for (const Variant& variant : variants) {
-        so.side = variant.side;
-        so.max_stack_texels = variant.max_stack_texels;
-        so.max_stack_overhang_texels = variant.max_stack_overhang_texels;
-        so.fit_irregular_faces = fit_irregular_faces;
-        RowPacking rows = PackStripsInRows(MakeStripCharts(mesh, patches, unfoldings, so), patches,
-                                           t, gutter, options.atlas_size, progress);
-        if (best.pieces.empty() || rows.texels < best_texels)
-          best_texels = rows.texels, best = std::move(rows);
-      }
-    charts = std::move(best.pieces);
-    for (std::size_t c = 0; c < charts.size(); ++c)
-      drop_chart(charts[c], best.outlines[c], best.drops[c]);
-  } else {
-    // Charts are packed by their outlines (the texels the bake writes), largest
-    // first, each at the best of kPackingRotations turns and the first position
-    // where it overlaps nothing, so charts nest in each other's concavities.
-    std::vector<std::vector<ChartOutline>> outlines(charts.size());
-    std::vector<double> area(charts.size(), 0.0);
-    std::size_t outlined = 0;
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::size_t c = 0; c < charts.size(); ++c) {
-      const double upright = UprightBoxAngle(charts[c], patches);
-      outlines[c].push_back(Outline(charts[c], upright, patches, t, gutter));
-      // A long thin chart (a run of slivers) is tried at quarter turns only:
-      // turned by less, its outline is a tall diagonal that never packs better
-      // and is slow to place.
-      const ChartOutline& upright_outline = outlines[c][0];
-      const int long_side = std::max(upright_outline.Width(), upright_outline.Height());
-      const int short_side = std::min(upright_outline.Width(), upright_outline.Height());
-      const bool thin = long_side >= kThinChartAspect * short_side;
-      for (int r = 1; r < kPackingRotations; ++r)
-        if (!thin || r % (kPackingRotations / 4) == 0)
-          outlines[c].push_back(
-              Outline(charts[c], upright + 2.0 * kPi * r / kPackingRotations, patches, t, gutter));
-      for (const auto& o : outlines[c]) area[c] = std::max(area[c], o.area);
-#pragma omp critical(texlume_chart_outlines)
-      {
-        ++outlined;
-        if (progress && (outlined % 8 == 0 || outlined == charts.size()))
-          progress("chart outlines", outlined, charts.size());
-      }
-    }
-    std::vector<std::size_t> order(charts.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::size_t a, std::size_t b) { return area[a] > area[b]; });
-    for (const auto& chart_outlines : outlines) {
-      bool fits = false;
-      for (const auto& o : chart_outlines)
-        fits = fits || (o.Width() <= options.atlas_size && o.Height() <= options.atlas_size);
-      if (!fits)
-        throw OptionError("a chart of " + std::to_string(chart_outlines[0].Width()) + " x " +
-                          std::to_string(chart_outlines[0].Height()) +
-                          " texels does not fit an atlas of " + std::to_string(options.atlas_size));
-    }
-    // Both drop rules; the layout with fewer atlas texels wins.
-    OutlinePacking best_packing;
-    std::size_t placed = 0;
-    const std::size_t to_place = 2 * charts.size();
-    const auto count_placed = [&] {
-      ++placed;
-      if (progress && (placed % 8 == 0 || placed == to_place))
-        progress("packing", placed, to_place);
-    };
-    for (const DropRule rule : {DropRule::kLowestBottom, DropRule::kLowestPosition}) {
-      OutlinePacking packing =
-          PackOutlines(outlines, order, options.atlas_size, rule, count_placed);
-      if (best_packing.drops.empty() || packing.texels < best_packing.texels)
-        best_packing = std::move(packing);
-    }
-    for (std::size_t c = 0; c < charts.size(); ++c) {
-      const OutlineDrop& drop = best_packing.drops[c];
-      drop_chart(charts[c], outlines[c][static_cast<std::size_t>(drop.rotation)],
-                 {drop.bin, drop.x, drop.y});
-    }
-  }
-
-  AtlasLayout layout;
-  layout.num_charts = static_cast<int>(charts.size());
-  layout.flattening = options.flattening;
-  layout.faces.resize(num_faces);
-  int num_atlases = 0;
-  std::vector<int> used_height;
-  for (std::size_t c = 0; c < charts.size(); ++c) {
-    const auto [bin, x0, y0] = packed[c];
-    num_atlases = std::max(num_atlases, bin + 1);
-    used_height.resize(static_cast<std::size_t>(num_atlases), 0);
-    used_height[static_cast<std::size_t>(bin)] =
-        std::max(used_height[static_cast<std::size_t>(bin)], y0 + sizes[c].second);
-    for (const ChartFace& cf : charts[c]) {
-      FacePlacement& fp = layout.faces[static_cast<std::size_t>(cf.face)];
-      fp.atlas = bin;
-      fp.chart = static_cast<int>(c);
-      fp.linear = cf.linear;
-      fp.offset = Eigen::Vector2d(x0 + cf.translation.x() / t - chart_lo[c].x(),
-                                  y0 + chart_hi[c].y() - cf.translation.y() / t);
-      for (int k = 0; k < 3; ++k) {
-        const Eigen::Vector2d q = cf.linear * patches[static_cast<std::size_t>(cf.face)]
-                                                  .corners_in_frame[static_cast<std::size_t>(k)];
-        fp.corners_px[static_cast<std::size_t>(k)] =
-            Eigen::Vector2d(fp.offset.x() + q.x() / t, fp.offset.y() - q.y() / t);
-      }
-    }
-  }
-  for (int a = 0; a < num_atlases; ++a)
-    layout.atlas_sizes.emplace_back(options.atlas_size,
-                                    std::max(1, used_height[static_cast<std::size_t>(a)]));
-  return layout;
+  return AtlasLayouter(mesh, patches, unfoldings, texel_size, options, progress).Run();
 }
 
 AtlasCoverage VisitAtlasTexels(const AtlasLayout& layout, double texel_size, int gutter,

@@ -177,188 +177,269 @@ OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlin
   return packing;
 }
 
-RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
-                            const std::vector<synth::TrianglePatch>& patches, double t, int gutter,
-                            int atlas_size, const ProgressCallback& progress) {
+namespace {
+
+// Where the faces at one end of a band slide to in the current row: the turn (-1: nowhere),
+// the outline box's x and its rows below the row's top, and the gap its left end leaves.
+struct Slide {
+  int turn = -1, x = 0, dy = 0;
+  double gap = 0.0;
+  ChartOutline outline;
+};
+
+// Strip charts packed in rows (RowPacking): the bands are sorted tallest first, then each in
+// turn (by best fit in a started row) is placed along the rows, cut where it overruns one.
+class RowPacker {
+ public:
+  RowPacker(const std::vector<synth::TrianglePatch>& patches, double t, int gutter, int atlas_size,
+            const ProgressCallback& progress)
+      : patches_(patches), t_(t), gutter_(gutter), atlas_size_(atlas_size), progress_(progress) {}
+
+  // Packs the charts and counts the atlas texels used.
+  RowPacking Run(const std::vector<std::vector<ChartFace>>& charts);
+
+ private:
   // Band x of a face (texels): the centroid of its corners in the chart frame.
-  auto band_x = [&](const ChartFace& cf) {
-    double x = 0;
-    for (const auto& c : patches[static_cast<std::size_t>(cf.face)].corners_in_frame)
-      x += (cf.linear * c + cf.translation).x();
-    return x / (3.0 * t);
-  };
-  std::vector<std::vector<ChartFace>> queue;
-  std::vector<int> height;  // texels, outline box at turn 0
+  double BandX(const ChartFace& cf) const;
+  // The charts' faces in band order, their heights, and the order they are packed in.
+  void SortBands(const std::vector<std::vector<ChartFace>>& charts);
+  // Starts a row of height h, in the next atlas when this one is full.
+  void NewRow(int h);
+  // Where `o` slides to in the current row: the smallest x where no run
+  // overlaps the row's used texels.
+  int SlideTo(const ChartOutline& o, int dy) const;
+  // Texels left empty between the row's right edge and outline `o` slid to
+  // x at dy, per row of the outline: the gap its left end leaves.
+  double GapPerRow(const ChartOutline& o, int x, int dy) const;
+  // Whole chart c's outline at turn 0 or 1 (180 degrees), made when first needed.
+  const ChartOutline& WholeOutline(std::size_t c, int turn);
+  // The position in `order_` of the chart to pack next.
+  std::size_t PickChart();
+  // Places all of chart c, cut into pieces along the rows.
+  void PackChart(std::size_t c);
+  // The `count` faces at the front of the band (turn 0, placed from the left)
+  // or at its back (turned by 180 degrees, the back comes first).
+  std::pair<std::vector<ChartFace>::iterator, std::vector<ChartFace>::iterator> EndOfRest(
+      int turn, std::size_t count);
+  // The best slide of the `count` faces at the chosen end, over both
+  // turns and, for pieces shorter than the row, every height in it.
+  Slide BestSlide(std::size_t count);
+  // Places the longest prefix of the rest of chart c (in the turned order) that fits the
+  // current row; false if none does.
+  bool PlacePiece(std::size_t c);
+  // The atlas texels used, the last atlas cropped to its used rows.
+  void CountTexels();
+
+  const std::vector<synth::TrianglePatch>& patches_;
+  const double t_;
+  const int gutter_;
+  const int atlas_size_;
+  const ProgressCallback& progress_;
+
+  std::vector<std::vector<ChartFace>> queue_;
+  std::vector<int> height_;  // texels, outline box at turn 0
+  std::vector<std::size_t> order_;
+  // Whole charts' outlines at 0 and 180 degrees, made when first needed.
+  std::vector<std::array<std::optional<ChartOutline>, 2>> whole_;
+  std::vector<char> pending_;  // per position in `order_`
+  std::size_t first_pending_ = 0;
+  std::size_t done_ = 0;
+
+  RowPacking out_;
+  int atlas_ = 0, row_y_ = 0, row_height_ = 0;
+  std::vector<int> right_edge_;  // per row of the current band row: first free x
+  std::vector<ChartFace> rest_;  // faces of the chart being packed not yet placed
+};
+
+RowPacking RowPacker::Run(const std::vector<std::vector<ChartFace>>& charts) {
+  SortBands(charts);
+  whole_.resize(queue_.size());
+  pending_.assign(order_.size(), 1);
+  while (done_ < order_.size()) {
+    const std::size_t pick = PickChart();
+    pending_[pick] = 0;
+    PackChart(order_[pick]);
+    ++done_;
+    if (progress_ && (done_ % 8 == 0 || done_ == order_.size()))
+      progress_("packing", done_, order_.size());
+  }
+  CountTexels();
+  return std::move(out_);
+}
+
+double RowPacker::BandX(const ChartFace& cf) const {
+  double x = 0;
+  for (const auto& c : patches_[static_cast<std::size_t>(cf.face)].corners_in_frame)
+    x += (cf.linear * c + cf.translation).x();
+  return x / (3.0 * t_);
+}
+
+void RowPacker::SortBands(const std::vector<std::vector<ChartFace>>& charts) {
   for (const auto& chart : charts) {
     std::vector<ChartFace> sorted = chart;
     std::stable_sort(sorted.begin(), sorted.end(),
-                     [&](const ChartFace& a, const ChartFace& b) { return band_x(a) < band_x(b); });
-    queue.push_back(std::move(sorted));
-    height.push_back(Box(chart, 0.0, patches, t, gutter, nullptr).Height());
+                     [&](const ChartFace& a, const ChartFace& b) { return BandX(a) < BandX(b); });
+    queue_.push_back(std::move(sorted));
+    height_.push_back(Box(chart, 0.0, patches_, t_, gutter_, nullptr).Height());
   }
-  std::vector<std::size_t> order(queue.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return height[a] != height[b] ? height[a] > height[b] : queue[a].size() > queue[b].size();
+  order_.resize(queue_.size());
+  for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = i;
+  std::stable_sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) {
+    return height_[a] != height_[b] ? height_[a] > height_[b] : queue_[a].size() > queue_[b].size();
   });
+}
 
-  RowPacking out;
-  int atlas = 0, row_y = 0, row_height = 0;
-  std::vector<int> right_edge;  // per row of the current band row: first free x
-  auto new_row = [&](int h) {
-    row_y += row_height;
-    if (row_y + h > atlas_size) ++atlas, row_y = 0;
-    row_height = h;
-    right_edge.assign(static_cast<std::size_t>(h), 0);
-  };
-  // Where `o` slides to in the current row: the smallest x where no run
-  // overlaps the row's used texels.
-  auto slide = [&](const ChartOutline& o, int dy) {
-    int x = 0;
-    for (const ChartOutline::Run& r : o.runs)
-      x = std::max(x, right_edge[static_cast<std::size_t>(r.row + dy)] - r.x);
-    return x;
-  };
-  // Texels left empty between the row's right edge and outline `o` slid to
-  // x at dy, per row of the outline: the gap its left end leaves.
-  auto gap_per_row = [&](const ChartOutline& o, int x, int dy) {
-    double gap = 0.0;
-    int rows = 0;
-    for (int row = 0; row < o.Height(); ++row) {
-      const int first = o.row_first_x[static_cast<std::size_t>(row)];
-      if (first == std::numeric_limits<int>::max()) continue;
-      gap += x + first - right_edge[static_cast<std::size_t>(row + dy)];
-      ++rows;
-    }
-    return rows > 0 ? gap / rows : 0.0;
-  };
-  // Whole charts' outlines at 0 and 180 degrees, made when first needed.
-  std::vector<std::array<std::optional<ChartOutline>, 2>> whole(queue.size());
-  auto whole_outline = [&](std::size_t c, int turn) -> const ChartOutline& {
-    auto& o = whole[c][static_cast<std::size_t>(turn)];
-    if (!o) o = Outline(queue[c], turn * kPi, patches, t, gutter);
-    return *o;
-  };
-  std::vector<char> pending(order.size(), 1);  // per position in `order`
-  std::size_t first_pending = 0;
-  std::size_t done = 0;
-  while (done < order.size()) {
-    while (!pending[first_pending]) ++first_pending;
-    std::size_t pick = first_pending;
-    // Best fit: in a started row, the whole chart (of the next
-    // kBestFitCandidates of the row's height) whose left end leaves the least
-    // gap, so slanted ends nest instead of leaving triangles empty.
-    if (row_height > 0 &&
-        std::any_of(right_edge.begin(), right_edge.end(), [](int e) { return e > 0; })) {
-      double best_gap = std::numeric_limits<double>::max();
-      int tried = 0;
-      for (std::size_t i = first_pending; i < order.size() && tried < kBestFitCandidates; ++i) {
-        if (!pending[i] || height[order[i]] != row_height) continue;
-        ++tried;
-        for (int turn = 0; turn < 2; ++turn) {
-          const ChartOutline& o = whole_outline(order[i], turn);
-          for (int dy = 0; dy + o.Height() <= row_height; ++dy) {
-            const int x = slide(o, dy);
-            if (x + o.Width() > atlas_size) continue;
-            const double gap = gap_per_row(o, x, dy);
-            if (gap < best_gap) best_gap = gap, pick = i;
-          }
-        }
-      }
-    }
-    pending[pick] = 0;
-    const std::size_t c = order[pick];
-    if (height[c] > atlas_size)
-      throw OptionError("a strip chart of " + std::to_string(height[c]) +
-                        " texels' height does not fit an atlas of " + std::to_string(atlas_size));
-    std::vector<ChartFace> rest = queue[c];
-    // The `count` faces at the front of the band (turn 0, placed from the left)
-    // or at its back (turned by 180 degrees, the back comes first).
-    auto end_of_rest = [&](int turn, std::size_t count) {
-      const auto n = static_cast<std::ptrdiff_t>(count);
-      return turn == 0 ? std::make_pair(rest.begin(), rest.begin() + n)
-                       : std::make_pair(rest.end() - n, rest.end());
-    };
-    while (!rest.empty()) {
-      if (row_height == 0) new_row(height[c]);
-      // The longest prefix of `rest` (in the turned order) that fits this row.
-      bool placed = false;
-      if (height[c] <= row_height) {
-        // The best slide of the `count` faces at the chosen end, over both
-        // turns and, for pieces shorter than the row, every height in it.
-        struct Slide {
-          int turn = -1, x = 0, dy = 0;
-          double gap = 0.0;
-          ChartOutline outline;
-        };
-        auto best_slide = [&](std::size_t count) {
-          Slide best;
-          for (int turn = 0; turn < 2; ++turn) {
-            const auto [first, last] = end_of_rest(turn, count);
-            ChartOutline o =
-                Outline(std::vector<ChartFace>(first, last), turn * kPi, patches, t, gutter);
-            // Shorter pieces may sit lower in the row, under others.
-            for (int dy = 0; dy + o.Height() <= row_height; ++dy) {
-              const int x = slide(o, dy);
-              if (x + o.Width() > atlas_size) continue;
-              const double gap = gap_per_row(o, x, dy);
-              if (best.turn < 0 || gap < best.gap ||
-                  (gap == best.gap && x + o.Width() < best.x + best.outline.Width()))
-                best = Slide{turn, x, dy, gap, o};
-            }
-          }
-          return best;
-        };
-        std::size_t count = rest.size();
-        Slide best = best_slide(count);
-        if (best.turn < 0) {
-          // The most faces that fit, by bisection (fewer faces never fit worse).
-          std::size_t fits = 0, fails = count;
-          while (fails - fits > 1) {
-            const std::size_t mid = fits + (fails - fits) / 2;
-            Slide s = best_slide(mid);
-            if (s.turn >= 0) {
-              fits = mid;
-              best = std::move(s);
-            } else {
-              fails = mid;
-            }
-          }
-          count = fits;
-        }
-        if (count > 0 && best.turn >= 0) {
-          const auto [first, last] = end_of_rest(best.turn, count);
-          std::vector<ChartFace> piece(first, last);
-          rest.erase(first, last);
-          for (const ChartOutline::Run& r : best.outline.runs) {
-            int& edge = right_edge[static_cast<std::size_t>(r.row + best.dy)];
-            edge = std::max(edge, best.x + r.x + r.length);
-          }
-          out.pieces.push_back(std::move(piece));
-          out.outlines.push_back(std::move(best.outline));
-          out.drops.push_back({atlas, best.x, row_y + best.dy});
-          placed = true;
-        }
-      }
-      if (!placed) {
-        if (std::all_of(right_edge.begin(), right_edge.end(), [](int e) { return e == 0; }))
-          throw OptionError("a strip chart does not fit an atlas of " + std::to_string(atlas_size));
-        new_row(height[c]);
-      }
-    }
-    ++done;
-    if (progress && (done % 8 == 0 || done == order.size()))
-      progress("packing", done, order.size());
+void RowPacker::NewRow(int h) {
+  row_y_ += row_height_;
+  if (row_y_ + h > atlas_size_) ++atlas_, row_y_ = 0;
+  row_height_ = h;
+  right_edge_.assign(static_cast<std::size_t>(h), 0);
+}
+
+int RowPacker::SlideTo(const ChartOutline& o, int dy) const {
+  int x = 0;
+  for (const ChartOutline::Run& r : o.runs)
+    x = std::max(x, right_edge_[static_cast<std::size_t>(r.row + dy)] - r.x);
+  return x;
+}
+
+double RowPacker::GapPerRow(const ChartOutline& o, int x, int dy) const {
+  double gap = 0.0;
+  int rows = 0;
+  for (int row = 0; row < o.Height(); ++row) {
+    const int first = o.row_first_x[static_cast<std::size_t>(row)];
+    if (first == std::numeric_limits<int>::max()) continue;
+    gap += x + first - right_edge_[static_cast<std::size_t>(row + dy)];
+    ++rows;
   }
-  std::vector<int> used_rows(static_cast<std::size_t>(atlas) + 1, 0);
-  for (std::size_t p = 0; p < out.pieces.size(); ++p) {
-    int& rows = used_rows[static_cast<std::size_t>(out.drops[p][0])];
-    rows = std::max(rows, out.drops[p][2] + out.outlines[p].Height());
+  return rows > 0 ? gap / rows : 0.0;
+}
+
+const ChartOutline& RowPacker::WholeOutline(std::size_t c, int turn) {
+  auto& o = whole_[c][static_cast<std::size_t>(turn)];
+  if (!o) o = Outline(queue_[c], turn * kPi, patches_, t_, gutter_);
+  return *o;
+}
+
+std::size_t RowPacker::PickChart() {
+  while (!pending_[first_pending_]) ++first_pending_;
+  std::size_t pick = first_pending_;
+  // Best fit: in a started row, the whole chart (of the next
+  // kBestFitCandidates of the row's height) whose left end leaves the least
+  // gap, so slanted ends nest instead of leaving triangles empty.
+  if (row_height_ > 0 &&
+      std::any_of(right_edge_.begin(), right_edge_.end(), [](int e) { return e > 0; })) {
+    double best_gap = std::numeric_limits<double>::max();
+    int tried = 0;
+    for (std::size_t i = first_pending_; i < order_.size() && tried < kBestFitCandidates; ++i) {
+      if (!pending_[i] || height_[order_[i]] != row_height_) continue;
+      ++tried;
+      for (int turn = 0; turn < 2; ++turn) {
+        const ChartOutline& o = WholeOutline(order_[i], turn);
+        for (int dy = 0; dy + o.Height() <= row_height_; ++dy) {
+          const int x = SlideTo(o, dy);
+          if (x + o.Width() > atlas_size_) continue;
+          const double gap = GapPerRow(o, x, dy);
+          if (gap < best_gap) best_gap = gap, pick = i;
+        }
+      }
+    }
+  }
+  return pick;
+}
+
+void RowPacker::PackChart(std::size_t c) {
+  if (height_[c] > atlas_size_)
+    throw OptionError("a strip chart of " + std::to_string(height_[c]) +
+                      " texels' height does not fit an atlas of " + std::to_string(atlas_size_));
+  rest_ = queue_[c];
+  while (!rest_.empty()) {
+    if (row_height_ == 0) NewRow(height_[c]);
+    if (!PlacePiece(c)) {
+      if (std::all_of(right_edge_.begin(), right_edge_.end(), [](int e) { return e == 0; }))
+        throw OptionError("a strip chart does not fit an atlas of " + std::to_string(atlas_size_));
+      NewRow(height_[c]);
+    }
+  }
+}
+
+std::pair<std::vector<ChartFace>::iterator, std::vector<ChartFace>::iterator> RowPacker::EndOfRest(
+    int turn, std::size_t count) {
+  const auto n = static_cast<std::ptrdiff_t>(count);
+  return turn == 0 ? std::make_pair(rest_.begin(), rest_.begin() + n)
+                   : std::make_pair(rest_.end() - n, rest_.end());
+}
+
+Slide RowPacker::BestSlide(std::size_t count) {
+  Slide best;
+  for (int turn = 0; turn < 2; ++turn) {
+    const auto [first, last] = EndOfRest(turn, count);
+    ChartOutline o =
+        Outline(std::vector<ChartFace>(first, last), turn * kPi, patches_, t_, gutter_);
+    // Shorter pieces may sit lower in the row, under others.
+    for (int dy = 0; dy + o.Height() <= row_height_; ++dy) {
+      const int x = SlideTo(o, dy);
+      if (x + o.Width() > atlas_size_) continue;
+      const double gap = GapPerRow(o, x, dy);
+      if (best.turn < 0 || gap < best.gap ||
+          (gap == best.gap && x + o.Width() < best.x + best.outline.Width()))
+        best = Slide{turn, x, dy, gap, o};
+    }
+  }
+  return best;
+}
+
+bool RowPacker::PlacePiece(std::size_t c) {
+  // The longest prefix of `rest` (in the turned order) that fits this row.
+  if (height_[c] > row_height_) return false;
+  std::size_t count = rest_.size();
+  Slide best = BestSlide(count);
+  if (best.turn < 0) {
+    // The most faces that fit, by bisection (fewer faces never fit worse).
+    std::size_t fits = 0, fails = count;
+    while (fails - fits > 1) {
+      const std::size_t mid = fits + (fails - fits) / 2;
+      Slide s = BestSlide(mid);
+      if (s.turn >= 0) {
+        fits = mid;
+        best = std::move(s);
+      } else {
+        fails = mid;
+      }
+    }
+    count = fits;
+  }
+  if (count == 0 || best.turn < 0) return false;
+  const auto [first, last] = EndOfRest(best.turn, count);
+  std::vector<ChartFace> piece(first, last);
+  rest_.erase(first, last);
+  for (const ChartOutline::Run& r : best.outline.runs) {
+    int& edge = right_edge_[static_cast<std::size_t>(r.row + best.dy)];
+    edge = std::max(edge, best.x + r.x + r.length);
+  }
+  out_.pieces.push_back(std::move(piece));
+  out_.outlines.push_back(std::move(best.outline));
+  out_.drops.push_back({atlas_, best.x, row_y_ + best.dy});
+  return true;
+}
+
+void RowPacker::CountTexels() {
+  std::vector<int> used_rows(static_cast<std::size_t>(atlas_) + 1, 0);
+  for (std::size_t p = 0; p < out_.pieces.size(); ++p) {
+    int& rows = used_rows[static_cast<std::size_t>(out_.drops[p][0])];
+    rows = std::max(rows, out_.drops[p][2] + out_.outlines[p].Height());
   }
   for (std::size_t a = 0; a < used_rows.size(); ++a)
-    out.texels += static_cast<std::int64_t>(atlas_size) *
-                  (a + 1 < used_rows.size() ? atlas_size : used_rows[a]);
-  return out;
+    out_.texels += static_cast<std::int64_t>(atlas_size_) *
+                   (a + 1 < used_rows.size() ? atlas_size_ : used_rows[a]);
+}
+
+}  // namespace
+
+RowPacking PackStripsInRows(const std::vector<std::vector<ChartFace>>& charts,
+                            const std::vector<synth::TrianglePatch>& patches, double t, int gutter,
+                            int atlas_size, const ProgressCallback& progress) {
+  return RowPacker(patches, t, gutter, atlas_size, progress).Run(charts);
 }
 
 }  // namespace texlume::atlas::chart_packing

@@ -197,66 +197,123 @@ cv::Mat CoverageMask(const Rendering& rendering) {
   return mask;
 }
 
-SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::path& dir,
-                           const ProgressCallback& progress) {
-  options.Check();
-  const auto start = std::chrono::steady_clock::now();
-  SceneSummary summary;
-  summary.dir = dir;
-  StageTimer timer(summary);
-  auto report = [&](std::string_view stage, std::size_t done, std::size_t total) {
-    if (progress) progress(stage, done, total);
-  };
-  namespace fs = std::filesystem;
-  for (const char* sub :
-       {"material/capture", "material/held_out", "material/btf", "material/ground_truth",
-        "object/images", "object/masks", "object/held_out/images", "object/held_out/masks"}) {
-    fs::create_directories(dir / sub);
-  }
-  std::size_t files = 0;
-  const double texel = options.material.texel_size;
+namespace {
 
-  // ------------------------------------------------------------ material sample
-  const Material sample_material(options.material);
-  const double extent = options.capture_size * texel;
-  const double margin = kSampleMarginTexels * texel;
-  SurfacePatch sample_patch = ShapePatches(SceneShape::kPlane)[0];
-  sample_patch.u0 = sample_patch.v0 = -margin;
-  sample_patch.u1 = sample_patch.v1 = extent + margin;
-  const BakedMaterial sample_baked(sample_material, sample_patch.u0, sample_patch.u1,
-                                   sample_patch.v0, sample_patch.v1, false, false, texel);
-  const Renderer sample_renderer(DisplacePatches({sample_patch}, {&sample_baked}, texel),
-                                 {&sample_baked});
-  ShadingOptions capture_shading = options.shading;
-  capture_shading.exposure = 1.0;
-  auto capture_set = [&](const std::vector<Eigen::Vector3d>& lights, const fs::path& folder,
-                         const char* pattern, const std::string& stage) {
+namespace fs = std::filesystem;
+
+// Writes one synthetic scene into a folder (GenerateScene), a method per stage; the
+// summary, the file count and the renderers the stages share are its members.
+class SceneGenerator {
+ public:
+  SceneGenerator(const SceneOptions& options, const fs::path& dir, const ProgressCallback& progress)
+      : options_(options),
+        dir_(dir),
+        progress_(progress),
+        texel_(options.material.texel_size),
+        extent_(options.capture_size * texel_) {
+    summary_.dir = dir;
+  }
+  SceneGenerator(const SceneGenerator&) = delete;
+  SceneGenerator& operator=(const SceneGenerator&) = delete;
+
+  // Runs every stage in order, timing each, and returns what was written.
+  SceneSummary Run() {
+    MakeFolders();
+
+    // ---------------------------------------------------------- material sample
+    BuildSample();
+    CaptureRti();
+    timer_.Done("material_capture");
+    WriteGroundTruth();
+    timer_.Done("ground_truth");
+    if (options_.write_surface) WritePlanarSurface();
+    timer_.Done("planar_surface");
+    if (options_.write_btf) CaptureBtf();
+    timer_.Done("btf_capture");
+
+    // ------------------------------------------------------------------- object
+    BuildObject();
+    timer_.Done("object_geometry");
+    PhotographObject();
+    timer_.Done("object_photos");
+    if (options_.num_held_out_views > 0) RenderHeldOutViews();
+    timer_.Done("held_out_views");
+
+    // ------------------------------------------------------------------ records
+    summary_.seconds_total =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    WriteSceneRecord();
+    WriteManifest();
+    summary_.num_files = files_;
+    return summary_;
+  }
+
+ private:
+  // Passes a stage's progress to the callback, if there is one.
+  void Report(std::string_view stage, std::size_t done, std::size_t total) const {
+    if (progress_) progress_(stage, done, total);
+  }
+
+  // Creates the scene's folder tree.
+  void MakeFolders() const {
+    for (const char* sub :
+         {"material/capture", "material/held_out", "material/btf", "material/ground_truth",
+          "object/images", "object/masks", "object/held_out/images", "object/held_out/masks"}) {
+      fs::create_directories(dir_ / sub);
+    }
+  }
+
+  // Bakes the flat material sample (with a margin around the captured area) and its renderer.
+  void BuildSample() {
+    const Material sample_material(options_.material);
+    const double margin = kSampleMarginTexels * texel_;
+    SurfacePatch sample_patch = ShapePatches(SceneShape::kPlane)[0];
+    sample_patch.u0 = sample_patch.v0 = -margin;
+    sample_patch.u1 = sample_patch.v1 = extent_ + margin;
+    sample_baked_ = std::make_unique<const BakedMaterial>(sample_material, sample_patch.u0,
+                                                          sample_patch.u1, sample_patch.v0,
+                                                          sample_patch.v1, false, false, texel_);
+    sample_renderer_ = std::make_unique<const Renderer>(
+        DisplacePatches({sample_patch}, {sample_baked_.get()}, texel_),
+        std::vector<const BakedMaterial*>{sample_baked_.get()});
+    capture_shading_ = options_.shading;
+    capture_shading_.exposure = 1.0;
+  }
+
+  // Renders the sample from above under each light into `folder`, with its lights.lp.
+  void CaptureLightSet(const std::vector<Eigen::Vector3d>& lights, const fs::path& folder,
+                       const char* pattern, const std::string& stage) {
     std::vector<sfm::LpEntry> entries;
     for (std::size_t i = 0; i < lights.size(); ++i) {
-      const Rendering r = sample_renderer.RenderOrthographic(
-          options.capture_size, options.capture_size, 0.0, extent, texel, Eigen::Vector3d::UnitZ(),
-          {{lights[i], 1.0}}, capture_shading);
+      const Rendering r = sample_renderer_->RenderOrthographic(
+          options_.capture_size, options_.capture_size, 0.0, extent_, texel_,
+          Eigen::Vector3d::UnitZ(), {{lights[i], 1.0}}, capture_shading_);
       const std::string name = Numbered(pattern, static_cast<int>(i));
       WritePngAtomically(folder / name, LinearToSrgb8(r.linear_rgb));
       entries.push_back({name, lights[i]});
-      ++files;
-      report(stage, i + 1, lights.size());
+      ++files_;
+      Report(stage, i + 1, lights.size());
     }
     sfm::WriteLpFile(entries, folder / "lights.lp");
-    ++files;
-  };
-  capture_set(DomeLights(options.num_capture_lights, 15, 80, 0.0), dir / "material/capture",
-              "rti_%03d.png", "rti capture");
-  if (options.num_held_out_capture_lights > 0) {
-    capture_set(DomeLights(options.num_held_out_capture_lights, 20, 75, 0.5),
-                dir / "material/held_out", "rti_held_%03d.png", "rti held-out");
+    ++files_;
   }
-  timer.Done("material_capture");
+
+  // The sample's RTI capture, and its held-out lights if any.
+  void CaptureRti() {
+    CaptureLightSet(DomeLights(options_.num_capture_lights, 15, 80, 0.0), dir_ / "material/capture",
+                    "rti_%03d.png", "rti capture");
+    if (options_.num_held_out_capture_lights > 0) {
+      CaptureLightSet(DomeLights(options_.num_held_out_capture_lights, 20, 75, 0.5),
+                      dir_ / "material/held_out", "rti_held_%03d.png", "rti held-out");
+    }
+  }
 
   // Ground truth in the material frame, at the capture's texels (pixel centres).
-  {
-    const int n = options.capture_size;
+  void WriteGroundTruth() {
+    const int n = options_.capture_size;
     cv::Mat albedo(n, n, CV_32FC3), height(n, n, CV_32FC1), normals(n, n, CV_32FC3);
+    const BakedMaterial& sample_baked = *sample_baked_;
+    const double texel = texel_, extent = extent_;
 #pragma omp parallel for schedule(dynamic, 8)
     for (int y = 0; y < n; ++y) {
       for (int x = 0; x < n; ++x) {
@@ -274,7 +331,7 @@ SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::p
     std::vector<cv::Mat> a, nm;
     cv::split(albedo, a);
     cv::split(normals, nm);
-    const fs::path gt = dir / "material/ground_truth";
+    const fs::path gt = dir_ / "material/ground_truth";
     ptm::WriteExr(gt / "albedo.exr", a, {"R", "G", "B"});
     ptm::WriteExr(gt / "height.exr", {height}, {"Y"});
     ptm::WriteExr(gt / "normals.exr", nm, {"X", "Y", "Z"});
@@ -283,20 +340,19 @@ SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::p
     normals.convertTo(normals_png, CV_8UC3, 127.5, 127.5);
     cv::cvtColor(normals_png, normals_png, cv::COLOR_RGB2BGR);
     WritePngAtomically(gt / "normals.png", normals_png);
-    files += 5;
+    files_ += 5;
   }
-  timer.Done("ground_truth");
 
   // Photos of an unseen planar surface of the material (synth2d input).
-  if (options.write_surface) {
-    fs::create_directories(dir / "material/surface/photos");
-    fs::create_directories(dir / "material/surface/truth");
+  void WritePlanarSurface() {
+    fs::create_directories(dir_ / "material/surface/photos");
+    fs::create_directories(dir_ / "material/surface/truth");
     PlanarSurfaceOptions surface;
-    surface.material = options.material;
-    surface.size = options.capture_size - options.capture_size % 2;
+    surface.material = options_.material;
+    surface.size = options_.capture_size - options_.capture_size % 2;
     surface.scale = 2;
-    surface.offset = options.capture_size + 2 * kSampleMarginTexels;
-    surface.shading = capture_shading;
+    surface.offset = options_.capture_size + 2 * kSampleMarginTexels;
+    surface.shading = capture_shading_;
     const std::vector<Eigen::Vector3d> photo_lights = {
         Eigen::Vector3d(0.6, 0.2, 0.77).normalized(), Eigen::Vector3d(-0.4, 0.5, 0.77).normalized(),
         Eigen::Vector3d(-0.1, -0.65, 0.75).normalized()};
@@ -306,27 +362,26 @@ SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::p
     std::vector<sfm::LpEntry> photo_entries, truth_entries;
     for (std::size_t i = 0; i < renders.photos.size(); ++i) {
       const std::string name = Numbered("photo_%02d.png", static_cast<int>(i));
-      WritePngAtomically(dir / "material/surface/photos" / name, renders.photos[i]);
+      WritePngAtomically(dir_ / "material/surface/photos" / name, renders.photos[i]);
       photo_entries.push_back({name, photo_lights[i]});
     }
     for (std::size_t i = 0; i < renders.truth.size(); ++i) {
       const std::string name = Numbered("truth_%02d.png", static_cast<int>(i));
-      WritePngAtomically(dir / "material/surface/truth" / name, renders.truth[i]);
+      WritePngAtomically(dir_ / "material/surface/truth" / name, renders.truth[i]);
       truth_entries.push_back({name, truth_lights[i]});
     }
-    sfm::WriteLpFile(photo_entries, dir / "material/surface/photos/lights.lp");
-    sfm::WriteLpFile(truth_entries, dir / "material/surface/truth/lights.lp");
-    files += renders.photos.size() + renders.truth.size() + 2;
+    sfm::WriteLpFile(photo_entries, dir_ / "material/surface/photos/lights.lp");
+    sfm::WriteLpFile(truth_entries, dir_ / "material/surface/truth/lights.lp");
+    files_ += renders.photos.size() + renders.truth.size() + 2;
   }
-  timer.Done("planar_surface");
 
   // BTF: views x lights, rectified to the material frame.
-  nlohmann::json btf;
-  if (options.write_btf) {
-    const auto views = BtfViewDirections(options.btf_view_count);
-    const auto lights = DomeLights(options.btf_light_count, 20, 75, 0.25);
-    btf["texel_size"] = texel;
-    btf["size"] = options.btf_size;
+  void CaptureBtf() {
+    nlohmann::json btf;
+    const auto views = BtfViewDirections(options_.btf_view_count);
+    const auto lights = DomeLights(options_.btf_light_count, 20, 75, 0.25);
+    btf["texel_size"] = texel_;
+    btf["size"] = options_.btf_size;
     btf["frame"] =
         "material: x right (u), y up (v), z out of the sample; directions towards viewer/light";
     btf["file_pattern"] = "view_%02d_light_%02d.png";
@@ -335,93 +390,99 @@ SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::p
     std::size_t done = 0;
     for (std::size_t vi = 0; vi < views.size(); ++vi) {
       for (std::size_t li = 0; li < lights.size(); ++li) {
-        const Rendering r = sample_renderer.RenderOrthographic(
-            options.btf_size, options.btf_size, 0.0, options.btf_size * texel, texel, views[vi],
-            {{lights[li], 1.0}}, capture_shading);
+        const Rendering r = sample_renderer_->RenderOrthographic(
+            options_.btf_size, options_.btf_size, 0.0, options_.btf_size * texel_, texel_,
+            views[vi], {{lights[li], 1.0}}, capture_shading_);
         WritePngAtomically(
-            dir / "material/btf" /
+            dir_ / "material/btf" /
                 Numbered("view_%02d_light_%02d.png", static_cast<int>(vi), static_cast<int>(li)),
             LinearToSrgb8(r.linear_rgb));
-        ++files;
-        report("btf capture", ++done, views.size() * lights.size());
+        ++files_;
+        Report("btf capture", ++done, views.size() * lights.size());
       }
     }
     WriteFileAtomically(
-        dir / "material/btf/btf.json", [&](std::ostream& o) { o << btf.dump(2) << "\n"; }, false);
-    ++files;
+        dir_ / "material/btf/btf.json", [&](std::ostream& o) { o << btf.dump(2) << "\n"; }, false);
+    ++files_;
   }
-  timer.Done("btf_capture");
 
-  // --------------------------------------------------------------------- object
-  ObjectSceneOptions object_options;
-  object_options.shape = options.shape;
-  object_options.resolution = options.mesh_resolution;
-  object_options.num_images = options.num_images;
-  object_options.image_width = options.image_width;
-  object_options.image_height = options.image_height;
-  object_options.focal_px = options.focal_px;
-  object_options.camera_distance = options.camera_distance;
-  object_options.camera_model = options.camera_model;
-  object_options.max_lights_per_image = options.max_lights_per_image;
-  object_options.seed = options.seed;
-  const ObjectScene object = MakeObjectScene(object_options);
+  // The object's COLMAP scene and its displaced geometry, with the material baked per patch.
+  void BuildObject() {
+    ObjectSceneOptions object_options;
+    object_options.shape = options_.shape;
+    object_options.resolution = options_.mesh_resolution;
+    object_options.num_images = options_.num_images;
+    object_options.image_width = options_.image_width;
+    object_options.image_height = options_.image_height;
+    object_options.focal_px = options_.focal_px;
+    object_options.camera_distance = options_.camera_distance;
+    object_options.camera_model = options_.camera_model;
+    object_options.max_lights_per_image = options_.max_lights_per_image;
+    object_options.seed = options_.seed;
+    object_ = MakeObjectScene(object_options);
 
-  const std::vector<SurfacePatch> patches = ShapePatches(options.shape);
-  std::vector<std::unique_ptr<BakedMaterial>> materials;
-  std::vector<const BakedMaterial*> material_ptrs;
-  for (const SurfacePatch& p : patches) {
-    const Material material(options.material, p.periodic_u ? p.u1 - p.u0 : 0.0,
-                            p.periodic_v ? p.v1 - p.v0 : 0.0);
-    materials.push_back(std::make_unique<BakedMaterial>(material, p.u0, p.u1, p.v0, p.v1,
-                                                        p.periodic_u, p.periodic_v, texel));
-    material_ptrs.push_back(materials.back().get());
-  }
-  const double step = options.tessellation_step > 0 ? options.tessellation_step : 2 * texel;
-  const Renderer renderer(DisplacePatches(patches, material_ptrs, step), material_ptrs);
-  summary.displaced_triangles = renderer.NumTriangles();
-  timer.Done("object_geometry");
-
-  std::mt19937_64 rng(options.seed * 31u + 7u);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  nlohmann::json photos = nlohmann::json::object();
-  const sfm::Camera& camera = object.reconstruction.cameras.begin()->second;
-  std::size_t done = 0;
-  for (const auto& [id, image] : object.reconstruction.images) {
-    ShadingOptions shading = options.shading;
-    shading.exposure = options.vary_exposure ? 0.8 + 0.4 * uniform(rng) : 1.0;
-    std::vector<RenderLight> lights;
-    for (const auto& l : object.lights.at(image.name)) {
-      lights.push_back({l.direction_in_world, l.intensity});
+    const std::vector<SurfacePatch> patches = ShapePatches(options_.shape);
+    std::vector<const BakedMaterial*> material_ptrs;
+    for (const SurfacePatch& p : patches) {
+      const Material material(options_.material, p.periodic_u ? p.u1 - p.u0 : 0.0,
+                              p.periodic_v ? p.v1 - p.v0 : 0.0);
+      materials_.push_back(std::make_unique<BakedMaterial>(material, p.u0, p.u1, p.v0, p.v1,
+                                                           p.periodic_u, p.periodic_v, texel_));
+      material_ptrs.push_back(materials_.back().get());
     }
-    const Rendering r = renderer.RenderPerspective(camera, image.cam_from_world, lights, shading);
-    WritePngAtomically(dir / "object/images" / image.name, LinearToSrgb8(r.linear_rgb));
-    WritePngAtomically(dir / "object/masks" / image.name, CoverageMask(r));
-    photos[image.name] = {{"exposure", shading.exposure}, {"lights", lights.size()}};
-    files += 2;
-    report("object photos", ++done, object.reconstruction.images.size());
+    step_ = options_.tessellation_step > 0 ? options_.tessellation_step : 2 * texel_;
+    renderer_ = std::make_unique<const Renderer>(DisplacePatches(patches, material_ptrs, step_),
+                                                 material_ptrs);
+    summary_.displaced_triangles = renderer_->NumTriangles();
   }
-  WriteObjectScene(object, dir / "object");
-  files += 9;
-  timer.Done("object_photos");
+
+  // The camera of the object's photos.
+  const sfm::Camera& PhotoCamera() const { return object_.reconstruction.cameras.begin()->second; }
+
+  // The object's photos and masks under their lights (exposure drawn per photo), and its model.
+  void PhotographObject() {
+    std::mt19937_64 rng(options_.seed * 31u + 7u);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    const sfm::Camera& camera = PhotoCamera();
+    std::size_t done = 0;
+    for (const auto& [id, image] : object_.reconstruction.images) {
+      ShadingOptions shading = options_.shading;
+      shading.exposure = options_.vary_exposure ? 0.8 + 0.4 * uniform(rng) : 1.0;
+      std::vector<RenderLight> lights;
+      for (const auto& l : object_.lights.at(image.name)) {
+        lights.push_back({l.direction_in_world, l.intensity});
+      }
+      const Rendering r =
+          renderer_->RenderPerspective(camera, image.cam_from_world, lights, shading);
+      WritePngAtomically(dir_ / "object/images" / image.name, LinearToSrgb8(r.linear_rgb));
+      WritePngAtomically(dir_ / "object/masks" / image.name, CoverageMask(r));
+      photos_[image.name] = {{"exposure", shading.exposure}, {"lights", lights.size()}};
+      files_ += 2;
+      Report("object photos", ++done, object_.reconstruction.images.size());
+    }
+    WriteObjectScene(object_, dir_ / "object");
+    files_ += 9;
+  }
 
   // Held-out views x held-out lights: ground truth for relighting from new views.
-  if (options.num_held_out_views > 0) {
+  void RenderHeldOutViews() {
+    const sfm::Camera& camera = PhotoCamera();
     sfm::Reconstruction held;
-    const sfm::Camera held_camera = camera.Scaled(options.held_out_scale);
+    const sfm::Camera held_camera = camera.Scaled(options_.held_out_scale);
     held.cameras[held_camera.camera_id] = held_camera;
     sfm::ObjectLights held_lights;
     std::uint32_t next_id = 1;
-    done = 0;
+    std::size_t done = 0;
     const std::size_t total =
-        static_cast<std::size_t>(options.num_held_out_views * options.held_out_lights_per_view);
-    const bool plane = options.shape == SceneShape::kPlane;
-    for (int v = 0; v < options.num_held_out_views; ++v) {
-      const double azimuth = 2 * kPi * (v + 0.5) / options.num_held_out_views + 0.2;
+        static_cast<std::size_t>(options_.num_held_out_views * options_.held_out_lights_per_view);
+    const bool plane = options_.shape == SceneShape::kPlane;
+    for (int v = 0; v < options_.num_held_out_views; ++v) {
+      const double azimuth = 2 * kPi * (v + 0.5) / options_.num_held_out_views + 0.2;
       const double elevation = (plane ? 50.0 : 22.0) * kPi / 180.0;
-      const sfm::Rigid3d pose =
-          LookAt(options.camera_distance * FromAngles(azimuth, elevation), Eigen::Vector3d::Zero());
-      const auto dome = DomeLights(options.held_out_lights_per_view, 25, 65, 0.3);
-      for (int k = 0; k < options.held_out_lights_per_view; ++k) {
+      const sfm::Rigid3d pose = LookAt(options_.camera_distance * FromAngles(azimuth, elevation),
+                                       Eigen::Vector3d::Zero());
+      const auto dome = DomeLights(options_.held_out_lights_per_view, 25, 65, 0.3);
+      for (int k = 0; k < options_.held_out_lights_per_view; ++k) {
         // The dome is turned towards the view so the visible side is lit.
         const Eigen::Vector3d d = dome[static_cast<std::size_t>(k)];
         const Eigen::Vector3d light = Eigen::AngleAxisd(azimuth, Eigen::Vector3d::UnitZ()) *
@@ -435,95 +496,125 @@ SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::p
         sfm::ObjectLight object_light;
         object_light.direction_in_world = light.normalized();
         held_lights[image.name] = {object_light};
-        ShadingOptions shading = options.shading;
+        ShadingOptions shading = options_.shading;
         shading.exposure = 1.0;
         const Rendering r =
-            renderer.RenderPerspective(held_camera, pose, {{light.normalized(), 1.0}}, shading);
-        WritePngAtomically(dir / "object/held_out/images" / image.name,
+            renderer_->RenderPerspective(held_camera, pose, {{light.normalized(), 1.0}}, shading);
+        WritePngAtomically(dir_ / "object/held_out/images" / image.name,
                            LinearToSrgb8(r.linear_rgb));
-        WritePngAtomically(dir / "object/held_out/masks" / image.name, CoverageMask(r));
-        files += 2;
-        report("held-out views", ++done, total);
+        WritePngAtomically(dir_ / "object/held_out/masks" / image.name, CoverageMask(r));
+        files_ += 2;
+        Report("held-out views", ++done, total);
       }
     }
-    sfm::WriteModel(held, dir / "object/held_out/sparse", sfm::ModelFormat::kBinary);
-    sfm::WriteModel(held, dir / "object/held_out/sparse_txt", sfm::ModelFormat::kText);
-    sfm::WriteObjectLightsFile(held_lights, dir / "object/held_out/lights.json");
-    files += 7;
+    sfm::WriteModel(held, dir_ / "object/held_out/sparse", sfm::ModelFormat::kBinary);
+    sfm::WriteModel(held, dir_ / "object/held_out/sparse_txt", sfm::ModelFormat::kText);
+    sfm::WriteObjectLightsFile(held_lights, dir_ / "object/held_out/lights.json");
+    files_ += 7;
   }
-  timer.Done("held_out_views");
 
-  // ------------------------------------------------------------ records
-  summary.seconds_total =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  nlohmann::json record;
-  record["generator"] = "texlume scene";
-  record["shape"] = SceneShapeName(options.shape);
-  record["material"] = {{"kind", MaterialKindName(options.material.kind)},
-                        {"texel_size", texel},
-                        {"relief_height", options.material.relief_height},
-                        {"feature_scale", options.material.feature_scale},
-                        {"specular", options.material.specular},
-                        {"shininess", options.material.shininess}};
-  record["seed"] = options.seed;
-  record["units"] = "world units of the COLMAP model (the shapes are about 2 units across)";
-  record["camera"] = {{"model", sfm::CameraModelName(options.camera_model)},
-                      {"width", options.image_width},
-                      {"height", options.image_height},
-                      {"focal_px", options.focal_px},
-                      {"distance", options.camera_distance},
-                      {"held_out_scale", options.held_out_scale}};
-  record["shading"] = {
-      {"ambient", options.shading.ambient},
-      {"samples_per_pixel", options.shading.samples_per_axis * options.shading.samples_per_axis},
-      {"shadows", options.shading.shadows}};
-  record["capture"] = {{"size", options.capture_size},
-                       {"lights", options.num_capture_lights},
-                       {"held_out_lights", options.num_held_out_capture_lights}};
-  record["photos"] = photos;
-  record["displaced_triangles"] = summary.displaced_triangles;
-  record["tessellation_step"] = step;
-  for (const auto& [stage, s] : summary.stage_seconds) record["timings_s"][stage] = s;
-  record["timings_s"]["total"] = summary.seconds_total;
-  WriteFileAtomically(
-      dir / "scene.json", [&](std::ostream& o) { o << record.dump(2) << "\n"; }, false);
-  ++files;
+  // scene.json: the settings, per-photo exposures and lights, and the stage timings.
+  void WriteSceneRecord() {
+    nlohmann::json record;
+    record["generator"] = "texlume scene";
+    record["shape"] = SceneShapeName(options_.shape);
+    record["material"] = {{"kind", MaterialKindName(options_.material.kind)},
+                          {"texel_size", texel_},
+                          {"relief_height", options_.material.relief_height},
+                          {"feature_scale", options_.material.feature_scale},
+                          {"specular", options_.material.specular},
+                          {"shininess", options_.material.shininess}};
+    record["seed"] = options_.seed;
+    record["units"] = "world units of the COLMAP model (the shapes are about 2 units across)";
+    record["camera"] = {{"model", sfm::CameraModelName(options_.camera_model)},
+                        {"width", options_.image_width},
+                        {"height", options_.image_height},
+                        {"focal_px", options_.focal_px},
+                        {"distance", options_.camera_distance},
+                        {"held_out_scale", options_.held_out_scale}};
+    record["shading"] = {{"ambient", options_.shading.ambient},
+                         {"samples_per_pixel",
+                          options_.shading.samples_per_axis * options_.shading.samples_per_axis},
+                         {"shadows", options_.shading.shadows}};
+    record["capture"] = {{"size", options_.capture_size},
+                         {"lights", options_.num_capture_lights},
+                         {"held_out_lights", options_.num_held_out_capture_lights}};
+    record["photos"] = photos_;
+    record["displaced_triangles"] = summary_.displaced_triangles;
+    record["tessellation_step"] = step_;
+    for (const auto& [stage, s] : summary_.stage_seconds) record["timings_s"][stage] = s;
+    record["timings_s"]["total"] = summary_.seconds_total;
+    WriteFileAtomically(
+        dir_ / "scene.json", [&](std::ostream& o) { o << record.dump(2) << "\n"; }, false);
+    ++files_;
+  }
 
-  std::ostringstream manifest;
-  manifest
-      << "# Synthetic texlume scene: " << MaterialKindName(options.material.kind) << " "
-      << SceneShapeName(options.shape) << " (seed " << options.seed << ")\n\n"
-      << "Generated by `texlume scene`; layout and conventions in texlume's "
-         "docs/synthetic_scenes.md. Settings and timings: `scene.json`.\n\n"
-      << "| path | what |\n| --- | --- |\n"
-      << "| `material/capture/rti_NNN.png`, `lights.lp` | RTI capture of the flat sample: "
-      << options.capture_size << "x" << options.capture_size << " texels of " << texel
-      << " world units, orthographic from above, " << options.num_capture_lights
-      << " directional lights (8-bit sRGB) |\n"
-      << "| `material/held_out/` | the same sample under " << options.num_held_out_capture_lights
-      << " other lights, for leave-out tests |\n"
-      << "| `material/surface/photos/`, `material/surface/truth/` | an unseen planar surface of "
-         "the material: 3 photos at half resolution (`lights.lp`), and ground truth at full "
-         "resolution under the photo lights then 4 others (`lights.lp`) |\n"
-      << "| `material/btf/view_VV_light_LL.png`, `btf.json` | BTF capture, views x lights, "
-         "rectified to the material frame |\n"
-      << "| `material/ground_truth/` | albedo (linear EXR, sRGB PNG), height (EXR, world "
-         "units), normals (EXR, material frame; PNG as 0.5 + 0.5 n) |\n"
-      << "| `object/images/`, `object/masks/` | " << options.num_images
-      << " photos of the displaced " << SceneShapeName(options.shape)
-      << " and their object masks |\n"
-      << "| `object/sparse/`, `object/sparse_txt/` | the COLMAP model (binary, text) |\n"
-      << "| `object/lights.json` | object lights per photo (world frame) |\n"
-      << "| `object/mesh.ply` | the coarse undisplaced mesh, in the model's frame |\n"
-      << "| `object/held_out/` | held-out views x held-out lights: images, masks, COLMAP "
-         "model, lights |\n\n"
-      << "Light directions point from the surface to the light. In `.lp` files: x right, y "
-         "up, z out of the sample. In JSON: world frame (Z up).\n";
-  WriteFileAtomically(
-      dir / "MANIFEST.md", [&](std::ostream& o) { o << manifest.str(); }, false);
-  ++files;
-  summary.num_files = files;
-  return summary;
+  // MANIFEST.md: what each path of the scene holds.
+  void WriteManifest() {
+    std::ostringstream manifest;
+    manifest
+        << "# Synthetic texlume scene: " << MaterialKindName(options_.material.kind) << " "
+        << SceneShapeName(options_.shape) << " (seed " << options_.seed << ")\n\n"
+        << "Generated by `texlume scene`; layout and conventions in texlume's "
+           "docs/synthetic_scenes.md. Settings and timings: `scene.json`.\n\n"
+        << "| path | what |\n| --- | --- |\n"
+        << "| `material/capture/rti_NNN.png`, `lights.lp` | RTI capture of the flat sample: "
+        << options_.capture_size << "x" << options_.capture_size << " texels of " << texel_
+        << " world units, orthographic from above, " << options_.num_capture_lights
+        << " directional lights (8-bit sRGB) |\n"
+        << "| `material/held_out/` | the same sample under " << options_.num_held_out_capture_lights
+        << " other lights, for leave-out tests |\n"
+        << "| `material/surface/photos/`, `material/surface/truth/` | an unseen planar surface of "
+           "the material: 3 photos at half resolution (`lights.lp`), and ground truth at full "
+           "resolution under the photo lights then 4 others (`lights.lp`) |\n"
+        << "| `material/btf/view_VV_light_LL.png`, `btf.json` | BTF capture, views x lights, "
+           "rectified to the material frame |\n"
+        << "| `material/ground_truth/` | albedo (linear EXR, sRGB PNG), height (EXR, world "
+           "units), normals (EXR, material frame; PNG as 0.5 + 0.5 n) |\n"
+        << "| `object/images/`, `object/masks/` | " << options_.num_images
+        << " photos of the displaced " << SceneShapeName(options_.shape)
+        << " and their object masks |\n"
+        << "| `object/sparse/`, `object/sparse_txt/` | the COLMAP model (binary, text) |\n"
+        << "| `object/lights.json` | object lights per photo (world frame) |\n"
+        << "| `object/mesh.ply` | the coarse undisplaced mesh, in the model's frame |\n"
+        << "| `object/held_out/` | held-out views x held-out lights: images, masks, COLMAP "
+           "model, lights |\n\n"
+        << "Light directions point from the surface to the light. In `.lp` files: x right, y "
+           "up, z out of the sample. In JSON: world frame (Z up).\n";
+    WriteFileAtomically(
+        dir_ / "MANIFEST.md", [&](std::ostream& o) { o << manifest.str(); }, false);
+    ++files_;
+  }
+
+  const SceneOptions& options_;
+  const fs::path& dir_;
+  const ProgressCallback& progress_;
+  const double texel_;
+  const double extent_;  // the captured sample's side, world units
+  const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  SceneSummary summary_;
+  StageTimer timer_{summary_};
+  std::size_t files_ = 0;
+
+  // The material sample (material stages).
+  std::unique_ptr<const BakedMaterial> sample_baked_;
+  std::unique_ptr<const Renderer> sample_renderer_;
+  ShadingOptions capture_shading_;
+
+  // The object (object stages).
+  ObjectScene object_;
+  std::vector<std::unique_ptr<BakedMaterial>> materials_;
+  double step_ = 0.0;  // tessellation step of the displaced geometry
+  std::unique_ptr<const Renderer> renderer_;
+  nlohmann::json photos_ = nlohmann::json::object();
+};
+
+}  // namespace
+
+SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::path& dir,
+                           const ProgressCallback& progress) {
+  options.Check();
+  return SceneGenerator(options, dir, progress).Run();
 }
 
 }  // namespace texlume::datasets

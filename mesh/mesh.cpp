@@ -149,31 +149,52 @@ std::vector<std::string> MeshReport::Problems() const {
   return out;
 }
 
-LoadedMesh CleanMesh(const std::vector<Eigen::Vector3d>& vertices,
-                     const std::vector<std::vector<int>>& polygons, const MeshCleanOptions& options,
-                     const std::string& label) {
-  options.Check();
-  LoadedMesh result;
-  MeshReport& report = result.report;
-  report.input_vertices = vertices.size();
-  report.input_faces = polygons.size();
+namespace {
 
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (std::size_t i = 0; i < vertices.size(); ++i) {
-    if (!vertices[i].allFinite()) {
-      throw InputError(label, "vertex " + std::to_string(i) + " has a non-finite coordinate");
-    }
-    lo = lo.cwiseMin(vertices[i]);
-    hi = hi.cwiseMax(vertices[i]);
+// Repairs a polygon soup into a clean triangle mesh (CleanMesh), a method per step;
+// the faces, the vertex map and the report being built are its members.
+class MeshCleaner {
+ public:
+  MeshCleaner(const std::vector<Eigen::Vector3d>& vertices,
+              const std::vector<std::vector<int>>& polygons, const MeshCleanOptions& options,
+              const std::string& label)
+      : vertices_(vertices), polygons_(polygons), options_(options), label_(label) {}
+  MeshCleaner(const MeshCleaner&) = delete;
+  MeshCleaner& operator=(const MeshCleaner&) = delete;
+
+  // Runs the steps in order and returns the cleaned mesh with its report.
+  LoadedMesh Run() {
+    report_.input_vertices = vertices_.size();
+    report_.input_faces = polygons_.size();
+    MeasureBounds();
+    WeldVertices();
+    TriangulatePolygons();
+    CountEdgeProblems();
+    if (options_.fix_orientation) OrientFaces();
+    CompactVertices();
+    return std::move(result_);
   }
-  const double diagonal = vertices.empty() ? 0.0 : (hi - lo).norm();
+
+ private:
+  // Checks the coordinates are finite and measures the bounding box and its diagonal.
+  void MeasureBounds() {
+    lo_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo_;
+    for (std::size_t i = 0; i < vertices_.size(); ++i) {
+      if (!vertices_[i].allFinite()) {
+        throw InputError(label_, "vertex " + std::to_string(i) + " has a non-finite coordinate");
+      }
+      lo_ = lo_.cwiseMin(vertices_[i]);
+      hi = hi.cwiseMax(vertices_[i]);
+    }
+    diagonal_ = vertices_.empty() ? 0.0 : (hi - lo_).norm();
+  }
 
   // 1. Weld duplicate vertices on a hash grid (cells of the tolerance size,
   //    neighbouring cells searched so no pair within tolerance is missed).
-  std::vector<int> representative(vertices.size());
-  {
-    const double tol = options.weld_relative_tolerance * diagonal;
+  void WeldVertices() {
+    representative_.resize(vertices_.size());
+    const double tol = options_.weld_relative_tolerance * diagonal_;
     const double cell = tol > 0.0 ? tol : 1.0;
     struct KeyHash {
       std::size_t operator()(const std::array<std::int64_t, 3>& k) const {
@@ -186,20 +207,20 @@ LoadedMesh CleanMesh(const std::vector<Eigen::Vector3d>& vertices,
                                 (std::hash<double>()(p[2]) << 2);
                        })>
         exact;
-    for (std::size_t i = 0; i < vertices.size(); ++i) {
-      const Eigen::Vector3d& p = vertices[i];
+    for (std::size_t i = 0; i < vertices_.size(); ++i) {
+      const Eigen::Vector3d& p = vertices_[i];
       int found = -1;
       if (tol > 0.0) {
         std::array<std::int64_t, 3> key;
         for (int c = 0; c < 3; ++c)
-          key[c] = static_cast<std::int64_t>(std::floor((p[c] - lo[c]) / cell));
+          key[c] = static_cast<std::int64_t>(std::floor((p[c] - lo_[c]) / cell));
         for (int dx = -1; dx <= 1 && found < 0; ++dx)
           for (int dy = -1; dy <= 1 && found < 0; ++dy)
             for (int dz = -1; dz <= 1 && found < 0; ++dz) {
               const auto it = grid.find({key[0] + dx, key[1] + dy, key[2] + dz});
               if (it == grid.end()) continue;
               for (int j : it->second) {
-                if ((vertices[static_cast<std::size_t>(j)] - p).norm() <= tol) {
+                if ((vertices_[static_cast<std::size_t>(j)] - p).norm() <= tol) {
                   found = j;
                   break;
                 }
@@ -211,153 +232,208 @@ LoadedMesh CleanMesh(const std::vector<Eigen::Vector3d>& vertices,
             exact.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<int>(i));
         if (!inserted) found = it->second;
       }
-      representative[i] = found < 0 ? static_cast<int>(i) : found;
-      if (found >= 0) ++report.duplicate_vertices_merged;
+      representative_[i] = found < 0 ? static_cast<int>(i) : found;
+      if (found >= 0) ++report_.duplicate_vertices_merged;
     }
   }
 
   // 2. Triangulate (fan), map to representatives, drop degenerate and duplicate faces.
-  std::vector<std::array<int, 3>> faces;
-  std::vector<std::size_t> source;
-  faces.reserve(polygons.size());
-  const double min_area = options.degenerate_relative_area * diagonal * diagonal;
-  std::unordered_map<std::uint64_t, std::vector<std::size_t>> seen;  // min vertex -> faces
-  for (std::size_t pi = 0; pi < polygons.size(); ++pi) {
-    const auto& polygon = polygons[pi];
-    if (polygon.size() < 3) {
-      ++report.degenerate_faces_removed;
-      continue;
-    }
-    for (int idx : polygon) {
-      if (idx < 0 || static_cast<std::size_t>(idx) >= vertices.size()) {
-        throw InputError(label, "face " + std::to_string(pi) + " refers to vertex " +
-                                    std::to_string(idx) + " but the mesh has " +
-                                    std::to_string(vertices.size()) + " vertices");
-      }
-    }
-    if (polygon.size() > 3) ++report.polygons_triangulated;
-    for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
-      const std::array<int, 3> f = {representative[static_cast<std::size_t>(polygon[0])],
-                                    representative[static_cast<std::size_t>(polygon[k])],
-                                    representative[static_cast<std::size_t>(polygon[k + 1])]};
-      const Eigen::Vector3d& a = vertices[static_cast<std::size_t>(f[0])];
-      const double area = 0.5 * (vertices[static_cast<std::size_t>(f[1])] - a)
-                                    .cross(vertices[static_cast<std::size_t>(f[2])] - a)
-                                    .norm();
-      if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2] || !(area > min_area)) {
-        ++report.degenerate_faces_removed;
+  void TriangulatePolygons() {
+    faces_.reserve(polygons_.size());
+    min_area_ = options_.degenerate_relative_area * diagonal_ * diagonal_;
+    for (std::size_t pi = 0; pi < polygons_.size(); ++pi) {
+      const auto& polygon = polygons_[pi];
+      if (polygon.size() < 3) {
+        ++report_.degenerate_faces_removed;
         continue;
       }
-      std::array<int, 3> sorted = f;
-      std::sort(sorted.begin(), sorted.end());
-      const std::uint64_t key = static_cast<std::uint64_t>(sorted[0]);
-      bool duplicate = false;
-      for (std::size_t other : seen[key]) {
-        std::array<int, 3> s = faces[other];
-        std::sort(s.begin(), s.end());
-        if (s == sorted) {
-          duplicate = true;
-          break;
+      for (int idx : polygon) {
+        if (idx < 0 || static_cast<std::size_t>(idx) >= vertices_.size()) {
+          throw InputError(label_, "face " + std::to_string(pi) + " refers to vertex " +
+                                       std::to_string(idx) + " but the mesh has " +
+                                       std::to_string(vertices_.size()) + " vertices");
         }
       }
-      if (duplicate) {
-        ++report.duplicate_faces_removed;
-        continue;
+      if (polygon.size() > 3) ++report_.polygons_triangulated;
+      for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
+        AddTriangle({representative_[static_cast<std::size_t>(polygon[0])],
+                     representative_[static_cast<std::size_t>(polygon[k])],
+                     representative_[static_cast<std::size_t>(polygon[k + 1])]},
+                    pi);
       }
-      seen[key].push_back(faces.size());
-      faces.push_back(f);
-      source.push_back(pi);
     }
+    if (faces_.empty()) throw InputError(label_, "the mesh has no usable faces");
   }
-  if (faces.empty()) throw InputError(label, "the mesh has no usable faces");
 
-  // 3. Non-manifold edges and orientation.
-  auto uses = EdgeUses(faces);
-  for (const auto& [key, list] : uses) {
-    if (list.size() > 2) ++report.non_manifold_edges;
-    if (list.size() == 2 && SameDirection(faces, list[0], list[1])) {
-      ++report.inconsistently_oriented_edges;
+  // Keeps triangle `f` of polygon `pi` unless it is degenerate or repeats a kept face.
+  void AddTriangle(const std::array<int, 3>& f, std::size_t pi) {
+    const Eigen::Vector3d& a = vertices_[static_cast<std::size_t>(f[0])];
+    const double area = 0.5 * (vertices_[static_cast<std::size_t>(f[1])] - a)
+                                  .cross(vertices_[static_cast<std::size_t>(f[2])] - a)
+                                  .norm();
+    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2] || !(area > min_area_)) {
+      ++report_.degenerate_faces_removed;
+      return;
+    }
+    std::array<int, 3> sorted = f;
+    std::sort(sorted.begin(), sorted.end());
+    const std::uint64_t key = static_cast<std::uint64_t>(sorted[0]);
+    bool duplicate = false;
+    for (std::size_t other : seen_[key]) {
+      std::array<int, 3> s = faces_[other];
+      std::sort(s.begin(), s.end());
+      if (s == sorted) {
+        duplicate = true;
+        break;
+      }
+    }
+    if (duplicate) {
+      ++report_.duplicate_faces_removed;
+      return;
+    }
+    seen_[key].push_back(faces_.size());
+    faces_.push_back(f);
+    source_.push_back(pi);
+  }
+
+  // 3. Non-manifold edges and orientation: counts the edges used by more than two
+  //    faces and those two faces traverse in the same direction.
+  void CountEdgeProblems() {
+    uses_ = EdgeUses(faces_);
+    for (const auto& [key, list] : uses_) {
+      if (list.size() > 2) ++report_.non_manifold_edges;
+      if (list.size() == 2 && SameDirection(faces_, list[0], list[1])) {
+        ++report_.inconsistently_oriented_edges;
+      }
     }
   }
-  if (options.fix_orientation) {
+
+  // Orients every connected component consistently, and outwards where it is closed.
+  void OrientFaces() {
     // Breadth-first over manifold edges: a face reached through an edge it
     // traverses in the same direction as its parent gets flipped.
-    std::vector<int> flip(faces.size(), -1);  // -1 unvisited, 0 keep, 1 flip
-    for (std::size_t seed = 0; seed < faces.size(); ++seed) {
-      if (flip[seed] >= 0) continue;
-      std::vector<std::size_t> component;
-      bool orientable = true;
-      std::queue<std::size_t> queue;
-      flip[seed] = 0;
-      queue.push(seed);
-      while (!queue.empty()) {
-        const std::size_t f = queue.front();
-        queue.pop();
-        component.push_back(f);
-        for (int k = 0; k < 3; ++k) {
-          const int a = faces[f][static_cast<std::size_t>(k)];
-          const int b = faces[f][static_cast<std::size_t>((k + 1) % 3)];
-          const auto& list = uses[EdgeKey(a, b)];
-          if (list.size() != 2) continue;
-          const EdgeUse& mine = list[0].face == static_cast<int>(f) ? list[0] : list[1];
-          const EdgeUse& other = list[0].face == static_cast<int>(f) ? list[1] : list[0];
-          const int relation = SameDirection(faces, mine, other) ? 1 : 0;  // 1: must differ
-          const int wanted = flip[f] ^ relation;
-          const auto g = static_cast<std::size_t>(other.face);
-          if (flip[g] < 0) {
-            flip[g] = wanted;
-            queue.push(g);
-          } else if (flip[g] != wanted) {
-            orientable = false;
-          }
+    flip_.assign(faces_.size(), -1);  // -1 unvisited, 0 keep, 1 flip
+    for (std::size_t seed = 0; seed < faces_.size(); ++seed) {
+      if (flip_[seed] >= 0) continue;
+      const std::vector<std::size_t> component = PropagateOrientation(seed);
+      OrientComponent(component);
+    }
+  }
+
+  // Decides breadth-first from `seed` which faces of its component flip; returns the
+  // component's faces in visiting order.
+  std::vector<std::size_t> PropagateOrientation(std::size_t seed) {
+    std::vector<std::size_t> component;
+    bool orientable = true;
+    std::queue<std::size_t> queue;
+    flip_[seed] = 0;
+    queue.push(seed);
+    while (!queue.empty()) {
+      const std::size_t f = queue.front();
+      queue.pop();
+      component.push_back(f);
+      for (int k = 0; k < 3; ++k) {
+        const int a = faces_[f][static_cast<std::size_t>(k)];
+        const int b = faces_[f][static_cast<std::size_t>((k + 1) % 3)];
+        const auto& list = uses_[EdgeKey(a, b)];
+        if (list.size() != 2) continue;
+        const EdgeUse& mine = list[0].face == static_cast<int>(f) ? list[0] : list[1];
+        const EdgeUse& other = list[0].face == static_cast<int>(f) ? list[1] : list[0];
+        const int relation = SameDirection(faces_, mine, other) ? 1 : 0;  // 1: must differ
+        const int wanted = flip_[f] ^ relation;
+        const auto g = static_cast<std::size_t>(other.face);
+        if (flip_[g] < 0) {
+          flip_[g] = wanted;
+          queue.push(g);
+        } else if (flip_[g] != wanted) {
+          orientable = false;
         }
       }
-      if (!orientable) ++report.non_orientable_components;
-      // Closed components face outwards (positive signed volume); open ones keep
-      // the orientation of the majority of their faces.
-      double volume = 0.0;
-      std::size_t flipped = 0;
-      bool closed = true;
-      for (std::size_t f : component) {
-        std::array<int, 3> face = faces[f];
-        if (flip[f] == 1) std::swap(face[1], face[2]);
-        volume += SignedVolume(vertices, face);
-        flipped += static_cast<std::size_t>(flip[f]);
-        for (int k = 0; k < 3 && closed; ++k) {
-          closed = uses[EdgeKey(face[static_cast<std::size_t>(k)],
-                                face[static_cast<std::size_t>((k + 1) % 3)])]
-                       .size() == 2;
-        }
+    }
+    if (!orientable) ++report_.non_orientable_components;
+    return component;
+  }
+
+  // Applies the flips to one component, inverting them all where that faces it the
+  // right way.
+  void OrientComponent(const std::vector<std::size_t>& component) {
+    // Closed components face outwards (positive signed volume); open ones keep
+    // the orientation of the majority of their faces.
+    double volume = 0.0;
+    std::size_t flipped = 0;
+    bool closed = true;
+    for (std::size_t f : component) {
+      std::array<int, 3> face = faces_[f];
+      if (flip_[f] == 1) std::swap(face[1], face[2]);
+      volume += SignedVolume(vertices_, face);
+      flipped += static_cast<std::size_t>(flip_[f]);
+      for (int k = 0; k < 3 && closed; ++k) {
+        closed = uses_[EdgeKey(face[static_cast<std::size_t>(k)],
+                               face[static_cast<std::size_t>((k + 1) % 3)])]
+                     .size() == 2;
       }
-      const bool invert = closed ? volume < 0.0 : 2 * flipped > component.size();
-      for (std::size_t f : component) {
-        if (invert) flip[f] ^= 1;
-        if (flip[f] == 1) {
-          std::swap(faces[f][1], faces[f][2]);
-          ++report.faces_flipped;
-        }
+    }
+    const bool invert = closed ? volume < 0.0 : 2 * flipped > component.size();
+    for (std::size_t f : component) {
+      if (invert) flip_[f] ^= 1;
+      if (flip_[f] == 1) {
+        std::swap(faces_[f][1], faces_[f][2]);
+        ++report_.faces_flipped;
       }
     }
   }
 
   // 4. Compact vertices: keep those used by a face, in their original order.
-  std::vector<int> new_index(vertices.size(), -1);
-  for (const auto& f : faces)
-    for (int v : f) new_index[static_cast<std::size_t>(v)] = 0;
-  int next = 0;
-  for (std::size_t i = 0; i < vertices.size(); ++i) {
-    if (new_index[i] == 0) {
-      new_index[i] = next++;
-      result.mesh.vertices.push_back(vertices[i]);
-    } else if (representative[i] == static_cast<int>(i)) {
-      ++report.unused_vertices_removed;
+  void CompactVertices() {
+    std::vector<int> new_index(vertices_.size(), -1);
+    for (const auto& f : faces_)
+      for (int v : f) new_index[static_cast<std::size_t>(v)] = 0;
+    int next = 0;
+    for (std::size_t i = 0; i < vertices_.size(); ++i) {
+      if (new_index[i] == 0) {
+        new_index[i] = next++;
+        result_.mesh.vertices.push_back(vertices_[i]);
+      } else if (representative_[i] == static_cast<int>(i)) {
+        ++report_.unused_vertices_removed;
+      }
     }
+    for (auto& f : faces_)
+      for (int& v : f) v = new_index[static_cast<std::size_t>(v)];
+    result_.mesh.faces = std::move(faces_);
+    result_.source_face = std::move(source_);
   }
-  for (auto& f : faces)
-    for (int& v : f) v = new_index[static_cast<std::size_t>(v)];
-  result.mesh.faces = std::move(faces);
-  result.source_face = std::move(source);
-  return result;
+
+  const std::vector<Eigen::Vector3d>& vertices_;
+  const std::vector<std::vector<int>>& polygons_;
+  const MeshCleanOptions& options_;
+  const std::string& label_;
+  LoadedMesh result_;
+  MeshReport& report_ = result_.report;
+
+  // Bounds and welding.
+  Eigen::Vector3d lo_;               // bounding box corner, the weld grid's origin
+  double diagonal_ = 0.0;            // bounding box diagonal, the scale of the tolerances
+  std::vector<int> representative_;  // vertex -> the vertex it is welded to
+
+  // Faces.
+  double min_area_ = 0.0;  // triangles of at most this area are degenerate
+  std::vector<std::array<int, 3>> faces_;
+  std::vector<std::size_t> source_;  // face -> its input polygon
+
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> seen_;  // min vertex -> faces
+
+  // Edges and orientation.
+  std::unordered_map<std::uint64_t, std::vector<EdgeUse>> uses_;
+  std::vector<int> flip_;  // per face: -1 unvisited, 0 keep, 1 flip
+};
+
+}  // namespace
+
+LoadedMesh CleanMesh(const std::vector<Eigen::Vector3d>& vertices,
+                     const std::vector<std::vector<int>>& polygons, const MeshCleanOptions& options,
+                     const std::string& label) {
+  options.Check();
+  return MeshCleaner(vertices, polygons, options, label).Run();
 }
 
 LoadedMesh LoadMesh(const std::filesystem::path& path, const MeshCleanOptions& options) {

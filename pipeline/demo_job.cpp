@@ -11,6 +11,7 @@
 #include "sfm/lights.h"
 #include "model/baselines.h"
 #include "model/model_io.h"
+#include "pipeline/report_pictures.h"
 #include "report/report.h"
 
 namespace texlume::pipeline {
@@ -100,6 +101,7 @@ class DemoJob {
     job_.lights_file = scene_dir_ / "object/lights.json";
     job_.mesh_file = scene_dir_ / "object/mesh.ply";
     job_.sample_file = options_.out_dir / "sample.exr";
+    job_.sample = &sample_;  // as fitted: sample.exr holds it for the command line
     job_.out_dir = options_.out_dir / "model";
     job_.synthesis.sample_texel_size = scene_.material.texel_size;
     out_ << "\n4. texlume synth --model " << job_.model_dir.string() << " --images "
@@ -143,7 +145,7 @@ class DemoJob {
   }
 
   // The photos and the held-out views (with truth and masks) the report shows.
-  void AddReportViews(report::ReportInputs& rep) const {
+  void AddReportViews(report::ReportInputs& rep, ReportScene& scene) const {
     const sfm::LoadedModel photos_model = sfm::ReadModel(job_.model_dir);
     const sfm::ObjectLights photo_lights = sfm::ReadObjectLightsFile(job_.lights_file);
     for (const auto& [id, image] : photos_model.reconstruction.images)
@@ -154,14 +156,14 @@ class DemoJob {
     for (const auto& [id, image] : held_model.reconstruction.images) {
       const auto it = held_lights.find(image.name);
       if (it == held_lights.end()) continue;
-      report::ReportView view;
+      render::PictureView view;
       view.name = image.name;
       view.camera = held_model.reconstruction.cameras.at(image.camera_id);
       view.cam_from_world = image.cam_from_world;
       view.lights = it->second;
       view.reference_image = held_ / "images" / image.name;
       view.reference_mask = held_ / "masks" / image.name;
-      rep.views.push_back(std::move(view));
+      scene.views.push_back(std::move(view));
     }
     rep.views_heading = "Held-out views under held-out lights";
   }
@@ -175,8 +177,8 @@ class DemoJob {
   // error maps, a light sweep, the atlases, metrics and timings.
   void WriteDemoReport() {
     out_ << "\n6. The report\n";
-    const model::TexturedModel model = model::ReadModelFolder(job_.out_dir);
-    const model::ModelBaselines baselines = model::ReadModelBaselines(job_.out_dir, model);
+    const model::TexturedModel& model = *synthesis_.model;
+    const model::ModelBaselines& baselines = synthesis_.baselines;
     report::ReportInputs rep;
     rep.title = "texlume demo: a " + material_ + " " + shape_;
     rep.intro =
@@ -187,10 +189,13 @@ class DemoJob {
         "ground truth and two baselines: the coarse mesh flat-shaded with the mean albedo, and "
         "the photos baked into an ordinary texture.";
     rep.model = &model;
-    rep.flat_albedo = baselines.flat_albedo;
-    rep.baked = baselines.baked;
-    rep.sample = &sample_;
-    AddReportViews(rep);
+    ReportScene scene;
+    scene.model = &model;
+    scene.flat_albedo = baselines.flat_albedo;
+    scene.baked = baselines.baked;
+    scene.sample = &sample_;
+    AddReportViews(rep, scene);
+    DrawReportPictures(scene, rep, progress_);
     rep.metrics = {MetricsOf("texlume (PTM atlases)", ours_), MetricsOf("flat baseline", flat_),
                    MetricsOf("baked baseline", baked_)};
     rep.occupancy = synthesis_.occupancy;

@@ -18,6 +18,7 @@
 #include "synth/colour_sample.h"
 #include "model/baselines.h"
 #include "render/model_render.h"
+#include "pipeline/report_pictures.h"
 #include "report/report.h"
 
 namespace texlume::pipeline {
@@ -272,13 +273,15 @@ class SynthJob {
     model::WriteModelFolder(options_.out_dir, model_, Record(), extra_images_, write_report);
     summary_.seconds_export = SecondsSince(t) - summary_.seconds_report;
     summary_.seconds_total = SecondsSince(start);
+    summary_.model = std::make_shared<const model::TexturedModel>(std::move(model_));
+    summary_.baselines = {flat_albedo_, std::move(baked_)};
     return summary_;
   }
 
  private:
   void Load() {
     inputs_ = LoadSynthInputs(options_);
-    sample_ = ReadSample(options_.sample_file);
+    sample_ = options_.sample ? Sample{*options_.sample, {}} : ReadSample(options_.sample_file);
     PrepareSynthMesh(inputs_, options_, std::min(sample_.ptm.width, sample_.ptm.height),
                      options_.synthesis.sample_texel_size, options_.synthesis.strip, progress_);
     summary_.CountInputs(inputs_);
@@ -386,13 +389,13 @@ class SynthJob {
   }
 
   // The photos and their views (under their lights, beside the photo divided by its gain).
-  void AddPhotoViews(report::ReportInputs& report) const {
+  void AddPhotoViews(report::ReportInputs& report, ReportScene& scene) const {
     const std::vector<synth::MeshPhoto>& photos = inputs_.photos;
     for (std::size_t i = 0; i < photos.size(); ++i) {
       const synth::MeshPhoto& p = photos[i];
       const sfm::Image& image = inputs_.reconstruction.images.at(p.image_id);
       report.photos.push_back({p.name, options_.images_dir / p.name, p.lights, p.image});
-      report::ReportView view;
+      render::PictureView view;
       view.name = p.name;
       view.camera = inputs_.reconstruction.cameras.at(image.camera_id);
       view.cam_from_world = image.cam_from_world;
@@ -400,7 +403,7 @@ class SynthJob {
       view.reference_image = options_.images_dir / p.name;
       view.reference = p.image;
       view.reference_gain = i < synthesis_.photo_gains.size() ? synthesis_.photo_gains[i] : 1.0;
-      report.views.push_back(std::move(view));
+      scene.views.push_back(std::move(view));
     }
     report.views_heading = "Photo views under the photos' lights";
   }
@@ -417,10 +420,13 @@ class SynthJob {
         "its estimated exposure) and the two baselines; texlume render measures it on "
         "held-out views.";
     report.model = &model_;
-    report.flat_albedo = flat_albedo_;
-    report.baked = baked_;
-    report.sample = &sample_.ptm;
-    AddPhotoViews(report);
+    ReportScene scene;
+    scene.model = &model_;
+    scene.flat_albedo = flat_albedo_;
+    scene.baked = baked_;
+    scene.sample = &sample_.ptm;
+    AddPhotoViews(report, scene);
+    DrawReportPictures(scene, report, progress_);
     report.occupancy = s.occupancy;
     report.facts = {
         {"triangles", std::to_string(s.faces) + " (" + std::to_string(s.from_photos) +

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -11,6 +12,8 @@
 #include "sfm/visibility.h"
 #include "atlas/atlas.h"
 #include "synth/mesh_synthesis.h"
+#include "model/baselines.h"
+#include "model/model_io.h"
 #include "render/model_render.h"
 
 namespace texlume::pipeline {
@@ -22,6 +25,9 @@ struct SynthJobOptions {
   std::filesystem::path lights_file;  ///< object-lights JSON (docs/lights.md)
   std::filesystem::path mesh_file;    ///< coarse mesh in the model's frame
   std::filesystem::path sample_file;  ///< sample: PTM (.ptm, .exr) or colour photo (ReadSample)
+  /// The PTM sample already in memory (borrowed): used instead of reading
+  /// `sample_file`, which then only names it in the manifest.
+  const ptm::Ptm* sample = nullptr;
   std::filesystem::path out_dir;      ///< the model folder written
   synth::MeshSynthesisOptions synthesis;     ///< sample_texel_size required
   atlas::AtlasOptions atlas;
@@ -61,6 +67,9 @@ struct SynthCounts {
 
 struct SynthJobSummary : SynthCounts {
   atlas::AtlasStretch stretch;
+  /// The model and its baselines as written into the model folder.
+  std::shared_ptr<const model::TexturedModel> model;
+  model::ModelBaselines baselines;
   double seconds_load = 0, seconds_visibility = 0, seconds_synthesis = 0, seconds_atlas = 0,
          seconds_baselines = 0, seconds_report = 0, seconds_export = 0, seconds_total = 0;
 };

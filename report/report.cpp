@@ -13,15 +13,13 @@
 #include "core/check.h"
 #include "core/errors.h"
 #include "core/file_util.h"
-#include "render/model_render.h"
+#include "core/timing.h"
 
 namespace texlume::report {
 namespace fs = std::filesystem;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-// Elevation of the light-sweep and sample lights above the image (or sample) plane.
-constexpr double kSweepElevationDeg = 40.0;
 
 std::string Fixed(double v, int digits) {
   std::ostringstream s;
@@ -58,17 +56,6 @@ std::string LightsText(const std::vector<sfm::ObjectLight>& lights) {
     if (l.intensity != 1.0) text += " &times;" + Fixed(l.intensity, 2);
   }
   return text;
-}
-
-// The reference divided by its exposure (linear domain), back to display values.
-cv::Mat WithoutGain(const cv::Mat& rgb, double gain) {
-  if (gain == 1.0) return rgb;
-  cv::Mat out = rgb.clone();
-  out.forEach<cv::Vec3f>([gain](cv::Vec3f& p, const int*) {
-    for (int c = 0; c < 3; ++c)
-      p[c] = LinearToSrgb(std::min(1.0f, static_cast<float>(SrgbToLinear(p[c]) / gain)));
-  });
-  return out;
 }
 
 // Mean absolute difference over the channels, black (0) to bright at `max`,
@@ -145,295 +132,287 @@ std::vector<double> AtlasOccupancies(const model::TexturedModel& model) {
   return occupancy;
 }
 
+namespace {
+
+// The report's sections, each a method, written into one page and a folder of
+// pictures (WriteReport).
+class ReportWriter {
+ public:
+  ReportWriter(const ReportInputs& in, const fs::path& pictures, const fs::path& tmp,
+               const ProgressCallback& progress)
+      : in_(in), pictures_(pictures), tmp_(tmp), progress_(progress) {
+    photo_ids_ = render::EvenlySpread(in.photos.size(), in.max_photos);
+    steps_ = (in.sample_relit.empty() ? 0 : 1) + photo_ids_.size() + in.views.size() +
+             (in.sweep.empty() ? 0 : 1) + in.model->atlases.size();
+  }
+
+  void Write() {
+    Header();
+    Sample();
+    Photos();
+    Views();
+    Sweep();
+    Atlases();
+    Metrics();
+  }
+
+  // The timings table (with this report's own time) and the page's end.
+  std::string Finish(double seconds) {
+    html_ << "<h2>Timings</h2>\n<table class=\"m\" border=\"1\"><tr><th>stage</th><th>seconds</th>"
+             "</tr>\n";
+    for (const auto& [stage, s] : in_.timings_s)
+      html_ << "<tr><th>" << HtmlEscape(stage) << "</th><td>" << Fixed(s, 2) << "</td></tr>\n";
+    html_ << "<tr><th>this report</th><td>" << Fixed(seconds, 2)
+          << "</td></tr>\n</table>\n</body></html>\n";
+    return html_.str();
+  }
+
+  ReportSummary& summary() { return summary_; }
+
+ private:
+  void Advance() {
+    ++step_;
+    if (progress_) progress_("report", step_, steps_);
+  }
+
+  std::string WritePicture(const std::string& name, const cv::Mat& bgr8) {
+    WriteBytesAtomically(tmp_ / name, EncodePng(bgr8, (pictures_ / name).string()));
+    ++summary_.pictures;
+    return "report/" + name;
+  }
+
+  // Title, introduction, facts and links.
+  void Header() {
+    html_ << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>"
+          << HtmlEscape(in_.title)
+          << "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:110em}"
+             "td,th{padding:3px 9px;text-align:left;vertical-align:top}"
+             "table.m td{text-align:right}figure{display:inline-block;margin:4px}"
+             "figcaption{font-size:smaller;max-width:24em}.strip img{margin:0}"
+             "h2{margin-top:1.6em}</style></head><body>\n<h1>"
+          << HtmlEscape(in_.title) << "</h1>\n<p>" << HtmlEscape(in_.intro) << "</p>\n";
+    if (!in_.facts.empty()) {
+      html_ << "<table>";
+      for (const auto& [name, value] : in_.facts)
+        html_ << "<tr><th>" << HtmlEscape(name) << "</th><td>" << HtmlEscape(value)
+              << "</td></tr>";
+      html_ << "</table>\n";
+    }
+    if (!in_.links.empty()) {
+      html_ << "<p>Files: ";
+      for (std::size_t i = 0; i < in_.links.size(); ++i)
+        html_ << (i ? ", " : "") << "<a href=\"" << HtmlEscape(in_.links[i].second) << "\">"
+              << HtmlEscape(in_.links[i].first) << "</a>";
+      html_ << ".</p>\n";
+    }
+  }
+
+  // The material sample relit: head-on, then four lights around it.
+  void Sample() {
+    if (in_.sample_relit.empty()) return;
+    html_ << "<h2>Material sample</h2>\n<p>The sample PTM (" << in_.sample_width << " &times; "
+          << in_.sample_height << " texels) relit in its own frame.</p>\n";
+    for (std::size_t k = 0; k < in_.sample_relit.size(); ++k) {
+      const auto& [light, image] = in_.sample_relit[k];
+      const std::string src =
+          WritePicture("sample_light_" + std::to_string(k) + ".png", ToBgr8(image));
+      html_ << Figure(src, "light " + DirectionText(light), image.cols);
+    }
+    html_ << "\n";
+    Advance();
+  }
+
+  // The constraint photos.
+  void Photos() {
+    if (photo_ids_.empty()) return;
+    html_ << "<h2>Constraint photos</h2>\n<p>" << photo_ids_.size() << " of the "
+          << in_.photos.size()
+          << " photos that constrain the synthesis, with their lights (world frame).</p>\n";
+    for (const std::size_t i : photo_ids_) {
+      const ReportPhoto& p = in_.photos[i];
+      const cv::Mat image = ResizedToWidth(p.image.empty() ? ReadPhotoRgb(p.file) : p.image, 200);
+      const std::string src = WritePicture("photo_" + std::to_string(i) + ".png", ToBgr8(image));
+      html_ << Figure(src, HtmlEscape(p.name) + "<br>" + LightsText(p.lights), 200);
+      Advance();
+    }
+    html_ << "\n";
+  }
+
+  // The model from the views, beside the reference, the baselines and error maps.
+  void Views() {
+    if (in_.views.empty()) return;
+    html_ << "<h2>" << HtmlEscape(in_.views_heading) << "</h2>\n<p>" << in_.views.size() << " of "
+          << std::max(in_.views_total, in_.views.size())
+          << " views. Error maps: mean absolute difference over the channels inside the mask, "
+             "from black (0) to bright yellow ("
+          << Fixed(in_.error_map_max, 2)
+          << " or more, display values in [0, 1]); grey outside. PSNR (dB) and SSIM at the "
+             "pictures' resolution.</p>\n<table><tr><th>reference</th>";
+    for (const auto& drawn : in_.views.front().drawn)
+      html_ << "<th>" << drawn.model << " (and its error)</th>";
+    html_ << "</tr>\n";
+    for (std::size_t i = 0; i < in_.views.size(); ++i) {
+      ViewRow(in_.views[i], "view_" + std::to_string(i));
+      Advance();
+    }
+    html_ << "</table>\n";
+  }
+
+  void ViewRow(const render::ViewPictures& v, const std::string& stem) {
+    const int width = v.drawn.empty() ? v.reference.cols : v.drawn.front().rgb.cols;
+    html_ << "<tr>";
+    if (!v.reference.empty()) {
+      html_ << "<td>"
+            << Figure(WritePicture(stem + "_reference.png", ToBgr8(v.reference)),
+                      HtmlEscape(v.name) + "<br>" + LightsText(v.lights), width)
+            << "</td>";
+    } else {
+      html_ << "<td>" << HtmlEscape(v.name) << "<br>" << LightsText(v.lights) << "</td>";
+    }
+    for (const render::ViewPictures::Drawn& d : v.drawn) {
+      html_ << "<td>"
+            << Figure(WritePicture(stem + "_" + d.model + ".png", ToBgr8(d.rgb)), d.model, width);
+      if (v.reference.empty()) {
+        html_ << "</td>";
+        continue;
+      }
+      html_ << "<br>"
+            << Figure(WritePicture(stem + "_" + d.model + "_error.png",
+                                   ErrorMap(d.rgb, v.reference, v.inside, in_.error_map_max)),
+                      "error: " + Fixed(d.psnr, 2) + " dB, SSIM " + Fixed(d.ssim, 3), width)
+            << "</td>";
+      summary_.rows.push_back({v.name, d.model, d.psnr, d.ssim});
+    }
+    html_ << "</tr>\n";
+  }
+
+  // A light circling the first view.
+  void Sweep() {
+    if (in_.sweep.empty()) return;
+    std::vector<cv::Mat> frames;
+    for (const cv::Mat& f : in_.sweep) frames.push_back(ToBgr8(f));
+    cv::Mat strip;
+    cv::hconcat(frames, strip);
+    html_ << "<h2>Light sweep</h2>\n<p>The model from " << HtmlEscape(in_.sweep_view)
+          << " with the light circling the viewing axis at " << Fixed(in_.sweep_elevation_deg, 0)
+          << "&deg; above the image plane, starting at the right and turning counter-clockwise "
+             "in steps of "
+          << Fixed(360.0 / static_cast<double>(in_.sweep.size()), 0)
+          << "&deg;.</p>\n<div class=\"strip\"><img src=\""
+          << WritePicture("light_sweep.png", strip) << "\" width=\"" << strip.cols
+          << "\" alt=\"\"></div>\n";
+    Advance();
+  }
+
+  // Atlases: base colour with the triangle outlines, and occupancy.
+  void Atlases() {
+    const std::vector<double> occupancy = AtlasOccupancies(*in_.model);
+    html_ << "<h2>Atlases</h2>\n<p>" << in_.model->atlases.size()
+          << " atlas(es), occupancy of the layout " << Fixed(in_.occupancy, 3)
+          << " (atlas texels inside triangles); the PTM under a head-on light, triangle outlines "
+             "in green.</p>\n";
+    for (std::size_t a = 0; a < in_.model->atlases.size(); ++a) {
+      const ptm::Ptm& atlas = in_.model->atlases[a];
+      const int width = std::min(480, atlas.width);
+      html_ << Figure(WritePicture("atlas_" + std::to_string(a) + ".png", AtlasThumbnail(a, width)),
+                      "atlas " + std::to_string(a) + ": " + std::to_string(atlas.width) +
+                          " &times; " + std::to_string(atlas.height) + " texels, occupancy " +
+                          Fixed(occupancy[a], 3),
+                      width);
+      Advance();
+    }
+    html_ << "\n";
+  }
+
+  // Atlas `a` under a head-on light, `width` texels wide, triangle outlines in green.
+  cv::Mat AtlasThumbnail(std::size_t a, int width) const {
+    const model::TexturedModel& model = *in_.model;
+    const double s = static_cast<double>(width) / model.atlases[a].width;
+    cv::Mat thumb = ResizedToWidth(model::BaseColourImage(model.atlases[a]), width);
+    cv::Mat outlines = thumb.clone();
+    constexpr int kShift = 3;
+    for (std::size_t f = 0; f < model.corner_px.size(); ++f) {
+      if (static_cast<std::size_t>(model.face_atlas[f]) != a) continue;
+      std::vector<cv::Point> corners;
+      for (int k = 0; k < 3; ++k)
+        corners.emplace_back(
+            static_cast<int>(std::lround(model.corner_px[f][k].x() * s * (1 << kShift))),
+            static_cast<int>(std::lround(model.corner_px[f][k].y() * s * (1 << kShift))));
+      cv::polylines(outlines, corners, true, cv::Scalar(60, 220, 60), 1, cv::LINE_AA, kShift);
+    }
+    cv::addWeighted(thumb, 0.7, outlines, 0.3, 0.0, thumb);
+    return thumb;
+  }
+
+  // The full-resolution tables given, and the pictures' own measurements.
+  void Metrics() {
+  if (!in_.metrics.empty() || !summary_.rows.empty()) html_ << "<h2>Metrics</h2>\n";
+  if (!in_.metrics.empty()) {
+    html_ << "<p>Every held-out view, inside the ground-truth masks, as <code>texlume "
+            "render</code> measured it at full resolution and reduced to the photos' "
+            "resolution.</p>\n<table class=\"m\" border=\"1\"><tr><th>model</th><th>PSNR "
+            "full (dB)</th><th>SSIM full</th><th>PSNR reduced (dB)</th><th>SSIM "
+            "reduced</th></tr>\n";
+    for (const ReportMetrics& m : in_.metrics)
+      html_ << "<tr><th>" << HtmlEscape(m.label) << "</th><td>" << Fixed(m.mean_psnr, 2)
+           << "</td><td>" << Fixed(m.mean_ssim, 3) << "</td><td>"
+           << Fixed(m.mean_psnr_reduced, 2) << "</td><td>"
+           << Fixed(m.mean_ssim_reduced, 3) << "</td></tr>\n";
+    html_ << "</table>\n<p>Per view (PSNR dB / SSIM at full resolution):</p>\n<table class=\"m\" "
+            "border=\"1\"><tr><th>view</th>";
+    for (const ReportMetrics& m : in_.metrics) html_ << "<th>" << HtmlEscape(m.label) << "</th>";
+    html_ << "</tr>\n";
+    for (std::size_t i = 0; i < in_.metrics.front().views.size(); ++i) {
+      html_ << "<tr><th>" << HtmlEscape(in_.metrics.front().views[i].name) << "</th>";
+      for (const ReportMetrics& m : in_.metrics) {
+        if (i < m.views.size())
+          html_ << "<td>" << Fixed(m.views[i].psnr, 2) << " / "
+               << Fixed(m.views[i].ssim, 3) << "</td>";
+        else
+          html_ << "<td></td>";
+      }
+      html_ << "</tr>\n";
+    }
+    html_ << "</table>\n";
+  }
+  if (!summary_.rows.empty()) {
+    html_ << "<p>On the pictures above (their resolution, inside the mask):</p>\n<table "
+            "class=\"m\" "
+            "border=\"1\"><tr><th>view</th><th>model</th><th>PSNR (dB)</th><th>SSIM</th></tr>\n";
+    for (const ReportSummary::Row& r : summary_.rows)
+      html_ << "<tr><th>" << HtmlEscape(r.view) << "</th><td>" << r.model << "</td><td>"
+           << Fixed(r.psnr, 2) << "</td><td>" << Fixed(r.ssim, 3) << "</td></tr>\n";
+    html_ << "</table>\n";
+  }
+  }
+
+  const ReportInputs& in_;
+  const fs::path pictures_, tmp_;
+  const ProgressCallback& progress_;
+  std::vector<std::size_t> photo_ids_;
+  std::size_t steps_ = 0, step_ = 0;
+  std::ostringstream html_;
+  ReportSummary summary_;
+};
+
+}  // namespace
+
 ReportSummary WriteReport(const fs::path& dir, const ReportInputs& in,
                           const ProgressCallback& progress) {
   TEXLUME_CHECK(in.model != nullptr, "the report needs a model");
-  if (in.picture_width < 32 || in.picture_width > 4096)
-    throw OptionError("report picture width must be in [32, 4096]");
-  if (in.max_views < 0 || in.max_photos < 0 || in.sweep_frames < 0 || in.sweep_frames > 64)
-    throw OptionError("report counts must be non-negative (sweep frames at most 64)");
+  if (in.max_photos < 0) throw OptionError("report counts must be non-negative");
   const auto start = std::chrono::steady_clock::now();
-  ReportSummary summary;
   fs::create_directories(dir);
   const fs::path pictures = dir / "report";
   const fs::path tmp = dir / ("report.partial-" + std::to_string(::getpid()));
   fs::remove_all(tmp);
   fs::create_directories(tmp);
-  std::ostringstream html;
+  ReportWriter writer(in, pictures, tmp, progress);
+  std::string html;
   try {
-    // Which views and photos are drawn: evenly spread over the lists.
-    auto spread = [](std::size_t n, int wanted) {
-      std::vector<std::size_t> picked;
-      const std::size_t k = std::min<std::size_t>(n, static_cast<std::size_t>(wanted));
-      for (std::size_t i = 0; i < k; ++i) picked.push_back(i * n / k);
-      return picked;
-    };
-    const std::vector<std::size_t> view_ids = spread(in.views.size(), in.max_views);
-    const std::vector<std::size_t> photo_ids = spread(in.photos.size(), in.max_photos);
-    const bool has_sweep = !in.views.empty() && in.sweep_frames > 0;
-    const std::size_t steps = (in.sample ? 1 : 0) + photo_ids.size() + view_ids.size() +
-                              (has_sweep ? 1 : 0) + in.model->atlases.size();
-    std::size_t step = 0;
-    auto advance = [&] {
-      ++step;
-      if (progress) progress("report", step, steps);
-    };
-    auto write_picture = [&](const std::string& name, const cv::Mat& bgr8) {
-      WriteBytesAtomically(tmp / name, EncodePng(bgr8, (pictures / name).string()));
-      ++summary.pictures;
-      return "report/" + name;
-    };
-
-    html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>"
-         << HtmlEscape(in.title)
-         << "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:110em}"
-            "td,th{padding:3px 9px;text-align:left;vertical-align:top}"
-            "table.m td{text-align:right}figure{display:inline-block;margin:4px}"
-            "figcaption{font-size:smaller;max-width:24em}.strip img{margin:0}"
-            "h2{margin-top:1.6em}</style></head><body>\n<h1>"
-         << HtmlEscape(in.title) << "</h1>\n<p>" << HtmlEscape(in.intro) << "</p>\n";
-    if (!in.facts.empty()) {
-      html << "<table>";
-      for (const auto& [name, value] : in.facts)
-        html << "<tr><th>" << HtmlEscape(name) << "</th><td>" << HtmlEscape(value) << "</td></tr>";
-      html << "</table>\n";
-    }
-    if (!in.links.empty()) {
-      html << "<p>Files: ";
-      for (std::size_t i = 0; i < in.links.size(); ++i)
-        html << (i ? ", " : "") << "<a href=\"" << HtmlEscape(in.links[i].second) << "\">"
-             << HtmlEscape(in.links[i].first) << "</a>";
-      html << ".</p>\n";
-    }
-
-    // The material sample relit: head-on, then four lights around it.
-    if (in.sample) {
-      html << "<h2>Material sample</h2>\n<p>The sample PTM (" << in.sample->width << " &times; "
-           << in.sample->height << " texels) relit in its own frame.</p>\n";
-      std::vector<Eigen::Vector3d> lights = {Eigen::Vector3d::UnitZ()};
-      const double el = kSweepElevationDeg * kPi / 180.0;
-      for (int k = 0; k < 4; ++k) {
-        const double az = k * kPi / 2.0;
-        lights.emplace_back(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-      }
-      const int width = std::min(200, in.sample->width);
-      for (std::size_t k = 0; k < lights.size(); ++k) {
-        const std::vector<float> rgb = ptm::Relight(*in.sample, lights[k]);
-        const cv::Mat image(in.sample->height, in.sample->width, CV_32FC3,
-                            const_cast<float*>(rgb.data()));
-        const std::string src = write_picture("sample_light_" + std::to_string(k) + ".png",
-                                              ToBgr8(ResizedToWidth(image, width)));
-        html << Figure(src, "light " + DirectionText(lights[k]), width);
-      }
-      html << "\n";
-      advance();
-    }
-
-    // The constraint photos.
-    if (!photo_ids.empty()) {
-      html << "<h2>Constraint photos</h2>\n<p>" << photo_ids.size() << " of the "
-           << in.photos.size()
-           << " photos that constrain the synthesis, with their lights (world frame).</p>\n";
-      for (const std::size_t i : photo_ids) {
-        const ReportPhoto& p = in.photos[i];
-        const cv::Mat image = ResizedToWidth(p.image.empty() ? ReadPhotoRgb(p.file) : p.image, 200);
-        const std::string src = write_picture("photo_" + std::to_string(i) + ".png", ToBgr8(image));
-        html << Figure(src, HtmlEscape(p.name) + "<br>" + LightsText(p.lights), 200);
-        advance();
-      }
-      html << "\n";
-    }
-
-    // The model from the views, beside the reference, the baselines and error maps.
-    render::ModelRenderer renderer(*in.model);
-    renderer.flat_albedo = in.flat_albedo;
-    renderer.baked = in.baked;
-    std::vector<std::pair<std::string, render::RenderMode>> modes = {{"texlume", render::RenderMode::kPtm},
-                                                             {"flat", render::RenderMode::kFlat}};
-    if (!in.baked.empty()) modes.emplace_back("baked", render::RenderMode::kBaked);
-    auto scaled_camera = [&](const sfm::Camera& camera) {
-      const double factor =
-          std::min(1.0, static_cast<double>(in.picture_width) / static_cast<double>(camera.width));
-      return factor < 1.0 ? camera.Scaled(factor) : camera;
-    };
-    if (!view_ids.empty()) {
-      html << "<h2>" << HtmlEscape(in.views_heading) << "</h2>\n<p>" << view_ids.size() << " of "
-           << in.views.size()
-           << " views. Error maps: mean absolute difference over the channels inside the mask, "
-              "from black (0) to bright yellow ("
-           << Fixed(in.error_map_max, 2)
-           << " or more, display values in [0, 1]); grey outside. PSNR (dB) and SSIM at the "
-              "pictures' resolution.</p>\n<table><tr><th>reference</th>";
-      for (const auto& [name, mode] : modes) html << "<th>" << name << " (and its error)</th>";
-      html << "</tr>\n";
-      for (const std::size_t i : view_ids) {
-        const ReportView& v = in.views[i];
-        const sfm::Camera camera = scaled_camera(v.camera);
-        const std::string stem = "view_" + std::to_string(i);
-        cv::Mat reference, inside;
-        html << "<tr>";
-        if (!v.reference_image.empty() || !v.reference.empty()) {
-          const cv::Mat full = v.reference.empty() ? ReadPhotoRgb(v.reference_image) : v.reference;
-          if (full.cols != static_cast<int>(v.camera.width) ||
-              full.rows != static_cast<int>(v.camera.height))
-            throw InputError(v.reference_image.string(), "does not match its camera's size");
-          cv::resize(WithoutGain(full, v.reference_gain), reference,
-                     cv::Size(static_cast<int>(camera.width), static_cast<int>(camera.height)), 0,
-                     0, cv::INTER_AREA);
-          if (!v.reference_mask.empty()) {
-            const cv::Mat mask = ReadImageGrey(v.reference_mask) > 0.5f;
-            if (mask.size() != full.size())
-              throw InputError(v.reference_mask.string(), "does not match its image's size");
-            cv::resize(mask, inside, reference.size(), 0, 0, cv::INTER_NEAREST);
-            inside = inside > 127;
-          }
-          html << "<td>"
-               << Figure(write_picture(stem + "_reference.png", ToBgr8(reference)),
-                         HtmlEscape(v.name) + "<br>" + LightsText(v.lights), camera.width)
-               << "</td>";
-        } else {
-          html << "<td>" << HtmlEscape(v.name) << "<br>" << LightsText(v.lights) << "</td>";
-        }
-        for (const auto& [name, mode] : modes) {
-          const render::RenderedView r = renderer.Render(camera, v.cam_from_world, v.lights, mode, 2);
-          html << "<td>"
-               << Figure(write_picture(stem + "_" + name + ".png", ToBgr8(r.rgb)), name,
-                         camera.width);
-          if (reference.empty()) {
-            html << "</td>";
-            continue;
-          }
-          if (inside.empty()) inside = r.coverage > 0.5f;
-          ReportSummary::Row row{v.name, name, render::MaskedPsnr(r.rgb, reference, inside),
-                                 render::MaskedSsim(r.rgb, reference, inside)};
-          html << "<br>"
-               << Figure(write_picture(stem + "_" + name + "_error.png",
-                                       ErrorMap(r.rgb, reference, inside, in.error_map_max)),
-                         "error: " + Fixed(row.psnr, 2) + " dB, SSIM " + Fixed(row.ssim, 3),
-                         camera.width)
-               << "</td>";
-          summary.rows.push_back(row);
-        }
-        html << "</tr>\n";
-        advance();
-      }
-      html << "</table>\n";
-    }
-
-    // A light circling the first view.
-    if (has_sweep) {
-      const ReportView& v = in.views[view_ids.front()];
-      const sfm::Camera camera =
-          v.camera.Scaled(std::min(1.0, 160.0 / static_cast<double>(v.camera.width)));
-      const Eigen::Matrix3d world_from_cam =
-          v.cam_from_world.rotation.toRotationMatrix().transpose();
-      const double el = kSweepElevationDeg * kPi / 180.0;
-      std::vector<cv::Mat> frames;
-      for (int k = 0; k < in.sweep_frames; ++k) {
-        const double az = 2.0 * kPi * k / in.sweep_frames;
-        // Camera frame: x right, y down, z forward; the light on the viewer's side.
-        const Eigen::Vector3d towards_light_in_cam(std::cos(el) * std::cos(az),
-                                                   -std::cos(el) * std::sin(az), -std::sin(el));
-        sfm::ObjectLight light;
-        light.direction_in_world = (world_from_cam * towards_light_in_cam).normalized();
-        frames.push_back(
-            ToBgr8(renderer.Render(camera, v.cam_from_world, {light}, render::RenderMode::kPtm, 2).rgb));
-      }
-      cv::Mat strip;
-      cv::hconcat(frames, strip);
-      html << "<h2>Light sweep</h2>\n<p>The model from " << HtmlEscape(v.name)
-           << " with the light circling the viewing axis at " << Fixed(kSweepElevationDeg, 0)
-           << "&deg; above the image plane, starting at the right and turning counter-clockwise "
-              "in steps of "
-           << Fixed(360.0 / in.sweep_frames, 0) << "&deg;.</p>\n<div class=\"strip\"><img src=\""
-           << write_picture("light_sweep.png", strip) << "\" width=\"" << strip.cols
-           << "\" alt=\"\"></div>\n";
-      advance();
-    }
-
-    // Atlases: base colour with the triangle outlines, and occupancy.
-    {
-      const std::vector<double> occupancy = AtlasOccupancies(*in.model);
-      html << "<h2>Atlases</h2>\n<p>" << in.model->atlases.size()
-           << " atlas(es), occupancy of the layout " << Fixed(in.occupancy, 3)
-           << " (atlas texels inside triangles); the PTM under a head-on light, triangle outlines "
-              "in green.</p>\n";
-      for (std::size_t a = 0; a < in.model->atlases.size(); ++a) {
-        const ptm::Ptm& atlas = in.model->atlases[a];
-        const int width = std::min(480, atlas.width);
-        const double s = static_cast<double>(width) / atlas.width;
-        cv::Mat thumb = ResizedToWidth(model::BaseColourImage(atlas), width);
-        cv::Mat outlines = thumb.clone();
-        constexpr int kShift = 3;
-        for (std::size_t f = 0; f < in.model->corner_px.size(); ++f) {
-          if (static_cast<std::size_t>(in.model->face_atlas[f]) != a) continue;
-          std::vector<cv::Point> corners;
-          for (int k = 0; k < 3; ++k)
-            corners.emplace_back(
-                static_cast<int>(std::lround(in.model->corner_px[f][k].x() * s * (1 << kShift))),
-                static_cast<int>(std::lround(in.model->corner_px[f][k].y() * s * (1 << kShift))));
-          cv::polylines(outlines, corners, true, cv::Scalar(60, 220, 60), 1, cv::LINE_AA, kShift);
-        }
-        cv::addWeighted(thumb, 0.7, outlines, 0.3, 0.0, thumb);
-        html << Figure(write_picture("atlas_" + std::to_string(a) + ".png", thumb),
-                       "atlas " + std::to_string(a) + ": " + std::to_string(atlas.width) +
-                           " &times; " + std::to_string(atlas.height) + " texels, occupancy " +
-                           Fixed(occupancy[a], 3),
-                       width);
-        advance();
-      }
-      html << "\n";
-    }
-
-    // Metrics.
-    if (!in.metrics.empty() || !summary.rows.empty()) html << "<h2>Metrics</h2>\n";
-    if (!in.metrics.empty()) {
-      html << "<p>Every held-out view, inside the ground-truth masks, as <code>texlume "
-              "render</code> measured it at full resolution and reduced to the photos' "
-              "resolution.</p>\n<table class=\"m\" border=\"1\"><tr><th>model</th><th>PSNR "
-              "full (dB)</th><th>SSIM full</th><th>PSNR reduced (dB)</th><th>SSIM "
-              "reduced</th></tr>\n";
-      for (const ReportMetrics& m : in.metrics)
-        html << "<tr><th>" << HtmlEscape(m.label) << "</th><td>" << Fixed(m.mean_psnr, 2)
-             << "</td><td>" << Fixed(m.mean_ssim, 3) << "</td><td>"
-             << Fixed(m.mean_psnr_reduced, 2) << "</td><td>"
-             << Fixed(m.mean_ssim_reduced, 3) << "</td></tr>\n";
-      html << "</table>\n<p>Per view (PSNR dB / SSIM at full resolution):</p>\n<table class=\"m\" "
-              "border=\"1\"><tr><th>view</th>";
-      for (const ReportMetrics& m : in.metrics) html << "<th>" << HtmlEscape(m.label) << "</th>";
-      html << "</tr>\n";
-      for (std::size_t i = 0; i < in.metrics.front().views.size(); ++i) {
-        html << "<tr><th>" << HtmlEscape(in.metrics.front().views[i].name) << "</th>";
-        for (const ReportMetrics& m : in.metrics) {
-          if (i < m.views.size())
-            html << "<td>" << Fixed(m.views[i].psnr, 2) << " / "
-                 << Fixed(m.views[i].ssim, 3) << "</td>";
-          else
-            html << "<td></td>";
-        }
-        html << "</tr>\n";
-      }
-      html << "</table>\n";
-    }
-    if (!summary.rows.empty()) {
-      html << "<p>On the pictures above (their resolution, inside the mask):</p>\n<table "
-              "class=\"m\" "
-              "border=\"1\"><tr><th>view</th><th>model</th><th>PSNR (dB)</th><th>SSIM</th></tr>\n";
-      for (const ReportSummary::Row& r : summary.rows)
-        html << "<tr><th>" << HtmlEscape(r.view) << "</th><td>" << r.model << "</td><td>"
-             << Fixed(r.psnr, 2) << "</td><td>" << Fixed(r.ssim, 3) << "</td></tr>\n";
-      html << "</table>\n";
-    }
-
-    summary.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    html << "<h2>Timings</h2>\n<table class=\"m\" border=\"1\"><tr><th>stage</th><th>seconds</th>"
-            "</tr>\n";
-    for (const auto& [stage, seconds] : in.timings_s)
-      html << "<tr><th>" << HtmlEscape(stage) << "</th><td>" << Fixed(seconds, 2) << "</td></tr>\n";
-    html << "<tr><th>this report</th><td>" << Fixed(summary.seconds, 2)
-         << "</td></tr>\n</table>\n</body></html>\n";
-
+    writer.Write();
+    writer.summary().seconds = SecondsSince(start);
+    html = writer.Finish(writer.summary().seconds);
     fs::remove_all(pictures);
     fs::rename(tmp, pictures);
   } catch (const fs::filesystem_error& e) {
@@ -446,8 +425,8 @@ ReportSummary WriteReport(const fs::path& dir, const ReportInputs& in,
     throw;
   }
   WriteFileAtomically(
-      dir / "report.html", [&](std::ostream& o) { o << html.str(); }, false);
-  return summary;
+      dir / "report.html", [&](std::ostream& o) { o << html; }, false);
+  return writer.summary();
 }
 
 }  // namespace texlume::report

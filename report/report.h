@@ -2,37 +2,19 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "core/progress.h"
 #include "ptm/ptm.h"
-#include "sfm/camera_models.h"
-#include "sfm/lights.h"
-#include "sfm/reconstruction.h"
 #include "model/model_io.h"
 #include "render/metrics.h"
+#include "render/view_pictures.h"
+#include "sfm/lights.h"
 
 namespace texlume::report {
-
-/// A view the report draws the model from, beside its reference picture.
-struct ReportView {
-  std::string name;
-  sfm::Camera camera;
-  sfm::Rigid3d cam_from_world;
-  std::vector<sfm::ObjectLight> lights;
-  /// The reference (ground truth or the photo); empty = none.
-  std::filesystem::path reference_image;
-  /// The reference already in memory (CV_32FC3 display RGB, the camera's size);
-  /// used instead of reading `reference_image`, which then only names it.
-  cv::Mat reference;
-  /// Its object mask; empty = where the model covers the pixel.
-  std::filesystem::path reference_mask;
-  /// The reference's exposure relative to the model (a photo's gain, linear
-  /// domain); the reference is divided by it before comparing.
-  double reference_gain = 1.0;
-};
 
 /// A photo shown among the constraint photos.
 struct ReportPhoto {
@@ -50,36 +32,42 @@ struct ReportMetrics {
   double mean_psnr = 0, mean_ssim = 0, mean_psnr_reduced = 0, mean_ssim_reduced = 0;
 };
 
-/// Everything the report shows. Pointers are borrowed for the call.
+/// Everything the report shows, already drawn and measured (the report draws
+/// nothing: pipeline::DrawReportPictures renders the pictures). Pointers are
+/// borrowed for the call.
 struct ReportInputs {
   std::string title;
   std::string intro;                     ///< one paragraph of plain text
-  const model::TexturedModel* model = nullptr;  ///< required
-  Eigen::Vector3f flat_albedo = Eigen::Vector3f::Constant(0.5f);
-  std::vector<cv::Mat> baked;          ///< per atlas (display RGB); empty = no baked column
-  const ptm::Ptm* sample = nullptr;    ///< the material sample; null = no sample section
+  const model::TexturedModel* model = nullptr;  ///< required: its atlases are shown
+  /// The material sample relit in its own frame (render::RelightSample), and
+  /// its size in texels; empty = no sample section.
+  std::vector<std::pair<Eigen::Vector3d, cv::Mat>> sample_relit;
+  int sample_width = 0, sample_height = 0;
   std::vector<ReportPhoto> photos;     ///< the constraint photos
-  std::vector<ReportView> views;       ///< at most `max_views` are drawn, evenly spread
+  int max_photos = 12;                 ///< at most this many are shown, evenly spread
+  std::vector<render::ViewPictures> views;  ///< the views drawn (render::DrawView)
+  std::size_t views_total = 0;              ///< of how many views they were picked
   std::string views_heading;           ///< e.g. "Held-out views under held-out lights"
+  /// The light sweep (render::DrawLightSweep) from view `sweep_view`; empty = none.
+  std::vector<cv::Mat> sweep;
+  std::string sweep_view;
+  double sweep_elevation_deg = 40.0;
   std::vector<ReportMetrics> metrics;  ///< optional full-resolution tables
   std::vector<std::pair<std::string, std::string>> facts;  ///< summary lines (name, value)
   std::vector<std::pair<std::string, double>> timings_s;   ///< stage, seconds
   std::vector<std::pair<std::string, std::string>> links;  ///< label, href relative to the report
   double occupancy = 0.0;  ///< of the whole layout (atlas texels inside triangles)
-  int max_views = 4;
-  int max_photos = 12;
-  int picture_width = 300;  ///< pixels; views are rendered at (at most) this width
-  int sweep_frames = 8;
   /// Error maps run from black (0) to white at this mean absolute difference
   /// (display values in [0, 1]).
   double error_map_max = 0.25;
 };
 
-/// What the report measured on its own pictures.
+/// The report's pictures and the metrics it showed.
 struct ReportSummary {
   std::size_t pictures = 0;
   /// Per drawn view and model ("texlume", "flat", "baked"): PSNR (dB) and SSIM
-  /// against the reference inside its mask, at the pictures' resolution.
+  /// against the reference inside its mask, at the pictures' resolution (as
+  /// render::DrawView measured them).
   struct Row {
     std::string view, model;
     double psnr = 0, ssim = 0;
@@ -90,10 +78,9 @@ struct ReportSummary {
 
 /// Writes `dir`/report.html and its pictures in `dir`/report/: the sample
 /// relit at a few lights, the constraint photos, the model from the views
-/// beside the reference and both baselines, error maps (mean absolute
-/// difference over the channels), a light-sweep strip (the first view, a light
-/// circling at 35 degrees above the image plane), atlas thumbnails with the
-/// triangle outlines and occupancy, and the metrics and timings tables. The
+/// beside the reference and the baselines, error maps (mean absolute
+/// difference over the channels), the light-sweep strip, atlas thumbnails with
+/// the triangle outlines and occupancy, and the metrics and timings tables. The
 /// pictures are written to a temporary folder renamed into place, then the
 /// page atomically; relative links only, so the folder opens from disk.
 ReportSummary WriteReport(const std::filesystem::path& dir, const ReportInputs& inputs,

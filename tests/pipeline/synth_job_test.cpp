@@ -25,6 +25,7 @@
 #include "model/model_io.h"
 #include "render/model_render.h"
 #include "pipeline/render_job.h"
+#include "pipeline/report_pictures.h"
 #include "pipeline/synth_job.h"
 #include "report/report.h"
 #include "model/web_model.h"
@@ -592,22 +593,25 @@ TEST_F(MeshPipelineTest, ReportOnHeldOutViewsMeasuresAndSweepsTheLight) {
   report::ReportInputs in;
   in.title = "held-out <views> & \"truth\"";
   in.model = &model;
-  in.flat_albedo = baselines.flat_albedo;
-  in.baked = baselines.baked;
+  pipeline::ReportScene scene;
+  scene.model = &model;
+  scene.flat_albedo = baselines.flat_albedo;
+  scene.baked = baselines.baked;
   for (const auto& [id, image] : cameras.reconstruction.images) {
-    report::ReportView v;
+    render::PictureView v;
     v.name = image.name;
     v.camera = cameras.reconstruction.cameras.at(image.camera_id);
     v.cam_from_world = image.cam_from_world;
     v.lights = lights.at(image.name);
     v.reference_image = held / "images" / image.name;
     v.reference_mask = held / "masks" / image.name;
-    in.views.push_back(v);
+    scene.views.push_back(v);
   }
   in.views_heading = "Held-out views";
   in.occupancy = summary_->occupancy;
-  in.sweep_frames = 4;
-  in.picture_width = 160;
+  scene.sweep_frames = 4;
+  scene.picture_width = 160;
+  pipeline::DrawReportPictures(scene, in);
   testing::TempDir out;
   const report::ReportSummary s = report::WriteReport(out.path(), in);
   const std::string html = testing::ReadText(out.path() / "report.html");
@@ -647,10 +651,15 @@ TEST_F(MeshPipelineTest, ReportOnHeldOutViewsMeasuresAndSweepsTheLight) {
   EXPECT_NEAR(inside / total, summary_->occupancy, 0.02);
 
   // A reference of the wrong size: an error naming it, the earlier report kept whole.
-  report::ReportInputs bad = in;
+  pipeline::ReportScene bad = scene;
   bad.views[1].reference_image = held / "masks" / bad.views[0].name;
   bad.views[1].camera = bad.views[1].camera.Scaled(0.5);
-  EXPECT_THROW(report::WriteReport(out.path(), bad), InputError);
+  report::ReportInputs bad_report = in;
+  EXPECT_THROW(pipeline::DrawReportPictures(bad, bad_report), InputError);
+  // A photo that cannot be read while the report is written: the same.
+  report::ReportInputs bad_photo = in;
+  bad_photo.photos = {{"missing.png", out.path() / "missing.png", {}, {}}};
+  EXPECT_THROW(report::WriteReport(out.path(), bad_photo), InputError);
   EXPECT_EQ(testing::ReadText(out.path() / "report.html"), html);
   EXPECT_TRUE(fs::exists(out.path() / "report/light_sweep.png"));
   std::size_t entries = 0;

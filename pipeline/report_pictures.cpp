@@ -1,0 +1,53 @@
+#include "pipeline/report_pictures.h"
+
+#include <string>
+#include <utility>
+
+#include "core/check.h"
+#include "core/errors.h"
+
+namespace texlume::pipeline {
+
+void ReportScene::Check() const {
+  TEXLUME_CHECK(model != nullptr, "the report needs a model");
+  if (picture_width < 32 || picture_width > 4096 || sweep_width < 32 || sweep_width > 4096)
+    throw OptionError("report picture width must be in [32, 4096]");
+  if (max_views < 0 || sweep_frames < 0 || sweep_frames > 64 || sample_width < 1)
+    throw OptionError("report counts must be non-negative (sweep frames at most 64)");
+}
+
+void DrawReportPictures(const ReportScene& scene, report::ReportInputs& report,
+                        const ProgressCallback& progress) {
+  scene.Check();
+  if (scene.sample) {
+    report.sample_relit = render::RelightSample(
+        *scene.sample, std::min(scene.sample_width, scene.sample->width), scene.light_elevation_deg);
+    report.sample_width = scene.sample->width;
+    report.sample_height = scene.sample->height;
+  }
+  render::ModelRenderer renderer(*scene.model);
+  renderer.flat_albedo = scene.flat_albedo;
+  renderer.baked = scene.baked;
+  std::vector<std::pair<std::string, render::RenderMode>> modes = {
+      {"texlume", render::RenderMode::kPtm}, {"flat", render::RenderMode::kFlat}};
+  if (!scene.baked.empty()) modes.emplace_back("baked", render::RenderMode::kBaked);
+  const std::vector<std::size_t> picked = render::EvenlySpread(scene.views.size(), scene.max_views);
+  report.views.clear();
+  report.views_total = scene.views.size();
+  const bool sweep = !picked.empty() && scene.sweep_frames > 0;
+  const std::size_t steps = picked.size() + (sweep ? 1 : 0);
+  for (std::size_t k = 0; k < picked.size(); ++k) {
+    report.views.push_back(
+        render::DrawView(renderer, modes, scene.views[picked[k]], scene.picture_width));
+    if (progress) progress("report pictures", k + 1, steps);
+  }
+  if (!sweep) return;
+  const render::PictureView& first = scene.views[picked.front()];
+  report.sweep = render::DrawLightSweep(renderer, first, scene.sweep_width, scene.sweep_frames,
+                                        scene.light_elevation_deg);
+  report.sweep_view = first.name;
+  report.sweep_elevation_deg = scene.light_elevation_deg;
+  if (progress) progress("report pictures", steps, steps);
+}
+
+}  // namespace texlume::pipeline
