@@ -10,11 +10,11 @@
 #include <optional>
 #include <unordered_map>
 
+#include "atlas/chart_packing.h"
+#include "atlas/charts.h"
 #include "core/check.h"
 #include "core/errors.h"
 #include "ptm/coefficient_space.h"
-#include "atlas/chart_packing.h"
-#include "atlas/charts.h"
 #include "synth/planar_synthesis.h"
 
 namespace texlume::atlas {
@@ -50,7 +50,8 @@ std::int64_t AtlasLayout::Texels() const {
   return texels;
 }
 
-AtlasStretch MeasureStretch(const std::vector<synth::TrianglePatch>& patches, const AtlasLayout& layout) {
+AtlasStretch MeasureStretch(const std::vector<synth::TrianglePatch>& patches,
+                            const AtlasLayout& layout) {
   AtlasStretch s;
   double weighted = 0, area = 0;
   s.min = std::numeric_limits<double>::max();
@@ -558,6 +559,37 @@ void DilateGutters(std::vector<cv::Mat>& planes, cv::Mat& coverage, int rings) {
   }
 }
 
+BakedPlanes BakeAtlasPlanes(const AtlasLayout& layout, double texel_size, int gutter,
+                            int num_planes, const TexelLookup& lookup,
+                            const ProgressCallback& progress) {
+  BakedPlanes out;
+  out.planes.resize(layout.atlas_sizes.size());
+  for (std::size_t a = 0; a < layout.atlas_sizes.size(); ++a)
+    for (int c = 0; c < num_planes; ++c)
+      out.planes[a].push_back(cv::Mat::zeros(layout.atlas_sizes[a], CV_32FC1));
+  std::vector<float> value(static_cast<std::size_t>(num_planes));
+  AtlasCoverage coverage = VisitAtlasTexels(
+      layout, texel_size, gutter,
+      [&](int atlas, int x, int y, int face, const Eigen::Vector2d& p_in_frame) {
+        lookup(face, p_in_frame, value.data());
+        std::vector<cv::Mat>& planes = out.planes[static_cast<std::size_t>(atlas)];
+        for (int c = 0; c < num_planes; ++c)
+          planes[static_cast<std::size_t>(c)].at<float>(y, x) = value[static_cast<std::size_t>(c)];
+      },
+      progress);
+  std::size_t total_texels = 0;
+  for (std::size_t a = 0; a < out.planes.size(); ++a) {
+    // Dilate into the few gutter texels no face reached (one ring per gutter texel).
+    DilateGutters(out.planes[a], coverage.coverage[a], gutter);
+    total_texels += coverage.coverage[a].total();
+  }
+  out.coverage = std::move(coverage.coverage);
+  out.occupancy =
+      total_texels ? static_cast<double>(coverage.inside_texels) / static_cast<double>(total_texels)
+                   : 0.0;
+  return out;
+}
+
 Atlases BuildAtlases(const mesh::TriangleMesh& mesh, const synth::MeshSynthesis& synthesis,
                      const AtlasOptions& options, const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
@@ -565,29 +597,21 @@ Atlases BuildAtlases(const mesh::TriangleMesh& mesh, const synth::MeshSynthesis&
                                            synthesis.texel_size, options, progress);
   // Bake: every texel inside a face (and its gutter ring) from the blended
   // synthesis, coefficients rotated into the atlas frame.
-  const std::size_t num_planes = synthesis.sample_planes.size();
+  const int num_planes = static_cast<int>(synthesis.sample_planes.size());
   const int coefficient_planes = synthesis.CoefficientPlanes();
-  std::vector<std::vector<cv::Mat>> planes(layout.atlas_sizes.size());
-  for (std::size_t a = 0; a < layout.atlas_sizes.size(); ++a)
-    for (std::size_t c = 0; c < num_planes; ++c)
-      planes[a].push_back(cv::Mat::zeros(layout.atlas_sizes[a], CV_32FC1));
   std::vector<Eigen::Matrix<double, 6, 6>> to_atlas;
   for (const FacePlacement& fp : layout.faces)
     to_atlas.push_back(ptm::OrthonormalFrameRotation(fp.AtlasFrameAngle()));
-  std::vector<float> value(num_planes);
-  AtlasCoverage coverage = VisitAtlasTexels(
-      layout, synthesis.texel_size, options.gutter,
-      [&](int atlas, int x, int y, int face, const Eigen::Vector2d& p_frame) {
-        synthesis.SampleBlended(face, p_frame, options.blend_strip, value.data());
+  BakedPlanes baked = BakeAtlasPlanes(
+      layout, synthesis.texel_size, options.gutter, num_planes,
+      [&](int face, const Eigen::Vector2d& p_frame, float* value) {
+        synthesis.SampleBlended(face, p_frame, options.blend_strip, value);
         for (int poly = 0; poly < coefficient_planes / 6; ++poly) {
           Eigen::Matrix<double, 6, 1> v;
-          for (int i = 0; i < 6; ++i) v[i] = value[static_cast<std::size_t>(poly * 6 + i)];
+          for (int i = 0; i < 6; ++i) v[i] = value[poly * 6 + i];
           v = to_atlas[static_cast<std::size_t>(face)] * v;
-          for (int i = 0; i < 6; ++i)
-            value[static_cast<std::size_t>(poly * 6 + i)] = static_cast<float>(v[i]);
+          for (int i = 0; i < 6; ++i) value[poly * 6 + i] = static_cast<float>(v[i]);
         }
-        auto& atlas_planes = planes[static_cast<std::size_t>(atlas)];
-        for (std::size_t c = 0; c < num_planes; ++c) atlas_planes[c].at<float>(y, x) = value[c];
       },
       progress);
   Atlases atlases;
@@ -595,17 +619,10 @@ Atlases BuildAtlases(const mesh::TriangleMesh& mesh, const synth::MeshSynthesis&
   atlases.flattening = layout.flattening;
   atlases.faces = layout.faces;
   atlases.stretch = MeasureStretch(synthesis.patches, layout);
-  std::size_t total_texels = 0;
-  for (std::size_t a = 0; a < planes.size(); ++a) {
-    // Dilate into the few gutter texels no face reached (one ring per gutter texel).
-    DilateGutters(planes[a], coverage.coverage[a], options.gutter);
-    total_texels += coverage.coverage[a].total();
-    atlases.ptms.push_back(synth::FromOrthonormalPlanes(planes[a], synthesis.format));
-  }
-  atlases.coverage = std::move(coverage.coverage);
-  atlases.occupancy =
-      total_texels ? static_cast<double>(coverage.inside_texels) / static_cast<double>(total_texels)
-                   : 0.0;
+  for (const std::vector<cv::Mat>& planes : baked.planes)
+    atlases.ptms.push_back(synth::FromOrthonormalPlanes(planes, synthesis.format));
+  atlases.coverage = std::move(baked.coverage);
+  atlases.occupancy = baked.occupancy;
   atlases.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return atlases;
 }

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "ptm/ptm.h"
 #include "mesh/mesh.h"
+#include "ptm/ptm.h"
 #include "synth/mesh_synthesis.h"
 
 namespace texlume::atlas {
@@ -98,7 +98,8 @@ struct AtlasLayout {
 /// by their outlines at 16 rotations, bottom-left, largest first). `patches` give each face's
 /// frame and corners, `unfoldings` its neighbours across edges; `texel_size` in
 /// world units. Throws OptionError when a chart does not fit an atlas.
-AtlasLayout LayoutAtlases(const mesh::TriangleMesh& mesh, const std::vector<synth::TrianglePatch>& patches,
+AtlasLayout LayoutAtlases(const mesh::TriangleMesh& mesh,
+                          const std::vector<synth::TrianglePatch>& patches,
                           const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
                           double texel_size, const AtlasOptions& options,
                           const ProgressCallback& progress = {});
@@ -125,6 +126,27 @@ AtlasCoverage VisitAtlasTexels(const AtlasLayout& layout, double texel_size, int
 /// their filled 8-neighbours, `rings` times (marking them 64), in every plane.
 void DilateGutters(std::vector<cv::Mat>& planes, cv::Mat& coverage, int rings);
 
+/// What a sample kind writes at one surface point: `face` and the point in its
+/// triangle frame (world units) in, the atlas texel's planes out (`out` holds
+/// the baker's plane count).
+using TexelLookup = std::function<void(int face, const Eigen::Vector2d& p_in_frame, float* out)>;
+
+/// Atlas planes baked from per-surface-point lookups, with the texels they cover.
+struct BakedPlanes {
+  std::vector<std::vector<cv::Mat>> planes;  ///< per atlas, `num_planes` CV_32FC1
+  std::vector<cv::Mat> coverage;             ///< as AtlasCoverage
+  double occupancy = 0.0;  ///< texels inside triangles over all atlas texels
+};
+
+/// The one baker of every sample kind: per atlas texel inside a face or its
+/// gutter, the lookup's `num_planes` values (VisitAtlasTexels), then the gutters
+/// dilated (DilateGutters). PTM atlases (BuildAtlases), BTF atlases
+/// (BuildBtfAtlases) and colour samples (as their Lambertian PTM) differ only in
+/// the lookup.
+BakedPlanes BakeAtlasPlanes(const AtlasLayout& layout, double texel_size, int gutter,
+                            int num_planes, const TexelLookup& lookup,
+                            const ProgressCallback& progress = {});
+
 /// Packed, baked, blended PTM atlases and the texture coordinates into them.
 /// Each atlas texel's coefficients are in the frame x = atlas +x (right), y =
 /// atlas up (-rows), z = face normal, i.e. the tangent frame derived from the
@@ -142,7 +164,8 @@ struct Atlases {
   AtlasStretch stretch;  ///< of the faces' maps (1 for rigid placements)
 };
 
-AtlasStretch MeasureStretch(const std::vector<synth::TrianglePatch>& patches, const AtlasLayout& layout);
+AtlasStretch MeasureStretch(const std::vector<synth::TrianglePatch>& patches,
+                            const AtlasLayout& layout);
 
 /// "rigid", "conformal", "strips" or "auto" (the manifest's and the CLI's names).
 const char* ChartFlatteningName(ChartFlattening flattening);

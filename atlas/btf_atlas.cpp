@@ -36,44 +36,33 @@ BtfAtlases BuildBtfAtlases(const mesh::TriangleMesh& mesh, const synth::BtfMeshS
                                     synthesis.texel_size, options, progress);
   const int n = sample.Components();
   // Planes: sample x, sample y, angle, the factors r, g, b, then g_0 .. g_{n-1}.
-  std::vector<std::vector<cv::Mat>> planes(out.layout.atlas_sizes.size());
-  for (std::size_t a = 0; a < planes.size(); ++a)
-    for (int c = 0; c < 6 + n; ++c)
-      planes[a].push_back(cv::Mat::zeros(out.layout.atlas_sizes[a], CV_32FC1));
   std::vector<double> face_angle;
   for (const atlas::FacePlacement& fp : out.layout.faces)
     face_angle.push_back(-fp.AtlasFrameAngle());  // the atlas frame's turn from the face frame
-  std::vector<float> g(static_cast<std::size_t>(n));
-  atlas::AtlasCoverage coverage = atlas::VisitAtlasTexels(
-      out.layout, synthesis.texel_size, options.gutter,
-      [&](int atlas, int x, int y, int face, const Eigen::Vector2d& p_in_frame) {
+  BakedPlanes baked = BakeAtlasPlanes(
+      out.layout, synthesis.texel_size, options.gutter, 6 + n,
+      [&](int face, const Eigen::Vector2d& p_in_frame, float* value) {
         const synth::BtfSampleLookup look = synthesis.Lookup(face, p_in_frame);
-        auto& p = planes[static_cast<std::size_t>(atlas)];
-        p[0].at<float>(y, x) = static_cast<float>(look.sample_px.x());
-        p[1].at<float>(y, x) = static_cast<float>(look.sample_px.y());
+        value[0] = static_cast<float>(look.sample_px.x());
+        value[1] = static_cast<float>(look.sample_px.y());
         // d_sample = R(look) d_face and d_face = R(-face) d_atlas.
-        p[2].at<float>(y, x) = static_cast<float>(
+        value[2] = static_cast<float>(
             WrapAngle(look.angle_rad - face_angle[static_cast<std::size_t>(face)]));
-        for (int c = 0; c < 3; ++c)
-          p[static_cast<std::size_t>(3 + c)].at<float>(y, x) = look.colour_gain[c];
-        btf::SampleGeometry(sample, look.sample_px, g.data());
-        for (int i = 0; i < n; ++i) p[static_cast<std::size_t>(6 + i)].at<float>(y, x) = g[i];
+        for (int c = 0; c < 3; ++c) value[3 + c] = look.colour_gain[c];
+        btf::SampleGeometry(sample, look.sample_px, value + 6);
       },
       progress);
-  std::size_t total = 0;
-  for (std::size_t a = 0; a < planes.size(); ++a) {
-    atlas::DilateGutters(planes[a], coverage.coverage[a], options.gutter);
-    total += coverage.coverage[a].total();
+  for (std::vector<cv::Mat>& planes : baked.planes) {
     cv::Mat coords;
-    cv::merge(std::vector<cv::Mat>(planes[a].begin(), planes[a].begin() + 3), coords);
+    cv::merge(std::vector<cv::Mat>(planes.begin(), planes.begin() + 3), coords);
     out.sample_coords.push_back(coords);
     cv::Mat gain;
-    cv::merge(std::vector<cv::Mat>(planes[a].begin() + 3, planes[a].begin() + 6), gain);
+    cv::merge(std::vector<cv::Mat>(planes.begin() + 3, planes.begin() + 6), gain);
     out.colour_gain.push_back(gain);
-    out.geometry.emplace_back(planes[a].begin() + 6, planes[a].end());
+    out.geometry.emplace_back(planes.begin() + 6, planes.end());
   }
-  out.coverage = std::move(coverage.coverage);
-  out.occupancy = total ? static_cast<double>(coverage.inside_texels) / total : 0.0;
+  out.coverage = std::move(baked.coverage);
+  out.occupancy = baked.occupancy;
   return out;
 }
 
@@ -87,7 +76,8 @@ std::vector<ptm::Ptm> PreviewPtms(const BtfAtlases& atlases, const btf::BtfFacto
   Eigen::MatrixXd basis(count, 6);
   for (int j = 0; j < count; ++j) {
     appearance.middleRows(j * 3, 3) =
-        btf::InterpolateAppearance(sample, Eigen::Vector3d::UnitZ(), lights[static_cast<std::size_t>(j)])
+        btf::InterpolateAppearance(sample, Eigen::Vector3d::UnitZ(),
+                                   lights[static_cast<std::size_t>(j)])
             .transpose();
     const auto phi = ptm::PtmBasis(lights[static_cast<std::size_t>(j)].x(),
                                    lights[static_cast<std::size_t>(j)].y());

@@ -10,10 +10,10 @@
 #include <optional>
 #include <unordered_map>
 
+#include "atlas/charts.h"
 #include "core/check.h"
 #include "core/errors.h"
 #include "ptm/coefficient_space.h"
-#include "atlas/charts.h"
 #include "synth/planar_synthesis.h"
 
 namespace texlume::atlas::chart_packing {

@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/progress.h"
 #include "atlas/charts.h"
+#include "core/progress.h"
 #include "synth/triangle_parts.h"
 
 // Packing charts into atlases (synth/atlas.cpp's LayoutAtlases): chart

@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
-#include "mesh/mesh.h"
 #include "atlas/charts.h"
+#include "mesh/mesh.h"
 
 // Geometry the chart makers share (synth/charts.cpp: rigid and conformal
 // charts; synth/strip_charts.cpp: strips and fans).

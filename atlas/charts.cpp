@@ -12,9 +12,9 @@
 #include <tuple>
 #include <unordered_map>
 
+#include "atlas/chart_parts.h"
 #include "core/check.h"
 #include "core/errors.h"
-#include "atlas/chart_parts.h"
 #include "mesh/triangle_frame.h"
 
 namespace texlume::atlas {
@@ -242,7 +242,8 @@ void StripChartOptions::Check() const {
 
 std::vector<std::vector<ChartFace>> MakeRigidCharts(
     const mesh::TriangleMesh& mesh, const std::vector<synth::TrianglePatch>& patches,
-    const std::vector<std::array<synth::Unfolding, 3>>& unfoldings, const RigidChartOptions& options) {
+    const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
+    const RigidChartOptions& options) {
   options.Check();
   const std::size_t num_faces = mesh.faces.size();
   TEXLUME_CHECK(patches.size() == num_faces && unfoldings.size() == num_faces,
@@ -302,7 +303,8 @@ std::vector<std::vector<ChartFace>> MakeRigidCharts(
         const Eigen::Vector2d q = p + (nearest - p) * (static_cast<double>(i) / steps);
         const int qx = static_cast<int>(std::floor(q.x() / t));
         const int qy = static_cast<int>(std::floor(q.y() / t));
-        if (mesh::SignedDistanceToTriangle(c, Eigen::Vector2d((qx + 0.5) * t, (qy + 0.5) * t)) <= 0.0)
+        if (mesh::SignedDistanceToTriangle(c, Eigen::Vector2d((qx + 0.5) * t, (qy + 0.5) * t)) <=
+            0.0)
           continue;
         if (!texels.count(Key(qx, qy))) return false;
       }
@@ -385,8 +387,8 @@ Eigen::Vector2d SingularValues2(const Eigen::Matrix2d& m) {
 
 std::vector<std::vector<ChartFace>> MakeConformalCharts(
     const mesh::TriangleMesh& mesh, const std::vector<synth::TrianglePatch>& patches,
-    const std::vector<std::array<synth::Unfolding, 3>>& unfoldings, const ConformalChartOptions& options,
-    ConformalChartStats* stats) {
+    const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
+    const ConformalChartOptions& options, ConformalChartStats* stats) {
   const std::size_t num_faces = mesh.faces.size();
   TEXLUME_CHECK(patches.size() == num_faces && unfoldings.size() == num_faces,
                 "charts need one patch and one unfolding per face");

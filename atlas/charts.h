@@ -35,7 +35,8 @@ struct RigidChartOptions {
 /// faces it does not touch on the mesh, and the chart stays within the extent.
 std::vector<std::vector<ChartFace>> MakeRigidCharts(
     const mesh::TriangleMesh& mesh, const std::vector<synth::TrianglePatch>& patches,
-    const std::vector<std::array<synth::Unfolding, 3>>& unfoldings, const RigidChartOptions& options);
+    const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
+    const RigidChartOptions& options);
 
 /// Settings of MakeConformalCharts.
 struct ConformalChartOptions {
@@ -71,8 +72,8 @@ struct ConformalChartStats {
 /// face ends in exactly one chart (a lone face is placed rigidly).
 std::vector<std::vector<ChartFace>> MakeConformalCharts(
     const mesh::TriangleMesh& mesh, const std::vector<synth::TrianglePatch>& patches,
-    const std::vector<std::array<synth::Unfolding, 3>>& unfoldings, const ConformalChartOptions& options,
-    ConformalChartStats* stats = nullptr);
+    const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
+    const ConformalChartOptions& options, ConformalChartStats* stats = nullptr);
 
 /// Which edge of a strip's seed face lies on the band line (after preferring
 /// one along the charted region or the mesh border).
@@ -157,8 +158,8 @@ struct StripChartStats {
 /// rectangles on curved surfaces). Every face ends in exactly one chart.
 std::vector<std::vector<ChartFace>> MakeStripCharts(
     const mesh::TriangleMesh& mesh, const std::vector<synth::TrianglePatch>& patches,
-    const std::vector<std::array<synth::Unfolding, 3>>& unfoldings, const StripChartOptions& options,
-    StripChartStats* stats = nullptr);
+    const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
+    const StripChartOptions& options, StripChartStats* stats = nullptr);
 
 /// The band height strips prefer (texels): the median over the faces of each
 /// face's tallest height, rounded, so bands of near-equal faces share one height.

@@ -25,11 +25,11 @@
 #include <utility>
 #include <vector>
 
+#include "atlas/atlas.h"
 #include "datasets_synthetic/material.h"
 #include "datasets_synthetic/shapes.h"
-#include "atlas/atlas.h"
-#include "synth/mesh_synthesis.h"
 #include "pipeline/synth_job.h"
+#include "synth/mesh_synthesis.h"
 
 using namespace texlume;
 

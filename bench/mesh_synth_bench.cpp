@@ -10,15 +10,15 @@
 #include <filesystem>
 #include <map>
 
+#include "atlas/atlas.h"
 #include "datasets_synthetic/scene.h"
+#include "mesh/mesh.h"
+#include "pipeline/synth_job.h"
 #include "ptm/fit.h"
 #include "sfm/colmap_io.h"
 #include "sfm/lights.h"
-#include "mesh/mesh.h"
 #include "sfm/visibility.h"
-#include "atlas/atlas.h"
 #include "synth/mesh_synthesis.h"
-#include "pipeline/synth_job.h"
 
 using namespace texlume;
 namespace fs = std::filesystem;

@@ -4,9 +4,9 @@
 #include <filesystem>
 
 #include "datasets_synthetic/shapes.h"
+#include "mesh/mesh.h"
 #include "sfm/camera_models.h"
 #include "sfm/lights.h"
-#include "mesh/mesh.h"
 #include "sfm/reconstruction.h"
 
 namespace texlume::datasets {

@@ -49,9 +49,9 @@ mesh::TriangleMesh CoarseMesh(SceneShape shape);
 /// Mesh generators (outward normals), also used by tests.
 mesh::TriangleMesh MakeIcosphere(int subdivisions, double radius);
 mesh::TriangleMesh MakeCylinder(int segments_around, int segments_along, double radius,
-                               double height);
+                                double height);
 mesh::TriangleMesh MakeGridPlane(int segments, double size);
 mesh::TriangleMesh MakeTorus(int segments_around, int segments_tube, double major_radius,
-                            double minor_radius);
+                             double minor_radius);
 
 }  // namespace texlume::datasets

@@ -11,8 +11,8 @@
 
 #include "core/image_io.h"
 #include "core/json_io.h"
-#include "ptm/ptm.h"
 #include "mesh/mesh.h"
+#include "ptm/ptm.h"
 
 namespace texlume::model {
 

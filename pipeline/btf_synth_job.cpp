@@ -9,18 +9,17 @@
 
 #include "core/errors.h"
 #include "core/timing.h"
+#include "model/baselines.h"
+#include "model/btf_model.h"
+#include "model/model_io.h"
+#include "model/web_model.h"
 #include "ptm/coefficient_space.h"
 #include "ptm/exr_io.h"
-#include "model/baselines.h"
-#include "model/model_io.h"
-#include "model/btf_model.h"
-#include "model/web_model.h"
 #include "render/model_render.h"
 
 namespace texlume::pipeline {
 namespace fs = std::filesystem;
 namespace {
-
 
 std::string GeometryFileName(std::size_t atlas, std::size_t part) {
   return "btf_geometry_" + std::to_string(atlas) + "_" + std::to_string(part) + ".png";
@@ -86,7 +85,7 @@ class BtfSynthJob {
     if (so_.sample_texel_size == 0.0) so_.sample_texel_size = sample_.texel_size;
     so_.Check();
     pipeline::PrepareSynthMesh(inputs_, job_, std::min(sample_.width, sample_.height),
-                            so_.sample_texel_size, so_.strip, progress_);
+                               so_.sample_texel_size, so_.strip, progress_);
     summary_.CountInputs(inputs_);
   }
 
@@ -116,14 +115,14 @@ class BtfSynthJob {
                                     : "none";
     summary_.occupancy = atlases_.occupancy;
     t = std::chrono::steady_clock::now();
-    model_ = pipeline::TexturedModelOf(inputs_.mesh, atlas::PreviewPtms(atlases_, sample_, progress_),
-                                    atlases_.layout.faces);
+    model_ = pipeline::TexturedModelOf(
+        inputs_.mesh, atlas::PreviewPtms(atlases_, sample_, progress_), atlases_.layout.faces);
     summary_.seconds_preview = SecondsSince(t);
     baked_ = render::BakePhotoTextures(model_, inputs_.reconstruction, inputs_.visibility,
-                                      inputs_.photos, synthesis_.photo_gains);
+                                       inputs_.photos, synthesis_.photo_gains);
     flat_albedo_ =
         render::MeanAlbedoFromPhotos(inputs_.mesh, inputs_.reconstruction, inputs_.visibility,
-                                    inputs_.photos, synthesis_.photo_gains);
+                                     inputs_.photos, synthesis_.photo_gains);
   }
 
   nlohmann::json Settings() const {

@@ -6,12 +6,12 @@
 #include <string>
 #include <vector>
 
+#include "atlas/btf_atlas.h"
 #include "btf/btf.h"
 #include "core/progress.h"
-#include "ptm/ptm.h"
-#include "atlas/btf_atlas.h"
-#include "synth/mesh_btf.h"
 #include "pipeline/synth_job.h"
+#include "ptm/ptm.h"
+#include "synth/mesh_btf.h"
 
 namespace texlume::pipeline {
 

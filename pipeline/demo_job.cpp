@@ -5,14 +5,14 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/timing.h"
-#include "pipeline/jobs.h"
-#include "ptm/ptm_io.h"
-#include "sfm/colmap_io.h"
-#include "sfm/lights.h"
 #include "model/baselines.h"
 #include "model/model_io.h"
+#include "pipeline/jobs.h"
 #include "pipeline/report_pictures.h"
+#include "ptm/ptm_io.h"
 #include "report/report.h"
+#include "sfm/colmap_io.h"
+#include "sfm/lights.h"
 
 namespace texlume::pipeline {
 namespace fs = std::filesystem;

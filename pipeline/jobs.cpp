@@ -8,14 +8,14 @@
 #include <opencv2/imgproc.hpp>
 
 #include "btf/btf.h"
-#include "pipeline/btf_synth_job.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
 #include "core/timing.h"
+#include "model/model_io.h"
+#include "pipeline/btf_synth_job.h"
 #include "ptm/ptm_io.h"
 #include "sfm/lights.h"
-#include "model/model_io.h"
 
 namespace texlume::pipeline {
 namespace fs = std::filesystem;

@@ -10,12 +10,12 @@
 
 #include "core/progress.h"
 #include "datasets_synthetic/scene.h"
+#include "pipeline/render_job.h"
+#include "pipeline/synth_job.h"
 #include "ptm/fit.h"
 #include "ptm/ptm.h"
 #include "ptm/sphere_lights.h"
 #include "sfm/inspect.h"
-#include "pipeline/render_job.h"
-#include "pipeline/synth_job.h"
 #include "synth/planar_synthesis.h"
 
 // The jobs the texlume program runs that are not in synth/pipeline.h: each an

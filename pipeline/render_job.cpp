@@ -88,8 +88,8 @@ class RenderJob {
   void LoadViews() {
     cameras_ = sfm::ReadModel(options_.cameras_dir);
     lights_ = sfm::ReadObjectLightsFile(options_.lights_file);
-    for (const std::string& name : sfm::CheckLightsAgainstModel(
-             lights_, cameras_.reconstruction, options_.lights_file.string()))
+    for (const std::string& name : sfm::CheckLightsAgainstModel(lights_, cameras_.reconstruction,
+                                                                options_.lights_file.string()))
       summary_.warnings.push_back("not rendering " + name + ": no light for it");
   }
 
@@ -125,8 +125,8 @@ class RenderJob {
     } else {
       truth_mask = coverage > 127;
     }
-    summary_.metrics.push_back(render::MeasureView(image_name, rgb, truth, truth_mask > 127,
-                                                   options_.reduced_factor));
+    summary_.metrics.push_back(
+        render::MeasureView(image_name, rgb, truth, truth_mask > 127, options_.reduced_factor));
   }
 
   void AverageMetrics() {
@@ -142,9 +142,12 @@ class RenderJob {
   std::string ModeName() const {
     if (btf_) return "btf";
     switch (options_.mode) {
-      case render::RenderMode::kPtm: return "ptm";
-      case render::RenderMode::kFlat: return "flat";
-      case render::RenderMode::kBaked: return "baked";
+      case render::RenderMode::kPtm:
+        return "ptm";
+      case render::RenderMode::kFlat:
+        return "flat";
+      case render::RenderMode::kBaked:
+        return "baked";
     }
     return "ptm";
   }

@@ -20,8 +20,9 @@ void DrawReportPictures(const ReportScene& scene, report::ReportInputs& report,
                         const ProgressCallback& progress) {
   scene.Check();
   if (scene.sample) {
-    report.sample_relit = render::RelightSample(
-        *scene.sample, std::min(scene.sample_width, scene.sample->width), scene.light_elevation_deg);
+    report.sample_relit =
+        render::RelightSample(*scene.sample, std::min(scene.sample_width, scene.sample->width),
+                              scene.light_elevation_deg);
     report.sample_width = scene.sample->width;
     report.sample_height = scene.sample->height;
   }

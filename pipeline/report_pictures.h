@@ -17,15 +17,15 @@ namespace texlume::pipeline {
 struct ReportScene {
   const model::TexturedModel* model = nullptr;  ///< required
   Eigen::Vector3f flat_albedo = Eigen::Vector3f::Constant(0.5f);
-  std::vector<cv::Mat> baked;        ///< per atlas (display RGB); empty = no baked column
-  const ptm::Ptm* sample = nullptr;  ///< null = no sample section
+  std::vector<cv::Mat> baked;              ///< per atlas (display RGB); empty = no baked column
+  const ptm::Ptm* sample = nullptr;        ///< null = no sample section
   std::vector<render::PictureView> views;  ///< at most `max_views` are drawn, evenly spread
   int max_views = 4;
   int picture_width = 300;  ///< pixels; views are drawn at (at most) this width
   int sweep_frames = 8;     ///< light-sweep frames of the first drawn view (0 = none)
   int sweep_width = 160;
   double light_elevation_deg = 40.0;  ///< of the sweep's and the sample's lights
-  int sample_width = 200;   ///< the sample relit at (at most) this width
+  int sample_width = 200;             ///< the sample relit at (at most) this width
 
   /// Throws OptionError when a count or size is out of range.
   void Check() const;

@@ -11,15 +11,15 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/timing.h"
+#include "mesh/mesh.h"
+#include "model/baselines.h"
+#include "pipeline/report_pictures.h"
 #include "ptm/ptm_io.h"
+#include "render/model_render.h"
+#include "report/report.h"
 #include "sfm/colmap_io.h"
 #include "sfm/lights.h"
-#include "mesh/mesh.h"
 #include "synth/colour_sample.h"
-#include "model/baselines.h"
-#include "render/model_render.h"
-#include "pipeline/report_pictures.h"
-#include "report/report.h"
 
 namespace texlume::pipeline {
 namespace fs = std::filesystem;
@@ -238,7 +238,7 @@ void RefuseForeignModelFolder(const fs::path& out) {
 }
 
 model::TexturedModel TexturedModelOf(const mesh::TriangleMesh& mesh, std::vector<ptm::Ptm> atlases,
-                              const std::vector<atlas::FacePlacement>& faces) {
+                                     const std::vector<atlas::FacePlacement>& faces) {
   model::TexturedModel model;
   model.mesh = mesh;
   model.atlases = std::move(atlases);
@@ -295,10 +295,11 @@ class SynthJob {
     const SynthInputs& in = inputs_;
     synthesis_ =
         sample_.colour.empty()
-            ? synth::SynthesizeMeshPtm(in.mesh, in.reconstruction, in.visibility, in.photos, sample_.ptm,
-                                options_.synthesis, progress_)
+            ? synth::SynthesizeMeshPtm(in.mesh, in.reconstruction, in.visibility, in.photos,
+                                       sample_.ptm, options_.synthesis, progress_)
             : synth::SynthesizeMeshColour(in.mesh, in.reconstruction, in.visibility, in.photos,
-                                   sample_.colour, ColourOptions(options_.synthesis), progress_);
+                                          sample_.colour, ColourOptions(options_.synthesis),
+                                          progress_);
     summary_.seconds_synthesis = SecondsSince(t);
     summary_.from_photos = synthesis_.num_from_photos;
     summary_.from_neighbours = synthesis_.num_from_neighbours;
@@ -308,7 +309,8 @@ class SynthJob {
   // Blending and atlases: the textured model.
   void LayOut() {
     const auto t = std::chrono::steady_clock::now();
-    atlas::Atlases atlases = atlas::BuildAtlases(inputs_.mesh, synthesis_, options_.atlas, progress_);
+    atlas::Atlases atlases =
+        atlas::BuildAtlases(inputs_.mesh, synthesis_, options_.atlas, progress_);
     summary_.seconds_atlas = SecondsSince(t);
     summary_.atlases = atlases.ptms.size();
     summary_.charts = static_cast<std::size_t>(atlases.num_charts);
@@ -325,9 +327,9 @@ class SynthJob {
     const auto t = std::chrono::steady_clock::now();
     const SynthInputs& in = inputs_;
     baked_ = render::BakePhotoTextures(model_, in.reconstruction, in.visibility, in.photos,
-                               synthesis_.photo_gains);
-    flat_albedo_ = render::MeanAlbedoFromPhotos(in.mesh, in.reconstruction, in.visibility, in.photos,
-                                        synthesis_.photo_gains);
+                                       synthesis_.photo_gains);
+    flat_albedo_ = render::MeanAlbedoFromPhotos(in.mesh, in.reconstruction, in.visibility,
+                                                in.photos, synthesis_.photo_gains);
     summary_.seconds_baselines = SecondsSince(t);
   }
 

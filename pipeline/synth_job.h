@@ -7,14 +7,14 @@
 #include <string>
 #include <vector>
 
+#include "atlas/atlas.h"
 #include "core/image_io.h"
 #include "core/progress.h"
-#include "sfm/visibility.h"
-#include "atlas/atlas.h"
-#include "synth/mesh_synthesis.h"
 #include "model/baselines.h"
 #include "model/model_io.h"
 #include "render/model_render.h"
+#include "sfm/visibility.h"
+#include "synth/mesh_synthesis.h"
 
 namespace texlume::pipeline {
 
@@ -28,8 +28,8 @@ struct SynthJobOptions {
   /// The PTM sample already in memory (borrowed): used instead of reading
   /// `sample_file`, which then only names it in the manifest.
   const ptm::Ptm* sample = nullptr;
-  std::filesystem::path out_dir;      ///< the model folder written
-  synth::MeshSynthesisOptions synthesis;     ///< sample_texel_size required
+  std::filesystem::path out_dir;          ///< the model folder written
+  synth::MeshSynthesisOptions synthesis;  ///< sample_texel_size required
   atlas::AtlasOptions atlas;
   sfm::VisibilityOptions visibility;
   /// Split every triangle in four (midpoints) up to this many times while the
@@ -90,7 +90,7 @@ Sample ReadSample(const std::filesystem::path& path);
 /// The main job's inputs, read and checked (shared with the BTF job, btf/).
 struct SynthInputs {
   sfm::Reconstruction reconstruction;
-  mesh::TriangleMesh mesh;         ///< subdivided as needed
+  mesh::TriangleMesh mesh;               ///< subdivided as needed
   std::vector<synth::MeshPhoto> photos;  ///< those with a light and a file
   sfm::VisibilityResult visibility;
   std::vector<std::string> warnings;
@@ -121,7 +121,7 @@ void RefuseForeignModelFolder(const std::filesystem::path& out_dir);
 /// The textured model of a layout: the mesh, and per face its atlas and its
 /// corners' texture coordinates (FacePlacement), with the atlases.
 model::TexturedModel TexturedModelOf(const mesh::TriangleMesh& mesh, std::vector<ptm::Ptm> atlases,
-                              const std::vector<atlas::FacePlacement>& faces);
+                                     const std::vector<atlas::FacePlacement>& faces);
 
 /// Runs the whole job: reads and checks the inputs, visibility and best views,
 /// per-triangle synthesis (Algorithm 2), blending, atlases, and the model folder

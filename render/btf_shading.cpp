@@ -48,10 +48,9 @@ Eigen::Vector3f ShadeBtf(const model::BtfModel& model, const ModelRenderer::Surf
 RenderedView RenderBtf(const ModelRenderer& renderer, const model::BtfModel& btf,
                        const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
                        const std::vector<sfm::ObjectLight>& lights, int samples_per_axis) {
-  return renderer.RenderWith(camera, cam_from_world, samples_per_axis,
-                             [&](const ModelRenderer::SurfaceSample& s) {
-                               return ShadeBtf(btf, s, lights);
-                             });
+  return renderer.RenderWith(
+      camera, cam_from_world, samples_per_axis,
+      [&](const ModelRenderer::SurfaceSample& s) { return ShadeBtf(btf, s, lights); });
 }
 
 }  // namespace texlume::render

@@ -10,7 +10,6 @@ namespace texlume::render {
 double MaskedPsnr(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask);
 double MaskedSsim(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask);
 
-
 /// A rendered view against its ground truth, inside a mask; also reduced by an
 /// integer factor (area averaging; the mask nearest) when it is over 1.
 struct ViewMetrics {

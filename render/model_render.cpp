@@ -44,7 +44,8 @@ ModelRenderer::ModelRenderer(const model::TexturedModel& model) : model_(model),
   const mesh::TriangleMesh& mesh = model.mesh;
   vertex_normals_ = mesh::VertexNormals(mesh);
   face_frames_.resize(mesh.faces.size());
-  for (std::size_t f = 0; f < mesh.faces.size(); ++f) face_frames_[f] = model::AtlasFaceFrame(model, f);
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    face_frames_[f] = model::AtlasFaceFrame(model, f);
   std::vector<Eigen::Vector3f> positions;
   for (const Eigen::Vector3d& v : mesh.vertices) positions.push_back(v.cast<float>());
   std::vector<std::array<std::uint32_t, 3>> triangles;
@@ -157,8 +158,8 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
       std::vector<std::pair<Eigen::Vector3d, double>> local;  // lights in the face frame
       for (const sfm::ObjectLight& l : lights)
         local.emplace_back(s.frame.transpose() * l.DirectionFrom(s.point), l.intensity);
-      value =
-          synth::RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format, local, 1.0);
+      value = synth::RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format,
+                                    local, 1.0);
     }
     return value;
   });

@@ -6,12 +6,12 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "sfm/lights.h"
 #include "mesh/mesh.h"
+#include "model/model_io.h"
+#include "sfm/lights.h"
 #include "sfm/reconstruction.h"
 #include "sfm/visibility.h"
 #include "synth/mesh_synthesis.h"
-#include "model/model_io.h"
 
 namespace texlume::render {
 

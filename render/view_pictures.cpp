@@ -101,7 +101,7 @@ std::vector<cv::Mat> DrawLightSweep(const ModelRenderer& renderer, const Picture
 }
 
 std::vector<std::pair<Eigen::Vector3d, cv::Mat>> RelightSample(const ptm::Ptm& sample, int width,
-                                                              double elevation_deg) {
+                                                               double elevation_deg) {
   std::vector<Eigen::Vector3d> lights = {Eigen::Vector3d::UnitZ()};
   const double el = elevation_deg * std::numbers::pi / 180.0;
   for (int k = 0; k < 4; ++k) {

@@ -66,7 +66,7 @@ std::vector<cv::Mat> DrawLightSweep(const ModelRenderer& renderer, const Picture
 /// The sample PTM relit in its own frame, at most `width` texels wide: head-on,
 /// then four lights around it at `elevation_deg` (CV_32FC3 display RGB).
 std::vector<std::pair<Eigen::Vector3d, cv::Mat>> RelightSample(const ptm::Ptm& sample, int width,
-                                                              double elevation_deg);
+                                                               double elevation_deg);
 
 /// `count` of `n` items, evenly spread (the first always).
 std::vector<std::size_t> EvenlySpread(std::size_t n, int count);

@@ -194,8 +194,7 @@ class ReportWriter {
     if (!in_.facts.empty()) {
       html_ << "<table>";
       for (const auto& [name, value] : in_.facts)
-        html_ << "<tr><th>" << HtmlEscape(name) << "</th><td>" << HtmlEscape(value)
-              << "</td></tr>";
+        html_ << "<tr><th>" << HtmlEscape(name) << "</th><td>" << HtmlEscape(value) << "</td></tr>";
       html_ << "</table>\n";
     }
     if (!in_.links.empty()) {
@@ -346,44 +345,44 @@ class ReportWriter {
 
   // The full-resolution tables given, and the pictures' own measurements.
   void Metrics() {
-  if (!in_.metrics.empty() || !summary_.rows.empty()) html_ << "<h2>Metrics</h2>\n";
-  if (!in_.metrics.empty()) {
-    html_ << "<p>Every held-out view, inside the ground-truth masks, as <code>texlume "
-            "render</code> measured it at full resolution and reduced to the photos' "
-            "resolution.</p>\n<table class=\"m\" border=\"1\"><tr><th>model</th><th>PSNR "
-            "full (dB)</th><th>SSIM full</th><th>PSNR reduced (dB)</th><th>SSIM "
-            "reduced</th></tr>\n";
-    for (const ReportMetrics& m : in_.metrics)
-      html_ << "<tr><th>" << HtmlEscape(m.label) << "</th><td>" << Fixed(m.mean_psnr, 2)
-           << "</td><td>" << Fixed(m.mean_ssim, 3) << "</td><td>"
-           << Fixed(m.mean_psnr_reduced, 2) << "</td><td>"
-           << Fixed(m.mean_ssim_reduced, 3) << "</td></tr>\n";
-    html_ << "</table>\n<p>Per view (PSNR dB / SSIM at full resolution):</p>\n<table class=\"m\" "
-            "border=\"1\"><tr><th>view</th>";
-    for (const ReportMetrics& m : in_.metrics) html_ << "<th>" << HtmlEscape(m.label) << "</th>";
-    html_ << "</tr>\n";
-    for (std::size_t i = 0; i < in_.metrics.front().views.size(); ++i) {
-      html_ << "<tr><th>" << HtmlEscape(in_.metrics.front().views[i].name) << "</th>";
-      for (const ReportMetrics& m : in_.metrics) {
-        if (i < m.views.size())
-          html_ << "<td>" << Fixed(m.views[i].psnr, 2) << " / "
-               << Fixed(m.views[i].ssim, 3) << "</td>";
-        else
-          html_ << "<td></td>";
-      }
+    if (!in_.metrics.empty() || !summary_.rows.empty()) html_ << "<h2>Metrics</h2>\n";
+    if (!in_.metrics.empty()) {
+      html_ << "<p>Every held-out view, inside the ground-truth masks, as <code>texlume "
+               "render</code> measured it at full resolution and reduced to the photos' "
+               "resolution.</p>\n<table class=\"m\" border=\"1\"><tr><th>model</th><th>PSNR "
+               "full (dB)</th><th>SSIM full</th><th>PSNR reduced (dB)</th><th>SSIM "
+               "reduced</th></tr>\n";
+      for (const ReportMetrics& m : in_.metrics)
+        html_ << "<tr><th>" << HtmlEscape(m.label) << "</th><td>" << Fixed(m.mean_psnr, 2)
+              << "</td><td>" << Fixed(m.mean_ssim, 3) << "</td><td>"
+              << Fixed(m.mean_psnr_reduced, 2) << "</td><td>" << Fixed(m.mean_ssim_reduced, 3)
+              << "</td></tr>\n";
+      html_ << "</table>\n<p>Per view (PSNR dB / SSIM at full resolution):</p>\n<table class=\"m\" "
+               "border=\"1\"><tr><th>view</th>";
+      for (const ReportMetrics& m : in_.metrics) html_ << "<th>" << HtmlEscape(m.label) << "</th>";
       html_ << "</tr>\n";
+      for (std::size_t i = 0; i < in_.metrics.front().views.size(); ++i) {
+        html_ << "<tr><th>" << HtmlEscape(in_.metrics.front().views[i].name) << "</th>";
+        for (const ReportMetrics& m : in_.metrics) {
+          if (i < m.views.size())
+            html_ << "<td>" << Fixed(m.views[i].psnr, 2) << " / " << Fixed(m.views[i].ssim, 3)
+                  << "</td>";
+          else
+            html_ << "<td></td>";
+        }
+        html_ << "</tr>\n";
+      }
+      html_ << "</table>\n";
     }
-    html_ << "</table>\n";
-  }
-  if (!summary_.rows.empty()) {
-    html_ << "<p>On the pictures above (their resolution, inside the mask):</p>\n<table "
-            "class=\"m\" "
-            "border=\"1\"><tr><th>view</th><th>model</th><th>PSNR (dB)</th><th>SSIM</th></tr>\n";
-    for (const ReportSummary::Row& r : summary_.rows)
-      html_ << "<tr><th>" << HtmlEscape(r.view) << "</th><td>" << r.model << "</td><td>"
-           << Fixed(r.psnr, 2) << "</td><td>" << Fixed(r.ssim, 3) << "</td></tr>\n";
-    html_ << "</table>\n";
-  }
+    if (!summary_.rows.empty()) {
+      html_ << "<p>On the pictures above (their resolution, inside the mask):</p>\n<table "
+               "class=\"m\" "
+               "border=\"1\"><tr><th>view</th><th>model</th><th>PSNR (dB)</th><th>SSIM</th></tr>\n";
+      for (const ReportSummary::Row& r : summary_.rows)
+        html_ << "<tr><th>" << HtmlEscape(r.view) << "</th><td>" << r.model << "</td><td>"
+              << Fixed(r.psnr, 2) << "</td><td>" << Fixed(r.ssim, 3) << "</td></tr>\n";
+      html_ << "</table>\n";
+    }
   }
 
   const ReportInputs& in_;

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "ptm/ptm.h"
 #include "model/model_io.h"
+#include "ptm/ptm.h"
 #include "render/metrics.h"
 #include "render/view_pictures.h"
 #include "sfm/lights.h"
@@ -37,22 +37,22 @@ struct ReportMetrics {
 /// borrowed for the call.
 struct ReportInputs {
   std::string title;
-  std::string intro;                     ///< one paragraph of plain text
+  std::string intro;                            ///< one paragraph of plain text
   const model::TexturedModel* model = nullptr;  ///< required: its atlases are shown
   /// The material sample relit in its own frame (render::RelightSample), and
   /// its size in texels; empty = no sample section.
   std::vector<std::pair<Eigen::Vector3d, cv::Mat>> sample_relit;
   int sample_width = 0, sample_height = 0;
-  std::vector<ReportPhoto> photos;     ///< the constraint photos
-  int max_photos = 12;                 ///< at most this many are shown, evenly spread
+  std::vector<ReportPhoto> photos;          ///< the constraint photos
+  int max_photos = 12;                      ///< at most this many are shown, evenly spread
   std::vector<render::ViewPictures> views;  ///< the views drawn (render::DrawView)
   std::size_t views_total = 0;              ///< of how many views they were picked
-  std::string views_heading;           ///< e.g. "Held-out views under held-out lights"
+  std::string views_heading;                ///< e.g. "Held-out views under held-out lights"
   /// The light sweep (render::DrawLightSweep) from view `sweep_view`; empty = none.
   std::vector<cv::Mat> sweep;
   std::string sweep_view;
   double sweep_elevation_deg = 40.0;
-  std::vector<ReportMetrics> metrics;  ///< optional full-resolution tables
+  std::vector<ReportMetrics> metrics;                      ///< optional full-resolution tables
   std::vector<std::pair<std::string, std::string>> facts;  ///< summary lines (name, value)
   std::vector<std::pair<std::string, double>> timings_s;   ///< stage, seconds
   std::vector<std::pair<std::string, std::string>> links;  ///< label, href relative to the report

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "sfm/colmap_io.h"
 #include "mesh/mesh.h"
+#include "sfm/colmap_io.h"
 #include "sfm/visibility.h"
 
 namespace texlume::sfm {

@@ -74,7 +74,8 @@ struct ImageViews {
   std::vector<std::pair<int, TriangleView>> records;
 };
 
-ImageViews ComputeImageViews(const mesh::TriangleMesh& mesh, const std::vector<Eigen::Vector3d>& normals,
+ImageViews ComputeImageViews(const mesh::TriangleMesh& mesh,
+                             const std::vector<Eigen::Vector3d>& normals,
                              const std::vector<Eigen::Vector3d>& centroids, const Image& image,
                              const Camera& camera, const VisibilityOptions& options) {
   const double full_w = static_cast<double>(camera.width);
@@ -209,7 +210,8 @@ std::vector<ImageId> TriangleVisibility::FullyVisibleViews() const {
   return ids;
 }
 
-VisibilityResult ComputeVisibility(const mesh::TriangleMesh& mesh, const Reconstruction& reconstruction,
+VisibilityResult ComputeVisibility(const mesh::TriangleMesh& mesh,
+                                   const Reconstruction& reconstruction,
                                    const VisibilityOptions& options,
                                    const ProgressCallback& progress) {
   options.Check();

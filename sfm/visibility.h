@@ -80,7 +80,8 @@ struct VisibilityResult {
 /// projection, so partial occlusion of a triangle is detected, not only of its
 /// corners. Images run in parallel (OpenMP). The mesh must be in the model's
 /// world frame with outward-facing normals (mesh::LoadMesh makes closed meshes so).
-VisibilityResult ComputeVisibility(const mesh::TriangleMesh& mesh, const Reconstruction& reconstruction,
+VisibilityResult ComputeVisibility(const mesh::TriangleMesh& mesh,
+                                   const Reconstruction& reconstruction,
                                    const VisibilityOptions& options = {},
                                    const ProgressCallback& progress = {});
 

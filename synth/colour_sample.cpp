@@ -22,8 +22,9 @@ std::array<float, 6> LambertianLuminance() {
   std::vector<std::array<double, 6>> rows;
   std::vector<double> values;
   for (int e = 0; e <= 15; ++e) {
-    const double elevation = (ptm::kHorizonElevationDeg + (90.0 - ptm::kHorizonElevationDeg) * e / 15.0) *
-                             std::numbers::pi / 180.0;
+    const double elevation =
+        (ptm::kHorizonElevationDeg + (90.0 - ptm::kHorizonElevationDeg) * e / 15.0) *
+        std::numbers::pi / 180.0;
     for (int a = 0; a < 36; ++a) {
       const double azimuth = 2.0 * std::numbers::pi * a / 36.0;
       const double lu = std::cos(elevation) * std::cos(azimuth);

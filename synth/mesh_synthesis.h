@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "ptm/ptm.h"
 #include "mesh/mesh.h"
+#include "ptm/ptm.h"
 #include "sfm/reconstruction.h"
 #include "sfm/visibility.h"
 #include "synth/triangle_engine.h"

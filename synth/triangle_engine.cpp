@@ -272,8 +272,8 @@ TriangleEngine::OverlapTargets TriangleEngine::CollectOverlapTargets(std::size_t
       for (std::size_t k = 0; k < 3; ++k) {
         const Unfolding& u = result_.unfoldings[f][k];
         if (u.face < 0 || !done_[static_cast<std::size_t>(u.face)]) continue;
-        const double d =
-            mesh::DistanceToSegment(patch.corners_in_frame[k], patch.corners_in_frame[(k + 1) % 3], p);
+        const double d = mesh::DistanceToSegment(patch.corners_in_frame[k],
+                                                 patch.corners_in_frame[(k + 1) % 3], p);
         if (d > options_.strip * t) continue;
         const TrianglePatch& other = result_.patches[static_cast<std::size_t>(u.face)];
         if (!sample_.PatchFeatures(other, t, u.rotation * p + u.translation, value.data()))

@@ -10,12 +10,12 @@
 #include <vector>
 
 #include "core/image_io.h"
+#include "mesh/mesh.h"
+#include "mesh/triangle_frame.h"
 #include "ptm/ptm.h"
 #include "sfm/lights.h"
-#include "mesh/mesh.h"
 #include "sfm/reconstruction.h"
 #include "sfm/visibility.h"
-#include "mesh/triangle_frame.h"
 
 // The parts of paper 003 Algorithm 2 that every per-triangle engine shares: the
 // photos, each face's frame and patch rectangle, the unfoldings across its

@@ -9,12 +9,12 @@
 #include <random>
 #include <set>
 
+#include "atlas/atlas.h"
 #include "core/check.h"
 #include "core/errors.h"
 #include "datasets_synthetic/shapes.h"
-#include "atlas/atlas.h"
-#include "pipeline/synth_job.h"
 #include "mesh/triangle_frame.h"
+#include "pipeline/synth_job.h"
 
 namespace texlume::synth {
 namespace {
@@ -52,10 +52,9 @@ mesh::TriangleMesh JitteredIcosphere(unsigned seed) {
 }
 
 // Strip charts of the mesh, every face in exactly one of them.
-std::vector<std::vector<atlas::ChartFace>> CheckedStripCharts(const mesh::TriangleMesh& mesh,
-                                                       const PatchGeometry& g,
-                                                       const atlas::StripChartOptions& o,
-                                                       atlas::StripChartStats* stats = nullptr) {
+std::vector<std::vector<atlas::ChartFace>> CheckedStripCharts(
+    const mesh::TriangleMesh& mesh, const PatchGeometry& g, const atlas::StripChartOptions& o,
+    atlas::StripChartStats* stats = nullptr) {
   auto charts = atlas::MakeStripCharts(mesh, g.patches, g.unfoldings, o, stats);
   ExpectEachFaceInOneChart(charts, mesh.faces.size());
   return charts;
@@ -123,7 +122,8 @@ TEST(Charts, ConformalChartsOfASphereStayWithinTheStretchBound) {
 // The atlas frame (dP/du, n x dP/du, n) that a renderer derives from the
 // texture coordinates is the triangle frame turned by AtlasFrameAngle, and
 // FrameFromAtlas inverts the placement.
-void ExpectLayoutAgreesWithTextureCoordinates(const mesh::TriangleMesh& mesh, const PatchGeometry& g,
+void ExpectLayoutAgreesWithTextureCoordinates(const mesh::TriangleMesh& mesh,
+                                              const PatchGeometry& g,
                                               const atlas::AtlasLayout& layout) {
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     const atlas::FacePlacement& fp = layout.faces[f];
@@ -268,7 +268,8 @@ TEST(Charts, StripsOfASphereAreBandsWithinTheStretchBound) {
   std::size_t previous_charts = 0;
   for (const double bound : {1.25, 1.1}) {
     o.max_stretch = bound;
-    for (const atlas::StripSide side : {atlas::StripSide::kTallest, atlas::StripSide::kNearestPreferred}) {
+    for (const atlas::StripSide side :
+         {atlas::StripSide::kTallest, atlas::StripSide::kNearestPreferred}) {
       o.side = side;
       const auto charts = CheckedStripCharts(mesh, g, o);
       ExpectBands(charts, g, mesh, bound);
@@ -465,16 +466,16 @@ TEST(Charts, FansOfCylinderCapsAreUprightSectors) {
 atlas::AtlasCoverage ExpectNoTexelInTwoCharts(const atlas::AtlasLayout& layout, int gutter) {
   std::vector<cv::Mat> owner;
   for (const cv::Size& size : layout.atlas_sizes) owner.emplace_back(size, CV_32SC1, -1);
-  return atlas::VisitAtlasTexels(layout, kTexel, gutter,
-                          [&](int atlas, int x, int y, int face, const Eigen::Vector2d&) {
-                            int& who = owner[static_cast<std::size_t>(atlas)].at<int>(y, x);
-                            const int chart = layout.faces[static_cast<std::size_t>(face)].chart;
-                            if (who >= 0) {
-                              EXPECT_EQ(layout.faces[static_cast<std::size_t>(who)].chart, chart)
-                                  << "texel " << x << ", " << y;
-                            }
-                            who = face;
-                          });
+  return atlas::VisitAtlasTexels(
+      layout, kTexel, gutter, [&](int atlas, int x, int y, int face, const Eigen::Vector2d&) {
+        int& who = owner[static_cast<std::size_t>(atlas)].at<int>(y, x);
+        const int chart = layout.faces[static_cast<std::size_t>(face)].chart;
+        if (who >= 0) {
+          EXPECT_EQ(layout.faces[static_cast<std::size_t>(who)].chart, chart)
+              << "texel " << x << ", " << y;
+        }
+        who = face;
+      });
 }
 
 // A latitude-longitude sphere's poles are curved fans (their angles sum to
@@ -539,7 +540,8 @@ TEST(Charts, StripLayoutsFillAtlasesAboveEightyFivePercent) {
     const PatchGeometry g = Geometry(mesh);
     atlas::AtlasOptions o;
     ASSERT_EQ(o.flattening, atlas::ChartFlattening::kAuto);
-    const atlas::AtlasLayout layout = atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+    const atlas::AtlasLayout layout =
+        atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
     EXPECT_EQ(layout.flattening, atlas::ChartFlattening::kStrips);
     const atlas::AtlasCoverage coverage = ExpectNoTexelInTwoCharts(layout, o.gutter);
     double texels = 0;
@@ -561,11 +563,13 @@ TEST(Charts, AutoKeepsTheSmallerOfStripsAndRigidCharts) {
   const PatchGeometry g = Geometry(mesh);
   atlas::AtlasOptions o;
   std::int64_t texels[3];
-  const atlas::ChartFlattening kinds[3] = {atlas::ChartFlattening::kAuto, atlas::ChartFlattening::kStrips,
-                                    atlas::ChartFlattening::kRigid};
+  const atlas::ChartFlattening kinds[3] = {atlas::ChartFlattening::kAuto,
+                                           atlas::ChartFlattening::kStrips,
+                                           atlas::ChartFlattening::kRigid};
   for (int i = 0; i < 3; ++i) {
     o.flattening = kinds[i];
-    const atlas::AtlasLayout layout = atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+    const atlas::AtlasLayout layout =
+        atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
     texels[i] = layout.Texels();
     EXPECT_NE(layout.flattening, atlas::ChartFlattening::kAuto);
   }
@@ -582,10 +586,12 @@ TEST(Charts, FragmentedStripsOfAnIrregularSphereNestInRows) {
   const PatchGeometry g = Geometry(mesh);
   atlas::AtlasOptions o;
   double occupancy[2] = {0, 0};
-  const atlas::ChartFlattening kinds[2] = {atlas::ChartFlattening::kStrips, atlas::ChartFlattening::kRigid};
+  const atlas::ChartFlattening kinds[2] = {atlas::ChartFlattening::kStrips,
+                                           atlas::ChartFlattening::kRigid};
   for (int i = 0; i < 2; ++i) {
     o.flattening = kinds[i];
-    const atlas::AtlasLayout layout = atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+    const atlas::AtlasLayout layout =
+        atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
     const atlas::AtlasCoverage coverage = ExpectNoTexelInTwoCharts(layout, o.gutter);
     occupancy[i] =
         static_cast<double>(coverage.inside_texels) / static_cast<double>(layout.Texels());
@@ -633,7 +639,8 @@ TEST(Charts, RigidChartsGatherARunOfSliversLongerThanTheExtent) {
     EXPECT_EQ(charts.size(), 1u) << width_texels;
     atlas::AtlasOptions o;
     o.flattening = atlas::ChartFlattening::kRigid;
-    const atlas::AtlasLayout layout = atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+    const atlas::AtlasLayout layout =
+        atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
     ASSERT_EQ(layout.atlas_sizes.size(), 1u);
     // The run's width, a gutter ring each side, a texel of rounding.
     EXPECT_LE(layout.atlas_sizes[0].height, kSlivers / 2 * width_texels + 2 * o.gutter + 2)

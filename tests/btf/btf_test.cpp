@@ -9,8 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 
-#include "pipeline/btf_synth_job.h"
 #include "core/errors.h"
+#include "pipeline/btf_synth_job.h"
 #include "synth/mesh_synthesis.h"
 #include "tests/test_util.h"
 

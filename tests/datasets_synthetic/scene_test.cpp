@@ -7,10 +7,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "datasets_synthetic/object_scene.h"
+#include "mesh/mesh.h"
 #include "ptm/exr_io.h"
 #include "sfm/colmap_io.h"
 #include "sfm/lights.h"
-#include "mesh/mesh.h"
 #include "tests/test_util.h"
 
 namespace texlume::datasets {

@@ -86,7 +86,8 @@ TEST(TriangleRowSpan, HoldsThePointsWithinTheMarginAndLittleMore) {
                                                  Eigen::Vector2d(2, 0)};
   const auto [lo, hi] = mesh::TriangleRowSpan(sliver, 400.0, 2.5);
   EXPECT_LT(hi - lo, 2.0 + 4 * 2.5 + 1e-9);
-  EXPECT_GT(mesh::TriangleRowSpan(sliver, 900.0, 2.5).first, mesh::TriangleRowSpan(sliver, 900.0, 2.5).second);
+  EXPECT_GT(mesh::TriangleRowSpan(sliver, 900.0, 2.5).first,
+            mesh::TriangleRowSpan(sliver, 900.0, 2.5).second);
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // Issue 8: per-triangle image-constrained BTF quilting with graph-cut seams,
 // the BTF model folder and its rendering, on a small glossy sphere.
-#include "synth/mesh_btf.h"
+#include "pipeline/btf_synth_job.h"
 
 #include <gtest/gtest.h>
 
@@ -10,16 +10,16 @@
 #include <numbers>
 
 #include "btf/btf.h"
-#include "pipeline/btf_synth_job.h"
 #include "core/errors.h"
 #include "datasets_synthetic/scene.h"
-#include "ptm/fit.h"
-#include "ptm/ptm_io.h"
-#include "model/model_io.h"
 #include "model/btf_model.h"
+#include "model/model_io.h"
 #include "pipeline/render_job.h"
 #include "pipeline/synth_job.h"
+#include "ptm/fit.h"
+#include "ptm/ptm_io.h"
 #include "render/btf_shading.h"
+#include "synth/mesh_btf.h"
 #include "tests/small_scene.h"
 #include "tests/test_util.h"
 
@@ -87,7 +87,7 @@ class MeshBtfTest : public ::testing::Test {
     return o;
   }
   static pipeline::RenderJobSummary Render(const fs::path& model, const std::string& out,
-                                        render::RenderMode mode, bool as_btf) {
+                                           render::RenderMode mode, bool as_btf) {
     pipeline::RenderJobOptions r;
     const fs::path held = tmp_->path() / "scene/object/held_out";
     r.model_folder = model;

@@ -1,5 +1,7 @@
 // The main job (issue 6): per-triangle synthesis, blending, atlases, export,
 // rendering, on a small synthetic sphere with ground truth.
+#include "pipeline/synth_job.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,24 +13,23 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "atlas/atlas.h"
 #include "core/errors.h"
-#include "model/baselines.h"
 #include "datasets_synthetic/scene.h"
+#include "mesh/mesh.h"
+#include "model/baselines.h"
+#include "model/model_io.h"
+#include "model/web_model.h"
+#include "pipeline/render_job.h"
+#include "pipeline/report_pictures.h"
 #include "ptm/coefficient_space.h"
 #include "ptm/fit.h"
 #include "ptm/ptm_io.h"
+#include "render/model_render.h"
+#include "report/report.h"
 #include "sfm/colmap_io.h"
 #include "sfm/lights.h"
-#include "mesh/mesh.h"
-#include "atlas/atlas.h"
 #include "synth/mesh_synthesis.h"
-#include "model/model_io.h"
-#include "render/model_render.h"
-#include "pipeline/render_job.h"
-#include "pipeline/report_pictures.h"
-#include "pipeline/synth_job.h"
-#include "report/report.h"
-#include "model/web_model.h"
 #include "tests/small_scene.h"
 #include "tests/test_util.h"
 
@@ -70,7 +71,7 @@ class MeshPipelineTest : public ::testing::Test {
     return j;
   }
   static pipeline::RenderJobSummary Render(render::RenderMode mode, const std::string& out,
-                                 const std::string& model = "model") {
+                                           const std::string& model = "model") {
     pipeline::RenderJobOptions r;
     const fs::path held = tmp_->path() / "scene/object/held_out";
     r.model_folder = tmp_->path() / model;
@@ -367,7 +368,8 @@ TEST_F(MeshPipelineTest, DetailTransferBringsHeldOutViewsCloserToTheTruth) {
   job.write_report = false;
   pipeline::RunSynthJob(job);
   const pipeline::RenderJobSummary with = Render(render::RenderMode::kPtm, "render_detail");
-  const pipeline::RenderJobSummary without = Render(render::RenderMode::kPtm, "render_no_detail", "model_no_detail");
+  const pipeline::RenderJobSummary without =
+      Render(render::RenderMode::kPtm, "render_no_detail", "model_no_detail");
   std::printf("held-out PSNR / SSIM: detail transfer %.2f / %.3f, without %.2f / %.3f\n",
               with.mean_psnr, with.mean_ssim, without.mean_psnr, without.mean_ssim);
   EXPECT_GT(with.mean_ssim, without.mean_ssim + 0.015);
@@ -391,7 +393,8 @@ TEST_F(MeshPipelineTest, EstimatedPriorShrinkDoesAsWellAsTheBetterEnd) {
     ssim[end] = r.mean_ssim;
     psnr[end] = r.mean_psnr;
   }
-  const pipeline::RenderJobSummary estimated = Render(render::RenderMode::kPtm, "render_shrink_estimated");
+  const pipeline::RenderJobSummary estimated =
+      Render(render::RenderMode::kPtm, "render_shrink_estimated");
   std::printf(
       "held-out PSNR / SSIM: estimated shrink %.2f / %.3f, 0: %.2f / %.3f, 1: %.2f / %.3f\n",
       estimated.mean_psnr, estimated.mean_ssim, psnr[0], ssim[0], psnr[1], ssim[1]);

@@ -9,8 +9,8 @@
 #include <random>
 
 #include "datasets_synthetic/shapes.h"
-#include "synth/mesh_synthesis.h"
 #include "pipeline/synth_job.h"
+#include "synth/mesh_synthesis.h"
 #include "tests/small_scene.h"
 #include "tests/test_util.h"
 
@@ -233,7 +233,8 @@ TEST(PhotoFrames, BricksOnAColumnRunAroundItAndMatchThePhotosBetter) {
   job.synthesis.correction_iterations = 0;  // the quilting alone
   job.synthesis.detail_transfer = false;
   pipeline::SynthInputs inputs = pipeline::LoadSynthInputs(job);
-  pipeline::PrepareSynthMesh(inputs, job, std::min(sample.width, sample.height), 0.004, job.synthesis.strip);
+  pipeline::PrepareSynthMesh(inputs, job, std::min(sample.width, sample.height), 0.004,
+                             job.synthesis.strip);
   auto synthesise = [&](TangentFrame frame) {
     job.synthesis.tangent_frame = frame;
     return SynthesizeMeshPtm(inputs.mesh, inputs.reconstruction, inputs.visibility, inputs.photos,
