@@ -6,7 +6,7 @@
 #include "datasets_synthetic/object_scene.h"
 #include "tests/test_util.h"
 
-namespace texlume::sfm {
+namespace texlume::mesh {
 namespace {
 
 using testing::TempDir;
@@ -184,5 +184,17 @@ TEST(MeshBadInput, UnparsableMissingAndOutOfRangeFilesAreNamed) {
   }
 }
 
+TEST(SubdivideMidpoint, SplitsEveryTriangleInFourAndWeldsMidpoints) {
+  mesh::TriangleMesh m;
+  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  m.faces = {{0, 1, 2}, {1, 3, 2}};
+  const mesh::TriangleMesh s = mesh::SubdivideMidpoint(m);
+  EXPECT_EQ(s.faces.size(), 8u);
+  EXPECT_EQ(s.vertices.size(), 9u);  // 4 + 5 edge midpoints, the shared one once
+  double area = 0;
+  for (double a : mesh::FaceAreas(s)) area += a;
+  EXPECT_NEAR(area, 1.0, 1e-12);
+}
+
 }  // namespace
-}  // namespace texlume::sfm
+}  // namespace texlume::mesh

@@ -222,34 +222,6 @@ TEST_F(MeshPipelineTest, BlendingMakesEdgesContinuous) {
   EXPECT_LT(blended, 0.05 * raw);
 }
 
-TEST(PackSkyline, RectanglesDoNotOverlapAndStayInTheirBins) {
-  std::mt19937 rng(2);
-  std::vector<std::pair<int, int>> sizes;
-  for (int i = 0; i < 300; ++i)
-    sizes.emplace_back(std::uniform_int_distribution<int>(3, 60)(rng),
-                       std::uniform_int_distribution<int>(3, 60)(rng));
-  const auto placed = atlas::PackSkyline(sizes, 256, 256);
-  int bins = 0;
-  for (const auto& p : placed) bins = std::max(bins, p[0] + 1);
-  std::vector<cv::Mat> used(static_cast<std::size_t>(bins));
-  for (cv::Mat& m : used) m = cv::Mat::zeros(256, 256, CV_8UC1);
-  long area = 0;
-  for (std::size_t i = 0; i < sizes.size(); ++i) {
-    const auto [bin, x, y] = placed[i];
-    ASSERT_GE(x, 0);
-    ASSERT_GE(y, 0);
-    ASSERT_LE(x + sizes[i].first, 256);
-    ASSERT_LE(y + sizes[i].second, 256);
-    cv::Mat roi =
-        used[static_cast<std::size_t>(bin)](cv::Rect(x, y, sizes[i].first, sizes[i].second));
-    ASSERT_EQ(cv::countNonZero(roi), 0) << "rectangle " << i << " overlaps";
-    roi.setTo(1);
-    area += sizes[i].first * sizes[i].second;
-  }
-  EXPECT_GT(static_cast<double>(area) / (bins * 256.0 * 256.0), 0.6);  // skyline packs tightly
-  EXPECT_THROW(atlas::PackSkyline({{300, 10}}, 256, 256), OptionError);
-}
-
 TEST_F(MeshPipelineTest, AtlasFacesDoNotOverlapAndChartsPackTighter) {
   const model::TexturedModel model = model::ReadModelFolder(tmp_->path() / "model");
   std::vector<cv::Mat> owner;
@@ -450,18 +422,6 @@ TEST_F(MeshPipelineTest, BadInputIsRefusedWithNothingWritten) {
   bool named = false;
   for (const std::string& w : s.warnings) named = named || w.find(dropped) != std::string::npos;
   EXPECT_TRUE(named);
-}
-
-TEST(SubdivideMidpoint, SplitsEveryTriangleInFourAndWeldsMidpoints) {
-  mesh::TriangleMesh m;
-  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
-  m.faces = {{0, 1, 2}, {1, 3, 2}};
-  const mesh::TriangleMesh s = mesh::SubdivideMidpoint(m);
-  EXPECT_EQ(s.faces.size(), 8u);
-  EXPECT_EQ(s.vertices.size(), 9u);  // 4 + 5 edge midpoints, the shared one once
-  double area = 0;
-  for (double a : mesh::FaceAreas(s)) area += a;
-  EXPECT_NEAR(area, 1.0, 1e-12);
 }
 
 }  // namespace
@@ -668,16 +628,6 @@ TEST_F(MeshPipelineTest, ReportOnHeldOutViewsMeasuresAndSweepsTheLight) {
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(out.path())) ++entries;
   EXPECT_EQ(entries, 2u);  // report.html and report/
-}
-
-TEST(QuantisePlane, ConstantPlanesAndExtremesAreExact) {
-  const model::QuantisedPlane constant = model::QuantisePlane({0.25f, 0.25f});
-  EXPECT_EQ(constant.bias, 0.25f);
-  EXPECT_EQ(constant.bytes[0], 0);
-  const model::QuantisedPlane q = model::QuantisePlane({-1.0f, 0.5f, 3.0f});
-  EXPECT_EQ(q.bytes[0], 0);
-  EXPECT_EQ(q.bytes[2], 255);
-  EXPECT_NEAR(q.bytes[1] / 255.0 * q.scale + q.bias, 0.5, 0.5 * q.scale / 255.0);
 }
 
 }  // namespace
