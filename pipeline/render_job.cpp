@@ -30,6 +30,19 @@ void RenderJobOptions::Check() const {
     throw OptionError("truth masks need truth images");
 }
 
+nlohmann::json RenderJobOptions::ToJson() const {
+  nlohmann::json settings = {{"model", model_folder.string()},
+                             {"cameras", cameras_dir.string()},
+                             {"lights", lights_file.string()},
+                             {"mode", render::RenderModeName(mode)},
+                             {"btf_as_btf", btf_as_btf},
+                             {"samples_per_axis", samples_per_axis},
+                             {"reduced_factor", reduced_factor}};
+  if (!truth_images_dir.empty()) settings["truth_images"] = truth_images_dir.string();
+  if (!truth_masks_dir.empty()) settings["truth_masks"] = truth_masks_dir.string();
+  return settings;
+}
+
 namespace {
 
 fs::path PngName(const std::string& image_name) {
@@ -139,19 +152,6 @@ class RenderJob {
     }
   }
 
-  std::string ModeName() const {
-    if (btf_) return "btf";
-    switch (options_.mode) {
-      case render::RenderMode::kPtm:
-        return "ptm";
-      case render::RenderMode::kFlat:
-        return "flat";
-      case render::RenderMode::kBaked:
-        return "baked";
-    }
-    return "ptm";
-  }
-
   nlohmann::json MetricsJson() const {
     nlohmann::json views = nlohmann::json::array();
     for (const render::ViewMetrics& m : summary_.metrics)
@@ -172,11 +172,8 @@ class RenderJob {
   void WriteRecord() const {
     nlohmann::json record;
     record["command"] = "render";
-    record["settings"] = {{"model", options_.model_folder.string()},
-                          {"cameras", options_.cameras_dir.string()},
-                          {"lights", options_.lights_file.string()},
-                          {"mode", ModeName()},
-                          {"samples_per_axis", options_.samples_per_axis}};
+    record["settings"] = options_.ToJson();
+    record["settings"]["mode"] = btf_ ? "btf" : render::RenderModeName(options_.mode);
     record["rendered"] = summary_.rendered;
     record["warnings"] = summary_.warnings;
     if (!summary_.metrics.empty()) record["metrics"] = MetricsJson();

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,9 @@ struct RenderJobOptions {
 
   /// Throws OptionError when a path is missing or a setting is out of range.
   void Check() const;
+  /// The settings as render.json records them ("mode" as asked; the job
+  /// records the mode it drew in).
+  nlohmann::json ToJson() const;
 };
 
 struct RenderJobSummary {

@@ -40,6 +40,18 @@ struct ModelRenderer::Impl {
   std::unique_ptr<mesh::RayCaster> caster;
 };
 
+const char* RenderModeName(RenderMode mode) {
+  switch (mode) {
+    case RenderMode::kPtm:
+      return "ptm";
+    case RenderMode::kFlat:
+      return "flat";
+    case RenderMode::kBaked:
+      return "baked";
+  }
+  return "ptm";
+}
+
 ModelRenderer::ModelRenderer(const model::TexturedModel& model) : model_(model), impl_(new Impl) {
   const mesh::TriangleMesh& mesh = model.mesh;
   vertex_normals_ = mesh::VertexNormals(mesh);

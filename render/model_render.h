@@ -29,6 +29,9 @@ enum class RenderMode {
   kBaked,  ///< the photos baked into an ordinary texture, shown as they are (unlit)
 };
 
+/// "ptm", "flat" or "baked", as settings files name the modes.
+const char* RenderModeName(RenderMode mode);
+
 /// Ray-casts a textured model (Embree) through COLMAP cameras, distortion
 /// included: perspective-correct by construction (barycentrics of the hit),
 /// nearest surface only, bilinear texture lookups, `samples_per_axis`^2 rays

@@ -60,5 +60,20 @@ TEST(RenderJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
   EXPECT_THROW(pipeline::RunRenderJob(o), OptionError);
 }
 
+TEST(RenderJobOptions, SettingsNameEveryChoice) {
+  pipeline::RenderJobOptions o;
+  o.model_folder = "model";
+  o.mode = render::RenderMode::kBaked;
+  o.reduced_factor = 2;
+  o.truth_images_dir = "truth";
+  const nlohmann::json s = o.ToJson();
+  EXPECT_EQ(s["model"], "model");
+  EXPECT_EQ(s["mode"], "baked");
+  EXPECT_EQ(s["reduced_factor"], 2);
+  EXPECT_EQ(s["truth_images"], "truth");
+  EXPECT_FALSE(s.contains("truth_masks"));
+  EXPECT_EQ(s["btf_as_btf"], true);
+}
+
 }  // namespace
 }  // namespace texlume::synth
