@@ -135,7 +135,7 @@ using TexelLookup = std::function<void(int face, const Eigen::Vector2d& p_in_fra
 struct BakedPlanes {
   std::vector<std::vector<cv::Mat>> planes;  ///< per atlas, `num_planes` CV_32FC1
   std::vector<cv::Mat> coverage;             ///< as AtlasCoverage
-  double occupancy = 0.0;  ///< texels inside triangles over all atlas texels
+  double occupancy = 0.0;                    ///< texels inside triangles over all atlas texels
 };
 
 /// The one baker of every sample kind: per atlas texel inside a face or its

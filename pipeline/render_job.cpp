@@ -31,13 +31,11 @@ void RenderJobOptions::Check() const {
 }
 
 nlohmann::json RenderJobOptions::ToJson() const {
-  nlohmann::json settings = {{"model", model_folder.string()},
-                             {"cameras", cameras_dir.string()},
-                             {"lights", lights_file.string()},
-                             {"mode", render::RenderModeName(mode)},
-                             {"btf_as_btf", btf_as_btf},
-                             {"samples_per_axis", samples_per_axis},
-                             {"reduced_factor", reduced_factor}};
+  nlohmann::json settings = {
+      {"model", model_folder.string()},  {"cameras", cameras_dir.string()},
+      {"lights", lights_file.string()},  {"mode", render::RenderModeName(mode)},
+      {"btf_as_btf", btf_as_btf},        {"samples_per_axis", samples_per_axis},
+      {"reduced_factor", reduced_factor}};
   if (!truth_images_dir.empty()) settings["truth_images"] = truth_images_dir.string();
   if (!truth_masks_dir.empty()) settings["truth_masks"] = truth_masks_dir.string();
   return settings;
