@@ -1,0 +1,109 @@
+#include "report/report.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "core/errors.h"
+#include "tests/test_util.h"
+
+namespace texlume::report {
+namespace {
+namespace fs = std::filesystem;
+
+std::vector<std::string> Links(const std::string& html) {
+  std::vector<std::string> links;
+  for (const std::string attribute : {"src=\"", "href=\""})
+    for (std::size_t at = html.find(attribute); at != std::string::npos;
+         at = html.find(attribute, at + 1)) {
+      const std::size_t begin = at + attribute.size();
+      links.push_back(html.substr(begin, html.find('"', begin) - begin));
+    }
+  return links;
+}
+
+// One triangle on a 16 x 16 atlas of a flat grey PTM.
+model::TexturedModel OneTriangle() {
+  model::TexturedModel m;
+  m.mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  m.mesh.faces = {{0, 1, 2}};
+  m.corner_px = {{Eigen::Vector2f(1, 15), Eigen::Vector2f(15, 15), Eigen::Vector2f(1, 1)}};
+  m.face_atlas = {0};
+  ptm::Ptm atlas;
+  atlas.Resize(ptm::PtmFormat::kRgb, 16, 16);
+  for (std::size_t t = 0; t < atlas.NumTexels(); ++t)
+    for (int p = 0; p < 3; ++p) atlas.coefficients[(t * 3 + p) * 6 + 5] = 0.5f;  // a5: constant
+  m.atlases = {atlas};
+  return m;
+}
+
+// The report lays out pictures and metrics it is given: every picture it links
+// exists, the metrics shown are the given ones (it measures nothing), and
+// text is escaped.
+TEST(WriteReport, ShowsTheGivenPicturesAndMetricsAndLinksOnlyWhatItWrote) {
+  const model::TexturedModel model = OneTriangle();
+  ReportInputs in;
+  in.title = "a <stone> & \"sphere\"";
+  in.model = &model;
+  in.occupancy = 0.5;
+  const cv::Mat grey(24, 32, CV_32FC3, cv::Scalar::all(0.4));
+  in.sample_relit = {{Eigen::Vector3d::UnitZ(), grey}, {Eigen::Vector3d::UnitX(), grey}};
+  in.sample_width = 32;
+  in.sample_height = 24;
+  render::ViewPictures view;
+  view.name = "view_0.png";
+  view.reference = grey;
+  view.inside = cv::Mat(24, 32, CV_8UC1, cv::Scalar(255));
+  view.drawn = {{"texlume", grey, 31.25, 0.875}, {"flat", grey, 12.5, 0.25}};
+  in.views = {view, view};
+  in.views_total = 5;
+  in.views_heading = "Held-out views";
+  in.sweep = {grey, grey, grey, grey};
+  in.sweep_view = view.name;
+  in.metrics = {{"texlume", {{"view_0.png", 22.5, 0.5, 23.5, 0.625}}, 22.5, 0.5, 23.5, 0.625}};
+  testing::TempDir out;
+  const ReportSummary s = WriteReport(out.path(), in);
+  const std::string html = testing::ReadText(out.path() / "report.html");
+  EXPECT_NE(html.find("a &lt;stone&gt; &amp; &quot;sphere&quot;"), std::string::npos);
+  EXPECT_NE(html.find("2 of 5 views"), std::string::npos);
+  EXPECT_NE(html.find("31.25 dB, SSIM 0.875"), std::string::npos);
+  EXPECT_NE(html.find("22.50"), std::string::npos);
+  for (const std::string& link : Links(html)) EXPECT_TRUE(fs::exists(out.path() / link)) << link;
+  // 2 sample, 2 x (reference + 2 models + 2 errors), the sweep, 1 atlas.
+  EXPECT_EQ(s.pictures, 2u + 2u * 5u + 1u + 1u);
+  ASSERT_EQ(s.rows.size(), 4u);
+  EXPECT_EQ(s.rows[0].psnr, 31.25);
+  EXPECT_EQ(s.rows[1].model, "flat");
+  EXPECT_EQ(cv::imread((out.path() / "report/light_sweep.png").string()).cols, 4 * 32);
+  const std::vector<double> occupancy = AtlasOccupancies(model);
+  ASSERT_EQ(occupancy.size(), 1u);
+  // Every texel whose centre is inside counts (1 + ... + 14 of them), and no
+  // texel beyond the triangle grown by one texel (1 + ... + 16).
+  EXPECT_GE(occupancy[0], 105.0 / 256.0);
+  EXPECT_LE(occupancy[0], 136.0 / 256.0);
+}
+
+// A photo that cannot be read: an error naming it, the earlier report kept.
+TEST(WriteReport, AFailureKeepsTheEarlierReportWhole) {
+  const model::TexturedModel model = OneTriangle();
+  ReportInputs in;
+  in.model = &model;
+  testing::TempDir out;
+  WriteReport(out.path(), in);
+  const std::string before = testing::ReadText(out.path() / "report.html");
+  in.photos = {{"missing.png", out.path() / "missing.png", {}, {}}};
+  EXPECT_THROW(WriteReport(out.path(), in), InputError);
+  EXPECT_EQ(testing::ReadText(out.path() / "report.html"), before);
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(out.path())) ++entries;
+  EXPECT_EQ(entries, 2u);  // report.html and report/
+}
+
+TEST(HtmlEscape, EscapesTheFiveCharacters) {
+  EXPECT_EQ(HtmlEscape("<a href='x'>&\"</a>"), "&lt;a href=&#39;x&#39;&gt;&amp;&quot;&lt;/a&gt;");
+}
+
+}  // namespace
+}  // namespace texlume::report
