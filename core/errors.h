@@ -38,4 +38,12 @@ class OptionError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+/// Throws OptionError "`what` must be in [lo, hi]" unless lo <= value <= hi
+/// (NaN is refused).
+inline void RequireInRange(double value, double lo, double hi, const std::string& what) {
+  if (!(value >= lo && value <= hi))
+    throw OptionError(what + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                      "]");
+}
+
 }  // namespace texlume

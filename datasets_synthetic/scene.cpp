@@ -71,29 +71,24 @@ void SceneOptions::Check() const {
   material.Check();
   if (mesh_resolution < 0 || mesh_resolution > 7)
     throw OptionError("mesh resolution must be in [0, 7]");
-  auto in = [](double v, double lo, double hi, const char* what) {
-    if (!(v >= lo && v <= hi)) {
-      throw OptionError(std::string(what) + " must be in [" + std::to_string(lo) + ", " +
-                        std::to_string(hi) + "]");
-    }
-  };
-  in(num_images, 3, 500, "num_images");
-  in(image_width, 64, 8192, "image_width");
-  in(image_height, 64, 8192, "image_height");
-  in(focal_px, 1, 1e6, "focal_px");
-  in(camera_distance, 1.6, 1000, "camera_distance");
-  in(max_lights_per_image, 1, 3, "max_lights_per_image");
-  in(num_held_out_views, 0, 100, "num_held_out_views");
-  in(held_out_lights_per_view, 1, 20, "held_out_lights_per_view");
-  in(held_out_scale, 1, 4, "held_out_scale");
-  in(capture_size, 16, 4096, "capture_size");
-  in(num_capture_lights, 6, 500, "num_capture_lights");
-  in(num_held_out_capture_lights, 0, 500, "num_held_out_capture_lights");
-  in(btf_size, 16, 1024, "btf_size");
-  in(btf_view_count, 1, 64, "btf_view_count");
-  in(btf_light_count, 1, 128, "btf_light_count");
-  in(tessellation_step, 0, 1, "tessellation_step");
+  RequireInRange(num_images, 3, 500, "num_images");
+  RequireInRange(image_width, 64, 8192, "image_width");
+  RequireInRange(image_height, 64, 8192, "image_height");
+  RequireInRange(focal_px, 1, 1e6, "focal_px");
+  RequireInRange(camera_distance, 1.6, 1000, "camera_distance");
+  RequireInRange(max_lights_per_image, 1, 3, "max_lights_per_image");
+  RequireInRange(num_held_out_views, 0, 100, "num_held_out_views");
+  RequireInRange(held_out_lights_per_view, 1, 20, "held_out_lights_per_view");
+  RequireInRange(held_out_scale, 1, 4, "held_out_scale");
+  RequireInRange(capture_size, 16, 4096, "capture_size");
+  RequireInRange(num_capture_lights, 6, 500, "num_capture_lights");
+  RequireInRange(num_held_out_capture_lights, 0, 500, "num_held_out_capture_lights");
+  RequireInRange(btf_size, 16, 1024, "btf_size");
+  RequireInRange(btf_view_count, 1, 64, "btf_view_count");
+  RequireInRange(btf_light_count, 1, 128, "btf_light_count");
+  RequireInRange(tessellation_step, 0, 1, "tessellation_step");
   shading.Check();
+  sensor.Check();
   if (camera_model != sfm::CameraModelId::kPinhole && camera_model != sfm::CameraModelId::kOpenCV) {
     throw OptionError("camera_model must be PINHOLE or OPENCV");
   }
@@ -442,6 +437,7 @@ class SceneGenerator {
   // The object's photos and masks under their lights (exposure drawn per photo), and its model.
   void PhotographObject() {
     std::mt19937_64 rng(options_.seed * 31u + 7u);
+    std::mt19937_64 sensor_rng(options_.seed * 1000003u + 17u);  // apart from the exposures'
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
     const sfm::Camera& camera = PhotoCamera();
     std::size_t done = 0;
@@ -454,9 +450,16 @@ class SceneGenerator {
       }
       const Rendering r =
           renderer_->RenderPerspective(camera, image.cam_from_world, lights, shading);
-      WritePngAtomically(dir_ / "object/images" / image.name, LinearToSrgb8(r.linear_rgb));
+      SensorDraw draw;
+      const cv::Mat photo = options_.sensor.Active()
+                                ? ExposeOnSensor(r.linear_rgb, options_.sensor, sensor_rng, &draw)
+                                : LinearToSrgb8(r.linear_rgb);
+      WritePngAtomically(dir_ / "object/images" / image.name, photo);
       WritePngAtomically(dir_ / "object/masks" / image.name, CoverageMask(r));
       photos_[image.name] = {{"exposure", shading.exposure}, {"lights", lights.size()}};
+      if (options_.sensor.white_balance_spread > 0)
+        photos_[image.name]["white_balance"] = {draw.white_balance[0], draw.white_balance[1],
+                                                draw.white_balance[2]};
       files_ += 2;
       Report("object photos", ++done, object_.reconstruction.images.size());
     }
@@ -536,6 +539,7 @@ class SceneGenerator {
                          {"samples_per_pixel",
                           options_.shading.samples_per_axis * options_.shading.samples_per_axis},
                          {"shadows", options_.shading.shadows}};
+    record["sensor"] = options_.sensor.ToJson();
     record["capture"] = {{"size", options_.capture_size},
                          {"lights", options_.num_capture_lights},
                          {"held_out_lights", options_.num_held_out_capture_lights}};

@@ -7,6 +7,7 @@
 
 #include "core/progress.h"
 #include "datasets_synthetic/material.h"
+#include "datasets_synthetic/photo_sensor.h"
 #include "datasets_synthetic/renderer.h"
 #include "datasets_synthetic/shapes.h"
 #include "sfm/camera_models.h"
@@ -57,6 +58,9 @@ struct SceneOptions {
   /// Edge length of the displaced geometry's triangles, world units; 0 = 2 texels.
   double tessellation_step = 0.0;
   ShadingOptions shading;
+  /// What the camera adds to the object photos (noise, vignetting, white
+  /// balance, JPEG); off by default. The held-out truth stays clean.
+  SensorOptions sensor;
   std::uint32_t seed = 1;
 
   void Check() const;
