@@ -212,6 +212,7 @@ void AddDemoCommand(CLI::App& app, CommandRunners& run) {
       ->transform(Choice(MaterialWords()))
       ->default_str("stone");
   sub->add_option("--seed", o->seed, "random seed")->capture_default_str();
+  BindSensor(sub, o->sensor);
   run[sub] = [o](std::ostream& out, std::ostream& err) {
     ProgressBar bar;
     pipeline::RunDemoJob(*o, out, err, bar.Callback());

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "datasets_synthetic/material.h"
+#include "datasets_synthetic/photo_sensor.h"
 #include "datasets_synthetic/shapes.h"
 
 namespace texlume::apps {
@@ -63,5 +64,8 @@ CLI::Validator Choice(const std::map<std::string, Enum>& words) {
 /// The words of the synthetic scenes' shapes and materials (scene, demo).
 std::map<std::string, datasets::SceneShape> ShapeWords();
 std::map<std::string, datasets::MaterialKind> MaterialWords();
+/// The scene photos' sensor options (--shot-noise, --read-noise, --vignetting,
+/// --white-balance-spread, --jpeg-quality), for `scene` and `demo`.
+void BindSensor(CLI::App* sub, datasets::SensorOptions& s);
 
 }  // namespace texlume::apps

@@ -190,6 +190,23 @@ void AddRenderCommand(CLI::App& app, CommandRunners& run) {
   };
 }
 
+void BindSensor(CLI::App* sub, datasets::SensorOptions& s) {
+  sub->add_option("--shot-noise", s.shot_noise,
+                  "photos' shot noise: variance per unit linear signal (0: off)")
+      ->capture_default_str();
+  sub->add_option("--read-noise", s.read_noise,
+                  "photos' read noise: standard deviation, linear (0: off)")
+      ->capture_default_str();
+  sub->add_option("--vignetting", s.vignetting, "photos' brightness lost at the corners (0: off)")
+      ->capture_default_str();
+  sub->add_option("--white-balance-spread", s.white_balance_spread,
+                  "photos' per-channel gain drawn in [1 - s, 1 + s] (0: off)")
+      ->capture_default_str();
+  sub->add_option("--jpeg-quality", s.jpeg_quality,
+                  "photos stored as a JPEG of this quality would be (0: lossless)")
+      ->capture_default_str();
+}
+
 namespace {
 
 void BindSceneCapture(CLI::App* sub, datasets::SceneOptions& s) {
@@ -216,21 +233,6 @@ void BindSceneCapture(CLI::App* sub, datasets::SceneOptions& s) {
   sub->add_option("--btf-size", s.btf_size, "BTF capture side in texels")->capture_default_str();
   sub->add_option("--btf-views", s.btf_view_count, "BTF capture views")->capture_default_str();
   sub->add_option("--btf-lights", s.btf_light_count, "BTF capture lights")->capture_default_str();
-  sub->add_option("--shot-noise", s.sensor.shot_noise,
-                  "photos' shot noise: variance per unit linear signal (0: off)")
-      ->capture_default_str();
-  sub->add_option("--read-noise", s.sensor.read_noise,
-                  "photos' read noise: standard deviation, linear (0: off)")
-      ->capture_default_str();
-  sub->add_option("--vignetting", s.sensor.vignetting,
-                  "photos' brightness lost at the corners (0: off)")
-      ->capture_default_str();
-  sub->add_option("--white-balance-spread", s.sensor.white_balance_spread,
-                  "photos' per-channel gain drawn in [1 - s, 1 + s] (0: off)")
-      ->capture_default_str();
-  sub->add_option("--jpeg-quality", s.sensor.jpeg_quality,
-                  "photos stored as a JPEG of this quality would be (0: lossless)")
-      ->capture_default_str();
 }
 
 }  // namespace
@@ -257,6 +259,7 @@ void AddSceneCommand(CLI::App& app, CommandRunners& run) {
   sub->add_option("--width", s->image_width, "photo width in pixels")->capture_default_str();
   sub->add_option("--height", s->image_height, "photo height in pixels")->capture_default_str();
   BindSceneCapture(sub, *s);
+  BindSensor(sub, s->sensor);
   sub->add_flag("--no-btf", flags->first, "no BTF capture");
   sub->add_flag("--fixed-exposure", flags->second, "every photo at one exposure");
   run[sub] = [s, out_dir, flags](std::ostream& out, std::ostream&) {

@@ -28,6 +28,7 @@ class DemoJob {
     scene_.material.seed = options.seed;
     scene_.shape = options.shape;
     scene_.material.kind = options.material;
+    scene_.sensor = options.sensor;
     scene_.write_btf = false;
     scene_.write_surface = false;
     // Held-out views at twice the photos' resolution: metrics at full
@@ -259,12 +260,14 @@ class DemoJob {
 
 void DemoJobOptions::Check() const {
   if (out_dir.empty()) throw OptionError("give the demo's output folder");
+  sensor.Check();
 }
 
 nlohmann::json DemoJobOptions::ToJson() const {
   return {{"shape", std::string(datasets::SceneShapeName(shape))},
           {"material", std::string(datasets::MaterialKindName(material))},
-          {"seed", seed}};
+          {"seed", seed},
+          {"sensor", sensor.ToJson()}};
 }
 
 void RunDemoJob(const DemoJobOptions& options, std::ostream& out, std::ostream& err,

@@ -116,6 +116,8 @@ struct DemoJobOptions {
   datasets::SceneShape shape = datasets::SceneShape::kSphere;
   datasets::MaterialKind material = datasets::MaterialKind::kStone;
   std::uint32_t seed = 1;
+  /// What the camera adds to the scene's photos (off: the clean scene).
+  datasets::SensorOptions sensor;
   void Check() const;
   nlohmann::json ToJson() const;
 };

@@ -256,6 +256,32 @@ TEST(Scene, SameSeedSameBytes) {
             testing::ReadText(tmp / "c/material/capture/rti_000.png"));
 }
 
+// The sensor changes the object photos only, and scene.json records it.
+TEST(Scene, SensorChangesThePhotosOnlyAndIsRecorded) {
+  testing::TempDir tmp;
+  SceneOptions options = SmallScene(SceneShape::kSphere, MaterialKind::kStone);
+  options.num_held_out_views = 1;
+  GenerateScene(options, tmp / "clean");
+  options.sensor.read_noise = 0.01;
+  options.sensor.white_balance_spread = 0.1;
+  GenerateScene(options, tmp / "noisy");
+  const auto photo = [&](const char* scene) {
+    return cv::imread((tmp / scene / "object/images/image_000.png").string());
+  };
+  const double rms = cv::norm(photo("clean"), photo("noisy"), cv::NORM_L2) /
+                     std::sqrt(3.0 * static_cast<double>(photo("clean").total()));
+  EXPECT_GT(rms, 1.0);  // grey levels
+  for (const char* same : {"material/capture/rti_000.png", "object/masks/image_000.png"})
+    EXPECT_EQ(testing::ReadText(tmp / "clean" / same), testing::ReadText(tmp / "noisy" / same))
+        << same;
+  const fs::path held = *fs::directory_iterator(tmp / "clean/object/held_out/images");
+  EXPECT_EQ(testing::ReadText(held),
+            testing::ReadText(tmp / "noisy/object/held_out/images" / held.filename()));
+  const nlohmann::json record = nlohmann::json::parse(testing::ReadText(tmp / "noisy/scene.json"));
+  EXPECT_EQ(record["sensor"]["read_noise"], 0.01);
+  EXPECT_EQ(record["photos"]["image_000.png"]["white_balance"].size(), 3u);
+}
+
 TEST(Materials, PeriodicMaterialsAreSeamlessAndBakingIsFaithful) {
   for (auto kind : {MaterialKind::kStone, MaterialKind::kBrick, MaterialKind::kGrooves}) {
     MaterialOptions o;
