@@ -532,28 +532,32 @@ TEST(Charts, CurvedFansOfALatitudeLongitudeSphere) {
 // The default layout (auto) is strips on the demo's sphere, cylinder and torus, fills the
 // atlases above 85 % there (bench/atlas_bench measures the rest), never puts
 // two charts on one texel, and agrees with the texture coordinates.
-TEST(Charts, StripLayoutsFillAtlasesAboveEightyFivePercent) {
-  for (const datasets::SceneShape shape :
-       {datasets::SceneShape::kSphere, datasets::SceneShape::kCylinder,
-        datasets::SceneShape::kTorus}) {
-    const mesh::TriangleMesh mesh = datasets::CoarseMesh(shape);
-    const PatchGeometry g = Geometry(mesh);
-    atlas::AtlasOptions o;
-    ASSERT_EQ(o.flattening, atlas::ChartFlattening::kAuto);
-    const atlas::AtlasLayout layout =
-        atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
-    EXPECT_EQ(layout.flattening, atlas::ChartFlattening::kStrips);
-    const atlas::AtlasCoverage coverage = ExpectNoTexelInTwoCharts(layout, o.gutter);
-    double texels = 0;
-    for (const cv::Size& size : layout.atlas_sizes) texels += size.area();
-    EXPECT_GT(static_cast<double>(coverage.inside_texels) / texels, 0.85)
-        << datasets::SceneShapeName(shape);
-    const atlas::AtlasStretch stretch = atlas::MeasureStretch(g.patches, layout);
-    EXPECT_LE(stretch.max, o.max_chart_stretch + 1e-9);
-    EXPECT_GE(stretch.min, 1 / o.max_chart_stretch - 1e-9);
-    ExpectLayoutAgreesWithTextureCoordinates(mesh, g, layout);
-  }
+class StripLayoutTest : public ::testing::TestWithParam<datasets::SceneShape> {};
+
+TEST_P(StripLayoutTest, FillsAtlasesAboveEightyFivePercent) {
+  const datasets::SceneShape shape = GetParam();
+  const mesh::TriangleMesh mesh = datasets::CoarseMesh(shape);
+  const PatchGeometry g = Geometry(mesh);
+  atlas::AtlasOptions o;
+  ASSERT_EQ(o.flattening, atlas::ChartFlattening::kAuto);
+  const atlas::AtlasLayout layout = atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+  EXPECT_EQ(layout.flattening, atlas::ChartFlattening::kStrips);
+  const atlas::AtlasCoverage coverage = ExpectNoTexelInTwoCharts(layout, o.gutter);
+  double texels = 0;
+  for (const cv::Size& size : layout.atlas_sizes) texels += size.area();
+  EXPECT_GT(static_cast<double>(coverage.inside_texels) / texels, 0.85)
+      << datasets::SceneShapeName(shape);
+  const atlas::AtlasStretch stretch = atlas::MeasureStretch(g.patches, layout);
+  EXPECT_LE(stretch.max, o.max_chart_stretch + 1e-9);
+  EXPECT_GE(stretch.min, 1 / o.max_chart_stretch - 1e-9);
+  ExpectLayoutAgreesWithTextureCoordinates(mesh, g, layout);
 }
+
+// One ctest per shape, so that they spread over the cores.
+INSTANTIATE_TEST_SUITE_P(Charts, StripLayoutTest,
+                         ::testing::Values(datasets::SceneShape::kSphere,
+                                           datasets::SceneShape::kCylinder,
+                                           datasets::SceneShape::kTorus));
 
 // On an irregular mesh (vertices moved along the surface by up to a third of
 // an edge) strips fragment; auto keeps whichever of strips and rigid charts

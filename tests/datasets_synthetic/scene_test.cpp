@@ -260,7 +260,11 @@ TEST(Scene, SameSeedSameBytes) {
 TEST(Scene, SensorChangesThePhotosOnlyAndIsRecorded) {
   testing::TempDir tmp;
   SceneOptions options = SmallScene(SceneShape::kSphere, MaterialKind::kStone);
-  options.num_held_out_views = 1;
+  options.num_images = 3;
+  options.held_out_lights_per_view = 1;
+  options.write_btf = false;
+  options.write_surface = false;
+  options.material.texel_size = 0.008;
   GenerateScene(options, tmp / "clean");
   options.sensor.read_noise = 0.01;
   options.sensor.white_balance_spread = 0.1;
