@@ -13,15 +13,6 @@
 namespace texlume::render {
 namespace {
 
-cv::Mat ResizedToWidth(const cv::Mat& image, int width) {
-  if (image.cols <= width) return image.clone();
-  const int height = std::max(
-      1, static_cast<int>(std::lround(static_cast<double>(image.rows) * width / image.cols)));
-  cv::Mat out;
-  cv::resize(image, out, cv::Size(width, height), 0, 0, cv::INTER_AREA);
-  return out;
-}
-
 // The reference divided by its exposure (linear domain), back to display values.
 cv::Mat WithoutGain(const cv::Mat& rgb, double gain) {
   if (gain == 1.0) return rgb;
@@ -114,6 +105,15 @@ std::vector<std::pair<Eigen::Vector3d, cv::Mat>> RelightSample(const ptm::Ptm& s
     const cv::Mat image(sample.height, sample.width, CV_32FC3, const_cast<float*>(rgb.data()));
     out.emplace_back(light, ResizedToWidth(image, width));
   }
+  return out;
+}
+
+cv::Mat ResizedToWidth(const cv::Mat& image, int width) {
+  if (image.cols <= width) return image.clone();
+  const int height = std::max(
+      1, static_cast<int>(std::lround(static_cast<double>(image.rows) * width / image.cols)));
+  cv::Mat out;
+  cv::resize(image, out, cv::Size(width, height), 0, 0, cv::INTER_AREA);
   return out;
 }
 

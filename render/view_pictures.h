@@ -68,6 +68,10 @@ std::vector<cv::Mat> DrawLightSweep(const ModelRenderer& renderer, const Picture
 std::vector<std::pair<Eigen::Vector3d, cv::Mat>> RelightSample(const ptm::Ptm& sample, int width,
                                                                double elevation_deg);
 
+/// `image` scaled down (area averaging) to `width` pixels wide, its aspect
+/// kept; a copy when it is no wider.
+cv::Mat ResizedToWidth(const cv::Mat& image, int width);
+
 /// `count` of `n` items, evenly spread (the first always).
 std::vector<std::size_t> EvenlySpread(std::size_t n, int count);
 

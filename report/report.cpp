@@ -27,15 +27,6 @@ std::string Fixed(double v, int digits) {
   return s.str();
 }
 
-cv::Mat ResizedToWidth(const cv::Mat& image, int width, int interpolation = cv::INTER_AREA) {
-  if (image.cols <= width) return image.clone();
-  const int height = std::max(
-      1, static_cast<int>(std::lround(static_cast<double>(image.rows) * width / image.cols)));
-  cv::Mat out;
-  cv::resize(image, out, cv::Size(width, height), 0, 0, interpolation);
-  return out;
-}
-
 // Azimuth (degrees, from +x towards +y) and elevation (degrees above the xy plane).
 std::string DirectionText(const Eigen::Vector3d& d) {
   const double az = std::atan2(d.y(), d.x()) * 180.0 / kPi;
@@ -229,7 +220,8 @@ class ReportWriter {
           << " photos that constrain the synthesis, with their lights (world frame).</p>\n";
     for (const std::size_t i : photo_ids_) {
       const ReportPhoto& p = in_.photos[i];
-      const cv::Mat image = ResizedToWidth(p.image.empty() ? ReadPhotoRgb(p.file) : p.image, 200);
+      const cv::Mat image =
+          render::ResizedToWidth(p.image.empty() ? ReadPhotoRgb(p.file) : p.image, 200);
       const std::string src = WritePicture("photo_" + std::to_string(i) + ".png", ToBgr8(image));
       html_ << Figure(src, HtmlEscape(p.name) + "<br>" + LightsText(p.lights), 200);
       Advance();
@@ -327,7 +319,7 @@ class ReportWriter {
   cv::Mat AtlasThumbnail(std::size_t a, int width) const {
     const model::TexturedModel& model = *in_.model;
     const double s = static_cast<double>(width) / model.atlases[a].width;
-    cv::Mat thumb = ResizedToWidth(model::BaseColourImage(model.atlases[a]), width);
+    cv::Mat thumb = render::ResizedToWidth(model::BaseColourImage(model.atlases[a]), width);
     cv::Mat outlines = thumb.clone();
     constexpr int kShift = 3;
     for (std::size_t f = 0; f < model.corner_px.size(); ++f) {
