@@ -64,6 +64,7 @@ void MaterialOptions::Check() const {
   if (!(shininess >= 1.0 && shininess <= 10000.0)) {
     throw OptionError("shininess must be in [1, 10000]");
   }
+  if (!(sheen >= 0.0 && sheen <= 1.0)) throw OptionError("sheen must be in [0, 1]");
 }
 
 Material::Axis Material::MakeAxis(double nominal_cell, double period_world, std::int64_t multiple) {

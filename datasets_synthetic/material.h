@@ -35,8 +35,12 @@ struct MaterialOptions {
   double specular = 0.0;
   /// Multiplies the albedo (0.05 makes a near-black glossy material). [0, 1].
   double albedo_scale = 1.0;
-  /// Blinn-Phong exponent. [1, 10000].
+  /// Blinn-Phong exponent: the specular lobe's roughness (lower is rougher; 40 is
+  /// about a microfacet roughness of 0.22). [1, 10000].
   double shininess = 40.0;
+  /// Sheen: a white Fresnel-like term strongest at grazing angles between light
+  /// and viewer, sheen (1 - l.h)^5 n.l, as on dusty or fibrous stone. [0, 1].
+  double sheen = 0.0;
   std::uint32_t seed = 1;
 
   /// Throws OptionError when a value is out of range.

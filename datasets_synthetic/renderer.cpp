@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -113,6 +114,138 @@ struct Renderer::Impl {
   std::unique_ptr<mesh::RayCaster> caster;
 };
 
+namespace {
+
+// splitmix64: a fixed, well-mixed sequence per pixel sample, so one bounce of
+// interreflection is deterministic whatever the thread count.
+struct SampleSequence {
+  std::uint64_t state;
+  double Next() {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+  }
+};
+
+// Where a ray met the displaced surface, with what shading needs there.
+struct SurfaceHit {
+  Eigen::Vector3d position, normal, geometric_normal, albedo;
+  const MaterialOptions* material = nullptr;
+};
+
+// Shades rays against the displaced geometry: Lambert, Blinn-Phong and sheen per
+// light with shadow rays, an ambient term, and optionally one bounce of diffuse
+// interreflection (docs/synthetic_scenes.md, Rendering).
+class SurfaceShader {
+ public:
+  SurfaceShader(const DisplacedGeometry& geometry,
+                const std::vector<const BakedMaterial*>& materials, const mesh::RayCaster& caster,
+                const std::vector<RenderLight>& lights, const ShadingOptions& options)
+      : geometry_(geometry), materials_(materials), caster_(caster), options_(options) {
+    for (const auto& l : lights)
+      lights_.push_back({l.direction_in_world.normalized(), l.intensity});
+  }
+
+  // The radiance along a camera ray, or nothing when it misses.
+  std::optional<Eigen::Vector3d> Radiance(const Eigen::Vector3d& origin,
+                                          const Eigen::Vector3d& direction,
+                                          SampleSequence& sequence) const {
+    const std::optional<SurfaceHit> p = Trace(origin, direction);
+    if (!p) return std::nullopt;
+    Eigen::Vector3d radiance = options_.ambient * p->albedo;
+    AddDirect(*p, -direction, true, radiance);
+    if (options_.interreflection_rays > 0) radiance += Indirect(*p, sequence);
+    return radiance;
+  }
+
+ private:
+  std::optional<SurfaceHit> Trace(const Eigen::Vector3d& origin,
+                                  const Eigen::Vector3d& direction) const {
+    const std::optional<mesh::RayCaster::Hit> hit = caster_.Intersect(origin, direction);
+    if (!hit) return std::nullopt;
+    const auto& tri = geometry_.triangles[hit->triangle];
+    const double b1 = hit->b1, b2 = hit->b2, b0 = 1.0 - b1 - b2;
+    auto interp3 = [&](const std::vector<Eigen::Vector3f>& a) {
+      return (b0 * a[tri[0]].cast<double>() + b1 * a[tri[1]].cast<double>() +
+              b2 * a[tri[2]].cast<double>())
+          .eval();
+    };
+    const Eigen::Vector2d uv = b0 * geometry_.uv[tri[0]].cast<double>() +
+                               b1 * geometry_.uv[tri[1]].cast<double>() +
+                               b2 * geometry_.uv[tri[2]].cast<double>();
+    const Eigen::Vector3d base_normal = interp3(geometry_.normal).normalized();
+    const BakedMaterial& material = *materials_[geometry_.triangle_patch[hit->triangle]];
+    SurfaceHit p;
+    // Shading normal of the displaced surface: (S_u + h_u N) x (S_v + h_v N).
+    const Eigen::Vector2d grad = material.HeightGradient(uv.x(), uv.y());
+    const Eigen::Vector3d tu = interp3(geometry_.d_du) + grad.x() * base_normal;
+    const Eigen::Vector3d tv = interp3(geometry_.d_dv) + grad.y() * base_normal;
+    p.normal = tu.cross(tv);
+    p.normal = p.normal.norm() > 1e-9 ? Eigen::Vector3d(p.normal.normalized()) : base_normal;
+    p.geometric_normal = hit->geometric_normal.normalized();
+    if (p.geometric_normal.dot(direction) > 0) p.geometric_normal = -p.geometric_normal;
+    p.albedo = material.Albedo(uv.x(), uv.y());
+    p.position = origin + hit->distance * direction;
+    p.material = &material.options();
+    return p;
+  }
+
+  bool Lit(const SurfaceHit& p, const Eigen::Vector3d& l) const {
+    if (!options_.shadows) return true;
+    return !caster_.Occluded(p.position + 1e-5 * p.geometric_normal, l, 1e-5f);
+  }
+
+  // Adds the light arriving straight from the lights and leaving towards the
+  // viewer; `glossy` adds the specular lobe and the sheen to the Lambertian term.
+  void AddDirect(const SurfaceHit& p, const Eigen::Vector3d& to_viewer, bool glossy,
+                 Eigen::Vector3d& radiance) const {
+    const MaterialOptions& m = *p.material;
+    for (const auto& [l, intensity] : lights_) {
+      const double n_dot_l = p.normal.dot(l);
+      if (n_dot_l <= 0.0 || !Lit(p, l)) continue;
+      double white = 0.0;
+      if (glossy && (m.specular > 0.0 || m.sheen > 0.0)) {
+        const Eigen::Vector3d half = (l + to_viewer).normalized();
+        white = m.specular * std::pow(std::max(0.0, p.normal.dot(half)), m.shininess) +
+                m.sheen * std::pow(1.0 - std::clamp(l.dot(half), 0.0, 1.0), 5.0) * n_dot_l;
+      }
+      radiance += intensity * (p.albedo * n_dot_l + Eigen::Vector3d::Constant(white));
+    }
+  }
+
+  // One bounce of diffuse interreflection: the albedo times the mean Lambertian
+  // radiance of the surface seen along cosine-distributed rays (a Monte Carlo
+  // estimate of the irradiance / pi, in the units of Direct).
+  Eigen::Vector3d Indirect(const SurfaceHit& p, SampleSequence& sequence) const {
+    const Eigen::Vector3d& n = p.normal;
+    const Eigen::Vector3d t =
+        (std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY())
+            .cross(n)
+            .normalized();
+    const Eigen::Vector3d b = n.cross(t);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int k = 0; k < options_.interreflection_rays; ++k) {
+      const double u1 = sequence.Next(), phi = kTwoPi * sequence.Next();
+      const double r = std::sqrt(u1);
+      const Eigen::Vector3d d =
+          r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(1 - u1) * n;
+      if (d.dot(p.geometric_normal) <= 0.0) continue;
+      const std::optional<SurfaceHit> q = Trace(p.position + 1e-5 * p.geometric_normal, d);
+      if (q) AddDirect(*q, -d, false, sum);
+    }
+    return p.albedo.cwiseProduct(sum) / options_.interreflection_rays;
+  }
+
+  const DisplacedGeometry& geometry_;
+  const std::vector<const BakedMaterial*>& materials_;
+  const mesh::RayCaster& caster_;
+  const ShadingOptions& options_;
+  std::vector<std::pair<Eigen::Vector3d, double>> lights_;  // direction, intensity
+};
+
+}  // namespace
+
 Renderer::Renderer(DisplacedGeometry geometry, std::vector<const BakedMaterial*> materials)
     : geometry_(std::move(geometry)), materials_(std::move(materials)), impl_(new Impl) {
   for (std::uint16_t p : geometry_.triangle_patch) {
@@ -129,6 +262,8 @@ void ShadingOptions::Check() const {
   if (!(exposure > 0.0) || !std::isfinite(exposure)) throw OptionError("exposure must be > 0");
   if (samples_per_axis < 1 || samples_per_axis > 8)
     throw OptionError("samples_per_axis must be in [1, 8]");
+  if (interreflection_rays < 0 || interreflection_rays > 64)
+    throw OptionError("interreflection_rays must be in [0, 64]");
 }
 
 template <typename RayAt>
@@ -141,65 +276,23 @@ Rendering Renderer::Render(int width, int height, const RayAt& ray_at,
   out.coverage = cv::Mat(height, width, CV_32FC1, cv::Scalar::all(0));
   const int n = options.samples_per_axis;
   const double inv_samples = 1.0 / (n * n);
-  std::vector<Eigen::Vector3d> light_dirs;
-  for (const auto& l : lights) light_dirs.push_back(l.direction_in_world.normalized());
+  const SurfaceShader shader(geometry_, materials_, *impl_->caster, lights, options);
 
 #pragma omp parallel for schedule(dynamic, 4)
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       int hits = 0;
+      SampleSequence sequence{(static_cast<std::uint64_t>(y) * width + x) * 0x100000001B3ull};
       for (int sy = 0; sy < n; ++sy) {
         for (int sx = 0; sx < n; ++sx) {
           Eigen::Vector3d origin, direction;
           if (!ray_at(x + (sx + 0.5) / n, y + (sy + 0.5) / n, origin, direction)) continue;
-          const std::optional<mesh::RayCaster::Hit> hit =
-              impl_->caster->Intersect(origin, direction);
-          if (!hit) continue;
+          const std::optional<Eigen::Vector3d> radiance =
+              shader.Radiance(origin, direction, sequence);
+          if (!radiance) continue;
           ++hits;
-          const auto& tri = geometry_.triangles[hit->triangle];
-          const double b1 = hit->b1, b2 = hit->b2, b0 = 1.0 - b1 - b2;
-          auto interp3 = [&](const std::vector<Eigen::Vector3f>& a) {
-            return (b0 * a[tri[0]].cast<double>() + b1 * a[tri[1]].cast<double>() +
-                    b2 * a[tri[2]].cast<double>())
-                .eval();
-          };
-          const Eigen::Vector2d uv = b0 * geometry_.uv[tri[0]].cast<double>() +
-                                     b1 * geometry_.uv[tri[1]].cast<double>() +
-                                     b2 * geometry_.uv[tri[2]].cast<double>();
-          const Eigen::Vector3d base_normal = interp3(geometry_.normal).normalized();
-          const BakedMaterial& material = *materials_[geometry_.triangle_patch[hit->triangle]];
-          // Shading normal of the displaced surface: (S_u + h_u N) x (S_v + h_v N).
-          const Eigen::Vector2d grad = material.HeightGradient(uv.x(), uv.y());
-          const Eigen::Vector3d tu = interp3(geometry_.d_du) + grad.x() * base_normal;
-          const Eigen::Vector3d tv = interp3(geometry_.d_dv) + grad.y() * base_normal;
-          Eigen::Vector3d normal = tu.cross(tv);
-          normal = normal.norm() > 1e-9 ? Eigen::Vector3d(normal.normalized()) : base_normal;
-          Eigen::Vector3d geometric_normal = hit->geometric_normal;
-          geometric_normal.normalize();
-          if (geometric_normal.dot(direction) > 0) geometric_normal = -geometric_normal;
-          const Eigen::Vector3d albedo = material.Albedo(uv.x(), uv.y());
-          const Eigen::Vector3d position = origin + static_cast<double>(hit->distance) * direction;
-          const Eigen::Vector3d to_viewer = -direction;
-          Eigen::Vector3d radiance = options.ambient * albedo;
-          for (std::size_t li = 0; li < lights.size(); ++li) {
-            const Eigen::Vector3d& l = light_dirs[li];
-            const double n_dot_l = normal.dot(l);
-            if (n_dot_l <= 0.0) continue;
-            if (options.shadows) {
-              const Eigen::Vector3d start = position + 1e-5 * geometric_normal;
-              if (impl_->caster->Occluded(start, l, 1e-5f)) continue;
-            }
-            double specular = 0.0;
-            if (material.options().specular > 0.0) {
-              const Eigen::Vector3d half = (l + to_viewer).normalized();
-              specular = material.options().specular *
-                         std::pow(std::max(0.0, normal.dot(half)), material.options().shininess);
-            }
-            radiance +=
-                lights[li].intensity * (albedo * n_dot_l + Eigen::Vector3d::Constant(specular));
-          }
-          sum += radiance;
+          sum += *radiance;
         }
       }
       const Eigen::Vector3d value = sum * (inv_samples * options.exposure);

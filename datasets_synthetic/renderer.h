@@ -39,8 +39,9 @@ struct RenderLight {
   double intensity = 1.0;
 };
 
-/// Shading settings: Lambert plus Blinn-Phong (from the material), cast and self
-/// shadows from the displaced geometry, an ambient term.
+/// Shading settings: Lambert plus Blinn-Phong and sheen (from the material), cast
+/// and self shadows from the displaced geometry, an ambient term, optionally one
+/// bounce of diffuse interreflection.
 struct ShadingOptions {
   /// Ambient light as a fraction of the albedo, [0, 1].
   double ambient = 0.02;
@@ -49,6 +50,10 @@ struct ShadingOptions {
   /// Samples per pixel along each axis (stratified, fixed positions): n x n per pixel. [1, 8].
   int samples_per_axis = 2;
   bool shadows = true;
+  /// One bounce of diffuse interreflection: this many cosine-distributed rays
+  /// per sample gather the Lambertian light of the surface they meet (lit
+  /// directly, with shadows). 0 = off. [0, 64].
+  int interreflection_rays = 0;
 
   /// Throws OptionError naming the first setting out of range.
   void Check() const;

@@ -43,6 +43,26 @@ nlohmann::json RenderJobOptions::ToJson() const {
 
 namespace {
 
+// A view's appearance figures as render.json records them (render/fidelity.h).
+nlohmann::json FidelityJson(const render::FidelityMetrics& f) {
+  return {{"luma_bias", f.luma_bias},
+          {"chroma_spread_ratio", f.chroma_spread_ratio},
+          {"gradient_histogram_distance", f.gradient_histogram_distance},
+          {"gradient_p90", f.gradient_p90},
+          {"gradient_p90_truth", f.gradient_p90_truth},
+          {"power_spectrum_db", f.power_spectrum_db}};
+}
+
+// sum += scale * f, figure by figure (for the mean over the views).
+void AddScaled(const render::FidelityMetrics& f, double scale, render::FidelityMetrics& sum) {
+  sum.luma_bias += scale * f.luma_bias;
+  sum.chroma_spread_ratio += scale * f.chroma_spread_ratio;
+  sum.gradient_histogram_distance += scale * f.gradient_histogram_distance;
+  sum.gradient_p90 += scale * f.gradient_p90;
+  sum.gradient_p90_truth += scale * f.gradient_p90_truth;
+  sum.power_spectrum_db += scale * f.power_spectrum_db;
+}
+
 fs::path PngName(const std::string& image_name) {
   fs::path p(image_name);
   p.replace_extension(".png");
@@ -120,24 +140,10 @@ class RenderJob {
     if (!options_.truth_images_dir.empty()) Measure(image.name, view.rgb, mask);
   }
 
-  // PSNR and SSIM against the truth inside its mask (else the rendered coverage).
   void Measure(const std::string& image_name, const cv::Mat& rgb, const cv::Mat& coverage) {
-    const fs::path truth_path = options_.truth_images_dir / image_name;
-    const cv::Mat truth = ReadPhotoRgb(truth_path);
-    if (truth.size() != rgb.size())
-      throw InputError(truth_path.string(), "does not match the camera's size");
-    cv::Mat truth_mask;
-    const fs::path mask_path =
-        options_.truth_masks_dir.empty() ? fs::path() : options_.truth_masks_dir / image_name;
-    if (!mask_path.empty() && fs::exists(mask_path)) {
-      truth_mask = ReadImageGrey(mask_path) > 0.5f;
-      if (truth_mask.size() != truth.size())
-        throw InputError(mask_path.string(), "does not match its image's size");
-    } else {
-      truth_mask = coverage > 127;
-    }
     summary_.metrics.push_back(
-        render::MeasureView(image_name, rgb, truth, truth_mask > 127, options_.reduced_factor));
+        MeasureAgainstTruth(image_name, rgb, coverage, options_.truth_images_dir,
+                            options_.truth_masks_dir, options_.reduced_factor));
   }
 
   void AverageMetrics() {
@@ -147,6 +153,7 @@ class RenderJob {
       summary_.mean_ssim += m.ssim / n;
       summary_.mean_psnr_reduced += m.psnr_reduced / n;
       summary_.mean_ssim_reduced += m.ssim_reduced / n;
+      AddScaled(m.fidelity, 1.0 / n, summary_.mean_fidelity);
     }
   }
 
@@ -157,12 +164,14 @@ class RenderJob {
                        {"psnr_db", m.psnr},
                        {"ssim", m.ssim},
                        {"psnr_reduced_db", m.psnr_reduced},
-                       {"ssim_reduced", m.ssim_reduced}});
+                       {"ssim_reduced", m.ssim_reduced},
+                       {"fidelity", FidelityJson(m.fidelity)}});
     return {{"views", views},
             {"mean_psnr_db", summary_.mean_psnr},
             {"mean_ssim", summary_.mean_ssim},
             {"mean_psnr_reduced_db", summary_.mean_psnr_reduced},
             {"mean_ssim_reduced", summary_.mean_ssim_reduced},
+            {"mean_fidelity", FidelityJson(summary_.mean_fidelity)},
             {"reduced_factor", options_.reduced_factor},
             {"inside", "the ground-truth masks"}};
   }
@@ -192,6 +201,25 @@ class RenderJob {
 };
 
 }  // namespace
+
+render::ViewMetrics MeasureAgainstTruth(const std::string& image_name, const cv::Mat& rgb,
+                                        const cv::Mat& coverage, const fs::path& truth_images_dir,
+                                        const fs::path& truth_masks_dir, int reduced_factor) {
+  const fs::path truth_path = truth_images_dir / image_name;
+  const cv::Mat truth = ReadPhotoRgb(truth_path);
+  if (truth.size() != rgb.size())
+    throw InputError(truth_path.string(), "does not match the camera's size");
+  cv::Mat truth_mask;
+  const fs::path mask_path = truth_masks_dir.empty() ? fs::path() : truth_masks_dir / image_name;
+  if (!mask_path.empty() && fs::exists(mask_path)) {
+    truth_mask = ReadImageGrey(mask_path) > 0.5f;
+    if (truth_mask.size() != truth.size())
+      throw InputError(mask_path.string(), "does not match its image's size");
+  } else {
+    truth_mask = coverage > 127;
+  }
+  return render::MeasureView(image_name, rgb, truth, truth_mask > 127, reduced_factor);
+}
 
 RenderJobSummary RunRenderJob(const RenderJobOptions& options, const ProgressCallback& progress) {
   options.Check();

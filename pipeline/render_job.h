@@ -43,8 +43,19 @@ struct RenderJobSummary {
   std::vector<std::string> warnings;
   std::vector<render::ViewMetrics> metrics;  ///< with truth
   double mean_psnr = 0, mean_ssim = 0, mean_psnr_reduced = 0, mean_ssim_reduced = 0;
+  render::FidelityMetrics mean_fidelity;  ///< each figure averaged over the views
   double seconds = 0;
 };
+
+/// `rgb` (CV_32FC3 display RGB) against truth_images_dir/image_name inside
+/// truth_masks_dir/image_name when that mask exists, else inside `coverage`
+/// (CV_8UC1). Throws InputError naming a truth image or mask that cannot be read
+/// or is not of the rendering's size.
+render::ViewMetrics MeasureAgainstTruth(const std::string& image_name, const cv::Mat& rgb,
+                                        const cv::Mat& coverage,
+                                        const std::filesystem::path& truth_images_dir,
+                                        const std::filesystem::path& truth_masks_dir,
+                                        int reduced_factor);
 
 /// Renders the views (PNG, with a coverage mask in masks/), measures them
 /// against the truth when given, and writes render.json (settings, per-view

@@ -48,6 +48,8 @@ ViewMetrics MeasureView(const std::string& name, const cv::Mat& rendered, const 
   m.name = name;
   m.psnr = MaskedPsnr(rendered, truth, inside);
   m.ssim = MaskedSsim(rendered, truth, inside);
+  m.fidelity =
+      CompareAppearance(MeasureAppearance(rendered, inside), MeasureAppearance(truth, inside));
   if (reduced_factor > 1) {
     const cv::Size small(truth.cols / reduced_factor, truth.rows / reduced_factor);
     cv::Mat a, b, mk;

@@ -3,6 +3,8 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "render/fidelity.h"
+
 namespace texlume::render {
 
 /// PSNR (dB, peak 1) and SSIM (Gaussian window 11, sigma 1.5, on each channel,
@@ -15,11 +17,14 @@ double MaskedSsim(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask);
 struct ViewMetrics {
   std::string name;
   double psnr = 0, ssim = 0, psnr_reduced = 0, ssim_reduced = 0;
+  /// Luma bias, chroma spread, gradient and spectrum against the truth, at full
+  /// resolution.
+  FidelityMetrics fidelity;
 };
 
 /// Measures `rendered` against `truth` (CV_32FC3 display RGB, one size) inside
 /// `inside` (CV_8UC1), at full resolution and, for `reduced_factor` > 1,
-/// reduced by it.
+/// reduced by it; and its appearance (FidelityMetrics) at full resolution.
 ViewMetrics MeasureView(const std::string& name, const cv::Mat& rendered, const cv::Mat& truth,
                         const cv::Mat& inside, int reduced_factor);
 

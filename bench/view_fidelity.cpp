@@ -1,0 +1,90 @@
+// Measures folders of rendered views against their ground truth (issue 29):
+// PSNR and SSIM at full resolution and reduced, and the appearance figures of
+// render/fidelity.h, averaged over the views. bench/fidelity_bench.sh uses it to
+// put texlume, the baselines and "another instance" of the material side by side.
+//
+//   view_fidelity TRUTH_DIR MASKS_DIR REDUCED_FACTOR LABEL=DIR [LABEL=DIR ...]
+//
+// Every PNG of TRUTH_DIR is a view; each DIR must hold an image of that name.
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/errors.h"
+#include "core/image_io.h"
+#include "pipeline/render_job.h"
+
+namespace fs = std::filesystem;
+using namespace texlume;
+
+namespace {
+
+struct Row {
+  std::string label;
+  render::ViewMetrics mean;
+};
+
+Row MeasureFolder(const std::string& label, const fs::path& dir, const std::vector<fs::path>& views,
+                  const fs::path& truth_dir, const fs::path& masks_dir, int reduced_factor) {
+  Row row{label, {}};
+  const double n = static_cast<double>(views.size());
+  for (const fs::path& view : views) {
+    const std::string name = view.filename().string();
+    const cv::Mat rgb = ReadPhotoRgb(dir / name);
+    const cv::Mat coverage(rgb.size(), CV_8UC1, cv::Scalar(255));
+    const render::ViewMetrics m =
+        pipeline::MeasureAgainstTruth(name, rgb, coverage, truth_dir, masks_dir, reduced_factor);
+    row.mean.psnr += m.psnr / n;
+    row.mean.ssim += m.ssim / n;
+    row.mean.psnr_reduced += m.psnr_reduced / n;
+    row.mean.ssim_reduced += m.ssim_reduced / n;
+    render::FidelityMetrics& f = row.mean.fidelity;
+    f.luma_bias += m.fidelity.luma_bias / n;
+    f.chroma_spread_ratio += m.fidelity.chroma_spread_ratio / n;
+    f.gradient_histogram_distance += m.fidelity.gradient_histogram_distance / n;
+    f.gradient_p90 += m.fidelity.gradient_p90 / n;
+    f.gradient_p90_truth += m.fidelity.gradient_p90_truth / n;
+    f.power_spectrum_db += m.fidelity.power_spectrum_db / n;
+  }
+  return row;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 5) {
+    std::fprintf(stderr, "usage: %s TRUTH_DIR MASKS_DIR REDUCED_FACTOR LABEL=DIR...\n", argv[0]);
+    return 2;
+  }
+  try {
+    const fs::path truth_dir = argv[1], masks_dir = argv[2];
+    const int reduced_factor = std::stoi(argv[3]);
+    std::vector<fs::path> views;
+    for (const auto& e : fs::directory_iterator(truth_dir))
+      if (e.path().extension() == ".png") views.push_back(e.path());
+    std::sort(views.begin(), views.end());
+    if (views.empty()) throw InputError(truth_dir.string(), "holds no PNG views");
+    std::printf(
+        "| %-16s | PSNR dB | SSIM | PSNR/%d | SSIM/%d | luma bias %% | chroma %% | grad EMD | "
+        "grad p90 (truth) | spectrum dB |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        "", reduced_factor, reduced_factor);
+    for (int i = 4; i < argc; ++i) {
+      const std::string arg = argv[i];
+      const std::size_t eq = arg.find('=');
+      if (eq == std::string::npos) throw OptionError("expected LABEL=DIR, got " + arg);
+      const Row row = MeasureFolder(arg.substr(0, eq), arg.substr(eq + 1), views, truth_dir,
+                                    masks_dir, reduced_factor);
+      const render::FidelityMetrics& f = row.mean.fidelity;
+      std::printf(
+          "| %-16s | %.2f | %.3f | %.2f | %.3f | %+.1f | %+.1f | %.5f | %.4f (%.4f) | %.2f |\n",
+          row.label.c_str(), row.mean.psnr, row.mean.ssim, row.mean.psnr_reduced,
+          row.mean.ssim_reduced, 100 * f.luma_bias, 100 * f.chroma_spread_ratio,
+          f.gradient_histogram_distance, f.gradient_p90, f.gradient_p90_truth, f.power_spectrum_db);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "view_fidelity: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
