@@ -226,6 +226,17 @@ void BindSceneCapture(CLI::App* sub, datasets::SceneOptions& s) {
   sub->add_option("--relief", s.material.relief_height, "relief height, world units")
       ->capture_default_str();
   sub->add_option("--specular", s.material.specular, "specular strength")->capture_default_str();
+  sub->add_option("--shininess", s.material.shininess,
+                  "specular exponent: the lobe's roughness (lower is rougher)")
+      ->capture_default_str();
+  sub->add_option("--sheen", s.material.sheen, "sheen strength at grazing angles")
+      ->capture_default_str();
+  sub->add_option("--interreflection-rays", s.shading.interreflection_rays,
+                  "rays per sample for one bounce of interreflection (0: off)")
+      ->capture_default_str();
+  sub->add_option("--light-error", s.light_error_deg,
+                  "RMS error of the recorded photo lights, degrees (0: exact)")
+      ->capture_default_str();
   sub->add_option("--samples", s.shading.samples_per_axis, "samples per pixel along each axis")
       ->capture_default_str();
   sub->add_option("--mesh-resolution", s.mesh_resolution, "coarse mesh resolution [0, 7]")
@@ -235,13 +246,37 @@ void BindSceneCapture(CLI::App* sub, datasets::SceneOptions& s) {
   sub->add_option("--btf-lights", s.btf_light_count, "BTF capture lights")->capture_default_str();
 }
 
+// The options UseRealisticCapture sets: under --clean, each one not given on the
+// command line takes its clean-scene value.
+void ApplyClean(const CLI::App& sub, datasets::SceneOptions& s) {
+  const datasets::SceneOptions clean;
+  const auto unless_given = [&](const char* name, auto& value, const auto& clean_value) {
+    if (sub.count(name) == 0) value = clean_value;
+  };
+  unless_given("--shot-noise", s.sensor.shot_noise, clean.sensor.shot_noise);
+  unless_given("--read-noise", s.sensor.read_noise, clean.sensor.read_noise);
+  unless_given("--vignetting", s.sensor.vignetting, clean.sensor.vignetting);
+  unless_given("--white-balance-spread", s.sensor.white_balance_spread,
+               clean.sensor.white_balance_spread);
+  unless_given("--jpeg-quality", s.sensor.jpeg_quality, clean.sensor.jpeg_quality);
+  unless_given("--specular", s.material.specular, clean.material.specular);
+  unless_given("--shininess", s.material.shininess, clean.material.shininess);
+  unless_given("--sheen", s.material.sheen, clean.material.sheen);
+  unless_given("--interreflection-rays", s.shading.interreflection_rays,
+               clean.shading.interreflection_rays);
+  unless_given("--light-error", s.light_error_deg, clean.light_error_deg);
+}
+
 }  // namespace
 
 void AddSceneCommand(CLI::App& app, CommandRunners& run) {
   auto* sub = app.add_subcommand(
       "scene", "Write a synthetic heritage scene with ground truth (docs/synthetic_scenes.md).");
   auto s = std::make_shared<datasets::SceneOptions>();
+  datasets::UseRealisticCapture(*s);
   auto out_dir = std::make_shared<std::filesystem::path>();
+  auto clean = std::make_shared<bool>(false);
+  auto material_seed = std::make_shared<std::uint32_t>(0);
   auto flags = std::make_shared<std::pair<bool, bool>>(false, false);  // no BTF, fixed exposure
   sub->add_option("--out", *out_dir, "the folder to write")->required();
   sub->add_option("--kind", s->shape, "sphere, cylinder, plane or torus")
@@ -251,6 +286,12 @@ void AddSceneCommand(CLI::App& app, CommandRunners& run) {
       ->transform(Choice(MaterialWords()))
       ->default_str("stone");
   sub->add_option("--seed", s->seed, "random seed (scene and material)")->capture_default_str();
+  sub->add_option("--material-seed", *material_seed,
+                  "another instance of the material: its own seed (0: --seed)")
+      ->capture_default_str();
+  sub->add_flag("--clean", *clean,
+                "today's clean scene: no sensor effects, matte, no interreflection, exact lights "
+                "(options given still apply)");
   sub->add_option("--images", s->num_images, "object photos")->capture_default_str();
   sub->add_option("--camera-model", s->camera_model, "pinhole or opencv")
       ->transform(Choice(std::map<std::string, sfm::CameraModelId>{
@@ -262,8 +303,9 @@ void AddSceneCommand(CLI::App& app, CommandRunners& run) {
   BindSensor(sub, s->sensor);
   sub->add_flag("--no-btf", flags->first, "no BTF capture");
   sub->add_flag("--fixed-exposure", flags->second, "every photo at one exposure");
-  run[sub] = [s, out_dir, flags](std::ostream& out, std::ostream&) {
-    s->material.seed = s->seed;
+  run[sub] = [sub, s, out_dir, flags, clean, material_seed](std::ostream& out, std::ostream&) {
+    if (*clean) ApplyClean(*sub, *s);
+    s->material.seed = *material_seed != 0 ? *material_seed : s->seed;
     s->focal_px *= s->image_width / 640.0;
     s->write_btf = !flags->first;
     s->vary_exposure = !flags->second;

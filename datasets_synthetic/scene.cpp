@@ -80,6 +80,7 @@ void SceneOptions::Check() const {
   RequireInRange(num_held_out_views, 0, 100, "num_held_out_views");
   RequireInRange(held_out_lights_per_view, 1, 20, "held_out_lights_per_view");
   RequireInRange(held_out_scale, 1, 4, "held_out_scale");
+  RequireInRange(light_error_deg, 0.0, 20.0, "light_error_deg");
   RequireInRange(capture_size, 16, 4096, "capture_size");
   RequireInRange(num_capture_lights, 6, 500, "num_capture_lights");
   RequireInRange(num_held_out_capture_lights, 0, 500, "num_held_out_capture_lights");
@@ -93,6 +94,37 @@ void SceneOptions::Check() const {
     throw OptionError("camera_model must be PINHOLE or OPENCV");
   }
 }
+
+void UseRealisticCapture(SceneOptions& options) {
+  options.sensor.shot_noise = 0.00005;
+  options.sensor.read_noise = 0.0015;
+  options.sensor.vignetting = 0.2;
+  options.sensor.white_balance_spread = 0.05;
+  options.sensor.jpeg_quality = 90;
+  options.material.specular = 0.05;
+  options.material.shininess = 30.0;
+  options.material.sheen = 0.1;
+  options.shading.interreflection_rays = 4;
+  options.light_error_deg = 2.0;
+}
+
+namespace {
+
+// `direction` turned about a random axis by a random angle of RMS rms_deg.
+Eigen::Vector3d TurnedRandomly(const Eigen::Vector3d& direction, double rms_deg,
+                               std::mt19937_64& rng) {
+  // A 2-D Gaussian offset in the tangent plane, sigma = rms / sqrt(2) per axis:
+  // the angle's RMS is rms_deg.
+  std::normal_distribution<double> normal(0.0, rms_deg * kPi / 180.0 / std::sqrt(2.0));
+  const Eigen::Vector3d d = direction.normalized();
+  const Eigen::Vector3d t = d.unitOrthogonal(), b = d.cross(t);
+  const double a = normal(rng), c = normal(rng);
+  const double angle = std::hypot(a, c);
+  if (angle == 0.0) return d;
+  return (d + std::tan(angle) * (a * t + c * b) / angle).normalized();
+}
+
+}  // namespace
 
 SceneOptions MaterialOnlySceneOptions(MaterialKind kind, int capture_size, int capture_lights) {
   SceneOptions o;
@@ -463,8 +495,27 @@ class SceneGenerator {
       files_ += 2;
       Report("object photos", ++done, object_.reconstruction.images.size());
     }
+    if (options_.light_error_deg > 0) MisrecordLights();
     WriteObjectScene(object_, dir_ / "object");
     files_ += 9;
+  }
+
+  // The photos' lights as a calibration would record them: each turned by a
+  // random angle of light_error_deg RMS (the angles go into scene.json).
+  void MisrecordLights() {
+    std::mt19937_64 rng(options_.seed * 7919u + 3u);
+    for (auto& [name, lights] : object_.lights) {
+      nlohmann::json errors = nlohmann::json::array();
+      for (sfm::ObjectLight& l : lights) {
+        const Eigen::Vector3d recorded =
+            TurnedRandomly(l.direction_in_world, options_.light_error_deg, rng);
+        const double cosine =
+            std::clamp(recorded.dot(l.direction_in_world.normalized()), -1.0, 1.0);
+        errors.push_back(std::acos(cosine) * 180.0 / kPi);
+        l.direction_in_world = recorded;
+      }
+      photos_[name]["light_error_deg"] = errors;
+    }
   }
 
   // Held-out views x held-out lights: ground truth for relighting from new views.
@@ -526,7 +577,9 @@ class SceneGenerator {
                           {"relief_height", options_.material.relief_height},
                           {"feature_scale", options_.material.feature_scale},
                           {"specular", options_.material.specular},
-                          {"shininess", options_.material.shininess}};
+                          {"shininess", options_.material.shininess},
+                          {"sheen", options_.material.sheen},
+                          {"seed", options_.material.seed}};
     record["seed"] = options_.seed;
     record["units"] = "world units of the COLMAP model (the shapes are about 2 units across)";
     record["camera"] = {{"model", sfm::CameraModelName(options_.camera_model)},
@@ -538,7 +591,9 @@ class SceneGenerator {
     record["shading"] = {{"ambient", options_.shading.ambient},
                          {"samples_per_pixel",
                           options_.shading.samples_per_axis * options_.shading.samples_per_axis},
-                         {"shadows", options_.shading.shadows}};
+                         {"shadows", options_.shading.shadows},
+                         {"interreflection_rays", options_.shading.interreflection_rays}};
+    record["light_error_deg"] = options_.light_error_deg;
     record["sensor"] = options_.sensor.ToJson();
     record["capture"] = {{"size", options_.capture_size},
                          {"lights", options_.num_capture_lights},

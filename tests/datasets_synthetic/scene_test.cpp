@@ -286,6 +286,110 @@ TEST(Scene, SensorChangesThePhotosOnlyAndIsRecorded) {
   EXPECT_EQ(record["photos"]["image_000.png"]["white_balance"].size(), 3u);
 }
 
+// lights.json records each photo light turned by the angle scene.json gives for
+// it, of about the stated RMS; the photos themselves are lit as before.
+TEST(Scene, LightErrorTurnsTheRecordedLightsByTheRecordedAngles) {
+  testing::TempDir tmp;
+  SceneOptions options = SmallScene(SceneShape::kSphere, MaterialKind::kStone);
+  options.num_images = 12;
+  options.num_held_out_views = 0;
+  options.write_btf = false;
+  options.write_surface = false;
+  options.material.texel_size = 0.008;
+  options.image_width = options.image_height = 96;
+  options.focal_px = 90;
+  GenerateScene(options, tmp / "exact");
+  options.light_error_deg = 3.0;
+  GenerateScene(options, tmp / "off");
+  const auto exact = sfm::ReadObjectLightsFile(tmp / "exact/object/lights.json");
+  const auto off = sfm::ReadObjectLightsFile(tmp / "off/object/lights.json");
+  const nlohmann::json photos =
+      nlohmann::json::parse(testing::ReadText(tmp / "off/scene.json"))["photos"];
+  double sum_squares = 0;
+  int count = 0;
+  for (const auto& [name, lights] : exact) {
+    ASSERT_EQ(off.at(name).size(), lights.size());
+    EXPECT_EQ(testing::ReadText(tmp / "exact/object/images" / name),
+              testing::ReadText(tmp / "off/object/images" / name));
+    for (std::size_t k = 0; k < lights.size(); ++k) {
+      const double angle_deg =
+          std::acos(std::clamp(lights[k].direction_in_world.dot(off.at(name)[k].direction_in_world),
+                               -1.0, 1.0)) *
+          180.0 / M_PI;
+      EXPECT_NEAR(angle_deg, photos[name]["light_error_deg"][k].get<double>(), 1e-3) << name;
+      sum_squares += angle_deg * angle_deg;
+      ++count;
+    }
+  }
+  ASSERT_GE(count, 12);
+  const double rms = std::sqrt(sum_squares / count);
+  EXPECT_GT(rms, 1.5);
+  EXPECT_LT(rms, 4.5);
+}
+
+// A flat, relief-free sample seen from above under one light: what the sheen and
+// the interreflection add is known.
+class FlatSampleRender : public ::testing::Test {
+ protected:
+  Rendering Render(const MaterialOptions& material_options, const ShadingOptions& shading,
+                   const Eigen::Vector3d& light,
+                   const Eigen::Vector3d& view = Eigen::Vector3d::UnitZ()) {
+    material_ = std::make_unique<Material>(material_options);
+    baked_ = std::make_unique<BakedMaterial>(*material_, -0.1, 0.3, -0.1, 0.3, false, false,
+                                             material_options.texel_size);
+    const SurfacePatch plane{SurfacePatch::Domain::kRectangle,
+                             -0.1,
+                             0.3,
+                             -0.1,
+                             0.3,
+                             false,
+                             false,
+                             [](double u, double v) {
+                               return SurfacePoint{{u, v, 0}, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
+                             }};
+    const Renderer renderer(DisplacePatches({plane}, {baked_.get()}, 0.004), {baked_.get()});
+    return renderer.RenderOrthographic(48, 48, 0.0, 0.2, 0.004, view, {{light, 1.0}}, shading);
+  }
+  std::unique_ptr<Material> material_;
+  std::unique_ptr<BakedMaterial> baked_;
+};
+
+TEST_F(FlatSampleRender, SheenAddsItsGrazingTermExactly) {
+  MaterialOptions m;
+  m.relief_height = 0.0;
+  // Light and viewer low on opposite sides: where sheen is strongest.
+  const Eigen::Vector3d l = Eigen::Vector3d(0.9, 0.0, 0.25).normalized();
+  const Eigen::Vector3d v = Eigen::Vector3d(-0.9, 0.0, 0.3).normalized();
+  const cv::Mat matte = Render(m, {}, l, v).linear_rgb;
+  m.sheen = 0.4;
+  const cv::Mat sheen = Render(m, {}, l, v).linear_rgb;
+  const Eigen::Vector3d half = (l + v).normalized();
+  const double expected = 0.4 * std::pow(1.0 - l.dot(half), 5.0) * l.z();
+  ASSERT_GT(expected, 0.01);
+  const cv::Mat difference = sheen - matte;
+  double lo, hi;
+  cv::minMaxLoc(difference.reshape(1), &lo, &hi);
+  EXPECT_NEAR(lo, expected, 1e-5);
+  EXPECT_NEAR(hi, expected, 1e-5);
+}
+
+TEST_F(FlatSampleRender, InterreflectionOnlyAddsLightAndNoneOnAFlatSample) {
+  MaterialOptions m;
+  m.relief_height = 0.0;
+  const Eigen::Vector3d l = Eigen::Vector3d(0.3, 0.2, 0.8).normalized();
+  ShadingOptions bounce;
+  bounce.interreflection_rays = 8;
+  EXPECT_EQ(cv::norm(Render(m, {}, l).linear_rgb, Render(m, bounce, l).linear_rgb, cv::NORM_INF),
+            0.0);
+  m.relief_height = 0.02;  // deep relief: its walls light each other
+  const cv::Mat direct = Render(m, {}, l).linear_rgb, both = Render(m, bounce, l).linear_rgb;
+  double lo, hi;
+  const cv::Mat added = both - direct;
+  cv::minMaxLoc(added.reshape(1), &lo, &hi);
+  EXPECT_GE(lo, 0.0);
+  EXPECT_GT(cv::mean(both)[1], 1.005 * cv::mean(direct)[1]);
+}
+
 TEST(Materials, PeriodicMaterialsAreSeamlessAndBakingIsFaithful) {
   for (auto kind : {MaterialKind::kStone, MaterialKind::kBrick, MaterialKind::kGrooves}) {
     MaterialOptions o;

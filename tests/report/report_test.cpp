@@ -62,7 +62,7 @@ TEST(WriteReport, ShowsTheGivenPicturesAndMetricsAndLinksOnlyWhatItWrote) {
   in.views_heading = "Held-out views";
   in.sweep = {grey, grey, grey, grey};
   in.sweep_view = view.name;
-  in.metrics = {{"texlume", {{"view_0.png", 22.5, 0.5, 23.5, 0.625}}, 22.5, 0.5, 23.5, 0.625}};
+  in.metrics = {{"texlume", {{"view_0.png", 22.5, 0.5, 23.5, 0.625, {}}}, 22.5, 0.5, 23.5, 0.625}};
   testing::TempDir out;
   const ReportSummary s = WriteReport(out.path(), in);
   const std::string html = testing::ReadText(out.path() / "report.html");
