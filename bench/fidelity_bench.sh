@@ -10,7 +10,9 @@
 # instance: PSNR and SSIM at full and at the photos' resolution, the luma bias,
 # the chroma spread against the truth, the gradient-histogram distance and the
 # radially averaged power spectrum difference (bench/view_fidelity).
-# With CLEAN=1 the scenes are today's clean ones (texlume scene --clean).
+# With CLEAN=1 the scenes are today's clean ones (texlume scene --clean); with
+# COLMAP=1 it also builds the model from COLMAP's own cameras (a calibrated
+# camera: the scene's intrinsics held fixed), moved into the mesh's frame.
 # Usage: bench/fidelity_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [SHAPES (sphere cylinder)]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -39,22 +41,50 @@ for shape in $shapes; do
   held="$object/held_out"
   "$texlume" fit --images "$capture" --lights "$capture/lights.lp" --out "$dir/sample.ptm" \
     > /dev/null
-  rm -rf "$dir/model"
-  start=$SECONDS
-  "$texlume" synth --model "$object/sparse" --images "$object/images" \
-    --lights "$object/lights.json" --mesh "$object/mesh.ply" --no-report \
-    --sample "$dir/sample.ptm" --sample-texel-size 0.002 --out "$dir/model" > /dev/null
-  synth_s=$((SECONDS - start))
-  for mode in texlume flat baked; do
-    baseline=()
-    if [ "$mode" != texlume ]; then baseline=(--baseline "$mode"); fi
-    rm -rf "$dir/render_$mode"
-    "$texlume" render --model "$dir/model" --cameras "$held/sparse" --lights "$held/lights.json" \
-      --out "$dir/render_$mode" "${baseline[@]}" > /dev/null
-  done
+  render() {  # NAME MODEL_FOLDER [--baseline MODE]
+    local name=$1 model=$2
+    shift 2
+    rm -rf "$dir/render_$name"
+    "$texlume" render --model "$model" --cameras "$held/sparse" --lights "$held/lights.json" \
+      --out "$dir/render_$name" "$@" > /dev/null
+  }
+  synth() {  # NAME COLMAP_MODEL [synth options]
+    local name=$1 cameras=$2
+    shift 2
+    rm -rf "$dir/model_$name"
+    local start=$SECONDS
+    "$texlume" synth --model "$cameras" --images "$object/images" \
+      --lights "$object/lights.json" --mesh "$object/mesh.ply" --no-report \
+      --sample "$dir/sample.ptm" --sample-texel-size 0.002 --out "$dir/model_$name" "$@" > /dev/null
+    echo "synth $name: $((SECONDS - start)) s" >&2
+    render "$name" "$dir/model_$name"
+  }
+  synth texlume "$object/sparse"
+  render flat "$dir/model_texlume" --baseline flat
+  render baked "$dir/model_texlume" --baseline baked
+  rows=(texlume="$dir/render_texlume")
+  if [ "${COLMAP:-0}" = 1 ]; then
+    # COLMAP's own cameras for a calibrated camera (intrinsics fixed to the scene's),
+    # moved into the mesh's frame by the similarity of the camera centres.
+    if [ ! -d "$dir/colmap_model" ]; then
+      mkdir -p "$dir/colmap/sparse"
+      params=$(awk '!/^#/ {print $5","$6","$7","$8; exit}' "$object/sparse_txt/cameras.txt")
+      export QT_QPA_PLATFORM=offscreen
+      colmap feature_extractor --database_path "$dir/colmap/db.db" --image_path "$object/images" \
+        --SiftExtraction.use_gpu 0 --ImageReader.single_camera 1 \
+        --ImageReader.camera_model PINHOLE --ImageReader.camera_params "$params" > "$dir/colmap/log" 2>&1
+      colmap exhaustive_matcher --database_path "$dir/colmap/db.db" --SiftMatching.use_gpu 0 \
+        >> "$dir/colmap/log" 2>&1
+      colmap mapper --database_path "$dir/colmap/db.db" --image_path "$object/images" \
+        --output_path "$dir/colmap/sparse" --Mapper.ba_refine_focal_length 0 \
+        --Mapper.ba_refine_principal_point 0 >> "$dir/colmap/log" 2>&1
+      "$build/bench/sfm_alignment" "$object/sparse" "$dir/colmap/sparse/0" "$dir/colmap_model" >&2
+    fi
+    synth colmap "$dir/colmap_model"
+    rows+=(texlume_colmap="$dir/render_colmap")
+  fi
   echo
-  echo "### $shape${clean:+ (clean)}: held-out views x lights at 2x the photos' resolution (synth ${synth_s} s)"
-  "$view_fidelity" "$held/images" "$held/masks" 2 texlume="$dir/render_texlume" \
-    flat="$dir/render_flat" baked="$dir/render_baked" \
-    another_instance="$dir/other/object/held_out/images"
+  echo "### $shape${clean:+ (clean)}: held-out views x lights at 2x the photos' resolution"
+  "$view_fidelity" "$held/images" "$held/masks" 2 "${rows[@]}" flat="$dir/render_flat" \
+    baked="$dir/render_baked" another_instance="$dir/other/object/held_out/images"
 done

@@ -6,6 +6,8 @@
 //   view_fidelity TRUTH_DIR MASKS_DIR REDUCED_FACTOR LABEL=DIR [LABEL=DIR ...]
 //
 // Every PNG of TRUTH_DIR is a view; each DIR must hold an image of that name.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -23,7 +25,24 @@ namespace {
 struct Row {
   std::string label;
   render::ViewMetrics mean;
+  /// Per spectrum band, the mean over the views of 10 log10(power / truth's), dB.
+  std::vector<double> band_db = std::vector<double>(render::kSpectrumBands, 0.0);
 };
+
+// Adds each band's signed power ratio (dB) of `rgb` against the truth, / n.
+void AddBandRatios(const cv::Mat& rgb, const fs::path& truth_path, const fs::path& mask_path,
+                   double n, std::vector<double>& band_db) {
+  const cv::Mat truth = ReadPhotoRgb(truth_path);
+  const cv::Mat mask = fs::exists(mask_path) ? cv::Mat(ReadImageGrey(mask_path) > 0.5f)
+                                             : cv::Mat(rgb.size(), CV_8UC1, cv::Scalar(255));
+  const render::AppearanceStats a = render::MeasureAppearance(rgb, mask),
+                                b = render::MeasureAppearance(truth, mask);
+  for (int k = 0; k < render::kSpectrumBands; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    if (a.radial_power[i] > 0 && b.radial_power[i] > 0)
+      band_db[i] += 10.0 * std::log10(a.radial_power[i] / b.radial_power[i]) / n;
+  }
+}
 
 Row MeasureFolder(const std::string& label, const fs::path& dir, const std::vector<fs::path>& views,
                   const fs::path& truth_dir, const fs::path& masks_dir, int reduced_factor) {
@@ -35,6 +54,7 @@ Row MeasureFolder(const std::string& label, const fs::path& dir, const std::vect
     const cv::Mat coverage(rgb.size(), CV_8UC1, cv::Scalar(255));
     const render::ViewMetrics m =
         pipeline::MeasureAgainstTruth(name, rgb, coverage, truth_dir, masks_dir, reduced_factor);
+    AddBandRatios(rgb, truth_dir / name, masks_dir / name, n, row.band_db);
     row.mean.psnr += m.psnr / n;
     row.mean.ssim += m.ssim / n;
     row.mean.psnr_reduced += m.psnr_reduced / n;
@@ -69,6 +89,7 @@ int main(int argc, char** argv) {
         "| %-16s | PSNR dB | SSIM | PSNR/%d | SSIM/%d | luma bias %% | chroma %% | grad EMD | "
         "grad p90 (truth) | spectrum dB |\n|---|---|---|---|---|---|---|---|---|---|\n",
         "", reduced_factor, reduced_factor);
+    std::vector<Row> rows;
     for (int i = 4; i < argc; ++i) {
       const std::string arg = argv[i];
       const std::size_t eq = arg.find('=');
@@ -81,6 +102,20 @@ int main(int argc, char** argv) {
           row.label.c_str(), row.mean.psnr, row.mean.ssim, row.mean.psnr_reduced,
           row.mean.ssim_reduced, 100 * f.luma_bias, 100 * f.chroma_spread_ratio,
           f.gradient_histogram_distance, f.gradient_p90, f.gradient_p90_truth, f.power_spectrum_db);
+      rows.push_back(row);
+    }
+    std::printf(
+        "\nPower against the truth's per band (dB; band centre in cycles per pixel):\n| %-16s |",
+        "");
+    for (int k = 0; k < render::kSpectrumBands; ++k)
+      std::printf(" %.3f |", std::pow(2.0, -7.0 + 6.0 * (k + 0.5) / render::kSpectrumBands));
+    std::printf("\n|---|");
+    for (int k = 0; k < render::kSpectrumBands; ++k) std::printf("---|");
+    std::printf("\n");
+    for (const Row& row : rows) {
+      std::printf("| %-16s |", row.label.c_str());
+      for (double db : row.band_db) std::printf(" %+.1f |", db);
+      std::printf("\n");
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "view_fidelity: %s\n", e.what());

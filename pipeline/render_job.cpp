@@ -119,9 +119,12 @@ class RenderJob {
   void LoadViews() {
     cameras_ = sfm::ReadModel(options_.cameras_dir);
     lights_ = sfm::ReadObjectLightsFile(options_.lights_file);
-    for (const std::string& name : sfm::CheckLightsAgainstModel(lights_, cameras_.reconstruction,
-                                                                options_.lights_file.string()))
+    const sfm::LightsModelMatch match = sfm::CheckLightsAgainstModel(
+        lights_, cameras_.reconstruction, options_.lights_file.string());
+    for (const std::string& name : match.images_without_lights)
       summary_.warnings.push_back("not rendering " + name + ": no light for it");
+    for (const std::string& name : match.lights_without_images)
+      summary_.warnings.push_back("ignoring the light of " + name + ": no camera for it");
   }
 
   void RenderView(const sfm::Image& image, const std::vector<sfm::ObjectLight>& lights) {

@@ -74,11 +74,14 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
   inputs.reconstruction = sfm::ReadModel(options.model_dir).reconstruction;
   const sfm::Reconstruction& reconstruction = inputs.reconstruction;
   const sfm::ObjectLights lights = sfm::ReadObjectLightsFile(options.lights_file);
-  const std::vector<std::string> unlit =
+  const sfm::LightsModelMatch match =
       sfm::CheckLightsAgainstModel(lights, reconstruction, options.lights_file.string());
-  for (const std::string& name : unlit)
+  for (const std::string& name : match.images_without_lights)
     inputs.warnings.push_back("skipping " + name + ": no light for it in " +
                               options.lights_file.string());
+  for (const std::string& name : match.lights_without_images)
+    inputs.warnings.push_back("ignoring the light of " + name +
+                              ": the COLMAP model does not hold it (not registered?)");
   mesh::LoadedMesh loaded_mesh = mesh::LoadMesh(options.mesh_file);
   for (const std::string& problem : loaded_mesh.report.Problems())
     inputs.warnings.push_back(options.mesh_file.string() + ": " + problem);

@@ -52,4 +52,21 @@ SimilarityAlignment AlignByCameraCenters(const Reconstruction& reference,
   return a;
 }
 
+Reconstruction TransformedIntoReference(const Reconstruction& estimate,
+                                        const SimilarityAlignment& a) {
+  Reconstruction out = estimate;
+  const Eigen::Matrix3d est_from_ref_rotation = a.rotation.transpose();
+  for (auto& [id, image] : out.images) {
+    // x_cam' = s (R_c R^T (x_ref - t) / s + t_c) = R_c R^T x_ref + s t_c - R_c R^T t.
+    const Eigen::Matrix3d rotation =
+        image.cam_from_world.rotation.toRotationMatrix() * est_from_ref_rotation;
+    image.cam_from_world.translation =
+        a.scale * image.cam_from_world.translation - rotation * a.translation;
+    image.cam_from_world.rotation = Eigen::Quaterniond(rotation).normalized();
+  }
+  for (auto& [id, point] : out.points3d)
+    point.xyz = a.scale * a.rotation * point.xyz + a.translation;
+  return out;
+}
+
 }  // namespace texlume::sfm

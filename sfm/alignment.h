@@ -26,4 +26,11 @@ struct SimilarityAlignment {
 SimilarityAlignment AlignByCameraCenters(const Reconstruction& reference,
                                          const Reconstruction& estimate);
 
+/// `estimate` moved into the reference frame by `a` (reference_from_estimate):
+/// points map by x_ref = s R x_est + t; each camera keeps its intrinsics and
+/// its view (cam_from_ref = s cam_from_est(x_est), which projects alike).
+/// What a user has when a mesh in one frame meets an SfM model in another.
+Reconstruction TransformedIntoReference(const Reconstruction& estimate,
+                                        const SimilarityAlignment& a);
+
 }  // namespace texlume::sfm

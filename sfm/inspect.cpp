@@ -57,7 +57,9 @@ InspectReport RunInspect(const InspectOptions& options, const ProgressCallback& 
     } else {
       report.lights_kind = "object-lights JSON";
       const ObjectLights lights = ReadObjectLightsFile(path);
-      report.images_without_lights = CheckLightsAgainstModel(lights, r, path.string());
+      const LightsModelMatch match = CheckLightsAgainstModel(lights, r, path.string());
+      report.images_without_lights = match.images_without_lights;
+      report.lights_without_images = match.lights_without_images;
       report.num_lit_images = lights.size();
     }
   }
@@ -141,7 +143,8 @@ std::string FormatInspectReport(const InspectReport& rep) {
   }
   if (rep.lights_kind) {
     out << "Lights (" << *rep.lights_kind << "): " << rep.num_lit_images << " images lit, "
-        << rep.images_without_lights.size() << " model images without a light\n";
+        << rep.images_without_lights.size() << " model images without a light, "
+        << rep.lights_without_images.size() << " lights for images not in the model\n";
   }
   if (rep.missing_images) {
     out << "Images missing on disk: " << rep.missing_images->size() << "\n";
@@ -181,7 +184,8 @@ std::string InspectReportToJson(const InspectReport& rep) {
   if (rep.lights_kind) {
     j["lights"] = {{"kind", *rep.lights_kind},
                    {"lit_images", rep.num_lit_images},
-                   {"images_without_lights", rep.images_without_lights}};
+                   {"images_without_lights", rep.images_without_lights},
+                   {"lights_without_images", rep.lights_without_images}};
   }
   return j.dump(2);
 }

@@ -52,6 +52,8 @@ struct InspectReport {
   std::optional<std::string> lights_kind;                  ///< "object-lights JSON" or ".lp"
   std::size_t num_lit_images = 0;
   std::vector<std::string> images_without_lights;
+  /// Light entries naming images the model does not hold (unregistered photos).
+  std::vector<std::string> lights_without_images;
 };
 
 /// Reads and checks everything given (model, mesh, lights, image folder) and

@@ -233,22 +233,21 @@ void WriteObjectLightsFile(const ObjectLights& lights, const std::filesystem::pa
       path, [&](std::ostream& out) { WriteObjectLights(lights, out); }, false);
 }
 
-std::vector<std::string> CheckLightsAgainstModel(const ObjectLights& lights,
-                                                 const Reconstruction& reconstruction,
-                                                 const std::string& label) {
+LightsModelMatch CheckLightsAgainstModel(const ObjectLights& lights,
+                                         const Reconstruction& reconstruction,
+                                         const std::string& label) {
   std::set<std::string> model_names;
   for (const auto& [id, image] : reconstruction.images) model_names.insert(image.name);
-  for (const auto& [name, list] : lights) {
-    if (!model_names.count(name)) {
-      throw InputError(
-          label, "lights are given for image '" + name + "', which is not in the COLMAP model");
-    }
+  LightsModelMatch match;
+  for (const auto& [name, list] : lights)
+    if (!model_names.count(name)) match.lights_without_images.push_back(name);
+  if (!lights.empty() && match.lights_without_images.size() == lights.size()) {
+    throw InputError(label, "no light entry names an image of the COLMAP model (the first is '" +
+                                lights.begin()->first + "')");
   }
-  std::vector<std::string> without;
-  for (const auto& name : model_names) {
-    if (!lights.count(name)) without.push_back(name);
-  }
-  return without;
+  for (const auto& name : model_names)
+    if (!lights.count(name)) match.images_without_lights.push_back(name);
+  return match;
 }
 
 }  // namespace texlume::sfm

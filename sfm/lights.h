@@ -62,10 +62,19 @@ ObjectLights ReadObjectLightsFile(const std::filesystem::path& path);
 void WriteObjectLights(const ObjectLights& lights, std::ostream& out);
 void WriteObjectLightsFile(const ObjectLights& lights, const std::filesystem::path& path);
 
-/// Throws InputError(label, ...) naming the first light entry whose image is not
-/// in the model. Returns the names of model images that have no light.
-std::vector<std::string> CheckLightsAgainstModel(const ObjectLights& lights,
-                                                 const Reconstruction& reconstruction,
-                                                 const std::string& label);
+/// How the light entries and the model's images pair up, by name.
+struct LightsModelMatch {
+  /// Model images with no light: jobs skip them.
+  std::vector<std::string> images_without_lights;
+  /// Light entries for images the model does not hold (photos SfM did not
+  /// register, as COLMAP often leaves a few): jobs ignore them with a warning.
+  std::vector<std::string> lights_without_images;
+};
+
+/// Pairs lights and images. Throws InputError(label, ...) when no light entry
+/// names an image of the model (the file is for other photos), giving a name.
+LightsModelMatch CheckLightsAgainstModel(const ObjectLights& lights,
+                                         const Reconstruction& reconstruction,
+                                         const std::string& label);
 
 }  // namespace texlume::sfm

@@ -5,6 +5,7 @@
 #include "datasets_synthetic/scene.h"
 #include "sfm/alignment.h"
 #include "sfm/colmap_io.h"
+#include "tests/colmap_runner.h"
 #include "tests/test_util.h"
 
 namespace texlume::datasets {
@@ -20,30 +21,11 @@ TEST(ColmapSfm, RegistersTheGeneratedPhotosAndAlignsToGroundTruth) {
   options.write_btf = false;
   options.num_held_out_views = 0;
   GenerateScene(options, tmp / "scene");
-  const std::string images = (tmp / "scene/object/images").string();
-  const std::string db = (tmp / "db.db").string();
-  std::filesystem::create_directories(tmp / "sparse");
-  const std::string colmap = "QT_QPA_PLATFORM=offscreen colmap ";
-  std::string log;
-  ASSERT_EQ(testing::RunCommand(colmap + "feature_extractor --database_path " + db +
-                                    " --image_path " + images +
-                                    " --SiftExtraction.use_gpu 0 --ImageReader.single_camera 1"
-                                    " --ImageReader.camera_model PINHOLE",
-                                &log),
-            0)
-      << log;
-  ASSERT_EQ(
-      testing::RunCommand(
-          colmap + "exhaustive_matcher --database_path " + db + " --SiftMatching.use_gpu 0", &log),
-      0)
-      << log;
-  ASSERT_EQ(testing::RunCommand(colmap + "mapper --database_path " + db + " --image_path " +
-                                    images + " --output_path " + (tmp / "sparse").string(),
-                                &log),
-            0)
-      << log;
+  const std::filesystem::path sparse =
+      testing::RunColmapSfm(tmp / "scene/object/images", tmp.path());
+  ASSERT_FALSE(sparse.empty());
   const sfm::Reconstruction truth = sfm::ReadModel(tmp / "scene/object/sparse").reconstruction;
-  const sfm::Reconstruction estimate = sfm::ReadModel(tmp / "sparse/0").reconstruction;
+  const sfm::Reconstruction estimate = sfm::ReadModel(sparse).reconstruction;
   EXPECT_GE(estimate.images.size(), static_cast<std::size_t>(0.9 * options.num_images));
   const sfm::SimilarityAlignment a = sfm::AlignByCameraCenters(truth, estimate);
   // Camera centres within 1 % of the camera distance, orientations within 1 degree.

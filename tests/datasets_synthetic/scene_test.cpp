@@ -96,7 +96,10 @@ TEST_P(SceneShapesTest, MasksOfEveryViewMatchTheCoarseMeshProjectedWithTheColmap
   EXPECT_EQ(model.reconstruction.images.size(), 6u);
   EXPECT_GT(model.reconstruction.points3d.size(), 100u);
   const auto lights = sfm::ReadObjectLightsFile(tmp / "object/lights.json");
-  EXPECT_TRUE(sfm::CheckLightsAgainstModel(lights, model.reconstruction, "lights.json").empty());
+  const sfm::LightsModelMatch match =
+      sfm::CheckLightsAgainstModel(lights, model.reconstruction, "lights.json");
+  EXPECT_TRUE(match.images_without_lights.empty());
+  EXPECT_TRUE(match.lights_without_images.empty());
   for (const auto& [name, list] : lights) {
     EXPECT_GE(list.size(), 1u);
     EXPECT_LE(list.size(), 3u);

@@ -101,7 +101,7 @@ TEST(ObjectLightsBadInput, ErrorsNameTheFileAndTheImage) {
   }
 }
 
-TEST(ObjectLightsBadInput, LightsForUnknownImagesAreRefused) {
+TEST(ObjectLightsBadInput, LightsForUnregisteredImagesAreListedAndAllUnknownRefused) {
   Reconstruction r;
   Image image;
   image.image_id = ImageId(1);
@@ -112,11 +112,20 @@ TEST(ObjectLightsBadInput, LightsForUnknownImagesAreRefused) {
   r.images[image.image_id] = image;
   ObjectLights lights;
   lights["a.png"] = {ObjectLight{}};
-  EXPECT_EQ(CheckLightsAgainstModel(lights, r, "l.json"), std::vector<std::string>{"b.png"});
+  EXPECT_EQ(CheckLightsAgainstModel(lights, r, "l.json").images_without_lights,
+            std::vector<std::string>{"b.png"});
+  // A photo SfM did not register: listed, not refused.
   lights["zzz.png"] = {ObjectLight{}};
+  const LightsModelMatch match = CheckLightsAgainstModel(lights, r, "l.json");
+  EXPECT_EQ(match.lights_without_images, std::vector<std::string>{"zzz.png"});
+  EXPECT_EQ(match.images_without_lights, std::vector<std::string>{"b.png"});
+  // A file for other photos altogether: refused, naming one.
+  ObjectLights other;
+  other["zzz.png"] = {ObjectLight{}};
   const std::string error =
-      testing::InputErrorMessage([&] { CheckLightsAgainstModel(lights, r, "l.json"); });
+      testing::InputErrorMessage([&] { CheckLightsAgainstModel(other, r, "l.json"); });
   EXPECT_NE(error.find("zzz.png"), std::string::npos) << error;
+  EXPECT_NE(error.find("l.json"), std::string::npos) << error;
 }
 
 }  // namespace
