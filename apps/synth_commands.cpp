@@ -277,6 +277,7 @@ void AddSceneCommand(CLI::App& app, CommandRunners& run) {
   auto out_dir = std::make_shared<std::filesystem::path>();
   auto clean = std::make_shared<bool>(false);
   auto material_seed = std::make_shared<std::uint32_t>(0);
+  auto elevations = std::make_shared<std::vector<double>>();
   auto flags = std::make_shared<std::pair<bool, bool>>(false, false);  // no BTF, fixed exposure
   sub->add_option("--out", *out_dir, "the folder to write")->required();
   sub->add_option("--kind", s->shape, "sphere, cylinder, plane or torus")
@@ -289,6 +290,10 @@ void AddSceneCommand(CLI::App& app, CommandRunners& run) {
   sub->add_option("--material-seed", *material_seed,
                   "another instance of the material: its own seed (0: --seed)")
       ->capture_default_str();
+  sub->add_option("--held-out-elevation", *elevations,
+                  "held-out lights between these elevations, degrees: MIN,MAX (default 25,65)")
+      ->delimiter(',')
+      ->expected(2);
   sub->add_flag("--clean", *clean,
                 "today's clean scene: no sensor effects, matte, no interreflection, exact lights "
                 "(options given still apply)");
@@ -303,8 +308,13 @@ void AddSceneCommand(CLI::App& app, CommandRunners& run) {
   BindSensor(sub, s->sensor);
   sub->add_flag("--no-btf", flags->first, "no BTF capture");
   sub->add_flag("--fixed-exposure", flags->second, "every photo at one exposure");
-  run[sub] = [sub, s, out_dir, flags, clean, material_seed](std::ostream& out, std::ostream&) {
+  run[sub] = [sub, s, out_dir, flags, clean, material_seed, elevations](std::ostream& out,
+                                                                        std::ostream&) {
     if (*clean) ApplyClean(*sub, *s);
+    if (!elevations->empty()) {
+      s->held_out_min_elevation_deg = (*elevations)[0];
+      s->held_out_max_elevation_deg = (*elevations)[1];
+    }
     s->material.seed = *material_seed != 0 ? *material_seed : s->seed;
     s->focal_px *= s->image_width / 640.0;
     s->write_btf = !flags->first;

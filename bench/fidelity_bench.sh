@@ -13,6 +13,8 @@
 # With CLEAN=1 the scenes are today's clean ones (texlume scene --clean); with
 # COLMAP=1 it also builds the model from COLMAP's own cameras (a calibrated
 # camera: the scene's intrinsics held fixed), moved into the mesh's frame.
+# SCENE_ARGS adds options to both scenes (e.g. "--held-out-elevation 5,15" for
+# grazing held-out lights).
 # Usage: bench/fidelity_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [SHAPES (sphere cylinder)]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -33,7 +35,7 @@ for shape in $shapes; do
     if [ ! -f "$dir/$instance/scene.json" ]; then
       echo "fidelity_bench: $shape $instance ${clean[*]}" >&2
       "$texlume" scene --out "$dir/$instance" --kind "$shape" --held-out-scale 2 --no-btf \
-        "${clean[@]}" "${seed[@]}" > /dev/null
+        "${clean[@]}" "${seed[@]}" ${SCENE_ARGS:-} > /dev/null
     fi
   done
   object="$dir/scene/object"

@@ -80,6 +80,9 @@ void SceneOptions::Check() const {
   RequireInRange(num_held_out_views, 0, 100, "num_held_out_views");
   RequireInRange(held_out_lights_per_view, 1, 20, "held_out_lights_per_view");
   RequireInRange(held_out_scale, 1, 4, "held_out_scale");
+  RequireInRange(held_out_min_elevation_deg, 0.0, 90.0, "held_out_min_elevation_deg");
+  RequireInRange(held_out_max_elevation_deg, held_out_min_elevation_deg, 90.0,
+                 "held_out_max_elevation_deg");
   RequireInRange(light_error_deg, 0.0, 20.0, "light_error_deg");
   RequireInRange(capture_size, 16, 4096, "capture_size");
   RequireInRange(num_capture_lights, 6, 500, "num_capture_lights");
@@ -535,7 +538,9 @@ class SceneGenerator {
       const double elevation = (plane ? 50.0 : 22.0) * kPi / 180.0;
       const sfm::Rigid3d pose = LookAt(options_.camera_distance * FromAngles(azimuth, elevation),
                                        Eigen::Vector3d::Zero());
-      const auto dome = DomeLights(options_.held_out_lights_per_view, 25, 65, 0.3);
+      const auto dome =
+          DomeLights(options_.held_out_lights_per_view, options_.held_out_min_elevation_deg,
+                     options_.held_out_max_elevation_deg, 0.3);
       for (int k = 0; k < options_.held_out_lights_per_view; ++k) {
         // The dome is turned towards the view so the visible side is lit.
         const Eigen::Vector3d d = dome[static_cast<std::size_t>(k)];
@@ -588,6 +593,8 @@ class SceneGenerator {
                         {"focal_px", options_.focal_px},
                         {"distance", options_.camera_distance},
                         {"held_out_scale", options_.held_out_scale}};
+    record["held_out_light_elevations_deg"] = {options_.held_out_min_elevation_deg,
+                                               options_.held_out_max_elevation_deg};
     record["shading"] = {{"ambient", options_.shading.ambient},
                          {"samples_per_pixel",
                           options_.shading.samples_per_axis * options_.shading.samples_per_axis},

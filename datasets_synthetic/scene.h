@@ -34,6 +34,11 @@ struct SceneOptions {
   bool vary_exposure = true;
   int num_held_out_views = 4;        ///< [0, 100]
   int held_out_lights_per_view = 3;  ///< [1, 20]
+  /// Elevations (degrees above the horizontal plane) between which the held-out
+  /// lights lie, on a dome turned towards each view. Low ones test grazing
+  /// light: the relief's cast shadows, the PTM's horizon. [0, 90], min <= max.
+  double held_out_min_elevation_deg = 25.0;
+  double held_out_max_elevation_deg = 65.0;
   /// Held-out views are rendered at this many times the photos' resolution (the
   /// same camera, its size, focal length and principal point scaled), so models
   /// can be compared at full resolution and at the photos'. [1, 4]

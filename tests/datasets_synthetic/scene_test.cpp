@@ -460,6 +460,37 @@ TEST(SceneOptions, BadSettingsAreRefused) {
   o = {};
   o.material.relief_height = -1;
   EXPECT_THROW(o.Check(), std::invalid_argument);
+  o = {};
+  o.held_out_min_elevation_deg = 40;
+  o.held_out_max_elevation_deg = 30;
+  EXPECT_THROW(o.Check(), std::invalid_argument);
+  o = {};
+  o.light_error_deg = 25;
+  EXPECT_THROW(o.Check(), std::invalid_argument);
+}
+
+// Held-out lights can be grazing: every one lies between the elevations asked.
+TEST(Scene, HeldOutLightsLieBetweenTheElevationsAsked) {
+  testing::TempDir tmp;
+  SceneOptions options = SmallScene(SceneShape::kSphere, MaterialKind::kStone);
+  options.num_images = 3;
+  options.write_btf = false;
+  options.write_surface = false;
+  options.material.texel_size = 0.008;
+  options.image_width = options.image_height = 64;
+  options.focal_px = 60;
+  options.num_held_out_views = 2;
+  options.held_out_lights_per_view = 4;
+  options.held_out_min_elevation_deg = 5;
+  options.held_out_max_elevation_deg = 12;
+  GenerateScene(options, tmp.path());
+  const auto lights = sfm::ReadObjectLightsFile(tmp / "object/held_out/lights.json");
+  ASSERT_EQ(lights.size(), 8u);
+  for (const auto& [name, list] : lights) {
+    const double elevation_deg = std::asin(list.at(0).direction_in_world.z()) * 180.0 / M_PI;
+    EXPECT_GE(elevation_deg, 5.0 - 1e-6) << name;
+    EXPECT_LE(elevation_deg, 12.0 + 1e-6) << name;
+  }
 }
 
 TEST(ShadingOptions, OutOfRangeSettingsAreRefused) {
