@@ -25,49 +25,19 @@ namespace {
 struct Row {
   std::string label;
   render::ViewMetrics mean;
-  /// Per spectrum band, the mean over the views of 10 log10(power / truth's), dB.
-  std::vector<double> band_db = std::vector<double>(render::kSpectrumBands, 0.0);
 };
-
-// Adds each band's signed power ratio (dB) of `rgb` against the truth, / n.
-void AddBandRatios(const cv::Mat& rgb, const fs::path& truth_path, const fs::path& mask_path,
-                   double n, std::vector<double>& band_db) {
-  const cv::Mat truth = ReadPhotoRgb(truth_path);
-  const cv::Mat mask = fs::exists(mask_path) ? cv::Mat(ReadImageGrey(mask_path) > 0.5f)
-                                             : cv::Mat(rgb.size(), CV_8UC1, cv::Scalar(255));
-  const render::AppearanceStats a = render::MeasureAppearance(rgb, mask),
-                                b = render::MeasureAppearance(truth, mask);
-  for (int k = 0; k < render::kSpectrumBands; ++k) {
-    const auto i = static_cast<std::size_t>(k);
-    if (a.radial_power[i] > 0 && b.radial_power[i] > 0)
-      band_db[i] += 10.0 * std::log10(a.radial_power[i] / b.radial_power[i]) / n;
-  }
-}
 
 Row MeasureFolder(const std::string& label, const fs::path& dir, const std::vector<fs::path>& views,
                   const fs::path& truth_dir, const fs::path& masks_dir, int reduced_factor) {
-  Row row{label, {}};
-  const double n = static_cast<double>(views.size());
+  std::vector<render::ViewMetrics> metrics;
   for (const fs::path& view : views) {
     const std::string name = view.filename().string();
     const cv::Mat rgb = ReadPhotoRgb(dir / name);
     const cv::Mat coverage(rgb.size(), CV_8UC1, cv::Scalar(255));
-    const render::ViewMetrics m =
-        pipeline::MeasureAgainstTruth(name, rgb, coverage, truth_dir, masks_dir, reduced_factor);
-    AddBandRatios(rgb, truth_dir / name, masks_dir / name, n, row.band_db);
-    row.mean.psnr += m.psnr / n;
-    row.mean.ssim += m.ssim / n;
-    row.mean.psnr_reduced += m.psnr_reduced / n;
-    row.mean.ssim_reduced += m.ssim_reduced / n;
-    render::FidelityMetrics& f = row.mean.fidelity;
-    f.luma_bias += m.fidelity.luma_bias / n;
-    f.chroma_spread_ratio += m.fidelity.chroma_spread_ratio / n;
-    f.gradient_histogram_distance += m.fidelity.gradient_histogram_distance / n;
-    f.gradient_p90 += m.fidelity.gradient_p90 / n;
-    f.gradient_p90_truth += m.fidelity.gradient_p90_truth / n;
-    f.power_spectrum_db += m.fidelity.power_spectrum_db / n;
+    metrics.push_back(
+        pipeline::MeasureAgainstTruth(name, rgb, coverage, truth_dir, masks_dir, reduced_factor));
   }
-  return row;
+  return {label, render::MeanViewMetrics(metrics)};
 }
 
 }  // namespace
@@ -114,7 +84,7 @@ int main(int argc, char** argv) {
     std::printf("\n");
     for (const Row& row : rows) {
       std::printf("| %-16s |", row.label.c_str());
-      for (double db : row.band_db) std::printf(" %+.1f |", db);
+      for (double db : row.mean.fidelity.band_power_db) std::printf(" %+.1f |", db);
       std::printf("\n");
     }
   } catch (const std::exception& e) {

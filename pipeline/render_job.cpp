@@ -53,16 +53,6 @@ nlohmann::json FidelityJson(const render::FidelityMetrics& f) {
           {"power_spectrum_db", f.power_spectrum_db}};
 }
 
-// sum += scale * f, figure by figure (for the mean over the views).
-void AddScaled(const render::FidelityMetrics& f, double scale, render::FidelityMetrics& sum) {
-  sum.luma_bias += scale * f.luma_bias;
-  sum.chroma_spread_ratio += scale * f.chroma_spread_ratio;
-  sum.gradient_histogram_distance += scale * f.gradient_histogram_distance;
-  sum.gradient_p90 += scale * f.gradient_p90;
-  sum.gradient_p90_truth += scale * f.gradient_p90_truth;
-  sum.power_spectrum_db += scale * f.power_spectrum_db;
-}
-
 fs::path PngName(const std::string& image_name) {
   fs::path p(image_name);
   p.replace_extension(".png");
@@ -150,14 +140,12 @@ class RenderJob {
   }
 
   void AverageMetrics() {
-    const double n = static_cast<double>(summary_.metrics.size());
-    for (const render::ViewMetrics& m : summary_.metrics) {
-      summary_.mean_psnr += m.psnr / n;
-      summary_.mean_ssim += m.ssim / n;
-      summary_.mean_psnr_reduced += m.psnr_reduced / n;
-      summary_.mean_ssim_reduced += m.ssim_reduced / n;
-      AddScaled(m.fidelity, 1.0 / n, summary_.mean_fidelity);
-    }
+    const render::ViewMetrics mean = render::MeanViewMetrics(summary_.metrics);
+    summary_.mean_psnr = mean.psnr;
+    summary_.mean_ssim = mean.ssim;
+    summary_.mean_psnr_reduced = mean.psnr_reduced;
+    summary_.mean_ssim_reduced = mean.ssim_reduced;
+    summary_.mean_fidelity = mean.fidelity;
   }
 
   nlohmann::json MetricsJson() const {

@@ -124,10 +124,11 @@ FidelityMetrics CompareAppearance(const AppearanceStats& rendered, const Appeara
   m.gradient_p90_truth = truth.gradient_p90;
   int bands = 0;
   const std::size_t n = std::min(rendered.radial_power.size(), truth.radial_power.size());
+  m.band_power_db.assign(n, 0.0);
   for (std::size_t b = 0; b < n; ++b) {
     if (rendered.radial_power[b] <= 0 || truth.radial_power[b] <= 0) continue;
-    m.power_spectrum_db +=
-        std::abs(10.0 * std::log10(rendered.radial_power[b] / truth.radial_power[b]));
+    m.band_power_db[b] = 10.0 * std::log10(rendered.radial_power[b] / truth.radial_power[b]);
+    m.power_spectrum_db += std::abs(m.band_power_db[b]);
     ++bands;
   }
   if (bands > 0) m.power_spectrum_db /= bands;

@@ -44,6 +44,9 @@ struct FidelityMetrics {
   double gradient_p90 = 0, gradient_p90_truth = 0;
   /// Mean over the bands of |10 log10(power / truth's power)|, dB.
   double power_spectrum_db = 0;
+  /// Per band (kSpectrumBands), the signed 10 log10(power / truth's power), dB
+  /// (0 where either has no power).
+  std::vector<double> band_power_db = std::vector<double>(kSpectrumBands, 0.0);
 };
 
 FidelityMetrics CompareAppearance(const AppearanceStats& rendered, const AppearanceStats& truth);

@@ -62,4 +62,26 @@ ViewMetrics MeasureView(const std::string& name, const cv::Mat& rendered, const 
   return m;
 }
 
+ViewMetrics MeanViewMetrics(const std::vector<ViewMetrics>& views) {
+  ViewMetrics mean;
+  mean.name = "mean";
+  const double n = static_cast<double>(views.size());
+  FidelityMetrics& f = mean.fidelity;
+  for (const ViewMetrics& m : views) {
+    mean.psnr += m.psnr / n;
+    mean.ssim += m.ssim / n;
+    mean.psnr_reduced += m.psnr_reduced / n;
+    mean.ssim_reduced += m.ssim_reduced / n;
+    f.luma_bias += m.fidelity.luma_bias / n;
+    f.chroma_spread_ratio += m.fidelity.chroma_spread_ratio / n;
+    f.gradient_histogram_distance += m.fidelity.gradient_histogram_distance / n;
+    f.gradient_p90 += m.fidelity.gradient_p90 / n;
+    f.gradient_p90_truth += m.fidelity.gradient_p90_truth / n;
+    f.power_spectrum_db += m.fidelity.power_spectrum_db / n;
+    for (std::size_t b = 0; b < f.band_power_db.size() && b < m.fidelity.band_power_db.size(); ++b)
+      f.band_power_db[b] += m.fidelity.band_power_db[b] / n;
+  }
+  return mean;
+}
+
 }  // namespace texlume::render

@@ -2,6 +2,7 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 #include "render/fidelity.h"
 
@@ -27,5 +28,8 @@ struct ViewMetrics {
 /// reduced by it; and its appearance (FidelityMetrics) at full resolution.
 ViewMetrics MeasureView(const std::string& name, const cv::Mat& rendered, const cv::Mat& truth,
                         const cv::Mat& inside, int reduced_factor);
+
+/// Every figure of `views` averaged (per band too); named "mean". Zeros when empty.
+ViewMetrics MeanViewMetrics(const std::vector<ViewMetrics>& views);
 
 }  // namespace texlume::render

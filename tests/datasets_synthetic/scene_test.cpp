@@ -40,6 +40,19 @@ SceneOptions SmallScene(SceneShape shape, MaterialKind kind) {
   return o;
 }
 
+// The small stone sphere at coarse texels, square photos of `side` pixels, no
+// BTF or planar surface: for tests of the object's photos and lights alone.
+SceneOptions TinySphere(int images, int side, double focal_px) {
+  SceneOptions o = SmallScene(SceneShape::kSphere, MaterialKind::kStone);
+  o.num_images = images;
+  o.write_btf = false;
+  o.write_surface = false;
+  o.material.texel_size = 0.008;
+  o.image_width = o.image_height = side;
+  o.focal_px = focal_px;
+  return o;
+}
+
 // The coarse mesh projected with a COLMAP camera: the object mask it predicts.
 cv::Mat ProjectMesh(const mesh::TriangleMesh& mesh, const sfm::Camera& camera,
                     const sfm::Image& image) {
@@ -293,14 +306,8 @@ TEST(Scene, SensorChangesThePhotosOnlyAndIsRecorded) {
 // it, of about the stated RMS; the photos themselves are lit as before.
 TEST(Scene, LightErrorTurnsTheRecordedLightsByTheRecordedAngles) {
   testing::TempDir tmp;
-  SceneOptions options = SmallScene(SceneShape::kSphere, MaterialKind::kStone);
-  options.num_images = 12;
+  SceneOptions options = TinySphere(12, 96, 90);
   options.num_held_out_views = 0;
-  options.write_btf = false;
-  options.write_surface = false;
-  options.material.texel_size = 0.008;
-  options.image_width = options.image_height = 96;
-  options.focal_px = 90;
   GenerateScene(options, tmp / "exact");
   options.light_error_deg = 3.0;
   GenerateScene(options, tmp / "off");
@@ -472,13 +479,7 @@ TEST(SceneOptions, BadSettingsAreRefused) {
 // Held-out lights can be grazing: every one lies between the elevations asked.
 TEST(Scene, HeldOutLightsLieBetweenTheElevationsAsked) {
   testing::TempDir tmp;
-  SceneOptions options = SmallScene(SceneShape::kSphere, MaterialKind::kStone);
-  options.num_images = 3;
-  options.write_btf = false;
-  options.write_surface = false;
-  options.material.texel_size = 0.008;
-  options.image_width = options.image_height = 64;
-  options.focal_px = 60;
+  SceneOptions options = TinySphere(3, 64, 60);
   options.num_held_out_views = 2;
   options.held_out_lights_per_view = 4;
   options.held_out_min_elevation_deg = 5;
