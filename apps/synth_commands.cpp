@@ -15,7 +15,7 @@ struct SynthWords {
   std::string tangent_frame, prior_shrink;
   std::vector<double> tangent_field;
   bool best_view_only = false, no_additive = false, no_channel = false, no_detail = false,
-       no_report = false;
+       no_report = false, no_light_response = false, no_white_balance = false;
 };
 
 void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o) {
@@ -92,6 +92,10 @@ void BindCorrection(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords&
   sub->add_flag("--no-additive-correction", w.no_additive, "no change of the luminance");
   sub->add_flag("--no-channel-correction", w.no_channel, "no per-channel factors");
   sub->add_flag("--no-detail-transfer", w.no_detail, "keep the quilted patch's own detail");
+  sub->add_flag("--no-light-response", w.no_light_response,
+                "no light response from the photos (elevation factors, ambient)");
+  sub->add_flag("--no-white-balance", w.no_white_balance,
+                "keep each photo's white balance as taken");
 }
 
 void BindAtlas(CLI::App* sub, atlas::AtlasOptions& a, SynthWords& w) {
@@ -128,6 +132,8 @@ void Resolve(const CLI::App* sub, const SynthWords& w, pipeline::SynthCommandOpt
   s.additive_correction = !w.no_additive;
   s.channel_correction = !w.no_channel;
   s.detail_transfer = !w.no_detail;
+  s.light_response = !w.no_light_response;
+  s.white_balance = !w.no_white_balance;
   if (!w.prior_shrink.empty() && w.prior_shrink != "auto")
     s.correction_prior_shrink = std::stod(w.prior_shrink);
   if (w.tangent_frame == "first-edge") s.tangent_frame = synth::TangentFrame::kFirstEdge;

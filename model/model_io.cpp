@@ -234,7 +234,8 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
         {"domain", "display (sRGB-encoded); several lights sum in the linear domain"},
         {"horizon_elevation_deg", ptm::kHorizonElevationDeg},
         {"below_horizon_elevation",
-         "value at horizon_elevation_deg (same azimuth) times l_z / sin(horizon_elevation_deg)"}};
+         "value at horizon_elevation_deg (same azimuth) times l_z / sin(horizon_elevation_deg)"},
+        {"light_response", LightResponseJson(model.light_response)}};
     manifest["atlases"] = nlohmann::json::array();
     std::vector<std::vector<unsigned char>> pngs;
     std::vector<nlohmann::json> extras;
@@ -325,10 +326,52 @@ Eigen::Matrix3d AtlasFaceFrame(const TexturedModel& model, std::size_t f) {
   return frame;
 }
 
+nlohmann::json LightResponseJson(const ptm::LightResponse& response) {
+  std::vector<double> elevations;
+  for (int k = 0; k < ptm::LightResponse::kKnots; ++k)
+    elevations.push_back(k * ptm::LightResponse::kKnotSpacingDeg);
+  return {{"elevations_deg", elevations},
+          {"factors", response.elevation_factor},
+          {"ambient", response.ambient},
+          {"meaning",
+           "each light's linear value times the factor at its elevation above the texel's "
+           "tangent plane (linear between knots); plus ambient times the linear value under a "
+           "unit light at the zenith"}};
+}
+
+ptm::LightResponse LightResponseFromJson(const nlohmann::json& record, const std::string& file) {
+  ptm::LightResponse r;
+  const auto& factors = record.value("factors", nlohmann::json());
+  const auto& elevations = record.value("elevations_deg", nlohmann::json());
+  if (!factors.is_array() || factors.size() != r.elevation_factor.size() ||
+      !elevations.is_array() || elevations.size() != factors.size() ||
+      !record.contains("ambient") || !record["ambient"].is_number())
+    throw InputError(file, "light_response needs " + std::to_string(r.elevation_factor.size()) +
+                               " elevations_deg, as many factors and an ambient");
+  for (std::size_t k = 0; k < factors.size(); ++k) {
+    if (!factors[k].is_number() || !elevations[k].is_number() ||
+        elevations[k].get<double>() != static_cast<double>(k) * ptm::LightResponse::kKnotSpacingDeg)
+      throw InputError(file, "light_response: knot " + std::to_string(k) + " is not a number at " +
+                                 std::to_string(k * 10) + " degrees");
+    r.elevation_factor[k] = factors[k].get<double>();
+  }
+  r.ambient = record["ambient"].get<double>();
+  try {
+    r.Check();
+  } catch (const OptionError& e) {
+    throw InputError(file, e.what());
+  }
+  return r;
+}
+
 TexturedModel ReadModelFolder(const fs::path& dir) {
   const fs::path manifest_path = dir / "manifest.json";
   const nlohmann::json manifest = ReadModelManifest(dir);
   TexturedModel model;
+  const auto& evaluation = manifest.value("ptm_evaluation", nlohmann::json());
+  if (evaluation.is_object() && evaluation.contains("light_response"))
+    model.light_response =
+        LightResponseFromJson(evaluation["light_response"], manifest_path.string());
   for (const auto& entry : manifest["atlases"]) {
     if (!entry.is_object() || !entry.contains("exr") || !entry["exr"].is_string())
       throw InputError(manifest_path.string(), "an atlas entry has no \"exr\" file");

@@ -20,12 +20,23 @@ namespace texlume::model {
 /// pixels (x right, y down, pixel centres at +0.5), the atlas of each face, and
 /// the PTM atlases. Each atlas texel's coefficients are in the tangent frame of
 /// the texture coordinates: x = dP/du, y = dP/dv with v up, z = face normal.
+/// `light_response`: how the texels answer light beyond the biquadratic, as the
+/// photos showed it (ptm::LightResponse; the identity for models written before
+/// it, and for BTF models).
 struct TexturedModel {
   mesh::TriangleMesh mesh;
   std::vector<std::array<Eigen::Vector2f, 3>> corner_px;
   std::vector<int> face_atlas;
   std::vector<ptm::Ptm> atlases;
+  ptm::LightResponse light_response;
 };
+
+/// The light response as the manifest's and the glTF extras' "ptm_evaluation"
+/// record it: knot elevations (degrees), factors and ambient.
+nlohmann::json LightResponseJson(const ptm::LightResponse& response);
+/// Reads LightResponseJson's record; throws InputError naming `file` when it is
+/// malformed or out of range.
+ptm::LightResponse LightResponseFromJson(const nlohmann::json& record, const std::string& file);
 
 /// Writes the model into `dir` (created; an existing texlume model folder there
 /// is replaced, anything else is an error): model.obj + model.mtl with

@@ -105,6 +105,7 @@ WebModel BuildWebModel(const fs::path& model_dir) {
   scene["format"] = "texlume-web-2";
   scene["faces"] = model.mesh.faces.size();
   scene["horizon_elevation_deg"] = ptm::kHorizonElevationDeg;
+  scene["light_response"] = LightResponseJson(model.light_response);
   const std::vector<int> chart = ChartsOfModel(model);
   scene["charts"] = chart.empty() ? 0 : *std::max_element(chart.begin(), chart.end()) + 1;
 

@@ -117,6 +117,7 @@ class BtfSynthJob {
     t = std::chrono::steady_clock::now();
     model_ = pipeline::TexturedModelOf(
         inputs_.mesh, atlas::PreviewPtms(atlases_, sample_, progress_), atlases_.layout.faces);
+    model_.light_response = synthesis_.light_response;
     summary_.seconds_preview = SecondsSince(t);
     baked_ = render::BakePhotoTextures(model_, inputs_.reconstruction, inputs_.visibility,
                                        inputs_.photos, synthesis_.photo_gains);
@@ -137,6 +138,8 @@ class BtfSynthJob {
                                {"photo_correction", so_.photo_correction},
                                {"correction_noise", so_.correction_noise},
                                {"correction_sigma", so_.correction_sigma},
+                               {"light_response", so_.light_response},
+                               {"white_balance", so_.white_balance},
                                {"seed", so_.seed},
                                {"horizon_elevation_deg", ptm::kHorizonElevationDeg}};
     settings.update(pipeline::AtlasSettingsJson(job_.atlas));

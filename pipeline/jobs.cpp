@@ -376,6 +376,8 @@ pipeline::BtfSynthJobOptions BtfJobFrom(const SynthCommandOptions& c) {
   b.synthesis.correction_sigma = c.correction_sigma.value_or(b.synthesis.correction_sigma);
   b.synthesis.tangent_frame = ptm.tangent_frame;
   b.synthesis.field_direction_in_world = ptm.field_direction_in_world;
+  b.synthesis.light_response = ptm.light_response;
+  b.synthesis.white_balance = ptm.white_balance;
   b.job = c.job;
   return b;
 }

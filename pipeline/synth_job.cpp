@@ -228,6 +228,8 @@ void SynthCounts::CountInputs(const SynthInputs& inputs) {
 
 nlohmann::json EngineSummaryJson(const synth::TriangleSynthesis& synthesis) {
   return {{"photo_gains", synthesis.photo_gains},
+          {"light_response", model::LightResponseJson(synthesis.light_response)},
+          {"white_balance", synthesis.white_balance},
           {"tangent_frame", synth::TangentFrameName(synthesis.tangent_frame)},
           {"sample_coherence", synthesis.sample_coherence >= 0.0
                                    ? nlohmann::json(synthesis.sample_coherence)
@@ -323,6 +325,7 @@ class SynthJob {
     summary_.occupancy = atlases.occupancy;
     summary_.stretch = atlases.stretch;
     model_ = TexturedModelOf(inputs_.mesh, std::move(atlases.ptms), atlases.faces);
+    model_.light_response = synthesis_.light_response;
   }
 
   // The baselines `texlume render --baseline` draws.
@@ -356,6 +359,8 @@ class SynthJob {
                                         : nlohmann::json(so.correction_prior_shrink)},
         {"correction_sigma", so.correction_sigma},
         {"horizon_elevation_deg", ptm::kHorizonElevationDeg},
+        {"light_response", so.light_response},
+        {"white_balance", so.white_balance},
         {"seed", so.seed},
         {"sample_kind", sample_.colour.empty() ? "PTM" : "colour"}};
     settings.update(AtlasSettingsJson(options_.atlas));

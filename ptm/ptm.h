@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "ptm/light_response.h"
+
 namespace texlume::ptm {
 
 /// The two PTM layouts of paper 003 §2.1 (Malzbender et al.).
@@ -89,11 +91,5 @@ std::vector<float> Relight(const Ptm& ptm, const Eigen::Vector3d& light,
 /// Per-texel normals (row-major, 3 floats per texel) from the luminance of the PTM
 /// (for RGB: of the mean of the three polynomials).
 std::vector<float> NormalMap(const Ptm& ptm);
-
-/// Lights lower than this (degrees above the tangent plane) are evaluated at this
-/// elevation and faded linearly in l_z to 0 at the horizon (synth::RelightMixture): RTI
-/// domes rarely light below it, and the biquadratic overshoots there. Recorded in
-/// the model's manifest and glTF extras so that viewers do the same.
-inline constexpr double kHorizonElevationDeg = 15.0;
 
 }  // namespace texlume::ptm

@@ -8,7 +8,8 @@
 namespace texlume::render {
 
 Eigen::Vector3f ShadeBtf(const model::BtfModel& model, const ModelRenderer::SurfaceSample& s,
-                         const std::vector<sfm::ObjectLight>& lights) {
+                         const std::vector<sfm::ObjectLight>& lights,
+                         const ptm::LightResponse& response) {
   const cv::Mat& coords = model.sample_coords[static_cast<std::size_t>(s.atlas)];
   const int n = model.sample.Components();
   // Paper 004's lookup: the nearest texel's sample position, moved by the hit's
@@ -33,13 +34,19 @@ Eigen::Vector3f ShadeBtf(const model::BtfModel& model, const ModelRenderer::Surf
     view.z() = 0.02;
     view.normalize();
   }
+  // Each light times the light response's factor at its elevation, then the
+  // ambient term: the value under a unit light at the zenith times it.
   Eigen::Vector3f linear = Eigen::Vector3f::Zero();
   for (const sfm::ObjectLight& light : lights) {
     const Eigen::Vector3d l = to_sample(light.DirectionFrom(s.point));
     if (l.z() <= 0.0) continue;
-    linear += static_cast<float>(light.intensity) *
+    linear += static_cast<float>(light.intensity * response.FactorAt(l.z())) *
               (btf::InterpolateAppearance(model.sample, view, l).transpose() * g);
   }
+  if (response.ambient > 0.0)
+    linear +=
+        static_cast<float>(response.ambient) *
+        (btf::InterpolateAppearance(model.sample, view, Eigen::Vector3d::UnitZ()).transpose() * g);
   const cv::Vec3f k = model.colour_gain[static_cast<std::size_t>(s.atlas)].at<cv::Vec3f>(ny, nx);
   return {LinearToSrgb(linear[0] * k[0]), LinearToSrgb(linear[1] * k[1]),
           LinearToSrgb(linear[2] * k[2])};
@@ -48,9 +55,10 @@ Eigen::Vector3f ShadeBtf(const model::BtfModel& model, const ModelRenderer::Surf
 RenderedView RenderBtf(const ModelRenderer& renderer, const model::BtfModel& btf,
                        const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
                        const std::vector<sfm::ObjectLight>& lights, int samples_per_axis) {
-  return renderer.RenderWith(
-      camera, cam_from_world, samples_per_axis,
-      [&](const ModelRenderer::SurfaceSample& s) { return ShadeBtf(btf, s, lights); });
+  return renderer.RenderWith(camera, cam_from_world, samples_per_axis,
+                             [&](const ModelRenderer::SurfaceSample& s) {
+                               return ShadeBtf(btf, s, lights, renderer.model().light_response);
+                             });
 }
 
 }  // namespace texlume::render

@@ -171,7 +171,7 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
       for (const sfm::ObjectLight& l : lights)
         local.emplace_back(s.frame.transpose() * l.DirectionFrom(s.point), l.intensity);
       value = synth::RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format,
-                                    local, 1.0);
+                                    local, 1.0, model_.light_response);
     }
     return value;
   });

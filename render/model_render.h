@@ -70,6 +70,8 @@ class ModelRenderer {
   RenderedView RenderWith(const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
                           int samples_per_axis, const Shader& shade) const;
 
+  const model::TexturedModel& model() const { return model_; }
+
  private:
   struct Impl;
   const model::TexturedModel& model_;

@@ -135,12 +135,19 @@ class CoefficientCorrection::PatchPass {
     float a[6], colour[3];
     for (int m = 0; m < 6; ++m)
       a[m] = sample_at(red0_.planes[static_cast<std::size_t>(m)]) + static_cast<float>(a_delta[m]);
+    // The colour as the channel factors found so far have it, so that each
+    // round's factors answer what the last left.
     for (int c = 0; c < 3; ++c)
-      colour[c] = sample_at(red0_.planes[static_cast<std::size_t>(6 + c)]);
+      colour[c] = sample_at(red0_.planes[static_cast<std::size_t>(6 + c)]) *
+                  patch_.channel_gain[static_cast<std::size_t>(c)].at<float>(j, i);
     Eigen::Vector3d linear = Eigen::Vector3d::Zero();
     Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
-    for (const auto& [l, intensity] : r.lighting.lights) {
-      if (l.z() <= 0) continue;
+    // The lights as the texel answers them (horizon fade, light response and
+    // ambient), as RelightMixture relights.
+    for (const ptm::EffectiveLight& e :
+         ptm::EffectiveLights(r.lighting.lights, r.lighting.response)) {
+      const Eigen::Vector3d& l = e.direction;
+      const double intensity = e.weight;
       const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
       const std::array<double, 6> phi = ptm::PtmBasis(l.x(), l.y());
       const Row6d row = Eigen::Map<const Row6d>(phi.data()) * from_orthonormal;

@@ -74,8 +74,9 @@ void ColourSample::FeaturesAt(const Eigen::Vector2d& sample_px, float* out) cons
 }
 
 double ColourSample::LambertFactor(const FaceLighting& lighting) {
-  double factor = 0.0;
-  for (const auto& [l, intensity] : lighting.lights) factor += intensity * std::max(0.0, l.z());
+  double factor = lighting.response.ambient;
+  for (const auto& [l, intensity] : lighting.lights)
+    factor += intensity * std::max(0.0, l.z()) * lighting.response.FactorAt(l.z());
   return factor;
 }
 

@@ -14,7 +14,7 @@ namespace texlume::synth {
 /// features are the display RGB planes (image quilting's distance); a frame
 /// rotation leaves them as they are; values may be blended. Under a face's
 /// lighting it is Lambertian, relit in the linear domain,
-///   f = g * lin(c) * sum_lights I max(0, l_z),
+///   f = g * lin(c) * (ambient + sum_lights I max(0, l_z) r(l_z)),
 /// so the photos' shading is absorbed by the gain g and the Lambertian factor;
 /// what the sample cannot show (relief, highlights) the photo-consistency
 /// factors and the PTM it is baked into approximate.
@@ -37,7 +37,8 @@ class ColourSample : public MaterialSample {
                                double gain) const override;
   double RelitLinearSum(const FaceLighting& lighting, int cells) const override;
 
-  /// sum_lights I max(0, l_z): the Lambertian factor of a face's lighting.
+  /// ambient + sum_lights I max(0, l_z) r(l_z): the Lambertian factor of a
+  /// face's lighting (r and ambient: FaceLighting::response).
   static double LambertFactor(const FaceLighting& lighting);
 
  protected:

@@ -218,6 +218,8 @@ std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighti
   std::vector<cv::Mat> out(3);
   for (cv::Mat& m : out) m = cv::Mat(r.planes[0].size(), CV_32FC1);
   std::vector<float> a(static_cast<std::size_t>(polys * 6)), colour(3, 1.0f);
+  const std::vector<ptm::EffectiveLight> lights =
+      ptm::EffectiveLights(lighting.lights, lighting.response);
   for (int y = 0; y < r.planes[0].rows; ++y) {
     for (int x = 0; x < r.planes[0].cols; ++x) {
       for (int i = 0; i < polys * 6; ++i)
@@ -227,7 +229,7 @@ std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighti
           colour[static_cast<std::size_t>(c)] =
               r.planes[static_cast<std::size_t>(6 + c)].at<float>(y, x);
       const Eigen::Vector3f v =
-          RelightMixture(a.data(), colour.data(), ptm_.format, lighting.lights, gain);
+          RelightEffective(a.data(), colour.data(), ptm_.format, lights, gain);
       for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(c)].at<float>(y, x) = v[c];
     }
   }

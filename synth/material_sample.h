@@ -23,10 +23,15 @@ enum class PhotoDomain {
 /// What lights one face in one photo, in the face's frame: the direction
 /// towards the camera and every light of the photo (direction towards the
 /// light, unit; intensity). Lights below the face's horizon are kept: each
-/// sample decides how they act.
+/// sample decides how they act. `response`: how the object answers lights
+/// beyond the sample's own model, as the photos showed it (elevation factors
+/// and ambient light, ptm::LightResponse; the identity until the engine has
+/// estimated it). Every sample applies it: PTM and colour samples as
+/// RelightMixture does, a BTF as render::ShadeBtf.
 struct FaceLighting {
   Eigen::Vector3d view_in_frame = Eigen::Vector3d::UnitZ();
   std::vector<std::pair<Eigen::Vector3d, double>> lights;
+  ptm::LightResponse response;
 };
 
 /// A material sample as the synthesis engines see it (DESIGN.md, "Engines and

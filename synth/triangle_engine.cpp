@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <opencv2/imgproc.hpp>
 #include <string>
 
@@ -16,18 +17,39 @@
 namespace texlume::synth {
 namespace {
 
-// The photo's sum over a view's masked cells and R, G, B, in the linear domain.
-double PhotoLinearSum(const RectifiedView& r, PhotoDomain domain) {
-  double sum = 0.0;
-  if (domain == PhotoDomain::kLinear) {
-    for (const cv::Mat& plane : r.planes) sum += cv::sum(plane.mul(r.mask))[0];
-    return sum;
+// The photo's sums over a view's masked cells of R, G and B, in the linear domain.
+std::array<double, 3> PhotoLinearSums(const RectifiedView& r, PhotoDomain domain) {
+  std::array<double, 3> sums{0.0, 0.0, 0.0};
+  for (std::size_t c = 0; c < 3; ++c) {
+    const cv::Mat& plane = r.planes[c];
+    if (domain == PhotoDomain::kLinear) {
+      sums[c] = cv::sum(plane.mul(r.mask))[0];
+      continue;
+    }
+    for (int j = 0; j < r.mask.rows; ++j)
+      for (int i = 0; i < r.mask.cols; ++i)
+        if (r.mask.at<float>(j, i) > 0) sums[c] += SrgbToLinear(plane.at<float>(j, i));
   }
-  for (int j = 0; j < r.mask.rows; ++j)
-    for (int i = 0; i < r.mask.cols; ++i)
-      if (r.mask.at<float>(j, i) > 0)
-        for (const cv::Mat& plane : r.planes) sum += SrgbToLinear(plane.at<float>(j, i));
-  return sum;
+  return sums;
+}
+
+// Divides rectified planes by a photo's white balance (linear factors).
+void TakeOutWhiteBalance(const std::array<double, 3>& white_balance, PhotoDomain domain,
+                         std::vector<cv::Mat>& planes) {
+  for (std::size_t c = 0; c < 3; ++c) {
+    const double w = white_balance[c];
+    if (w == 1.0) continue;
+    cv::Mat& plane = planes[c];
+    if (domain == PhotoDomain::kLinear) {
+      plane /= w;
+      continue;
+    }
+    for (int j = 0; j < plane.rows; ++j)
+      for (int i = 0; i < plane.cols; ++i) {
+        float& v = plane.at<float>(j, i);
+        v = LinearToSrgb(static_cast<float>(SrgbToLinear(v) / w));
+      }
+  }
 }
 
 }  // namespace
@@ -72,7 +94,7 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
   SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, options_.tangent_frame,
                                  options_.field_direction_in_world));
   TurnFramesToPhotos();
-  EstimatePhotoGains();
+  EstimatePhotometry();
 
   // Breadth first from the best-seen face (Algorithm 2, step 2).
   const std::vector<int> order =
@@ -146,6 +168,8 @@ bool TriangleEngine::Rectify(std::size_t face, const sfm::TriangleView& view, Re
   cv::Mat rectified;
   cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   cv::split(rectified, out.planes);
+  if (!result_.white_balance.empty())
+    TakeOutWhiteBalance(result_.white_balance[it->second], sample_.Domain(), out.planes);
   if (sample_.Domain() == PhotoDomain::kLinear)
     for (cv::Mat& plane : out.planes)
       for (int j = 0; j < th; ++j)
@@ -155,6 +179,7 @@ bool TriangleEngine::Rectify(std::size_t face, const sfm::TriangleView& view, Re
       patch.frame.DirectionInFrame((image.ProjectionCenter() - origin).normalized());
   out.steep = !sample_.ViewDependent() || out.lighting.view_in_frame.z() > 0.5;
   out.lighting.lights.clear();
+  out.lighting.response = result_.light_response;
   for (const sfm::ObjectLight& light : photo.lights) {
     const Eigen::Vector3d l = patch.frame.DirectionInFrame(light.DirectionFrom(origin));
     out.lighting.lights.emplace_back(l, light.intensity);
@@ -197,7 +222,7 @@ void TriangleEngine::TurnFramesToPhotos() {
     const ReducedPlanes& red = sample_.Reduced(level);
     return SampleStructureTensor(
         [&](const Eigen::Vector3d& l) {
-          return sample_.Relight(red, FaceLighting{Eigen::Vector3d::UnitZ(), {{l, 1.0}}}, 1.0);
+          return sample_.Relight(red, FaceLighting{Eigen::Vector3d::UnitZ(), {{l, 1.0}}, {}}, 1.0);
         },
         red.rx, red.ry);
   };
@@ -218,30 +243,48 @@ void TriangleEngine::TurnFramesToPhotos() {
     SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, choice.field.tangents_in_world));
 }
 
-void TriangleEngine::EstimatePhotoGains() {
-  // For every face fully visible in a photo from steep enough directions,
-  // m = photo mean / sample mean relit at the face's lighting = a_T g_n (a_T
-  // the face's albedo relative to the sample's); log m = log a_T + log g_n is
-  // solved by alternating least squares with the mean log a_T at 0, so stains
-  // and colour do not leak into the gains.
-  std::vector<GainObservation> ratios;
+void TriangleEngine::EstimatePhotometry() {
+  // Every face fully visible in a photo (up to 8 steep views, whose lighting the
+  // gains trust, and 8 others): the photo's linear sum over the face, and the
+  // sample's mean relit under each light alone and at the zenith (synth/photometry.h).
+  std::vector<PhotometricObservation> observations;
   const std::size_t num_faces = mesh_.faces.size();
   for (std::size_t f = 0; f < num_faces; ++f) {
-    int used = 0;
+    int steep = 0, other = 0;
     for (const sfm::TriangleView& view : visibility_.triangles[f].views) {
-      if (!view.fully_visible || used >= 8) continue;
+      if (!view.fully_visible || steep >= 8) continue;
       RectifiedView rect;
-      // Grazing or hidden lights: the sample is least reliable there (and shadows).
-      if (!Rectify(f, view, rect) || !rect.steep) continue;
-      const double photo_linear = PhotoLinearSum(rect, sample_.Domain());
-      const double model_linear = sample_.RelitLinearSum(rect.lighting, rect.count);
-      // Dim faces (grazing light, shadow) say little about the gain.
-      if (!(model_linear > 0.02 * 3 * rect.count) || !(photo_linear > 1e-6)) continue;
-      ratios.push_back({f, rect.photo, std::log(photo_linear / model_linear), model_linear});
-      ++used;
+      if (!Rectify(f, view, rect)) continue;
+      if (!rect.steep && (other >= 8 || !options_.light_response)) continue;
+      ++(rect.steep ? steep : other);
+      observations.push_back(Observe(f, rect));
     }
   }
-  result_.photo_gains = SolvePhotoGains(ratios, num_faces, photos_.size());
+  const Photometry photometry = SolvePhotometry(std::move(observations), num_faces, photos_.size(),
+                                                options_.light_response, options_.white_balance);
+  result_.photo_gains = photometry.photo_gains;
+  result_.light_response = photometry.response;
+  if (options_.white_balance) result_.white_balance = photometry.white_balance;
+}
+
+PhotometricObservation TriangleEngine::Observe(std::size_t face, const RectifiedView& rect) const {
+  PhotometricObservation o;
+  o.face = face;
+  o.photo = rect.photo;
+  o.cells = rect.count;
+  o.steep = rect.steep;
+  o.photo_channels = PhotoLinearSums(rect, sample_.Domain());
+  o.photo_linear = o.photo_channels[0] + o.photo_channels[1] + o.photo_channels[2];
+  const auto relit_under = [&](const Eigen::Vector3d& l, double intensity) {
+    return sample_.RelitLinearSum(FaceLighting{rect.lighting.view_in_frame, {{l, intensity}}, {}},
+                                  rect.count);
+  };
+  for (const auto& [l, intensity] : rect.lighting.lights)
+    if (l.z() > 0.0)
+      o.lights.emplace_back(std::asin(std::min(1.0, l.z())) * 180.0 / std::numbers::pi,
+                            relit_under(l, intensity));
+  o.zenith_linear = relit_under(Eigen::Vector3d::UnitZ(), 1.0);
+  return o;
 }
 
 double TriangleEngine::OverlapTargets::Error(const MaterialSample& sample, int width, int sx,

@@ -14,6 +14,7 @@
 #include "sfm/reconstruction.h"
 #include "sfm/visibility.h"
 #include "synth/material_sample.h"
+#include "synth/photometry.h"
 #include "synth/triangle_parts.h"
 
 namespace texlume::synth {
@@ -46,6 +47,14 @@ struct TriangleEngineOptions {
   int min_photo_pixels = 6;
   /// Refuse up front when the patches would take more texels than this.
   std::int64_t max_texels = std::int64_t{1} << 30;
+  /// Estimate the object's light response (elevation factors and ambient,
+  /// ptm::LightResponse) from the photos with the gains, and relight under it
+  /// (samples that apply one; synth/photometry.h). Off: the identity, and the
+  /// gains with the object's mean albedo the sample's.
+  bool light_response = true;
+  /// Estimate each photo's white balance against the others' and take it out
+  /// of the photos before they are compared with the sample (SolveWhiteBalance).
+  bool white_balance = true;
   std::uint32_t seed = 1;
 
   /// Throws OptionError naming the first invalid setting.
@@ -80,6 +89,12 @@ struct TriangleSynthesis {
   std::vector<TrianglePatch> patches;                ///< per face
   std::vector<std::array<Unfolding, 3>> unfoldings;  ///< per face, edge k = (v_k, v_k+1)
   std::vector<double> photo_gains;  ///< per photo (linear-domain exposure x intensity)
+  /// How the object answers light beyond the sample's model, as the photos
+  /// showed it (TriangleEngineOptions::light_response; else the identity).
+  ptm::LightResponse light_response;
+  /// Per photo, its white balance against the others' (R, G, B linear factors,
+  /// TriangleEngineOptions::white_balance; empty when not estimated).
+  std::vector<std::array<double, 3>> white_balance;
   std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
   /// The frames the patches have (kAuto resolved to kPhotos or kFirstEdge).
   TangentFrame tangent_frame = TangentFrame::kFirstEdge;
@@ -147,8 +162,10 @@ class TriangleEngine {
   void SetUpPatches(PatchGeometry geometry);
   // Stage 1b: frames turned to the photos (synth/tangent_field.h).
   void TurnFramesToPhotos();
-  // Stage 2a: a gain per photo (exposure x light intensity, linear domain).
-  void EstimatePhotoGains();
+  // Stage 2a: a gain per photo (exposure x light intensity, linear domain) and
+  // the object's light response (synth/photometry.h).
+  void EstimatePhotometry();
+  PhotometricObservation Observe(std::size_t face, const RectifiedView& rect) const;
   // Stage 2b: one face, breadth first.
   void SynthesizeFace(std::size_t face, std::mt19937_64& rng);
   // The views that constrain a face, rectified.

@@ -15,36 +15,29 @@ namespace texlume::synth {
 
 using LightList = std::vector<std::pair<Eigen::Vector3d, double>>;  // (tangent-frame dir, I)
 
-Eigen::Vector3f RelightMixture(const float* coefficients, const float* colour,
-                               ptm::PtmFormat format, const LightList& lights, double gain) {
+Eigen::Vector3f RelightEffective(const float* coefficients, const float* colour,
+                                 ptm::PtmFormat format,
+                                 const std::vector<ptm::EffectiveLight>& lights, double gain) {
   Eigen::Vector3f linear = Eigen::Vector3f::Zero();
-  static const double z_horizon = std::sin(ptm::kHorizonElevationDeg * std::numbers::pi / 180.0);
-  for (const auto& [l_in, intensity] : lights) {
-    if (l_in.z() <= 0.0) continue;
-    // Below ptm::kHorizonElevationDeg the biquadratic is extrapolated beyond any
-    // capture light and overshoots: take its value at that elevation (same
-    // azimuth) fading linearly with l_z to 0 at the horizon.
-    Eigen::Vector3d l = l_in;
-    double fall = 1.0;
-    if (l.z() < z_horizon) {
-      fall = l.z() / z_horizon;
-      const double r = std::hypot(l.x(), l.y());
-      const double s = std::sqrt(1.0 - z_horizon * z_horizon) / r;
-      l = Eigen::Vector3d(l.x() * s, l.y() * s, z_horizon);
-    }
+  for (const ptm::EffectiveLight& e : lights) {
+    const Eigen::Vector3d& l = e.direction;
     for (int c = 0; c < 3; ++c) {
-      double v;
-      if (format == ptm::PtmFormat::kLrgb) {
-        v = ptm::EvaluatePolynomial(coefficients, l.x(), l.y()) * colour[c];
-      } else {
-        v = ptm::EvaluatePolynomial(coefficients + 6 * c, l.x(), l.y());
-      }
-      linear[c] += static_cast<float>(intensity * fall) * SrgbToLinear(static_cast<float>(v));
+      const double v = format == ptm::PtmFormat::kLrgb
+                           ? ptm::EvaluatePolynomial(coefficients, l.x(), l.y()) * colour[c]
+                           : ptm::EvaluatePolynomial(coefficients + 6 * c, l.x(), l.y());
+      linear[c] += static_cast<float>(e.weight) * SrgbToLinear(static_cast<float>(v));
     }
   }
   Eigen::Vector3f out;
   for (int c = 0; c < 3; ++c) out[c] = LinearToSrgb(static_cast<float>(gain) * linear[c]);
   return out;
+}
+
+Eigen::Vector3f RelightMixture(const float* coefficients, const float* colour,
+                               ptm::PtmFormat format, const LightList& lights, double gain,
+                               const ptm::LightResponse& response) {
+  return RelightEffective(coefficients, colour, format, ptm::EffectiveLights(lights, response),
+                          gain);
 }
 
 ReducedPlanes ReduceToDensityLevel(const std::vector<cv::Mat>& planes, int level) {
@@ -132,7 +125,8 @@ std::vector<sfm::TriangleView> ConstrainingViews(const sfm::TriangleVisibility& 
 }
 
 std::vector<double> SolvePhotoGains(const std::vector<GainObservation>& ratios,
-                                    std::size_t num_faces, std::size_t num_photos) {
+                                    std::size_t num_faces, std::size_t num_photos,
+                                    std::vector<double>* face_albedo) {
   std::vector<double> log_gain(num_photos, 0.0), log_albedo(num_faces, 0.0);
   for (int it = 0; it < 20; ++it) {
     std::vector<double> sum(num_faces, 0.0), weight(num_faces, 0.0);
@@ -156,6 +150,10 @@ std::vector<double> SolvePhotoGains(const std::vector<GainObservation>& ratios,
   }
   std::vector<double> gains(num_photos, 1.0);
   for (std::size_t n = 0; n < num_photos; ++n) gains[n] = std::exp(log_gain[n]);
+  if (face_albedo) {
+    face_albedo->assign(num_faces, 0.0);
+    for (const GainObservation& r : ratios) (*face_albedo)[r.face] = std::exp(log_albedo[r.face]);
+  }
   return gains;
 }
 

@@ -152,8 +152,10 @@ struct GainObservation {
 /// Gains g_n per photo: log m = log a_T + log g_n solved by alternating least
 /// squares (20 rounds) with the mean log a_T at 0, so the object's mean albedo is
 /// the sample's and stains do not leak into the gains. 1 for unobserved photos.
+/// `face_albedo`, when given, receives a_T per face (0 for unobserved faces).
 std::vector<double> SolvePhotoGains(const std::vector<GainObservation>& observations,
-                                    std::size_t num_faces, std::size_t num_photos);
+                                    std::size_t num_faces, std::size_t num_photos,
+                                    std::vector<double>* face_albedo = nullptr);
 /// The face with the largest projected area in its best fully visible view (0
 /// when there is none): where breadth-first synthesis starts.
 int BestSeenFace(const sfm::VisibilityResult& visibility);
@@ -172,11 +174,17 @@ void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& can
 
 /// The display value of a PTM texel under several lights (tangent frame) with
 /// intensities, times a gain: the sum is taken in the linear domain,
-/// srgb(gain * sum_i I_i lin(clamp(f(l_i)))). Lights below the horizon add 0;
-/// lights below ptm::kHorizonElevationDeg fade (see there).
+/// srgb(gain * (sum_i w_i lin(clamp(f(l'_i))) + ambient lin(clamp(f(0, 0))))), l'_i
+/// and w_i the lights as the texel answers them (ptm::Effective: horizon fade and
+/// the response's elevation factor), ambient the response's.
 Eigen::Vector3f RelightMixture(const float* coefficients_or_l, const float* colour,
                                ptm::PtmFormat format,
                                const std::vector<std::pair<Eigen::Vector3d, double>>& lights,
-                               double gain);
+                               double gain, const ptm::LightResponse& response = {});
+/// RelightMixture with the lights already as the texel answers them
+/// (ptm::EffectiveLights): for many texels under one lighting.
+Eigen::Vector3f RelightEffective(const float* coefficients_or_l, const float* colour,
+                                 ptm::PtmFormat format,
+                                 const std::vector<ptm::EffectiveLight>& lights, double gain);
 
 }  // namespace texlume::synth

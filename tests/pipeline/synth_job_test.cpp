@@ -265,6 +265,10 @@ TEST_F(MeshPipelineTest, ModelFolderRoundTripsAndTheGlbIsWellFormed) {
   const model::TexturedModel model = model::ReadModelFolder(tmp_->path() / "model");
   const mesh::TriangleMesh mesh = mesh::LoadMesh(job_->mesh_file).mesh;
   ASSERT_EQ(model.mesh.faces.size(), mesh.faces.size());
+  // The light response the job estimated from the photos comes back as written.
+  EXPECT_FALSE(model.light_response.IsIdentity());
+  EXPECT_EQ(model::LightResponseJson(model.light_response),
+            model::LightResponseJson(summary_->model->light_response));
   ASSERT_EQ(model.mesh.vertices.size(), mesh.vertices.size());
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
     ASSERT_LT((model.mesh.vertices[v] - mesh.vertices[v]).norm(), 1e-6);

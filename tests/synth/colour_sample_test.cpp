@@ -47,7 +47,7 @@ TEST(ColourSample, RelightsLambertianInTheLinearDomain) {
   EXPECT_TRUE(sample.Blendable());
   EXPECT_EQ(sample.Domain(), PhotoDomain::kLinear);
   const Eigen::Vector3d high(0.0, 0.6, 0.8), below(0.0, 0.0, -1.0);
-  const FaceLighting lighting{Eigen::Vector3d::UnitZ(), {{high, 2.0}, {below, 5.0}}};
+  const FaceLighting lighting{Eigen::Vector3d::UnitZ(), {{high, 2.0}, {below, 5.0}}, {}};
   EXPECT_NEAR(ColourSample::LambertFactor(lighting), 1.6, 1e-12);
   const std::vector<cv::Mat> relit = sample.Relight(sample.Reduced(0), lighting, 0.5);
   double sum = 0.0;

@@ -48,6 +48,8 @@ uniform float specular;      // ks of the specular enhancement, 0 = off
 uniform vec3 lightWorld;     // unit vector towards the light
 uniform vec3 flatAlbedo;     // display domain
 uniform float horizonZ;      // sin of the horizon elevation (PTM evaluation)
+uniform float responseFactor[10];  // light response: factor per 10 degrees of elevation
+uniform float ambient;       // light response: ambient times the zenith value (linear)
 ${varyings}
 float srgbToLinear(float v) { return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4); }
 vec3 srgbToLinear(vec3 v) { return vec3(srgbToLinear(v.r), srgbToLinear(v.g), srgbToLinear(v.b)); }
@@ -98,17 +100,33 @@ vec3 evaluate(vec3 c[6], vec3 colour, vec2 l) {
          colour;
 }
 
-// As texlume's renderer: lights below the horizon elevation are evaluated at it
-// (same azimuth), fading linearly with l_z to 0 at the horizon.
-vec3 relight(vec3 c[6], vec3 colour, vec3 l) {
-  if (l.z <= 0.0) return vec3(0.0);
-  float fall = 1.0;
-  if (l.z < horizonZ) {
-    fall = l.z / horizonZ;
-    float r = max(length(l.xy), 1e-6);
-    l = vec3(l.xy * sqrt(1.0 - horizonZ * horizonZ) / r, horizonZ);
+// The light response's factor at a light's l_z: linear in the elevation
+// between knots every 10 degrees (docs/synth.md, "Light response").
+float responseAt(float lz) {
+  float k = clamp(degrees(asin(clamp(lz, 0.0, 1.0))) / 10.0, 0.0, 9.0);
+  int i = int(min(floor(k), 8.0));
+  float f = k - float(i);
+  float lo = 1.0, hi = 1.0;
+  for (int j = 0; j < 9; ++j) {  // constant-index access (GLSL ES 1.0)
+    if (j == i) { lo = responseFactor[j]; hi = responseFactor[j + 1]; }
   }
-  return linearToSrgb(srgbToLinear(max(evaluate(c, colour, l.xy), vec3(0.0))) * fall);
+  return mix(lo, hi, f);
+}
+
+// As texlume's renderer: lights below the horizon elevation are evaluated at it
+// (same azimuth), fading linearly with l_z to 0 at the horizon; the light
+// response's factor and ambient term apply (ptm::EffectiveLights).
+vec3 relight(vec3 c[6], vec3 colour, vec3 l) {
+  vec3 linear = ambient * srgbToLinear(max(evaluate(c, colour, vec2(0.0)), vec3(0.0)));
+  if (l.z <= 0.0) return linearToSrgb(linear);
+  float fall = responseAt(l.z);
+  vec3 at = l;
+  if (l.z < horizonZ) {
+    fall *= l.z / horizonZ;
+    float r = max(length(l.xy), 1e-6);
+    at = vec3(l.xy * sqrt(1.0 - horizonZ * horizonZ) / r, horizonZ);
+  }
+  return linearToSrgb(linear + srgbToLinear(max(evaluate(c, colour, at.xy), vec3(0.0))) * fall);
 }
 
 // The direction of the biquadratic's maximum (Malzbender et al. 2001, eq. 16).
@@ -242,6 +260,8 @@ async function main() {
     specular: { value: 0 },
     flatAlbedo: { value: new THREE.Vector3(...scene.flat_albedo) },
     horizonZ: { value: Math.sin(scene.horizon_elevation_deg * Math.PI / 180) },
+    responseFactor: { value: scene.light_response.factors },
+    ambient: { value: scene.light_response.ambient },
   };
   const materials = [];
   for (const range of g.ranges) {

@@ -1,0 +1,73 @@
+#include "ptm/light_response.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/errors.h"
+
+namespace texlume::ptm {
+
+KnotWeights KnotWeightsAt(double elevation_deg) {
+  const double k = std::clamp(elevation_deg, 0.0, 90.0) / LightResponse::kKnotSpacingDeg;
+  KnotWeights w;
+  w.lower = std::min(static_cast<int>(k), LightResponse::kKnots - 2);
+  w.upper_weight = std::clamp(k - w.lower, 0.0, 1.0);
+  return w;
+}
+
+double LightResponse::FactorAt(double l_z) const {
+  if (!(l_z > 0.0)) return 0.0;
+  const double elevation_deg = std::asin(std::min(1.0, l_z)) * 180.0 / std::numbers::pi;
+  const KnotWeights w = KnotWeightsAt(elevation_deg);
+  const auto lower = static_cast<std::size_t>(w.lower);
+  return (1.0 - w.upper_weight) * elevation_factor[lower] +
+         w.upper_weight * elevation_factor[lower + 1];
+}
+
+bool LightResponse::IsIdentity() const {
+  return ambient == 0.0 && std::all_of(elevation_factor.begin(), elevation_factor.end(),
+                                       [](double f) { return f == 1.0; });
+}
+
+void LightResponse::Check() const {
+  for (double f : elevation_factor)
+    if (!(std::isfinite(f) && f >= 0.0 && f <= 10.0))
+      throw OptionError("light response: an elevation factor is not in [0, 10]");
+  if (!(std::isfinite(ambient) && ambient >= 0.0 && ambient <= 1.0))
+    throw OptionError("light response: ambient is not in [0, 1]");
+}
+
+EffectiveLight Effective(const Eigen::Vector3d& light_in_frame, double intensity,
+                         const LightResponse& response) {
+  static const double z_horizon = std::sin(kHorizonElevationDeg * std::numbers::pi / 180.0);
+  EffectiveLight out;
+  const Eigen::Vector3d& l = light_in_frame;
+  if (!(l.z() > 0.0)) return out;
+  out.direction = l;
+  double fall = 1.0;
+  if (l.z() < z_horizon) {
+    // Below the horizon elevation the biquadratic is extrapolated beyond any
+    // capture light and overshoots: its value there, fading with l_z.
+    fall = l.z() / z_horizon;
+    const double r = std::hypot(l.x(), l.y());
+    const double s = std::sqrt(1.0 - z_horizon * z_horizon) / r;
+    out.direction = Eigen::Vector3d(l.x() * s, l.y() * s, z_horizon);
+  }
+  out.weight = intensity * fall * response.FactorAt(l.z());
+  return out;
+}
+
+std::vector<EffectiveLight> EffectiveLights(
+    const std::vector<std::pair<Eigen::Vector3d, double>>& lights_in_frame,
+    const LightResponse& response) {
+  std::vector<EffectiveLight> out;
+  for (const auto& [l, intensity] : lights_in_frame) {
+    const EffectiveLight e = Effective(l, intensity, response);
+    if (e.weight > 0.0) out.push_back(e);
+  }
+  if (response.ambient > 0.0) out.push_back({Eigen::Vector3d::UnitZ(), response.ambient});
+  return out;
+}
+
+}  // namespace texlume::ptm

@@ -1,0 +1,225 @@
+#include "synth/photometry.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "synth/triangle_parts.h"
+
+namespace texlume::synth {
+namespace {
+
+constexpr int kKnots = ptm::LightResponse::kKnots;
+constexpr int kUnknowns = kKnots + 1;  // the knots, then the ambient
+using Row = Eigen::Matrix<double, 1, kUnknowns>;
+using Vector = Eigen::Matrix<double, kUnknowns, 1>;
+using Matrix = Eigen::Matrix<double, kUnknowns, kUnknowns>;
+
+constexpr double kUnlitFloor = 0.03;  // linear R + G + B per cell: errors relative to at least this
+constexpr double kHuberScale = 1.5;   // in robust standard deviations of the relative residual
+
+// The observation's prediction as a row: linear in the knots and the ambient.
+Row DesignRow(const PhotometricObservation& o) {
+  Row row = Row::Zero();
+  for (const auto& [elevation_deg, relit] : o.lights) {
+    const ptm::KnotWeights w = ptm::KnotWeightsAt(elevation_deg);
+    row[w.lower] += (1.0 - w.upper_weight) * relit;
+    row[w.lower + 1] += w.upper_weight * relit;
+  }
+  row[kKnots] = o.zenith_linear;
+  return row;
+}
+
+Vector ToVector(const ptm::LightResponse& r) {
+  Vector x;
+  for (int k = 0; k < kKnots; ++k) x[k] = r.elevation_factor[static_cast<std::size_t>(k)];
+  x[kKnots] = r.ambient;
+  return x;
+}
+
+// Gains and albedos from the steep observations under the current response;
+// the gains' mean log then set to 0.
+std::vector<double> GainsUnder(const std::vector<PhotometricObservation>& observations,
+                               std::size_t num_faces, std::size_t num_photos,
+                               const ptm::LightResponse& response, std::vector<double>& albedo,
+                               bool anchor_to_lights) {
+  std::vector<GainObservation> ratios;
+  for (const PhotometricObservation& o : observations) {
+    const double model = o.Predicted(response);
+    // Dim faces (grazing light, shadow) say little about the gain.
+    if (!o.steep || !(model > 0.02 * 3 * o.cells) || !(o.photo_linear > 1e-6)) continue;
+    ratios.push_back({o.face, o.photo, std::log(o.photo_linear / model), model});
+  }
+  std::vector<double> gains = SolvePhotoGains(ratios, num_faces, num_photos, &albedo);
+  if (!anchor_to_lights) return gains;
+  // Once more with Huber weights: a cast shadow or a highlight on one face in
+  // one photo must not move that face's albedo, nor through it the response.
+  std::vector<double> residual;
+  for (const GainObservation& r : ratios)
+    residual.push_back(std::abs(r.log_m - std::log(gains[r.photo] * albedo[r.face])));
+  std::vector<double> sorted = residual;
+  if (!sorted.empty()) {
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double sigma = std::max(1e-3, 1.4826 * sorted[sorted.size() / 2]);
+    for (std::size_t i = 0; i < ratios.size(); ++i)
+      ratios[i].weight *= std::min(1.0, kHuberScale * sigma / std::max(1e-12, residual[i]));
+    gains = SolvePhotoGains(ratios, num_faces, num_photos, &albedo);
+  }
+  std::vector<bool> observed(num_photos, false);
+  for (const GainObservation& r : ratios) observed[r.photo] = true;
+  double mean_log = 0.0;
+  int count = 0;
+  for (std::size_t n = 0; n < num_photos; ++n)
+    if (observed[n]) mean_log += std::log(gains[n]), ++count;
+  if (count == 0) return gains;
+  const double scale = std::exp(mean_log / count);
+  for (double& g : gains) g /= scale;
+  return gains;
+}
+
+// One weighted least-squares solve of the response (see SolvePhotometry).
+class ResponseFit {
+ public:
+  void Add(const Row& row, double target, double weight) {
+    normal_ += weight * row.transpose() * row;
+    rhs_ += weight * target * row.transpose();
+    // The best single factor on every light (no ambient): where knots go
+    // without observations.
+    const double lit = row.head<kKnots>().sum();
+    single_num_ += weight * target * lit;
+    single_den_ += weight * lit * lit;
+  }
+
+  ptm::LightResponse Solve() const {
+    Matrix a = normal_;
+    Vector b = rhs_;
+    const double scale = std::max(1e-12, a.diagonal().head<kKnots>().sum() / kKnots);
+    const double single = single_den_ > 0 ? single_num_ / single_den_ : 1.0;
+    const double smooth = 0.05 * scale, ridge = 1e-3 * scale;
+    for (int k = 1; k + 1 < kKnots; ++k) {  // (r_k-1 - 2 r_k + r_k+1)^2
+      Row d = Row::Zero();
+      d[k - 1] = 1, d[k] = -2, d[k + 1] = 1;
+      a += smooth * d.transpose() * d;
+    }
+    for (int k = 0; k < kKnots; ++k) a(k, k) += ridge, b[k] += ridge * single;
+    a(kKnots, kKnots) += ridge;
+    Vector x = a.ldlt().solve(b);
+    if (!(x[kKnots] >= 0.0)) {  // no negative ambient: solve without it
+      a.row(kKnots).setZero(), a.col(kKnots).setZero(), a(kKnots, kKnots) = 1, b[kKnots] = 0;
+      x = a.ldlt().solve(b);
+    }
+    ptm::LightResponse r;
+    for (int k = 0; k < kKnots; ++k)
+      r.elevation_factor[static_cast<std::size_t>(k)] = std::clamp(x[k], 0.25, 4.0);
+    r.ambient = std::clamp(x[kKnots], 0.0, 0.5);
+    return r;
+  }
+
+ private:
+  Matrix normal_ = Matrix::Zero();
+  Vector rhs_ = Vector::Zero();
+  double single_num_ = 0.0, single_den_ = 0.0;
+};
+
+ptm::LightResponse ResponseUnder(const std::vector<PhotometricObservation>& observations,
+                                 const std::vector<double>& gains,
+                                 const std::vector<double>& albedo,
+                                 const ptm::LightResponse& current) {
+  // Relative residuals at the current response, and their robust spread.
+  const Vector x = ToVector(current);
+  std::vector<double> relative(observations.size(), 0.0), scale(observations.size(), 0.0);
+  std::vector<double> magnitudes;
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const PhotometricObservation& o = observations[i];
+    if (!(albedo[o.face] > 0.0)) continue;  // no steep view: its albedo is unknown
+    const double cells = std::max(1, o.cells);
+    const double target = o.photo_linear / (gains[o.photo] * albedo[o.face]);
+    const double model = DesignRow(o).dot(x.transpose());
+    scale[i] = std::max(model, kUnlitFloor * cells);
+    relative[i] = (target - model) / scale[i];
+    magnitudes.push_back(std::abs(relative[i]));
+  }
+  if (magnitudes.empty()) return current;
+  std::nth_element(magnitudes.begin(), magnitudes.begin() + magnitudes.size() / 2,
+                   magnitudes.end());
+  const double sigma = std::max(1e-3, 1.4826 * magnitudes[magnitudes.size() / 2]);
+  ResponseFit fit;
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const PhotometricObservation& o = observations[i];
+    if (!(albedo[o.face] > 0.0)) continue;
+    const double huber =
+        std::min(1.0, kHuberScale * sigma / std::max(1e-12, std::abs(relative[i])));
+    const double weight = std::min(o.cells, 64) * huber / (scale[i] * scale[i]);
+    fit.Add(DesignRow(o), o.photo_linear / (gains[o.photo] * albedo[o.face]), weight);
+  }
+  return fit.Solve();
+}
+
+}  // namespace
+
+std::vector<std::array<double, 3>> SolveWhiteBalance(
+    const std::vector<PhotometricObservation>& observations, std::size_t num_faces,
+    std::size_t num_photos) {
+  std::vector<std::array<double, 3>> log_w(num_photos, {0.0, 0.0, 0.0});
+  std::vector<bool> observed(num_photos, false);
+  for (int c = 0; c < 3; ++c) {
+    std::vector<GainObservation> ratios;
+    for (const PhotometricObservation& o : observations) {
+      const double sum = o.photo_channels[0] + o.photo_channels[1] + o.photo_channels[2];
+      const double channel = o.photo_channels[static_cast<std::size_t>(c)];
+      if (!o.steep || !(channel > 1e-6) || !(sum > 0.02 * 3 * o.cells)) continue;
+      ratios.push_back({o.face, o.photo, std::log(channel / sum), sum});
+      observed[o.photo] = true;
+    }
+    const std::vector<double> w = SolvePhotoGains(ratios, num_faces, num_photos);
+    for (std::size_t n = 0; n < num_photos; ++n)
+      log_w[n][static_cast<std::size_t>(c)] = std::log(w[n]);
+  }
+  for (auto& row : log_w) {  // centred over each photo's channels
+    const double mean = (row[0] + row[1] + row[2]) / 3.0;
+    for (double& v : row) v -= mean;
+  }
+  std::size_t count = 0;
+  std::array<double, 3> mean{0.0, 0.0, 0.0};
+  for (std::size_t n = 0; n < num_photos; ++n)
+    if (observed[n]) {
+      ++count;
+      for (std::size_t c = 0; c < 3; ++c) mean[c] += log_w[n][c];
+    }
+  std::vector<std::array<double, 3>> w(num_photos, {1.0, 1.0, 1.0});
+  for (std::size_t n = 0; n < num_photos; ++n)
+    if (observed[n])
+      for (std::size_t c = 0; c < 3; ++c)
+        w[n][c] = std::exp(log_w[n][c] - mean[c] / static_cast<double>(count));
+  return w;
+}
+
+double PhotometricObservation::Predicted(const ptm::LightResponse& response) const {
+  return DesignRow(*this).dot(ToVector(response).transpose());
+}
+
+Photometry SolvePhotometry(std::vector<PhotometricObservation> observations, std::size_t num_faces,
+                           std::size_t num_photos, bool estimate_response,
+                           bool estimate_white_balance) {
+  Photometry p;
+  p.white_balance.assign(num_photos, {1.0, 1.0, 1.0});
+  if (estimate_white_balance) {
+    p.white_balance = SolveWhiteBalance(observations, num_faces, num_photos);
+    for (PhotometricObservation& o : observations) {
+      o.photo_linear = 0.0;
+      for (std::size_t c = 0; c < 3; ++c)
+        o.photo_linear += o.photo_channels[c] / p.white_balance[o.photo][c];
+    }
+  }
+  std::vector<double> albedo;
+  p.photo_gains = GainsUnder(observations, num_faces, num_photos, p.response, albedo, false);
+  if (!estimate_response) return p;
+  for (int round = 0; round < 6; ++round) {
+    p.photo_gains = GainsUnder(observations, num_faces, num_photos, p.response, albedo, true);
+    p.response = ResponseUnder(observations, p.photo_gains, albedo, p.response);
+  }
+  p.photo_gains = GainsUnder(observations, num_faces, num_photos, p.response, albedo, true);
+  return p;
+}
+
+}  // namespace texlume::synth

@@ -1,0 +1,74 @@
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <utility>
+#include <vector>
+
+#include "ptm/light_response.h"
+
+// Photometric calibration of the photos against the sample (beyond paper 003;
+// docs/synth.md, "Light response"): a gain per photo, and how the object
+// answers light beyond the sample's own model, estimated together from every
+// face seen fully in a photo.
+
+namespace texlume::synth {
+
+/// One face seen fully in one photo.
+struct PhotometricObservation {
+  std::size_t face = 0, photo = 0;
+  int cells = 0;  ///< photo cells summed (the face's rectified mask)
+  /// The photo's R, G and B over those cells, linear, as taken; and their sum
+  /// once the photo's white balance is taken out.
+  std::array<double, 3> photo_channels{};
+  double photo_linear = 0.0;
+  /// Per light above the face's horizon: its elevation in the face's frame
+  /// (degrees) and the sample's mean relit linear R + G + B under it alone
+  /// (intensity and horizon fade included) over as many cells.
+  std::vector<std::pair<double, double>> lights;
+  double zenith_linear = 0.0;  ///< the same under a unit light at the zenith
+  /// Every light and the view steep (RectifiedView::steep): the gains trust it.
+  bool steep = false;
+
+  /// sum_l r(elevation_l) P_l + ambient Z: the sample's prediction under a response.
+  double Predicted(const ptm::LightResponse& response) const;
+};
+
+struct Photometry {
+  std::vector<double> photo_gains;  ///< per photo, linear
+  ptm::LightResponse response;      ///< the identity unless estimated
+  /// Per photo, the factor on each of R, G, B (linear) by which it departs from
+  /// the photos' common white balance (all 1 unless estimated).
+  std::vector<std::array<double, 3>> white_balance;
+};
+
+/// Each photo's white balance against the others': per channel c, the log of the
+/// face's chromaticity in the photo, log(photo_c / (R + G + B)), is
+/// log k_f,c + log w_n,c, solved as SolvePhotoGains solves the gains, over the
+/// steep observations; then log w is centred over each photo's channels (the
+/// brightness is the gains') and over the photos for each channel (on average
+/// the photos are neutral). Stains and the object's colour stay in k.
+std::vector<std::array<double, 3>> SolveWhiteBalance(
+    const std::vector<PhotometricObservation>& observations, std::size_t num_faces,
+    std::size_t num_photos);
+
+/// Solves photo_linear = g_n a_f (sum_l r(theta_l) P_l + alpha Z) for the photo
+/// gains g_n, the faces' albedos a_f relative to the sample, the elevation
+/// factors r (ptm::LightResponse's knots) and the ambient alpha, alternating:
+///  - g and a from the steep observations under the current response
+///    (SolvePhotoGains: log ratios, the mean log a at 0), then the gains scaled
+///    so that their mean log is 0: on average the photos are exposed as the
+///    lights file states, and what sets the object apart from the sample in
+///    brightness goes into the response;
+///  - r and alpha from every observation by weighted least squares on
+///    photo / (g a): relative errors (a floor for the unlit), Huber weights
+///    against cast shadows and highlights, second differences of r penalised,
+///    and knots without observations drawn to the best single factor.
+/// Without `estimate_response`, the gains alone as SolvePhotoGains gives them.
+/// With `estimate_white_balance`, first each photo's white balance
+/// (SolveWhiteBalance), taken out of the photo sums before the rest.
+Photometry SolvePhotometry(std::vector<PhotometricObservation> observations, std::size_t num_faces,
+                           std::size_t num_photos, bool estimate_response,
+                           bool estimate_white_balance);
+
+}  // namespace texlume::synth
