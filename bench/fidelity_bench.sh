@@ -77,13 +77,19 @@ for shape in $shapes; do
         --ImageReader.camera_model PINHOLE --ImageReader.camera_params "$params" > "$dir/colmap/log" 2>&1
       colmap exhaustive_matcher --database_path "$dir/colmap/db.db" --SiftMatching.use_gpu 0 \
         >> "$dir/colmap/log" 2>&1
-      colmap mapper --database_path "$dir/colmap/db.db" --image_path "$object/images" \
+      if colmap mapper --database_path "$dir/colmap/db.db" --image_path "$object/images" \
         --output_path "$dir/colmap/sparse" --Mapper.ba_refine_focal_length 0 \
-        --Mapper.ba_refine_principal_point 0 >> "$dir/colmap/log" 2>&1
-      "$build/bench/sfm_alignment" "$object/sparse" "$dir/colmap/sparse/0" "$dir/colmap_model" >&2
+        --Mapper.ba_refine_principal_point 0 >> "$dir/colmap/log" 2>&1; then
+        "$build/bench/sfm_alignment" "$object/sparse" "$dir/colmap/sparse/0" "$dir/colmap_model" >&2
+      else
+        echo "fidelity_bench: COLMAP made no model of the $shape photos ($dir/colmap/log):" \
+          "no texlume_colmap row" >&2
+      fi
     fi
-    synth colmap "$dir/colmap_model"
-    rows+=(texlume_colmap="$dir/render_colmap")
+    if [ -d "$dir/colmap_model" ]; then
+      synth colmap "$dir/colmap_model"
+      rows+=(texlume_colmap="$dir/render_colmap")
+    fi
   fi
   echo
   echo "### $shape${clean:+ (clean)}: held-out views x lights at 2x the photos' resolution"

@@ -341,6 +341,7 @@ nlohmann::json LightResponseJson(const ptm::LightResponse& response) {
 
 ptm::LightResponse LightResponseFromJson(const nlohmann::json& record, const std::string& file) {
   ptm::LightResponse r;
+  if (!record.is_object()) throw InputError(file, "light_response is not an object");
   const auto& factors = record.value("factors", nlohmann::json());
   const auto& elevations = record.value("elevations_deg", nlohmann::json());
   if (!factors.is_array() || factors.size() != r.elevation_factor.size() ||

@@ -22,7 +22,8 @@ namespace texlume::model {
 /// the texture coordinates: x = dP/du, y = dP/dv with v up, z = face normal.
 /// `light_response`: how the texels answer light beyond the biquadratic, as the
 /// photos showed it (ptm::LightResponse; the identity for models written before
-/// it, and for BTF models).
+/// it). A BTF model's preview carries the BTF's, which render::ShadeBtf applies.
+/// The base-colour PNGs and the .ptm/.exr atlases hold the biquadratic alone.
 struct TexturedModel {
   mesh::TriangleMesh mesh;
   std::vector<std::array<Eigen::Vector2f, 3>> corner_px;

@@ -119,11 +119,12 @@ class BtfSynthJob {
         inputs_.mesh, atlas::PreviewPtms(atlases_, sample_, progress_), atlases_.layout.faces);
     model_.light_response = synthesis_.light_response;
     summary_.seconds_preview = SecondsSince(t);
-    baked_ = render::BakePhotoTextures(model_, inputs_.reconstruction, inputs_.visibility,
-                                       inputs_.photos, synthesis_.photo_gains);
-    flat_albedo_ =
-        render::MeanAlbedoFromPhotos(inputs_.mesh, inputs_.reconstruction, inputs_.visibility,
-                                     inputs_.photos, synthesis_.photo_gains);
+    baked_ =
+        render::BakePhotoTextures(model_, inputs_.reconstruction, inputs_.visibility,
+                                  inputs_.photos, synthesis_.photo_gains, synthesis_.white_balance);
+    flat_albedo_ = render::MeanAlbedoFromPhotos(inputs_.mesh, inputs_.reconstruction,
+                                                inputs_.visibility, inputs_.photos,
+                                                synthesis_.photo_gains, synthesis_.white_balance);
   }
 
   nlohmann::json Settings() const {

@@ -333,9 +333,10 @@ class SynthJob {
     const auto t = std::chrono::steady_clock::now();
     const SynthInputs& in = inputs_;
     baked_ = render::BakePhotoTextures(model_, in.reconstruction, in.visibility, in.photos,
-                                       synthesis_.photo_gains);
-    flat_albedo_ = render::MeanAlbedoFromPhotos(in.mesh, in.reconstruction, in.visibility,
-                                                in.photos, synthesis_.photo_gains);
+                                       synthesis_.photo_gains, synthesis_.white_balance);
+    flat_albedo_ =
+        render::MeanAlbedoFromPhotos(in.mesh, in.reconstruction, in.visibility, in.photos,
+                                     synthesis_.photo_gains, synthesis_.white_balance);
     summary_.seconds_baselines = SecondsSince(t);
   }
 

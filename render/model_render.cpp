@@ -30,6 +30,16 @@ void Bilinear(int width, int height, double x, double y, int count, const Get& g
   }
 }
 
+// A photo's gain times its white balance (when given), per channel.
+std::array<double, 3> ChannelGains(const std::vector<double>& gains,
+                                   const std::vector<std::array<double, 3>>& white_balance,
+                                   std::size_t photo) {
+  std::array<double, 3> g{gains[photo], gains[photo], gains[photo]};
+  if (photo < white_balance.size())
+    for (std::size_t c = 0; c < 3; ++c) g[c] *= white_balance[photo][c];
+  return g;
+}
+
 Eigen::Vector2d ToOpenCv(const Eigen::Vector2d& colmap_px) {
   return colmap_px - Eigen::Vector2d(0.5, 0.5);
 }
@@ -181,7 +191,8 @@ std::vector<cv::Mat> BakePhotoTextures(const model::TexturedModel& model,
                                        const sfm::Reconstruction& reconstruction,
                                        const sfm::VisibilityResult& visibility,
                                        const std::vector<synth::MeshPhoto>& photos,
-                                       const std::vector<double>& photo_gains) {
+                                       const std::vector<double>& photo_gains,
+                                       const std::vector<std::array<double, 3>>& white_balance) {
   std::map<sfm::ImageId, std::size_t> photo_index;
   for (std::size_t i = 0; i < photos.size(); ++i) photo_index[photos[i].image_id] = i;
   std::vector<cv::Mat> textures, filled;
@@ -197,7 +208,7 @@ std::vector<cv::Mat> BakePhotoTextures(const model::TexturedModel& model,
                         : photo_index.find(tv.best_view);
     if (it == photo_index.end()) continue;
     const synth::MeshPhoto& photo = photos[it->second];
-    const double gain = photo_gains[it->second];
+    const std::array<double, 3> gain = ChannelGains(photo_gains, white_balance, it->second);
     const sfm::Image& image = reconstruction.images.at(photo.image_id);
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
     cv::Mat& tex = textures[static_cast<std::size_t>(model.face_atlas[f])];
@@ -234,7 +245,8 @@ std::vector<cv::Mat> BakePhotoTextures(const model::TexturedModel& model,
             [&](int xx, int yy, int ch) { return photo.image.at<cv::Vec3f>(yy, xx)[ch]; }, rgb);
         cv::Vec3f& out = tex.at<cv::Vec3f>(y, x);
         for (int ch = 0; ch < 3; ++ch)
-          out[ch] = LinearToSrgb(static_cast<float>(SrgbToLinear(rgb[ch]) / gain));
+          out[ch] = LinearToSrgb(
+              static_cast<float>(SrgbToLinear(rgb[ch]) / gain[static_cast<std::size_t>(ch)]));
         mask.at<std::uint8_t>(y, x) = 255;
       }
     }
@@ -273,7 +285,8 @@ Eigen::Vector3f MeanAlbedoFromPhotos(const mesh::TriangleMesh& mesh,
                                      const sfm::Reconstruction& reconstruction,
                                      const sfm::VisibilityResult& visibility,
                                      const std::vector<synth::MeshPhoto>& photos,
-                                     const std::vector<double>& photo_gains) {
+                                     const std::vector<double>& photo_gains,
+                                     const std::vector<std::array<double, 3>>& white_balance) {
   std::map<sfm::ImageId, std::size_t> photo_index;
   for (std::size_t i = 0; i < photos.size(); ++i) photo_index[photos[i].image_id] = i;
   const std::vector<Eigen::Vector3d> normals = mesh::FaceNormals(mesh);
@@ -300,8 +313,9 @@ Eigen::Vector3f MeanAlbedoFromPhotos(const mesh::TriangleMesh& mesh,
       shading += l.intensity * std::max(0.0, normals[f].dot(l.DirectionFrom(centroid)));
     if (shading < 0.2) continue;
     const cv::Vec3f rgb = photo.image.at<cv::Vec3f>(y, x);
+    const std::array<double, 3> gain = ChannelGains(photo_gains, white_balance, it->second);
     for (int c = 0; c < 3; ++c)
-      colour_sum[c] += areas[f] * SrgbToLinear(rgb[c]) / photo_gains[it->second];
+      colour_sum[c] += areas[f] * SrgbToLinear(rgb[c]) / gain[static_cast<std::size_t>(c)];
     shading_sum += areas[f] * shading;
   }
   if (shading_sum <= 0) return Eigen::Vector3f::Constant(0.5f);

@@ -82,21 +82,23 @@ class ModelRenderer {
 
 /// The photogrammetry baseline: every atlas texel inside a face takes the colour
 /// of its surface point in the face's best view (bilinear, divided by the
-/// photo's gain in the linear domain); faces seen fully in no photo take the
-/// partial best view, then the mean. Gutters dilated. One CV_32FC3 per atlas.
-std::vector<cv::Mat> BakePhotoTextures(const model::TexturedModel& model,
-                                       const sfm::Reconstruction& reconstruction,
-                                       const sfm::VisibilityResult& visibility,
-                                       const std::vector<synth::MeshPhoto>& photos,
-                                       const std::vector<double>& photo_gains);
+/// photo's gain and white balance in the linear domain; `white_balance` per
+/// photo, or empty for none); faces seen fully in no photo take the partial
+/// best view, then the mean. Gutters dilated. One CV_32FC3 per atlas.
+std::vector<cv::Mat> BakePhotoTextures(
+    const model::TexturedModel& model, const sfm::Reconstruction& reconstruction,
+    const sfm::VisibilityResult& visibility, const std::vector<synth::MeshPhoto>& photos,
+    const std::vector<double>& photo_gains,
+    const std::vector<std::array<double, 3>>& white_balance = {});
 
 /// The mean albedo seen in the photos (display RGB): photo colour over Lambertian
 /// shading at the centroids of faces in their best views, area weighted, in the
-/// linear domain, over the photo's gain.
+/// linear domain, over the photo's gain and white balance (as BakePhotoTextures).
 Eigen::Vector3f MeanAlbedoFromPhotos(const mesh::TriangleMesh& mesh,
                                      const sfm::Reconstruction& reconstruction,
                                      const sfm::VisibilityResult& visibility,
                                      const std::vector<synth::MeshPhoto>& photos,
-                                     const std::vector<double>& photo_gains);
+                                     const std::vector<double>& photo_gains,
+                                     const std::vector<std::array<double, 3>>& white_balance = {});
 
 }  // namespace texlume::render

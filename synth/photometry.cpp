@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "synth/triangle_parts.h"
 
@@ -17,6 +18,9 @@ using Matrix = Eigen::Matrix<double, kUnknowns, kUnknowns>;
 
 constexpr double kUnlitFloor = 0.03;  // linear R + G + B per cell: errors relative to at least this
 constexpr double kHuberScale = 1.5;   // in robust standard deviations of the relative residual
+// A photo's white balance past these is not a camera's setting but faces no
+// other photo saw.
+constexpr std::pair<double, double> kWhiteBalanceRange{0.5, 2.0};
 
 // The observation's prediction as a row: linear in the knots and the ambient.
 Row DesignRow(const PhotometricObservation& o) {
@@ -42,7 +46,7 @@ Vector ToVector(const ptm::LightResponse& r) {
 std::vector<double> GainsUnder(const std::vector<PhotometricObservation>& observations,
                                std::size_t num_faces, std::size_t num_photos,
                                const ptm::LightResponse& response, std::vector<double>& albedo,
-                               bool anchor_to_lights) {
+                               bool anchor_to_lights, std::vector<bool>* photo_observed = nullptr) {
   std::vector<GainObservation> ratios;
   for (const PhotometricObservation& o : observations) {
     const double model = o.Predicted(response);
@@ -67,6 +71,7 @@ std::vector<double> GainsUnder(const std::vector<PhotometricObservation>& observ
   }
   std::vector<bool> observed(num_photos, false);
   for (const GainObservation& r : ratios) observed[r.photo] = true;
+  if (photo_observed) *photo_observed = observed;
   double mean_log = 0.0;
   int count = 0;
   for (std::size_t n = 0; n < num_photos; ++n)
@@ -124,14 +129,19 @@ class ResponseFit {
 ptm::LightResponse ResponseUnder(const std::vector<PhotometricObservation>& observations,
                                  const std::vector<double>& gains,
                                  const std::vector<double>& albedo,
+                                 const std::vector<bool>& photo_observed,
                                  const ptm::LightResponse& current) {
+  // Faces without a steep view and photos without one have no albedo or gain.
+  const auto known = [&](const PhotometricObservation& o) {
+    return albedo[o.face] > 0.0 && photo_observed[o.photo];
+  };
   // Relative residuals at the current response, and their robust spread.
   const Vector x = ToVector(current);
   std::vector<double> relative(observations.size(), 0.0), scale(observations.size(), 0.0);
   std::vector<double> magnitudes;
   for (std::size_t i = 0; i < observations.size(); ++i) {
     const PhotometricObservation& o = observations[i];
-    if (!(albedo[o.face] > 0.0)) continue;  // no steep view: its albedo is unknown
+    if (!known(o)) continue;
     const double cells = std::max(1, o.cells);
     const double target = o.photo_linear / (gains[o.photo] * albedo[o.face]);
     const double model = DesignRow(o).dot(x.transpose());
@@ -146,7 +156,7 @@ ptm::LightResponse ResponseUnder(const std::vector<PhotometricObservation>& obse
   ResponseFit fit;
   for (std::size_t i = 0; i < observations.size(); ++i) {
     const PhotometricObservation& o = observations[i];
-    if (!(albedo[o.face] > 0.0)) continue;
+    if (!known(o)) continue;
     const double huber =
         std::min(1.0, kHuberScale * sigma / std::max(1e-12, std::abs(relative[i])));
     const double weight = std::min(o.cells, 64) * huber / (scale[i] * scale[i]);
@@ -161,7 +171,7 @@ std::vector<std::array<double, 3>> SolveWhiteBalance(
     const std::vector<PhotometricObservation>& observations, std::size_t num_faces,
     std::size_t num_photos) {
   std::vector<std::array<double, 3>> log_w(num_photos, {0.0, 0.0, 0.0});
-  std::vector<bool> observed(num_photos, false);
+  std::vector<int> observed_channels(num_photos, 0);  // bit c: channel c observed
   for (int c = 0; c < 3; ++c) {
     std::vector<GainObservation> ratios;
     for (const PhotometricObservation& o : observations) {
@@ -169,12 +179,14 @@ std::vector<std::array<double, 3>> SolveWhiteBalance(
       const double channel = o.photo_channels[static_cast<std::size_t>(c)];
       if (!o.steep || !(channel > 1e-6) || !(sum > 0.02 * 3 * o.cells)) continue;
       ratios.push_back({o.face, o.photo, std::log(channel / sum), sum});
-      observed[o.photo] = true;
+      observed_channels[o.photo] |= 1 << c;
     }
     const std::vector<double> w = SolvePhotoGains(ratios, num_faces, num_photos);
     for (std::size_t n = 0; n < num_photos; ++n)
       log_w[n][static_cast<std::size_t>(c)] = std::log(w[n]);
   }
+  std::vector<bool> observed(num_photos, false);  // only photos seen in all three
+  for (std::size_t n = 0; n < num_photos; ++n) observed[n] = observed_channels[n] == 7;
   for (auto& row : log_w) {  // centred over each photo's channels
     const double mean = (row[0] + row[1] + row[2]) / 3.0;
     for (double& v : row) v -= mean;
@@ -190,7 +202,8 @@ std::vector<std::array<double, 3>> SolveWhiteBalance(
   for (std::size_t n = 0; n < num_photos; ++n)
     if (observed[n])
       for (std::size_t c = 0; c < 3; ++c)
-        w[n][c] = std::exp(log_w[n][c] - mean[c] / static_cast<double>(count));
+        w[n][c] = std::clamp(std::exp(log_w[n][c] - mean[c] / static_cast<double>(count)),
+                             kWhiteBalanceRange.first, kWhiteBalanceRange.second);
   return w;
 }
 
@@ -214,9 +227,11 @@ Photometry SolvePhotometry(std::vector<PhotometricObservation> observations, std
   std::vector<double> albedo;
   p.photo_gains = GainsUnder(observations, num_faces, num_photos, p.response, albedo, false);
   if (!estimate_response) return p;
+  std::vector<bool> photo_observed;
   for (int round = 0; round < 6; ++round) {
-    p.photo_gains = GainsUnder(observations, num_faces, num_photos, p.response, albedo, true);
-    p.response = ResponseUnder(observations, p.photo_gains, albedo, p.response);
+    p.photo_gains =
+        GainsUnder(observations, num_faces, num_photos, p.response, albedo, true, &photo_observed);
+    p.response = ResponseUnder(observations, p.photo_gains, albedo, photo_observed, p.response);
   }
   p.photo_gains = GainsUnder(observations, num_faces, num_photos, p.response, albedo, true);
   return p;

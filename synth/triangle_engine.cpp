@@ -168,12 +168,12 @@ bool TriangleEngine::Rectify(std::size_t face, const sfm::TriangleView& view, Re
   cv::Mat rectified;
   cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   cv::split(rectified, out.planes);
-  if (!result_.white_balance.empty())
-    TakeOutWhiteBalance(result_.white_balance[it->second], sample_.Domain(), out.planes);
   if (sample_.Domain() == PhotoDomain::kLinear)
     for (cv::Mat& plane : out.planes)
       for (int j = 0; j < th; ++j)
         for (int i = 0; i < tw; ++i) plane.at<float>(j, i) = SrgbToLinear(plane.at<float>(j, i));
+  if (!result_.white_balance.empty())
+    TakeOutWhiteBalance(result_.white_balance[it->second], sample_.Domain(), out.planes);
   const Eigen::Vector3d& origin = patch.frame.origin_in_world;
   out.lighting.view_in_frame =
       patch.frame.DirectionInFrame((image.ProjectionCenter() - origin).normalized());
@@ -256,8 +256,13 @@ void TriangleEngine::EstimatePhotometry() {
       RectifiedView rect;
       if (!Rectify(f, view, rect)) continue;
       if (!rect.steep && (other >= 8 || !options_.light_response)) continue;
-      ++(rect.steep ? steep : other);
-      observations.push_back(Observe(f, rect));
+      PhotometricObservation o = Observe(f, rect);
+      // A steep view counts towards the 8 only when it is lit enough for the
+      // gains (GainsUnder's test under the identity).
+      const bool lit = o.Predicted({}) > 0.02 * 3 * o.cells && o.photo_linear > 1e-6;
+      if (rect.steep && !lit && !options_.light_response) continue;
+      ++(rect.steep ? (lit ? steep : other) : other);
+      observations.push_back(std::move(o));
     }
   }
   const Photometry photometry = SolvePhotometry(std::move(observations), num_faces, photos_.size(),

@@ -26,7 +26,8 @@ TEST(LightResponseJson, RoundTripsAndRefusesMalformedRecordsNamingTheFile) {
   moved_knot["elevations_deg"][1] = 12.0;
   nlohmann::json no_ambient = record;
   no_ambient.erase("ambient");
-  for (const nlohmann::json& bad : {short_factors, negative, moved_knot, no_ambient}) {
+  for (const nlohmann::json& bad : {short_factors, negative, moved_knot, no_ambient,
+                                    nlohmann::json(), nlohmann::json::array()}) {
     try {
       LightResponseFromJson(bad, "m/manifest.json");
       ADD_FAILURE() << "accepted " << bad.dump();

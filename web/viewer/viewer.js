@@ -260,8 +260,9 @@ async function main() {
     specular: { value: 0 },
     flatAlbedo: { value: new THREE.Vector3(...scene.flat_albedo) },
     horizonZ: { value: Math.sin(scene.horizon_elevation_deg * Math.PI / 180) },
-    responseFactor: { value: scene.light_response.factors },
-    ambient: { value: scene.light_response.ambient },
+    // A scene.json without one (written before it): the identity.
+    responseFactor: { value: scene.light_response ? scene.light_response.factors : Array(10).fill(1) },
+    ambient: { value: scene.light_response ? scene.light_response.ambient : 0 },
   };
   const materials = [];
   for (const range of g.ranges) {
