@@ -94,7 +94,7 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
   SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, options_.tangent_frame,
                                  options_.field_direction_in_world));
   TurnFramesToPhotos();
-  EstimatePhotometry();
+  EstimatePhotometry(progress);
 
   // Breadth first from the best-seen face (Algorithm 2, step 2).
   const std::vector<int> order =
@@ -243,13 +243,14 @@ void TriangleEngine::TurnFramesToPhotos() {
     SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, choice.field.tangents_in_world));
 }
 
-void TriangleEngine::EstimatePhotometry() {
+void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
   // Every face fully visible in a photo (up to 8 steep views, whose lighting the
   // gains trust, and 8 others): the photo's linear sum over the face, and the
   // sample's mean relit under each light alone and at the zenith (synth/photometry.h).
   std::vector<PhotometricObservation> observations;
   const std::size_t num_faces = mesh_.faces.size();
   for (std::size_t f = 0; f < num_faces; ++f) {
+    if (progress && f % 256 == 0) progress("photometry", f, num_faces);
     int steep = 0, other = 0;
     for (const sfm::TriangleView& view : visibility_.triangles[f].views) {
       if (!view.fully_visible || steep >= 8) continue;
@@ -265,6 +266,7 @@ void TriangleEngine::EstimatePhotometry() {
       observations.push_back(std::move(o));
     }
   }
+  if (progress) progress("photometry", num_faces, num_faces);
   const Photometry photometry = SolvePhotometry(std::move(observations), num_faces, photos_.size(),
                                                 options_.light_response, options_.white_balance);
   result_.photo_gains = photometry.photo_gains;

@@ -164,7 +164,7 @@ class TriangleEngine {
   void TurnFramesToPhotos();
   // Stage 2a: a gain per photo (exposure x light intensity, linear domain) and
   // the object's light response (synth/photometry.h).
-  void EstimatePhotometry();
+  void EstimatePhotometry(const ProgressCallback& progress);
   PhotometricObservation Observe(std::size_t face, const RectifiedView& rect) const;
   // Stage 2b: one face, breadth first.
   void SynthesizeFace(std::size_t face, std::mt19937_64& rng);
