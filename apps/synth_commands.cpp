@@ -15,7 +15,8 @@ struct SynthWords {
   std::string tangent_frame, prior_shrink;
   std::vector<double> tangent_field;
   bool best_view_only = false, no_additive = false, no_channel = false, no_detail = false,
-       no_report = false, no_light_response = false, no_white_balance = false;
+       no_report = false, no_light_response = false, no_white_balance = false,
+       no_photo_blur = false;
 };
 
 void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o) {
@@ -96,6 +97,8 @@ void BindCorrection(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords&
                 "no light response from the photos (elevation factors, ambient)");
   sub->add_flag("--no-white-balance", w.no_white_balance,
                 "keep each photo's white balance as taken");
+  sub->add_flag("--no-photo-blur", w.no_photo_blur,
+                "compare the photos with the sharp model (no blur estimated from the photos)");
 }
 
 void BindAtlas(CLI::App* sub, atlas::AtlasOptions& a, SynthWords& w) {
@@ -134,6 +137,7 @@ void Resolve(const CLI::App* sub, const SynthWords& w, pipeline::SynthCommandOpt
   s.detail_transfer = !w.no_detail;
   s.light_response = !w.no_light_response;
   s.white_balance = !w.no_white_balance;
+  s.photo_blur = !w.no_photo_blur;
   if (!w.prior_shrink.empty() && w.prior_shrink != "auto")
     s.correction_prior_shrink = std::stod(w.prior_shrink);
   if (w.tangent_frame == "first-edge") s.tangent_frame = synth::TangentFrame::kFirstEdge;

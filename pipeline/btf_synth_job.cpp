@@ -141,6 +141,7 @@ class BtfSynthJob {
                                {"correction_sigma", so_.correction_sigma},
                                {"light_response", so_.light_response},
                                {"white_balance", so_.white_balance},
+                               {"photo_blur", so_.photo_blur},
                                {"seed", so_.seed},
                                {"horizon_elevation_deg", ptm::kHorizonElevationDeg}};
     settings.update(pipeline::AtlasSettingsJson(job_.atlas));

@@ -378,6 +378,7 @@ pipeline::BtfSynthJobOptions BtfJobFrom(const SynthCommandOptions& c) {
   b.synthesis.field_direction_in_world = ptm.field_direction_in_world;
   b.synthesis.light_response = ptm.light_response;
   b.synthesis.white_balance = ptm.white_balance;
+  b.synthesis.photo_blur = ptm.photo_blur;
   b.job = c.job;
   return b;
 }

@@ -230,6 +230,7 @@ nlohmann::json EngineSummaryJson(const synth::TriangleSynthesis& synthesis) {
   return {{"photo_gains", synthesis.photo_gains},
           {"light_response", model::LightResponseJson(synthesis.light_response)},
           {"white_balance", synthesis.white_balance},
+          {"photo_blur", synthesis.photo_blur},
           {"tangent_frame", synth::TangentFrameName(synthesis.tangent_frame)},
           {"sample_coherence", synthesis.sample_coherence >= 0.0
                                    ? nlohmann::json(synthesis.sample_coherence)
@@ -362,6 +363,7 @@ class SynthJob {
         {"horizon_elevation_deg", ptm::kHorizonElevationDeg},
         {"light_response", so.light_response},
         {"white_balance", so.white_balance},
+        {"photo_blur", so.photo_blur},
         {"seed", so.seed},
         {"sample_kind", sample_.colour.empty() ? "PTM" : "colour"}};
     settings.update(AtlasSettingsJson(options_.atlas));

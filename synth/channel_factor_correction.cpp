@@ -21,6 +21,9 @@ ChannelFactorCorrection::OnGrid ChannelFactorCorrection::ToGrid(const TrianglePa
   g.inside = view.mask;
   for (std::size_t ch = 0; ch < 3; ++ch) {
     cv::getRectSubPix(relit[ch], size, centre, g.model[ch]);
+    // The model as the photo sees it: through the photo's blur (synth/photo_blur.h).
+    if (view.blur_cells > 0.0)
+      cv::GaussianBlur(g.model[ch], g.model[ch], cv::Size(), view.blur_cells);
     g.photo[ch] = view.planes[ch];
   }
   if (size != grid) {

@@ -11,6 +11,7 @@
 
 #include "core/image_io.h"
 #include "ptm/coefficient_space.h"
+#include "synth/photo_blur.h"
 
 namespace texlume::synth {
 namespace {
@@ -256,21 +257,46 @@ class CoefficientCorrection::PatchPass {
       }
   }
 
+  // A view's prediction over the grid as the photo sees it, through its blur
+  // (a Gaussian of RectifiedView::blur_cells, synth/photo_blur.h), and the
+  // luminance Jacobian per cell (of the change at that cell alone).
+  struct ViewPrediction {
+    cv::Mat seen_by_photo;  // CV_32FC1
+    std::vector<Row6d> jacobian;
+  };
+  ViewPrediction PredictThroughBlur(const RectifiedView& r) const {
+    ViewPrediction p{cv::Mat::zeros(gh_, gw_, CV_32FC1),
+                     std::vector<Row6d>(static_cast<std::size_t>(gw_ * gh_), Row6d::Zero())};
+    cv::Mat seen = cv::Mat::zeros(gh_, gw_, CV_32FC1);
+    for (int j = 0; j < gh_; ++j)
+      for (int i = 0; i < gw_; ++i) {
+        if (!Seen(r, i, j)) continue;
+        p.seen_by_photo.at<float>(j, i) = static_cast<float>(Predict(
+            r, i, j, CorrectionAt(i, j), p.jacobian[static_cast<std::size_t>(j * gw_ + i)]));
+        seen.at<float>(j, i) = 1.0f;
+      }
+    p.seen_by_photo = MaskedGaussian(p.seen_by_photo, seen, r.blur_cells);
+    return p;
+  }
+
   // One Gauss-Newton step of the MAP estimate per seen cell:
   // q = m + Sigma J^T (J Sigma J^T + s^2 I)^-1 (r + J (q0 - m)), with m the
   // way to the sample's mean times `shrink` and s^2 = correction_noise x the
-  // mean predicted variance.
+  // mean predicted variance. The residual r is the photo's against the
+  // prediction through the photo's blur: detail the photo blurs away is no
+  // error, so the change does not take it out.
   void UpdateAdditiveChange(double shrink) {
+    std::vector<ViewPrediction> predicted;
+    for (const RectifiedView& r : views_) predicted.push_back(PredictThroughBlur(r));
     for (int j = 0; j < gh_; ++j) {
       for (int i = 0; i < gw_; ++i) {
         Eigen::Matrix<double, Eigen::Dynamic, 6> jac(static_cast<int>(views_.size()), 6);
         Eigen::VectorXd res(static_cast<int>(views_.size()));
         int rows = 0;
-        for (const RectifiedView& r : views_) {
-          if (!Seen(r, i, j)) continue;
-          Row6d row;
-          res[rows] = PhotoLuminance(r, i, j) - Predict(r, i, j, CorrectionAt(i, j), row);
-          jac.row(rows) = row;
+        for (std::size_t v = 0; v < views_.size(); ++v) {
+          if (!Seen(views_[v], i, j)) continue;
+          res[rows] = PhotoLuminance(views_[v], i, j) - predicted[v].seen_by_photo.at<float>(j, i);
+          jac.row(rows) = predicted[v].jacobian[static_cast<std::size_t>(j * gw_ + i)];
           ++rows;
         }
         if (rows == 0) continue;

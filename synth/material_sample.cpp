@@ -57,7 +57,8 @@ GridPoint OnCorrectionGrid(const TrianglePatch& patch, double u, double v) {
 
 // Detail transfer (on the correction's grid): the patch's own detail band out,
 // the band around each of the 4 nearest cells' matched sample points in,
-// weighted bilinearly. (uc, vc): the patch texel position, clamped.
+// weighted bilinearly and blended so that the detail keeps its contrast.
+// (uc, vc): the patch texel position, clamped.
 void TransferredDetail(const TrianglePatch& patch, const std::vector<cv::Mat>& band,
                        const GridPoint& g, double uc, double vc, float* out) {
   const double rx = patch.correction_density.x(), ry = patch.correction_density.y();
@@ -69,14 +70,32 @@ void TransferredDetail(const TrianglePatch& patch, const std::vector<cv::Mat>& b
   for (std::size_t c = 0; c < band.size(); ++c)
     out[c] -=
         static_cast<float>(BilinearClamped(band[c], patch.sample_x + uc, patch.sample_y + vc));
+  // The band read at each cell's match; cells whose matches coincide (a
+  // coherent match moved by one cell) read one band and add their weights.
+  std::array<std::pair<Eigen::Vector2d, double>, 4> sources;
+  std::size_t n = 0;
   for (const auto& [cell, w] : cells) {
     if (w <= 0.0f) continue;
     const cv::Vec2f s = patch.detail_source.at<cv::Vec2f>(cell.y, cell.x);
-    const double x = s[0] + uc - ((cell.x + 0.5) / rx - 0.5);
-    const double y = s[1] + vc - ((cell.y + 0.5) / ry - 0.5);
-    for (std::size_t c = 0; c < band.size(); ++c)
-      out[c] += static_cast<float>(w * BilinearClamped(band[c], x, y));
+    const Eigen::Vector2d at(s[0] + uc - ((cell.x + 0.5) / rx - 0.5),
+                             s[1] + vc - ((cell.y + 0.5) / ry - 0.5));
+    std::size_t k = 0;
+    while (k < n && (sources[k].first - at).squaredNorm() > 1e-6) ++k;
+    if (k == n) sources[n++] = {at, 0.0};
+    sources[k].second += w;
   }
+  // Variance-preserving blend of the distinct zero-mean bands (Heitz and
+  // Neyret 2018, histogram-preserving blending, without the mean): a plain weighted sum of
+  // uncorrelated bands would shrink the detail by sqrt(sum w^2).
+  double sum_w2 = 0.0;
+  for (std::size_t k = 0; k < n; ++k) sum_w2 += sources[k].second * sources[k].second;
+  if (n == 0 || !(sum_w2 > 0.0)) return;
+  const double norm = 1.0 / std::sqrt(sum_w2);
+  for (std::size_t k = 0; k < n; ++k)
+    for (std::size_t c = 0; c < band.size(); ++c)
+      out[c] +=
+          static_cast<float>(sources[k].second * norm *
+                             BilinearClamped(band[c], sources[k].first.x(), sources[k].first.y()));
 }
 
 // Catmull-Rom weights of the 4 taps around t in [0, 1).

@@ -5,17 +5,28 @@
 #include <cmath>
 #include <numbers>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 
 #include "core/check.h"
 #include "core/errors.h"
 #include "core/image_io.h"
 #include "core/timing.h"
+#include "synth/photo_blur.h"
 #include "synth/tangent_field.h"
 #include "synth/template_match.h"
 
 namespace texlume::synth {
 namespace {
+
+// The mean of a view's R, G and B planes.
+cv::Mat PhotoLuminance(const RectifiedView& r) {
+  return (r.planes[0] + r.planes[1] + r.planes[2]) / 3.0;
+}
+
+// One face in four, spread over the mesh whatever its face order, for the
+// photo blur (PhotoBlurEstimator takes the first kFacesPerPhoto per photo).
+bool SpreadForBlur(std::size_t face) { return ((face * 0x9E3779B97F4A7C15ull) >> 61) < 2; }
 
 // The photo's sums over a view's masked cells of R, G and B, in the linear domain.
 std::array<double, 3> PhotoLinearSums(const RectifiedView& r, PhotoDomain domain) {
@@ -149,7 +160,8 @@ bool TriangleEngine::Rectify(std::size_t face, const sfm::TriangleView& view, Re
   const sfm::Image& image = reconstruction_.images.at(view.image_id);
   const sfm::Camera& camera = reconstruction_.cameras.at(image.camera_id);
   const TrianglePatch& patch = result_.patches[face];
-  if (level < 0) level = PhotoDensityLevel(patch, view, t);
+  const int own_level = PhotoDensityLevel(patch, view, t);
+  if (level < 0) level = own_level;
   const ReducedPlanes& r = sample_.Reduced(level);
   const int tw = std::max(1, static_cast<int>(std::lround(patch.width * r.rx)));
   const int th = std::max(1, static_cast<int>(std::lround(patch.height * r.ry)));
@@ -188,6 +200,11 @@ bool TriangleEngine::Rectify(std::size_t face, const sfm::TriangleView& view, Re
   out.photo = it->second;
   out.view = view;
   out.level = level;
+  // Level L has 2^(-L/4) cells per texel, so a photo pixel (a cell at its own
+  // level) spans 2^((own - L)/4) cells here.
+  out.blur_cells = result_.photo_blur.empty()
+                       ? 0.0
+                       : result_.photo_blur[it->second] * std::pow(2.0, (own_level - level) / 4.0);
   return true;
 }
 
@@ -249,6 +266,8 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
   // sample's mean relit under each light alone and at the zenith (synth/photometry.h).
   std::vector<PhotometricObservation> observations;
   const std::size_t num_faces = mesh_.faces.size();
+  std::optional<PhotoBlurEstimator> blur;
+  if (options_.photo_blur) blur.emplace(photos_.size());
   for (std::size_t f = 0; f < num_faces; ++f) {
     if (progress && f % 256 == 0) progress("photometry", f, num_faces);
     int steep = 0, other = 0;
@@ -257,6 +276,8 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
       RectifiedView rect;
       if (!Rectify(f, view, rect)) continue;
       if (!rect.steep && (other >= 8 || !options_.light_response)) continue;
+      if (blur && blur->Wants(rect.photo) && SpreadForBlur(f))
+        blur->Add(rect.photo, PhotoLuminance(rect), SampleWindowLuminance(f, rect), rect.mask);
       PhotometricObservation o = Observe(f, rect);
       // A steep view counts towards the 8 only when it is lit enough for the
       // gains (GainsUnder's test under the identity).
@@ -270,8 +291,31 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
   const Photometry photometry = SolvePhotometry(std::move(observations), num_faces, photos_.size(),
                                                 options_.light_response, options_.white_balance);
   result_.photo_gains = photometry.photo_gains;
+  if (blur) {
+    std::vector<std::uint32_t> camera_of_photo;
+    for (const MeshPhoto& photo : photos_)
+      camera_of_photo.push_back(reconstruction_.images.at(photo.image_id).camera_id.value);
+    result_.photo_blur = blur->SolvePerCamera(camera_of_photo);
+  }
   result_.light_response = photometry.response;
   if (options_.white_balance) result_.white_balance = photometry.white_balance;
+}
+
+cv::Mat TriangleEngine::SampleWindowLuminance(std::size_t face, const RectifiedView& rect) const {
+  const ReducedPlanes& reduced = sample_.Reduced(rect.level);
+  const cv::Size size = rect.mask.size();
+  // A window at a place fixed by the face and the photo (any place will do: the
+  // estimate compares band energies, not values).
+  const std::uint64_t hash = (face + 1) * 0x9E3779B97F4A7C15ull ^ (rect.photo + 1) * 0xC2B2AE3Dull;
+  const int x =
+      static_cast<int>(hash % static_cast<std::uint64_t>(reduced.planes[0].cols - size.width + 1));
+  const int y = static_cast<int>(
+      (hash >> 32) % static_cast<std::uint64_t>(reduced.planes[0].rows - size.height + 1));
+  ReducedPlanes window{{}, reduced.rx, reduced.ry};
+  for (const cv::Mat& plane : reduced.planes)
+    window.planes.push_back(plane(cv::Rect(cv::Point(x, y), size)));
+  const std::vector<cv::Mat> relit = sample_.Relight(window, rect.lighting, 1.0);
+  return (relit[0] + relit[1] + relit[2]) / 3.0;
 }
 
 PhotometricObservation TriangleEngine::Observe(std::size_t face, const RectifiedView& rect) const {

@@ -55,6 +55,10 @@ struct TriangleEngineOptions {
   /// Estimate each photo's white balance against the others' and take it out
   /// of the photos before they are compared with the sample (SolveWhiteBalance).
   bool white_balance = true;
+  /// Estimate how much blurrier each photo is than the sample at its density
+  /// (synth/photo_blur.h), so that the photo-consistency pass compares the
+  /// photo with the model seen through that blur. Off: no blur.
+  bool photo_blur = true;
   std::uint32_t seed = 1;
 
   /// Throws OptionError naming the first invalid setting.
@@ -79,6 +83,8 @@ struct RectifiedView {
   /// Every light, and the view for a view-dependent sample, above 60 degrees
   /// from the face's horizon (the photo gains trust only such views).
   bool steep = true;
+  /// The photo's blur (TriangleSynthesis::photo_blur) in cells of this grid.
+  double blur_cells = 0.0;
 };
 
 /// What the engine produces: every face's placed patch in the sample (with
@@ -95,6 +101,10 @@ struct TriangleSynthesis {
   /// Per photo, its white balance against the others' (R, G, B linear factors,
   /// TriangleEngineOptions::white_balance; empty when not estimated).
   std::vector<std::array<double, 3>> white_balance;
+  /// Per photo, the Gaussian blur it shows against the sample, sigma in cells
+  /// of its own density level (about photo pixels; TriangleEngineOptions::
+  /// photo_blur; empty when not estimated).
+  std::vector<double> photo_blur;
   std::size_t num_from_photos = 0, num_from_neighbours = 0, num_random = 0;
   /// The frames the patches have (kAuto resolved to kPhotos or kFirstEdge).
   TangentFrame tangent_frame = TangentFrame::kFirstEdge;
@@ -166,6 +176,9 @@ class TriangleEngine {
   // the object's light response (synth/photometry.h).
   void EstimatePhotometry(const ProgressCallback& progress);
   PhotometricObservation Observe(std::size_t face, const RectifiedView& rect) const;
+  // The sample relit under a rectified view's lighting, as luminance, over a
+  // window of the view's grid size (the photo blur's comparison).
+  cv::Mat SampleWindowLuminance(std::size_t face, const RectifiedView& rect) const;
   // Stage 2b: one face, breadth first.
   void SynthesizeFace(std::size_t face, std::mt19937_64& rng);
   // The views that constrain a face, rectified.

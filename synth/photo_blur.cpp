@@ -1,0 +1,126 @@
+#include "synth/photo_blur.h"
+
+#include <algorithm>
+#include <map>
+#include <opencv2/imgproc.hpp>
+
+#include "core/check.h"
+
+namespace texlume::synth {
+
+cv::Mat MaskedGaussian(const cv::Mat& grid, const cv::Mat& mask, double sigma) {
+  if (sigma <= 0.0) return grid.clone();
+  const cv::Mat inside = mask > 0;
+  cv::Mat weight;
+  inside.convertTo(weight, CV_32FC1, 1.0 / 255.0);
+  cv::Mat blurred, blurred_weight;
+  cv::GaussianBlur(grid.mul(weight), blurred, cv::Size(), sigma, sigma, cv::BORDER_CONSTANT);
+  cv::GaussianBlur(weight, blurred_weight, cv::Size(), sigma, sigma, cv::BORDER_CONSTANT);
+  cv::Mat out = grid.clone();
+  for (int j = 0; j < grid.rows; ++j)
+    for (int i = 0; i < grid.cols; ++i)
+      if (blurred_weight.at<float>(j, i) > 1e-6f)
+        out.at<float>(j, i) = blurred.at<float>(j, i) / blurred_weight.at<float>(j, i);
+  return out;
+}
+
+BandEnergies MeasureBands(const cv::Mat& grid, const cv::Mat& mask) {
+  TEXLUME_CHECK(grid.type() == CV_32FC1 && mask.type() == CV_32FC1 && grid.size() == mask.size(),
+                "MeasureBands: grid and mask must be one-channel float of one size");
+  BandEnergies e;
+  cv::Mat inner;
+  const int k = 2 * BandEnergies::kBandSupport + 1;
+  cv::erode(mask > 0, inner, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)),
+            cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  const cv::Mat fine_low = MaskedGaussian(grid, mask, BandEnergies::kFineSigma);
+  const cv::Mat middle_low = MaskedGaussian(grid, mask, BandEnergies::kMiddleSigma);
+  for (int j = 0; j < grid.rows; ++j)
+    for (int i = 0; i < grid.cols; ++i) {
+      if (!inner.at<std::uint8_t>(j, i)) continue;
+      const double fine = grid.at<float>(j, i) - fine_low.at<float>(j, i);
+      const double middle = fine_low.at<float>(j, i) - middle_low.at<float>(j, i);
+      e.fine += fine * fine;
+      e.middle += middle * middle;
+      ++e.cells;
+    }
+  return e;
+}
+
+PhotoBlurEstimator::PhotoBlurEstimator(std::size_t num_photos) : photos_(num_photos) {}
+
+bool PhotoBlurEstimator::Wants(std::size_t photo) const {
+  return photo < photos_.size() && photos_[photo].faces < kFacesPerPhoto;
+}
+
+void PhotoBlurEstimator::Add(std::size_t photo, const cv::Mat& photo_luminance,
+                             const cv::Mat& sample_luminance, const cv::Mat& mask) {
+  TEXLUME_CHECK(photo < photos_.size(), "PhotoBlurEstimator: photo index out of range");
+  const BandEnergies seen = MeasureBands(photo_luminance, mask);
+  if (seen.cells == 0) return;
+  PerPhoto& p = photos_[photo];
+  ++p.faces;
+  p.photo_fine += seen.fine;
+  p.photo_middle += seen.middle;
+  // The sample blurred over the whole window (no mask: its cells around the
+  // face are as real as those inside), measured over the face's cells.
+  const cv::Mat everywhere = cv::Mat::ones(mask.size(), CV_32FC1);
+  for (int k = 0; k < kCandidates; ++k) {
+    const cv::Mat blurred = MaskedGaussian(sample_luminance, everywhere, k * kCandidateStep);
+    const BandEnergies e = MeasureBands(blurred, mask);
+    p.sample_fine[static_cast<std::size_t>(k)] += e.fine;
+    p.sample_middle[static_cast<std::size_t>(k)] += e.middle;
+  }
+}
+
+double SigmaMatchingRatio(double photo_ratio, const std::vector<double>& sample_ratio,
+                          double step) {
+  if (sample_ratio.empty() || !(photo_ratio < sample_ratio.front())) return 0.0;
+  for (std::size_t k = 1; k < sample_ratio.size(); ++k) {
+    const double above = sample_ratio[k - 1], below = sample_ratio[k];
+    if (photo_ratio < below) continue;
+    const double t = above > below ? (above - photo_ratio) / (above - below) : 0.0;
+    return (static_cast<double>(k - 1) + t) * step;
+  }
+  return static_cast<double>(sample_ratio.size() - 1) * step;
+}
+
+std::vector<double> PhotoBlurEstimator::SolvePerPhoto() const {
+  std::vector<double> sigma(photos_.size(), 0.0);
+  for (std::size_t n = 0; n < photos_.size(); ++n) {
+    const PerPhoto& p = photos_[n];
+    if (p.faces == 0 || !(p.photo_middle > 0.0)) continue;
+    std::vector<double> sample_ratio(kCandidates);
+    bool ok = true;
+    for (std::size_t k = 0; k < sample_ratio.size(); ++k) {
+      ok = ok && p.sample_middle[k] > 0.0;
+      sample_ratio[k] = ok ? p.sample_fine[k] / p.sample_middle[k] : 0.0;
+    }
+    if (ok)
+      sigma[n] = SigmaMatchingRatio(p.photo_fine / p.photo_middle, sample_ratio, kCandidateStep);
+  }
+  return sigma;
+}
+
+std::vector<double> PhotoBlurEstimator::SolvePerCamera(
+    const std::vector<std::uint32_t>& camera_of_photo) const {
+  TEXLUME_CHECK(camera_of_photo.size() == photos_.size(),
+                "PhotoBlurEstimator: one camera per photo");
+  const std::vector<double> per_photo = SolvePerPhoto();
+  std::map<std::uint32_t, std::vector<double>> by_camera;
+  for (std::size_t n = 0; n < photos_.size(); ++n)
+    if (photos_[n].faces > 0) by_camera[camera_of_photo[n]].push_back(per_photo[n]);
+  std::map<std::uint32_t, double> median;
+  for (auto& [camera, sigmas] : by_camera) {
+    const auto middle = sigmas.begin() + static_cast<std::ptrdiff_t>(sigmas.size() / 2);
+    std::nth_element(sigmas.begin(), middle, sigmas.end());
+    median[camera] = *middle;
+  }
+  std::vector<double> sigma(photos_.size(), 0.0);
+  for (std::size_t n = 0; n < photos_.size(); ++n) {
+    const auto it = median.find(camera_of_photo[n]);
+    if (it != median.end()) sigma[n] = it->second;
+  }
+  return sigma;
+}
+
+}  // namespace texlume::synth
