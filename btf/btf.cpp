@@ -250,6 +250,21 @@ Eigen::MatrixX3f InterpolateAppearance(const BtfFactorisation& factorisation,
   return p;
 }
 
+Eigen::MatrixX3f AppearanceUnder(const BtfFactorisation& factorisation, const Eigen::Vector3d& view,
+                                 const std::vector<MaterialLight>& lights,
+                                 const ptm::LightResponse& response) {
+  Eigen::MatrixX3f a = Eigen::MatrixX3f::Zero(factorisation.Components(), 3);
+  for (const auto& [l, intensity] : lights) {
+    if (l.z() <= 0.0) continue;
+    a += static_cast<float>(intensity * response.FactorAt(l.z())) *
+         InterpolateAppearance(factorisation, view, l);
+  }
+  if (response.ambient > 0.0)
+    a += static_cast<float>(response.ambient) *
+         InterpolateAppearance(factorisation, view, Eigen::Vector3d::UnitZ());
+  return a;
+}
+
 cv::Mat EvaluateBtf(const BtfFactorisation& factorisation, const Eigen::Vector3d& view,
                     const Eigen::Vector3d& light, int components) {
   const int n = components > 0 ? std::min(components, factorisation.Components())

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/progress.h"
+#include "ptm/light_response.h"
 
 namespace texlume::btf {
 
@@ -81,6 +82,16 @@ std::vector<std::pair<std::size_t, double>> DirectionWeights(
 /// direction grid: n x 3 (component, channel).
 Eigen::MatrixX3f InterpolateAppearance(const BtfFactorisation& factorisation,
                                        const Eigen::Vector3d& view, const Eigen::Vector3d& light);
+
+/// A light in the material frame (direction to the light) and its intensity.
+using MaterialLight = std::pair<Eigen::Vector3d, double>;
+/// sum_l I_l r(l) p_i(v, l) + alpha p_i(v, zenith): the appearance under the
+/// lights as the object answers them (ptm::LightResponse: each light above the
+/// horizon times the factor at its elevation, and the ambient alpha as a unit
+/// light at the zenith). n x 3 (component, channel).
+Eigen::MatrixX3f AppearanceUnder(const BtfFactorisation& factorisation, const Eigen::Vector3d& view,
+                                 const std::vector<MaterialLight>& lights,
+                                 const ptm::LightResponse& response);
 
 /// The factorised BTF as an image (CV_32FC3 linear RGB) for one view and light
 /// (interpolated over the grid), using the first `components` terms (0: all).

@@ -34,19 +34,12 @@ Eigen::Vector3f ShadeBtf(const model::BtfModel& model, const ModelRenderer::Surf
     view.z() = 0.02;
     view.normalize();
   }
-  // Each light times the light response's factor at its elevation, then the
-  // ambient term: the value under a unit light at the zenith times it.
-  Eigen::Vector3f linear = Eigen::Vector3f::Zero();
-  for (const sfm::ObjectLight& light : lights) {
-    const Eigen::Vector3d l = to_sample(light.DirectionFrom(s.point));
-    if (l.z() <= 0.0) continue;
-    linear += static_cast<float>(light.intensity * response.FactorAt(l.z())) *
-              (btf::InterpolateAppearance(model.sample, view, l).transpose() * g);
-  }
-  if (response.ambient > 0.0)
-    linear +=
-        static_cast<float>(response.ambient) *
-        (btf::InterpolateAppearance(model.sample, view, Eigen::Vector3d::UnitZ()).transpose() * g);
+  std::vector<btf::MaterialLight> in_sample;
+  in_sample.reserve(lights.size());
+  for (const sfm::ObjectLight& light : lights)
+    in_sample.emplace_back(to_sample(light.DirectionFrom(s.point)), light.intensity);
+  const Eigen::Vector3f linear =
+      btf::AppearanceUnder(model.sample, view, in_sample, response).transpose() * g;
   const cv::Vec3f k = model.colour_gain[static_cast<std::size_t>(s.atlas)].at<cv::Vec3f>(ny, nx);
   return {LinearToSrgb(linear[0] * k[0]), LinearToSrgb(linear[1] * k[1]),
           LinearToSrgb(linear[2] * k[2])};

@@ -34,17 +34,8 @@ void BtfSample::FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const {
 
 Eigen::MatrixX3f BtfSample::Appearance(const FaceLighting& lighting) const {
   const Eigen::Vector3d& v = lighting.view_in_frame;
-  Eigen::MatrixX3f a = Eigen::MatrixX3f::Zero(btf_.Components(), 3);
-  if (v.z() <= 0.0) return a;
-  for (const auto& [l, intensity] : lighting.lights) {
-    if (l.z() <= 0.0) continue;
-    a += static_cast<float>(intensity * lighting.response.FactorAt(l.z())) *
-         btf::InterpolateAppearance(btf_, v, l);
-  }
-  if (lighting.response.ambient > 0.0)
-    a += static_cast<float>(lighting.response.ambient) *
-         btf::InterpolateAppearance(btf_, v, Eigen::Vector3d::UnitZ());
-  return a;
+  if (v.z() <= 0.0) return Eigen::MatrixX3f::Zero(btf_.Components(), 3);
+  return btf::AppearanceUnder(btf_, v, lighting.lights, lighting.response);
 }
 
 std::vector<cv::Mat> BtfSample::Relight(const ReducedPlanes& r, const FaceLighting& lighting,

@@ -65,6 +65,8 @@ class CoefficientCorrection::PatchPass {
     patch.channel_gain.assign(3, cv::Mat());
     for (cv::Mat& m : patch.channel_gain) m = cv::Mat::ones(gh_, gw_, CV_32FC1);
     ComputeWayToMean();
+    for (const RectifiedView& r : views_)
+      effective_lights_.push_back(ptm::EffectiveLights(r.lighting.lights, r.lighting.response));
   }
 
   void Run() {
@@ -113,10 +115,10 @@ class CoefficientCorrection::PatchPass {
       }
   }
 
-  // Prediction (displayed luminance) and luminance Jacobian of view r at cell
+  // Prediction (displayed luminance) and luminance Jacobian of view `view` at cell
   // (i, j), with the change q_delta (orthonormal) added to the patch's
   // coefficients; the linear value per channel into `channel_linear`.
-  double Predict(const RectifiedView& r, int i, int j, const Vector6d& q_delta, Row6d& jac,
+  double Predict(std::size_t view, int i, int j, const Vector6d& q_delta, Row6d& jac,
                  Eigen::Vector3d* channel_linear = nullptr) const {
     // Cell (i, j)'s centre in the reduced sample's pixel coordinates (centres
     // at integers): (sample_x + (i + 0.5) / rx) rx - 0.5; bilinear there.
@@ -145,8 +147,7 @@ class CoefficientCorrection::PatchPass {
     Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
     // The lights as the texel answers them (horizon fade, light response and
     // ambient), as RelightMixture relights.
-    for (const ptm::EffectiveLight& e :
-         ptm::EffectiveLights(r.lighting.lights, r.lighting.response)) {
+    for (const ptm::EffectiveLight& e : effective_lights_[view]) {
       const Eigen::Vector3d& l = e.direction;
       const double intensity = e.weight;
       const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
@@ -163,7 +164,7 @@ class CoefficientCorrection::PatchPass {
         dlinear.row(c) += intensity * dlin * colour[c] * row;
       }
     }
-    const double g = gains_[r.photo];
+    const double g = gains_[views_[view].photo];
     double y_pred = 0.0;
     jac.setZero();
     for (int c = 0; c < 3; ++c) {
@@ -193,9 +194,10 @@ class CoefficientCorrection::PatchPass {
     for (int j = 0; j < gh_; ++j)
       for (int i = 0; i < gw_; ++i) {
         const Vector6d q_to_mean = ToMean(i, j);
-        for (const RectifiedView& r : views_) {
+        for (std::size_t v = 0; v < views_.size(); ++v) {
+          const RectifiedView& r = views_[v];
           if (!Seen(r, i, j)) continue;
-          const double at_patch = Predict(r, i, j, Vector6d::Zero(), jac);
+          const double at_patch = Predict(v, i, j, Vector6d::Zero(), jac);
           const double patch_departure = -(jac * q_to_mean)(0);
           photo_dot_patch +=
               (PhotoLuminance(r, i, j) - at_patch + patch_departure) * patch_departure;
@@ -217,11 +219,12 @@ class CoefficientCorrection::PatchPass {
       model_sum[static_cast<std::size_t>(c)] = cv::Mat::zeros(gh_, gw_, CV_32FC1);
     for (int j = 0; j < gh_; ++j) {
       for (int i = 0; i < gw_; ++i) {
-        for (const RectifiedView& r : views_) {
+        for (std::size_t v = 0; v < views_.size(); ++v) {
+          const RectifiedView& r = views_[v];
           if (!Seen(r, i, j)) continue;
           Row6d row;
           Eigen::Vector3d lin;
-          Predict(r, i, j, CorrectionAt(i, j), row, &lin);
+          Predict(v, i, j, CorrectionAt(i, j), row, &lin);
           for (int c = 0; c < 3; ++c) {
             photo_sum[static_cast<std::size_t>(c)].at<float>(j, i) +=
                 SrgbToLinear(r.planes[static_cast<std::size_t>(c)].at<float>(j, i));
@@ -264,7 +267,8 @@ class CoefficientCorrection::PatchPass {
     cv::Mat seen_by_photo;  // CV_32FC1
     std::vector<Row6d> jacobian;
   };
-  ViewPrediction PredictThroughBlur(const RectifiedView& r) const {
+  ViewPrediction PredictThroughBlur(std::size_t v) const {
+    const RectifiedView& r = views_[v];
     ViewPrediction p{cv::Mat::zeros(gh_, gw_, CV_32FC1),
                      std::vector<Row6d>(static_cast<std::size_t>(gw_ * gh_), Row6d::Zero())};
     cv::Mat seen = cv::Mat::zeros(gh_, gw_, CV_32FC1);
@@ -272,7 +276,7 @@ class CoefficientCorrection::PatchPass {
       for (int i = 0; i < gw_; ++i) {
         if (!Seen(r, i, j)) continue;
         p.seen_by_photo.at<float>(j, i) = static_cast<float>(Predict(
-            r, i, j, CorrectionAt(i, j), p.jacobian[static_cast<std::size_t>(j * gw_ + i)]));
+            v, i, j, CorrectionAt(i, j), p.jacobian[static_cast<std::size_t>(j * gw_ + i)]));
         seen.at<float>(j, i) = 1.0f;
       }
     p.seen_by_photo = MaskedGaussian(p.seen_by_photo, seen, r.blur_cells);
@@ -287,7 +291,7 @@ class CoefficientCorrection::PatchPass {
   // error, so the change does not take it out.
   void UpdateAdditiveChange(double shrink) {
     std::vector<ViewPrediction> predicted;
-    for (const RectifiedView& r : views_) predicted.push_back(PredictThroughBlur(r));
+    for (std::size_t v = 0; v < views_.size(); ++v) predicted.push_back(PredictThroughBlur(v));
     for (int j = 0; j < gh_; ++j) {
       for (int i = 0; i < gw_; ++i) {
         Eigen::Matrix<double, Eigen::Dynamic, 6> jac(static_cast<int>(views_.size()), 6);
@@ -356,6 +360,8 @@ class CoefficientCorrection::PatchPass {
   const MeshSynthesisOptions& options_;
   int gw_, gh_;
   std::vector<Vector6d> to_mean_of_cell_;
+  // Per view, the lights as the texel answers them (EffectiveLights), once.
+  std::vector<std::vector<ptm::EffectiveLight>> effective_lights_;
   cv::Mat known_;  // CV_8UC1: cells with a change
 };
 

@@ -268,6 +268,12 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
   const std::size_t num_faces = mesh_.faces.size();
   std::optional<PhotoBlurEstimator> blur;
   if (options_.photo_blur) blur.emplace(photos_.size());
+  // A view-independent sample's mean under a unit zenith light, once.
+  const double zenith_per_cell =
+      sample_.ViewDependent()
+          ? -1.0
+          : sample_.RelitLinearSum(
+                FaceLighting{Eigen::Vector3d::UnitZ(), {{Eigen::Vector3d::UnitZ(), 1.0}}, {}}, 1);
   for (std::size_t f = 0; f < num_faces; ++f) {
     if (progress && f % 256 == 0) progress("photometry", f, num_faces);
     int steep = 0, other = 0;
@@ -278,12 +284,16 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
       if (!rect.steep && (other >= 8 || !options_.light_response)) continue;
       if (blur && blur->Wants(rect.photo) && SpreadForBlur(f))
         blur->Add(rect.photo, PhotoLuminance(rect), SampleWindowLuminance(f, rect), rect.mask);
-      PhotometricObservation o = Observe(f, rect);
+      PhotometricObservation o = Observe(f, rect, zenith_per_cell);
       // A steep view counts towards the 8 only when it is lit enough for the
       // gains (GainsUnder's test under the identity).
       const bool lit = o.Predicted({}) > 0.02 * 3 * o.cells && o.photo_linear > 1e-6;
+      const bool counts_as_steep = rect.steep && lit;
       if (rect.steep && !lit && !options_.light_response) continue;
-      ++(rect.steep ? (lit ? steep : other) : other);
+      if (counts_as_steep)
+        ++steep;
+      else
+        ++other;
       observations.push_back(std::move(o));
     }
   }
@@ -318,7 +328,8 @@ cv::Mat TriangleEngine::SampleWindowLuminance(std::size_t face, const RectifiedV
   return (relit[0] + relit[1] + relit[2]) / 3.0;
 }
 
-PhotometricObservation TriangleEngine::Observe(std::size_t face, const RectifiedView& rect) const {
+PhotometricObservation TriangleEngine::Observe(std::size_t face, const RectifiedView& rect,
+                                               double zenith_per_cell) const {
   PhotometricObservation o;
   o.face = face;
   o.photo = rect.photo;
@@ -334,7 +345,8 @@ PhotometricObservation TriangleEngine::Observe(std::size_t face, const Rectified
     if (l.z() > 0.0)
       o.lights.emplace_back(std::asin(std::min(1.0, l.z())) * 180.0 / std::numbers::pi,
                             relit_under(l, intensity));
-  o.zenith_linear = relit_under(Eigen::Vector3d::UnitZ(), 1.0);
+  o.zenith_linear = zenith_per_cell >= 0.0 ? zenith_per_cell * rect.count
+                                           : relit_under(Eigen::Vector3d::UnitZ(), 1.0);
   return o;
 }
 

@@ -175,7 +175,10 @@ class TriangleEngine {
   // Stage 2a: a gain per photo (exposure x light intensity, linear domain) and
   // the object's light response (synth/photometry.h).
   void EstimatePhotometry(const ProgressCallback& progress);
-  PhotometricObservation Observe(std::size_t face, const RectifiedView& rect) const;
+  // `zenith_per_cell` >= 0: the sample's mean under a unit zenith light (a
+  // view-independent sample's, computed once); < 0: computed for the view.
+  PhotometricObservation Observe(std::size_t face, const RectifiedView& rect,
+                                 double zenith_per_cell) const;
   // The sample relit under a rectified view's lighting, as luminance, over a
   // window of the view's grid size (the photo blur's comparison).
   cv::Mat SampleWindowLuminance(std::size_t face, const RectifiedView& rect) const;
