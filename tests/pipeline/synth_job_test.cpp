@@ -109,6 +109,14 @@ TEST_F(MeshPipelineTest, EveryTriangleGetsAPatchMostFromThePhotos) {
   }
   EXPECT_TRUE(manifest["timings_s"].contains("synthesis"));
   EXPECT_EQ(manifest["settings"]["sample_texel_size"].get<double>(), 0.004);
+  // The photos' blur, one per photo (synth/photo_blur.h), within the candidates.
+  EXPECT_TRUE(manifest["settings"]["photo_blur"].get<bool>());
+  const nlohmann::json& blur = manifest["summary"]["photo_blur"];
+  ASSERT_EQ(blur.size(), manifest["summary"]["photo_gains"].size());
+  for (const auto& sigma : blur) {
+    EXPECT_GE(sigma.get<double>(), 0.0);
+    EXPECT_LE(sigma.get<double>(), 2.0);
+  }
 }
 
 // The coefficients baked into the atlas, relit in the frame a renderer derives
