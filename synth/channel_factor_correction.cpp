@@ -20,10 +20,13 @@ ChannelFactorCorrection::OnGrid ChannelFactorCorrection::ToGrid(const TrianglePa
   g.wide = view.wide_mask;
   g.inside = view.mask;
   for (std::size_t ch = 0; ch < 3; ++ch) {
-    cv::getRectSubPix(relit[ch], size, centre, g.model[ch]);
-    // The model as the photo sees it: through the photo's blur (synth/photo_blur.h).
-    if (view.blur_cells > 0.0)
-      cv::GaussianBlur(g.model[ch], g.model[ch], cv::Size(), view.blur_cells);
+    // The model as the photo sees it: through the photo's blur
+    // (synth/photo_blur.h), over the relit sample around the patch too.
+    const int margin = static_cast<int>(std::ceil(3.0 * view.blur_cells));
+    cv::Mat wide;
+    cv::getRectSubPix(relit[ch], size + cv::Size(2 * margin, 2 * margin), centre, wide);
+    if (view.blur_cells > 0.0) cv::GaussianBlur(wide, wide, cv::Size(), view.blur_cells);
+    g.model[ch] = wide(cv::Rect(cv::Point(margin, margin), size)).clone();
     g.photo[ch] = view.planes[ch];
   }
   if (size != grid) {

@@ -186,24 +186,36 @@ class CoefficientCorrection::PatchPass {
   // photos' departure from the mean's prediction on the patch's departure from
   // it, over the patch's cells and views (how much of the patch's own structure
   // the photos confirm where they see it), clamped to [0, 1]. The departure is
-  // linearised at the patch: d = -J (mean - patch).
+  // linearised at the patch, d = -J (mean - patch), and like the prediction
+  // seen through the photo's blur.
   double PriorShrink() const {
     if (options_.correction_prior_shrink >= 0.0) return options_.correction_prior_shrink;
     double photo_dot_patch = 0.0, patch_dot_patch = 0.0;
     Row6d jac;
-    for (int j = 0; j < gh_; ++j)
-      for (int i = 0; i < gw_; ++i) {
-        const Vector6d q_to_mean = ToMean(i, j);
-        for (std::size_t v = 0; v < views_.size(); ++v) {
-          const RectifiedView& r = views_[v];
+    for (std::size_t v = 0; v < views_.size(); ++v) {
+      const RectifiedView& r = views_[v];
+      // The prediction at the patch and the patch's departure, per cell, both
+      // as the photo sees them (through its blur, as the additive change).
+      cv::Mat at_patch = cv::Mat::zeros(gh_, gw_, CV_32FC1);
+      cv::Mat departure = cv::Mat::zeros(gh_, gw_, CV_32FC1);
+      cv::Mat seen = cv::Mat::zeros(gh_, gw_, CV_32FC1);
+      for (int j = 0; j < gh_; ++j)
+        for (int i = 0; i < gw_; ++i) {
           if (!Seen(r, i, j)) continue;
-          const double at_patch = Predict(v, i, j, Vector6d::Zero(), jac);
-          const double patch_departure = -(jac * q_to_mean)(0);
-          photo_dot_patch +=
-              (PhotoLuminance(r, i, j) - at_patch + patch_departure) * patch_departure;
-          patch_dot_patch += patch_departure * patch_departure;
+          at_patch.at<float>(j, i) = static_cast<float>(Predict(v, i, j, Vector6d::Zero(), jac));
+          departure.at<float>(j, i) = static_cast<float>(-(jac * ToMean(i, j))(0));
+          seen.at<float>(j, i) = 1.0f;
         }
-      }
+      at_patch = MaskedGaussian(at_patch, seen, r.blur_cells);
+      departure = MaskedGaussian(departure, seen, r.blur_cells);
+      for (int j = 0; j < gh_; ++j)
+        for (int i = 0; i < gw_; ++i) {
+          if (!Seen(r, i, j)) continue;
+          const double d = departure.at<float>(j, i);
+          photo_dot_patch += (PhotoLuminance(r, i, j) - at_patch.at<float>(j, i) + d) * d;
+          patch_dot_patch += d * d;
+        }
+    }
     const double rho = patch_dot_patch > 1e-12 ? photo_dot_patch / patch_dot_patch : 0.0;
     return 1.0 - std::clamp(rho, 0.0, 1.0);
   }

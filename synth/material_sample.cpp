@@ -70,27 +70,31 @@ void TransferredDetail(const TrianglePatch& patch, const std::vector<cv::Mat>& b
   for (std::size_t c = 0; c < band.size(); ++c)
     out[c] -=
         static_cast<float>(BilinearClamped(band[c], patch.sample_x + uc, patch.sample_y + vc));
-  // The band read at each cell's match; cells whose matches coincide (a
-  // coherent match moved by one cell) read one band and add their weights.
+  // The band read at each cell's match, blended so that it keeps its contrast
+  // (after Heitz and Neyret 2018's variance-preserving blend; the bands are
+  // zero-mean): sum_k w_k b_k / sqrt(sum_jk w_j w_k rho_jk), the standard
+  // deviation of the weighted sum of unit bands whose correlation falls with
+  // the distance d between their matches, rho = exp(-d^2 / (2 l^2)), l one
+  // cell (the band's coarsest detail). Coinciding matches (a coherent piece
+  // moved by a cell) count once; unrelated ones are not averaged flat.
   std::array<std::pair<Eigen::Vector2d, double>, 4> sources;
   std::size_t n = 0;
   for (const auto& [cell, w] : cells) {
     if (w <= 0.0f) continue;
     const cv::Vec2f s = patch.detail_source.at<cv::Vec2f>(cell.y, cell.x);
-    const Eigen::Vector2d at(s[0] + uc - ((cell.x + 0.5) / rx - 0.5),
-                             s[1] + vc - ((cell.y + 0.5) / ry - 0.5));
-    std::size_t k = 0;
-    while (k < n && (sources[k].first - at).squaredNorm() > 1e-6) ++k;
-    if (k == n) sources[n++] = {at, 0.0};
-    sources[k].second += w;
+    sources[n++] = {Eigen::Vector2d(s[0] + uc - ((cell.x + 0.5) / rx - 0.5),
+                                    s[1] + vc - ((cell.y + 0.5) / ry - 0.5)),
+                    w};
   }
-  // Variance-preserving blend of the distinct zero-mean bands (Heitz and
-  // Neyret 2018, histogram-preserving blending, without the mean): a plain weighted sum of
-  // uncorrelated bands would shrink the detail by sqrt(sum w^2).
-  double sum_w2 = 0.0;
-  for (std::size_t k = 0; k < n; ++k) sum_w2 += sources[k].second * sources[k].second;
-  if (n == 0 || !(sum_w2 > 0.0)) return;
-  const double norm = 1.0 / std::sqrt(sum_w2);
+  const double cell_texels_squared = 0.5 * (1.0 / (rx * rx) + 1.0 / (ry * ry));
+  double variance = 0.0;
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t k = 0; k < n; ++k)
+      variance += sources[j].second * sources[k].second *
+                  std::exp(-(sources[j].first - sources[k].first).squaredNorm() /
+                           (2.0 * cell_texels_squared));
+  if (n == 0 || !(variance > 0.0)) return;
+  const double norm = 1.0 / std::sqrt(variance);
   for (std::size_t k = 0; k < n; ++k)
     for (std::size_t c = 0; c < band.size(); ++c)
       out[c] +=

@@ -1,6 +1,7 @@
 #include "synth/photo_blur.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <opencv2/imgproc.hpp>
 
@@ -44,6 +45,13 @@ BandEnergies MeasureBands(const cv::Mat& grid, const cv::Mat& mask) {
       ++e.cells;
     }
   return e;
+}
+
+double BlurOnGrid(double sigma_cells, int own_level, int level) {
+  const double span = std::pow(2.0, (own_level - level) / 4.0);
+  const double pixel_variance = span > 1.0 ? (span * span - 1.0) / 12.0 : 0.0;
+  const double sigma = sigma_cells * span;
+  return std::min(kMaxBlurCells, std::sqrt(sigma * sigma + pixel_variance));
 }
 
 PhotoBlurEstimator::PhotoBlurEstimator(std::size_t num_photos) : photos_(num_photos) {}

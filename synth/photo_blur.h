@@ -43,6 +43,15 @@ BandEnergies MeasureBands(const cv::Mat& grid, const cv::Mat& mask);
 /// Gaussian blur of sigma cells (none at 0), normalised over `mask` (> 0).
 cv::Mat MaskedGaussian(const cv::Mat& grid, const cv::Mat& mask, double sigma);
 
+/// A photo's blur (sigma in cells of its own density level) in cells of a
+/// grid at density level `level`. Level L has 2^(-L/4) cells per texel, so a
+/// photo pixel spans s = 2^((own_level - level)/4) cells there: sigma s, and
+/// on a finer grid (s > 1) also the pixel's own integration, a box of s cells
+/// that the model's reduction to the grid no longer matches (its variance
+/// beyond a cell's, (s^2 - 1) / 12). At most kMaxBlurCells.
+inline constexpr double kMaxBlurCells = 4.0;
+double BlurOnGrid(double sigma_cells, int own_level, int level);
+
 /// Collects band energies per photo and solves for each photo's blur.
 class PhotoBlurEstimator {
  public:

@@ -200,11 +200,8 @@ bool TriangleEngine::Rectify(std::size_t face, const sfm::TriangleView& view, Re
   out.photo = it->second;
   out.view = view;
   out.level = level;
-  // Level L has 2^(-L/4) cells per texel, so a photo pixel (a cell at its own
-  // level) spans 2^((own - L)/4) cells here.
-  out.blur_cells = result_.photo_blur.empty()
-                       ? 0.0
-                       : result_.photo_blur[it->second] * std::pow(2.0, (own_level - level) / 4.0);
+  if (!result_.photo_blur.empty())
+    out.blur_cells = BlurOnGrid(result_.photo_blur[it->second], own_level, level);
   return true;
 }
 
@@ -282,7 +279,7 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
       RectifiedView rect;
       if (!Rectify(f, view, rect)) continue;
       if (!rect.steep && (other >= 8 || !options_.light_response)) continue;
-      if (blur && blur->Wants(rect.photo) && SpreadForBlur(f))
+      if (blur && rect.steep && blur->Wants(rect.photo) && SpreadForBlur(f))
         blur->Add(rect.photo, PhotoLuminance(rect), SampleWindowLuminance(f, rect), rect.mask);
       PhotometricObservation o = Observe(f, rect, zenith_per_cell);
       // A steep view counts towards the 8 only when it is lit enough for the

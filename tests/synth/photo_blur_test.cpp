@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -78,6 +79,16 @@ TEST(SigmaMatchingRatio, InterpolatesBetweenCandidatesAndClampsAtTheEnds) {
   EXPECT_NEAR(SigmaMatchingRatio(0.8, ratio, 0.1), 0.1, 1e-12);
   EXPECT_NEAR(SigmaMatchingRatio(0.65, ratio, 0.1), 0.15, 1e-12);
   EXPECT_NEAR(SigmaMatchingRatio(0.1, ratio, 0.1), 0.3, 1e-12);  // blurrier than the last
+}
+
+TEST(BlurOnGrid, ScalesByThePixelsSpanAndAddsItsIntegrationOnAFinerGrid) {
+  EXPECT_DOUBLE_EQ(BlurOnGrid(0.4, 3, 3), 0.4);
+  // Four levels finer: a photo pixel spans 2 cells, its box adds (4 - 1) / 12.
+  EXPECT_NEAR(BlurOnGrid(0.4, 3, -1), std::sqrt(0.8 * 0.8 + 0.25), 1e-12);
+  EXPECT_NEAR(BlurOnGrid(0.0, 3, -1), 0.5, 1e-12);
+  // Four levels coarser: half a cell per pixel, no box beyond the reduction's.
+  EXPECT_NEAR(BlurOnGrid(0.4, 3, 7), 0.2, 1e-12);
+  EXPECT_DOUBLE_EQ(BlurOnGrid(2.0, 20, 0), kMaxBlurCells);
 }
 
 TEST(PhotoBlurEstimator, RecoversAKnownBlurFromAnotherInstanceOfTheMaterial) {
