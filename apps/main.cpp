@@ -2,7 +2,10 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "core/partial_output.h"
 
 int main(int argc, char** argv) {
+  // Before any thread starts: SIGINT and SIGTERM remove partial outputs, then exit.
+  texlume::InstallInterruptCleanup();
   return texlume::apps::RunTexlume(argc, argv, std::cout, std::cerr);
 }

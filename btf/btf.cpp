@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -48,12 +49,35 @@ std::vector<Eigen::Vector3d> ReadDirections(const nlohmann::json& j, const char*
   return out;
 }
 
+// The capture's image name for (view, light): `pattern` is literal text with "%%"
+// and exactly two integer fields "%d" (or "%0<width>d", width at most 9), the view
+// then the light. It is expanded here, never handed to printf, so nothing in
+// btf.json can act as a format string. Empty when the pattern is not of that form.
 std::string FileName(const std::string& pattern, std::size_t view, std::size_t light) {
-  char name[512];
-  const int n = std::snprintf(name, sizeof name, pattern.c_str(), static_cast<int>(view),
-                              static_cast<int>(light));
-  if (n < 0 || static_cast<std::size_t>(n) >= sizeof name) return {};
-  return name;
+  const std::array<std::size_t, 2> values = {view, light};
+  std::string name;
+  std::size_t field = 0;
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] != '%') {
+      name.push_back(pattern[i]);
+      continue;
+    }
+    if (++i < pattern.size() && pattern[i] == '%') {
+      name.push_back('%');
+      continue;
+    }
+    const bool zero_pad = i < pattern.size() && pattern[i] == '0';
+    if (zero_pad) ++i;
+    std::size_t width = 0;
+    if (i < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[i]))) {
+      width = static_cast<std::size_t>(pattern[i++] - '0');
+    }
+    if (i >= pattern.size() || pattern[i] != 'd' || field >= values.size()) return {};
+    std::string digits = std::to_string(values[field++]);
+    if (digits.size() < width) digits.insert(0, width - digits.size(), zero_pad ? '0' : ' ');
+    name += digits;
+  }
+  return field == values.size() ? name : std::string();
 }
 
 nlohmann::json DirectionsJson(const std::vector<Eigen::Vector3d>& directions) {
@@ -104,9 +128,12 @@ BtfCapture ReadBtfCapture(const fs::path& dir) {
   for (std::size_t a = 0; a < capture.views.size(); ++a)
     for (std::size_t b = 0; b < capture.lights.size(); ++b) {
       const std::string name = FileName(pattern, a, b);
-      if (name.empty() || name.find('/') != std::string::npos)
-        throw InputError(label, "file_pattern '" + pattern + "' does not give a file name");
-      const fs::path file = dir / name;
+      if (name.empty()) {
+        throw InputError(label, "file_pattern '" + pattern +
+                                    "' must be a file name with two integer fields %d (or "
+                                    "%02d), the view's index then the light's");
+      }
+      const fs::path file = ContainedPath(dir, name, label, "file_pattern");
       if (!fs::exists(file))
         throw InputError(file.string(), "is missing: the capture has no image for view " +
                                             std::to_string(a) + " and light " + std::to_string(b));

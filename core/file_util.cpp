@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "core/errors.h"
+#include "core/partial_output.h"
 
 namespace texlume {
 
@@ -17,6 +18,8 @@ void WriteFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write, bool binary) {
   std::filesystem::path tmp = path;
   tmp += ".tmp-" + std::to_string(::getpid());
+  RemoveStalePartials(path);
+  RegisterPartial(tmp);
   try {
     {
       std::ofstream out(tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
@@ -26,7 +29,9 @@ void WriteFileAtomically(const std::filesystem::path& path,
       if (!out) throw std::runtime_error(path.string() + ": write failed (disk full?)");
     }
     std::filesystem::rename(tmp, path);
+    ForgetPartial(tmp);
   } catch (...) {
+    ForgetPartial(tmp);
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
     throw;
@@ -42,6 +47,43 @@ std::ifstream OpenForReading(const std::filesystem::path& path, bool binary) {
   std::ifstream in(path, binary ? std::ios::binary : std::ios::in);
   if (!in) throw InputError(path.string(), "cannot open for reading");
   return in;
+}
+
+std::string ContainedNameProblem(std::string_view name) {
+  if (name.empty()) return "is empty";
+  if (name.find('\0') != std::string_view::npos) return "holds a NUL character";
+  if (name.find('\\') != std::string_view::npos) return "holds a backslash; use '/'";
+  const std::filesystem::path relative(name);
+  if (relative.has_root_path()) return "is an absolute path; it must name a file inside its folder";
+  for (const auto& part : relative) {
+    if (part == "..") return "leaves its folder (a '..' component)";
+  }
+  return {};
+}
+
+std::filesystem::path ContainedPath(const std::filesystem::path& folder, std::string_view name,
+                                    const std::string& label, std::string_view what) {
+  const std::string problem = ContainedNameProblem(name);
+  if (!problem.empty()) {
+    throw InputError(label, std::string(what) + " '" + std::string(name) + "' " + problem);
+  }
+  return folder / std::filesystem::path(name);
+}
+
+std::string ReadFileBytes(const std::filesystem::path& path, std::uint64_t max_bytes) {
+  std::ifstream in = OpenForReading(path, true);
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw InputError(path.string(), "cannot measure the file's size");
+  if (static_cast<std::uint64_t>(size) > max_bytes) {
+    throw InputError(path.string(), "is " + std::to_string(size) +
+                                        " bytes, more than the limit of " +
+                                        std::to_string(max_bytes));
+  }
+  in.seekg(0, std::ios::beg);
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  if (!in.read(bytes.data(), size)) throw InputError(path.string(), "cannot read the file");
+  return bytes;
 }
 
 BinaryReader::BinaryReader(std::istream& in, std::string label)

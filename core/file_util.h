@@ -23,6 +23,20 @@ void WriteFileAtomically(const std::filesystem::path& path,
 /// The returned stream throws nothing; readers check it themselves.
 std::ifstream OpenForReading(const std::filesystem::path& path, bool binary);
 
+/// The file `name`, read from the file `label` (a manifest, btf.json, ...), inside
+/// `folder`. Throws InputError naming `label` and `what` unless `name` is a
+/// non-empty relative path none of whose components is "..", so that no file can
+/// send texlume outside its own folder.
+std::filesystem::path ContainedPath(const std::filesystem::path& folder, std::string_view name,
+                                    const std::string& label, std::string_view what);
+/// Why `name` cannot name a file inside a folder (as ContainedPath refuses it), or
+/// empty when it can.
+std::string ContainedNameProblem(std::string_view name);
+
+/// Reads a whole file into memory; throws InputError naming it when it cannot be
+/// read or holds more than `max_bytes` (checked before anything is allocated).
+std::string ReadFileBytes(const std::filesystem::path& path, std::uint64_t max_bytes);
+
 /// Bounded little-endian reader over a stream: every read and every count is
 /// checked against the bytes left, so a corrupt file can never make the caller
 /// allocate more than the file could hold. Errors are InputError with the label

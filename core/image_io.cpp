@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -35,7 +36,9 @@ std::unique_ptr<OIIO::ImageInput> OpenChecked(const fs::path& path) {
   auto in = OIIO::ImageInput::open(path.string(), &config);
   if (!in) throw InputError(path.string(), "is not a readable image: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.width > 65536 || spec.height > 65536)
+  // At most 65,536 a side and 250 megapixels (docs/robustness.md, "Limits").
+  if (spec.width <= 0 || spec.height <= 0 || spec.width > 65536 || spec.height > 65536 ||
+      static_cast<std::int64_t>(spec.width) * spec.height > 250'000'000)
     throw InputError(path.string(), "has an implausible size of " + std::to_string(spec.width) +
                                         " x " + std::to_string(spec.height) + " pixels");
   if (spec.nchannels <= 0 || spec.nchannels > 64)

@@ -14,6 +14,7 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/partial_output.h"
 #include "datasets_synthetic/object_scene.h"
 #include "ptm/exr_io.h"
 #include "sfm/colmap_io.h"
@@ -680,7 +681,11 @@ class SceneGenerator {
 SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::path& dir,
                            const ProgressCallback& progress) {
   options.Check();
-  return SceneGenerator(options, dir, progress).Run();
+  RequireReplaceableFolder(dir, "scene.json", "a texlume scene folder");
+  PartialOutput output(dir, PartialOutput::Kind::kFolder);
+  SceneSummary summary = SceneGenerator(options, output.path(), progress).Run();
+  output.Commit();
+  return summary;
 }
 
 }  // namespace texlume::datasets

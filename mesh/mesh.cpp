@@ -12,8 +12,10 @@
 #include <queue>
 #include <stdexcept>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "core/errors.h"
+#include "mesh/mesh_readers.h"
 
 namespace texlume::mesh {
 namespace {
@@ -34,53 +36,6 @@ void SilenceOpenMesh() {
     omout().disable();
   });
 }
-
-// Captures the polygon soup exactly as the OpenMesh reader delivers it, before
-// OpenMesh's own handling of non-manifold faces changes anything.
-class SoupImporter : public OpenMesh::IO::ImporterT<OmPolyMesh> {
- public:
-  using Base = OpenMesh::IO::ImporterT<OmPolyMesh>;
-  explicit SoupImporter(OmPolyMesh& mesh) : Base(mesh) {}
-
-  OpenMesh::VertexHandle add_vertex(const OpenMesh::Vec3f& p) override {
-    return Record(Base::add_vertex(p), Eigen::Vector3d(p[0], p[1], p[2]));
-  }
-  OpenMesh::VertexHandle add_vertex(const OpenMesh::Vec3d& p) override {
-    return Record(Base::add_vertex(p), Eigen::Vector3d(p[0], p[1], p[2]));
-  }
-  OpenMesh::VertexHandle add_vertex() override {
-    return Record(Base::add_vertex(), Eigen::Vector3d::Zero());
-  }
-  // Readers that add vertices first and place them later (PLY) call this.
-  void set_point(OpenMesh::VertexHandle vh, const OpenMesh::Vec3f& p) override {
-    Base::set_point(vh, p);
-    const auto it = soup_index_.find(vh.idx());
-    if (it != soup_index_.end()) {
-      vertices[static_cast<std::size_t>(it->second)] = Eigen::Vector3d(p[0], p[1], p[2]);
-    }
-  }
-  OpenMesh::FaceHandle add_face(const VHandles& indices) override {
-    std::vector<int> polygon;
-    polygon.reserve(indices.size());
-    for (const auto& vh : indices) {
-      const auto it = soup_index_.find(vh.idx());
-      polygon.push_back(it == soup_index_.end() ? -1 : it->second);
-    }
-    polygons.push_back(std::move(polygon));
-    return Base::add_face(indices);
-  }
-
-  std::vector<Eigen::Vector3d> vertices;
-  std::vector<std::vector<int>> polygons;
-
- private:
-  OpenMesh::VertexHandle Record(OpenMesh::VertexHandle vh, const Eigen::Vector3d& p) {
-    soup_index_[vh.idx()] = static_cast<int>(vertices.size());
-    vertices.push_back(p);
-    return vh;
-  }
-  std::unordered_map<int, int> soup_index_;
-};
 
 std::uint64_t EdgeKey(int a, int b) {
   const auto lo = static_cast<std::uint32_t>(std::min(a, b));
@@ -277,21 +232,10 @@ class MeshCleaner {
     }
     std::array<int, 3> sorted = f;
     std::sort(sorted.begin(), sorted.end());
-    const std::uint64_t key = static_cast<std::uint64_t>(sorted[0]);
-    bool duplicate = false;
-    for (std::size_t other : seen_[key]) {
-      std::array<int, 3> s = faces_[other];
-      std::sort(s.begin(), s.end());
-      if (s == sorted) {
-        duplicate = true;
-        break;
-      }
-    }
-    if (duplicate) {
+    if (!seen_.insert(sorted).second) {
       ++report_.duplicate_faces_removed;
       return;
     }
-    seen_[key].push_back(faces_.size());
     faces_.push_back(f);
     source_.push_back(pi);
   }
@@ -420,7 +364,16 @@ class MeshCleaner {
   std::vector<std::array<int, 3>> faces_;
   std::vector<std::size_t> source_;  // face -> its input polygon
 
-  std::unordered_map<std::uint64_t, std::vector<std::size_t>> seen_;  // min vertex -> faces
+  // The kept faces' sorted corners: a duplicate is found in constant time, so a fan
+  // of many faces around one vertex costs no more than any other mesh.
+  struct TripleHash {
+    std::size_t operator()(const std::array<int, 3>& t) const {
+      std::uint64_t h = 1469598103934665603ull;
+      for (int v : t) h = (h ^ static_cast<std::uint32_t>(v)) * 1099511628211ull;
+      return static_cast<std::size_t>(h);
+    }
+  };
+  std::unordered_set<std::array<int, 3>, TripleHash> seen_;
 
   // Edges and orientation.
   std::unordered_map<std::uint64_t, std::vector<EdgeUse>> uses_;
@@ -437,38 +390,9 @@ LoadedMesh CleanMesh(const std::vector<Eigen::Vector3d>& vertices,
 }
 
 LoadedMesh LoadMesh(const std::filesystem::path& path, const MeshCleanOptions& options) {
-  SilenceOpenMesh();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw InputError(path.string(), "mesh file not found");
-  }
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  if (ext != ".ply" && ext != ".obj" && ext != ".off" && ext != ".stl") {
-    throw InputError(path.string(), "unsupported mesh format '" + ext +
-                                        "' (texlume reads .ply, .obj, .off, .stl)");
-  }
-  OmPolyMesh om_mesh;
-  SoupImporter importer(om_mesh);
-  OpenMesh::IO::Options read_options;
-  bool ok = false;
-  try {
-    ok = OpenMesh::IO::IOManager().read(path.string(), importer, read_options);
-  } catch (const std::exception& e) {
-    throw InputError(path.string(), std::string("cannot parse mesh: ") + e.what());
-  }
-  if (!ok) throw InputError(path.string(), "cannot parse mesh (OpenMesh rejected the file)");
-  for (std::size_t i = 0; i < importer.polygons.size(); ++i) {
-    for (int idx : importer.polygons[i]) {
-      if (idx < 0) {
-        throw InputError(path.string(),
-                         "face " + std::to_string(i) + " refers to a vertex that does not exist");
-      }
-    }
-  }
-  if (importer.polygons.empty()) throw InputError(path.string(), "the mesh has no faces");
-  return CleanMesh(importer.vertices, importer.polygons, options, path.string());
+  const PolygonSoup soup = ReadPolygonSoup(path);
+  if (soup.polygons.empty()) throw InputError(path.string(), "the mesh has no faces");
+  return CleanMesh(soup.vertices, soup.polygons, options, path.string());
 }
 
 void SaveMesh(const TriangleMesh& mesh, const std::filesystem::path& path) {

@@ -71,7 +71,8 @@ struct LoadedMesh {
   std::vector<std::size_t> source_face;
 };
 
-/// Reads PLY, OBJ, OFF or STL (by extension) through OpenMesh, then CleanMesh.
+/// Reads PLY, OBJ, OFF or STL (by extension) with texlume's own bounded readers
+/// (mesh_readers.h), then CleanMesh.
 /// Throws InputError naming the file when it is missing, unparsable, or has no
 /// faces left after cleaning.
 LoadedMesh LoadMesh(const std::filesystem::path& path, const MeshCleanOptions& options = {});

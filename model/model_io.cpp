@@ -10,6 +10,7 @@
 
 #include "core/errors.h"
 #include "core/file_util.h"
+#include "core/partial_output.h"
 #include "ptm/ptm_io.h"
 #include "synth/mesh_synthesis.h"
 
@@ -18,6 +19,8 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kManifestFormat = "texlume-model";
+// How far outside [0, 1] a model folder's texture coordinate may round.
+constexpr double kTexcoordSlack = 1e-3;
 
 void WriteObj(const fs::path& path, const TexturedModel& model) {
   std::ofstream out(path);
@@ -47,7 +50,8 @@ void WriteObj(const fs::path& path, const TexturedModel& model) {
       out << "\n";
     }
   }
-  if (!out) throw InputError(path.string(), "cannot be written");
+  out.close();
+  if (!out) throw InputError(path.string(), "cannot be written (disk full?)");
 }
 
 }  // namespace
@@ -214,11 +218,9 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
       throw InputError(dir.string(),
                        "exists, is not empty and is not a texlume model folder; not replacing it");
   }
-  const fs::path tmp =
-      dir.parent_path() / (dir.filename().string() + ".partial-" + std::to_string(::getpid()));
-  fs::remove_all(tmp);
-  fs::create_directories(tmp);
-  try {
+  PartialOutput output(dir, PartialOutput::Kind::kFolder);
+  const fs::path& tmp = output.path();
+  {
     nlohmann::json manifest = record;
     manifest["format"] = kManifestFormat;
     manifest["version"] = 1;
@@ -271,8 +273,8 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
           << "\n# albedo: " << albedo << "; PTM: " << ptm_file << " (lossless " << exr_file
           << ")\n\n";
     }
-    if (!mtl) throw InputError((dir / "model.mtl").string(), "cannot be written");
     mtl.close();
+    if (!mtl) throw InputError((dir / "model.mtl").string(), "cannot be written (disk full?)");
     WriteObj(tmp / "model.obj", model);
     WriteGlb(tmp / "model.glb", model, pngs, extras);
     nlohmann::json files = nlohmann::json::array();
@@ -285,14 +287,20 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
     files.push_back("manifest.json");
     std::sort(files.begin(), files.end());
     manifest["files"] = files;
-    std::ofstream(tmp / "manifest.json") << manifest.dump(2) << "\n";
-    if (fs::exists(dir)) fs::remove_all(dir);
-    fs::rename(tmp, dir);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove_all(tmp, ec);
-    throw;
+    // The manifest last: a folder with a manifest is a finished model.
+    WriteFileAtomically(
+        tmp / "manifest.json", [&](std::ostream& o) { o << manifest.dump(2) << "\n"; }, false);
   }
+  output.Commit();
+}
+
+std::string ManifestFileName(const nlohmann::json& value, const fs::path& dir,
+                             const std::string& key) {
+  const std::string label = (dir / "manifest.json").string();
+  if (!value.is_string()) throw InputError(label, "\"" + key + "\" is not a file name");
+  const std::string name = value.get<std::string>();
+  ContainedPath(dir, name, label, key);
+  return name;
 }
 
 nlohmann::json ReadModelManifest(const fs::path& dir) {
@@ -376,7 +384,7 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
   for (const auto& entry : manifest["atlases"]) {
     if (!entry.is_object() || !entry.contains("exr") || !entry["exr"].is_string())
       throw InputError(manifest_path.string(), "an atlas entry has no \"exr\" file");
-    model.atlases.push_back(ptm::ReadPtmExr(dir / entry["exr"].get<std::string>()));
+    model.atlases.push_back(ptm::ReadPtmExr(dir / ManifestFileName(entry["exr"], dir, "exr")));
   }
   const fs::path obj_path = dir / "model.obj";
   std::ifstream obj = OpenForReading(obj_path, false);
@@ -399,6 +407,10 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
       Eigen::Vector2d t;
       if (!(s >> t.x() >> t.y()) || !t.allFinite())
         throw InputError(obj_path.string(), "bad texture coordinate", line_number);
+      // texlume writes atlas coordinates in [0, 1]; anything far outside is damage.
+      if ((t.array() < -kTexcoordSlack).any() || (t.array() > 1.0 + kTexcoordSlack).any())
+        throw InputError(obj_path.string(), "texture coordinate outside the atlas [0, 1]",
+                         line_number);
       texcoords.push_back(t);
     } else if (tag == "usemtl") {
       std::string name;

@@ -59,6 +59,12 @@ void WriteModelFolder(const std::filesystem::path& dir, const TexturedModel& mod
 /// "atlases" array). Throws InputError naming the file otherwise.
 nlohmann::json ReadModelManifest(const std::filesystem::path& dir);
 
+/// A file name the manifest of the model folder `dir` gives under `key`: throws
+/// InputError naming manifest.json unless it is a string naming a file inside
+/// `dir` (relative, no ".." component; core/file_util.h ContainedPath).
+std::string ManifestFileName(const nlohmann::json& value, const std::filesystem::path& dir,
+                             const std::string& key);
+
 /// The frame face f's atlas coefficients are in, as columns in world
 /// coordinates: x = dP/du made orthogonal to the normal, y = n x x (dP/dv
 /// direction, v up), z = the face normal (x = the first edge without texture

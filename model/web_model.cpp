@@ -224,13 +224,14 @@ WebModel BuildWebModel(const fs::path& model_dir) {
       textures.push_back({{"file", name}, {"scale", scale}, {"bias", bias}});
     }
     entry["textures"] = textures;
-    if (a < entries.size() && entries[a].contains("base_colour")) {
-      const std::string name = entries[a]["base_colour"].get<std::string>();
+    if (a < entries.size() && entries[a].is_object() && entries[a].contains("base_colour")) {
+      const std::string name =
+          ManifestFileName(entries[a]["base_colour"], model_dir, "base_colour");
       web.files[name] = ReadBytes(model_dir / name);
       entry["base_colour"] = name;
     }
     if (a < baked.size() && baked[a].is_string()) {
-      const std::string name = baked[a].get<std::string>();
+      const std::string name = ManifestFileName(baked[a], model_dir, "baked");
       if (fs::exists(model_dir / name)) {
         web.files[name] = ReadBytes(model_dir / name);
         entry["baked"] = name;

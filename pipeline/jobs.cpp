@@ -11,6 +11,7 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/partial_output.h"
 #include "core/timing.h"
 #include "model/model_io.h"
 #include "pipeline/btf_synth_job.h"
@@ -46,11 +47,27 @@ void WriteRgbImage(const fs::path& path, const std::vector<float>& rgb, int widt
     }
   }
   std::vector<unsigned char> bytes;
-  if (!cv::imencode(path.extension().string().empty() ? ".png" : path.extension().string(), image,
-                    bytes)) {
-    throw InputError(path.string(), "cannot be encoded (use .png, .jpg or .tif)");
+  bool encoded = false;
+  try {
+    encoded = cv::imencode(path.extension().string().empty() ? ".png" : path.extension().string(),
+                           image, bytes);
+  } catch (const cv::Exception&) {
+    encoded = false;
   }
+  if (!encoded) throw InputError(path.string(), "cannot be encoded (use .png, .jpg or .tif)");
   WriteBytesAtomically(path, bytes);
+}
+
+// Refuses an output image name whose extension WriteRgbImage cannot encode.
+void RequireImageExtension(const fs::path& path, const char* what) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  for (const char* ok : {"", ".png", ".jpg", ".jpeg", ".tif", ".tiff"}) {
+    if (ext == ok) return;
+  }
+  throw OptionError(std::string(what) + " '" + path.string() +
+                    "' must end in .png, .jpg or .tif (no extension writes PNG)");
 }
 
 }  // namespace
@@ -155,7 +172,9 @@ void RunBtfJob(const BtfJobOptions& options, std::ostream& out, const ProgressCa
   std::sort(counts.begin(), counts.end());
   counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
   const std::vector<btf::SvdError> errors = btf::SvdErrorTable(f, counts);
-  btf::WriteBtfFactorisation(f, errors, options.out_dir);
+  RequireReplaceableFolder(options.out_dir, "run.json", "a texlume btf folder");
+  PartialOutput output(options.out_dir, PartialOutput::Kind::kFolder);
+  btf::WriteBtfFactorisation(f, errors, output.path());
   out << "Factorised a " << capture.width << "x" << capture.height << " BTF of "
       << capture.views.size() << " views x " << capture.lights.size() << " lights into "
       << options.components << " components in " << factorise_seconds << " s. Wrote "
@@ -168,12 +187,15 @@ void RunBtfJob(const BtfJobOptions& options, std::ostream& out, const ProgressCa
   record["settings"] = options.ToJson();
   record["timings_s"] = {
       {"read", read_seconds}, {"factorise", factorise_seconds}, {"write", SecondsSince(t2)}};
-  WriteJson(options.out_dir / "run.json", record);
+  WriteJson(output.path() / "run.json", record);
+  output.Commit();
 }
 
 void RelightJobOptions::Check() const {
   RequirePath(ptm_file, "the PTM to relight");
   RequirePath(out_file, "the image to write");
+  RequireImageExtension(out_file, "the image to write");
+  if (!normals_file.empty()) RequireImageExtension(normals_file, "the normal map to write");
   if (!(light.allFinite() && light.norm() > 1e-9))
     throw OptionError("the light direction must be a nonzero vector");
   if (!(light.normalized().z() > 0))
@@ -315,8 +337,9 @@ void RunSynth2dJob(const Synth2dJobOptions& options, std::ostream& out) {
   const std::vector<synth::PlanarPhoto> photos = ReadPlanarPhotos(options);
   const synth::PlanarSynthesisResult result =
       synth::SynthesizePlanarPtm(sample, photos, options.synthesis);
-  const fs::path& out_dir = options.out_dir;
-  fs::create_directories(out_dir);
+  RequireReplaceableFolder(options.out_dir, "synth2d.json", "a texlume synth2d folder");
+  PartialOutput output(options.out_dir, PartialOutput::Kind::kFolder);
+  const fs::path& out_dir = output.path();
   ptm::WritePtmFile(result.ptm, out_dir / "ptm_out.ptm");
   ptm::WritePtmExr(result.ptm, out_dir / "ptm_out.exr");
   WriteRelitPhotos(result, photos, out_dir);
@@ -340,9 +363,11 @@ void RunSynth2dJob(const Synth2dJobOptions& options, std::ostream& out) {
   for (const auto& l : new_lights) record["new_lights"].push_back({l.x(), l.y(), l.z()});
   record["timings_s"] = {{"synthesis", result.seconds}};
   WriteJson(out_dir / "synth2d.json", record);
+  output.Commit();
   out << "Synthesised a " << w << "x" << h << " PTM from " << result.blocks.size() << " blocks of "
       << options.synthesis.block_size << " texels (" << photos.size() << " photos, scale "
-      << result.scale << ") in " << result.seconds << " s into " << out_dir.string() << "\n";
+      << result.scale << ") in " << result.seconds << " s into " << options.out_dir.string()
+      << "\n";
 }
 
 void SynthCommandOptions::Check() const {

@@ -7,6 +7,7 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/partial_output.h"
 #include "core/timing.h"
 #include "model/baselines.h"
 #include "model/btf_model.h"
@@ -74,6 +75,8 @@ class RenderJob {
     const auto start = std::chrono::steady_clock::now();
     LoadModel();
     LoadViews();
+    RequireReplaceableFolder(options_.out_dir, "render.json", "a texlume render folder");
+    output_.emplace(options_.out_dir, PartialOutput::Kind::kFolder);
     std::size_t done = 0;
     const std::size_t total = cameras_.reconstruction.images.size();
     for (const auto& [id, image] : cameras_.reconstruction.images) {
@@ -88,6 +91,7 @@ class RenderJob {
     AverageMetrics();
     summary_.seconds = SecondsSince(start);
     WriteRecord();
+    output_->Commit();
     return summary_;
   }
 
@@ -125,10 +129,10 @@ class RenderJob {
              : renderer_->Render(camera, image.cam_from_world, lights, options_.mode,
                                  options_.samples_per_axis);
     const fs::path name = PngName(image.name);
-    WritePng(options_.out_dir / name, ToBgr8(view.rgb));
+    WritePng(output_->path() / name, ToBgr8(view.rgb));
     cv::Mat mask;
     view.coverage.convertTo(mask, CV_8UC1, 255.0);
-    WritePng(options_.out_dir / "masks" / name, mask);
+    WritePng(output_->path() / "masks" / name, mask);
     ++summary_.rendered;
     if (!options_.truth_images_dir.empty()) Measure(image.name, view.rgb, mask);
   }
@@ -177,7 +181,7 @@ class RenderJob {
     if (!summary_.metrics.empty()) record["metrics"] = MetricsJson();
     record["timings_s"] = {{"total", summary_.seconds}};
     WriteFileAtomically(
-        options_.out_dir / "render.json", [&](std::ostream& o) { o << record.dump(2) << "\n"; },
+        output_->path() / "render.json", [&](std::ostream& o) { o << record.dump(2) << "\n"; },
         false);
   }
 
@@ -189,6 +193,7 @@ class RenderJob {
   std::unique_ptr<model::BtfModel> btf_;
   sfm::LoadedModel cameras_;
   sfm::ObjectLights lights_;
+  std::optional<PartialOutput> output_;  // the output folder while it is written
 };
 
 }  // namespace

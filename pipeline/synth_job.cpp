@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -43,6 +44,28 @@ synth::ColourSynthesisOptions ColourOptions(const synth::MeshSynthesisOptions& p
   colour.correction_noise = ptm.correction_noise;
   colour.correction_sigma = ptm.correction_sigma;
   return colour;
+}
+
+// The fewest sample texels across the mesh's bounding box for a texture to mean
+// anything: a larger texel size is a texel size in other units than the mesh's.
+constexpr double kMinTexelsAcrossMesh = 4.0;
+
+void RefuseSampleLargerThanMesh(const mesh::TriangleMesh& mesh, double sample_texel_size,
+                                const fs::path& mesh_path) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  const double diagonal = mesh.vertices.empty() ? 0.0 : (hi - lo).norm();
+  if (!(diagonal >= kMinTexelsAcrossMesh * sample_texel_size)) {
+    throw OptionError("the sample's texel size (" + std::to_string(sample_texel_size) +
+                      " world units) is not small against the mesh " + mesh_path.string() +
+                      " (diagonal " + std::to_string(diagonal) + ", fewer than " +
+                      std::to_string(static_cast<int>(kMinTexelsAcrossMesh)) +
+                      " texels across it); give --sample-texel-size in the mesh's units");
+  }
 }
 
 }  // namespace
@@ -135,6 +158,7 @@ void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int s
   const sfm::Reconstruction& reconstruction = inputs.reconstruction;
   const std::vector<synth::MeshPhoto>& photos = inputs.photos;
   mesh::TriangleMesh& mesh = inputs.mesh;
+  RefuseSampleLargerThanMesh(mesh, sample_texel_size, options.mesh_file);
   // Visibility (and subdivision while the largest triangle does not fit the sample).
   auto t = std::chrono::steady_clock::now();
   auto largest_patch = [&](const mesh::TriangleMesh& m) {

@@ -3,12 +3,18 @@
 #include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <stdexcept>
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/partial_output.h"
 
 namespace texlume::ptm {
+namespace {
+// The most values (width x height x channels) ReadExr allocates: 1 Gi floats, 4 GiB.
+constexpr std::uint64_t kMaxExrValues = std::uint64_t{1} << 30;
+}  // namespace
 
 void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& planes,
               const std::vector<std::string>& channel_names) {
@@ -32,6 +38,7 @@ void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& pla
       path.parent_path() / (path.stem().string() + ".tmp-" + std::to_string(::getpid()) + ".exr");
   auto out = OIIO::ImageOutput::create(tmp.string());
   if (!out) throw std::runtime_error(path.string() + ": OpenImageIO cannot write EXR");
+  RegisterPartial(tmp);
   OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
   spec.channelnames = channel_names;
   spec.attribute("compression", "zip");
@@ -42,9 +49,11 @@ void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& pla
   if (!ok) {
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
+    ForgetPartial(tmp);
     throw std::runtime_error(path.string() + ": cannot write EXR: " + out->geterror());
   }
   std::filesystem::rename(tmp, path);
+  ForgetPartial(tmp);
 }
 
 std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
@@ -55,6 +64,15 @@ std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.width > (1 << 16) ||
       spec.height > (1 << 16) || spec.nchannels > 64) {
     throw InputError(path.string(), "implausible image size or channel count");
+  }
+  const std::uint64_t values = static_cast<std::uint64_t>(spec.width) * spec.height *
+                               static_cast<std::uint64_t>(spec.nchannels);
+  if (values > kMaxExrValues) {
+    throw InputError(path.string(),
+                     std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
+                         std::to_string(spec.nchannels) + " channels is more than texlume reads (" +
+                         std::to_string(kMaxExrValues >> 20) + " Mi values, " +
+                         std::to_string((kMaxExrValues * 4) >> 30) + " GiB)");
   }
   std::vector<float> data(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data())) {

@@ -17,6 +17,12 @@
 namespace texlume::ptm {
 namespace {
 
+// Plausibility bounds of a .ptm file's quantisation (docs/ptm_format.md): a
+// coefficient (byte - bias) * scale / 255 of a relit value in [0, 1] never needs
+// more; beyond them a file relights to garbage.
+constexpr double kMaxPtmScale = 1e6;  // the message below says 1e6
+constexpr std::int64_t kMaxPtmBias = 1000000;
+
 // Quantisation of one coefficient index: coefficient = (byte - bias) * scale.
 struct Quantiser {
   float scale = 1.0f;
@@ -158,16 +164,31 @@ Ptm ReadPtm(std::istream& in, const std::string& label) {
   const auto scale_tokens = SplitWhitespace(scales_line);
   if (scale_tokens.size() != 6) throw InputError(label, "expected 6 scales", ln);
   float scale[6];
-  for (int i = 0; i < 6; ++i)
-    scale[i] = static_cast<float>(
-        ParseDouble(scale_tokens[static_cast<std::size_t>(i)], "a scale", label, ln));
+  for (int i = 0; i < 6; ++i) {
+    const double s = ParseDouble(scale_tokens[static_cast<std::size_t>(i)], "a scale", label, ln);
+    if (!(s > 0.0 && s <= kMaxPtmScale)) {
+      throw InputError(
+          label,
+          "scale " + std::string(scale_tokens[static_cast<std::size_t>(i)]) + " is not in (0, 1e6]",
+          ln);
+    }
+    scale[i] = static_cast<float>(s);
+  }
   const std::string bias_line = ReadHeaderLine(in, label, ++ln);
   const auto bias_tokens = SplitWhitespace(bias_line);
   if (bias_tokens.size() != 6) throw InputError(label, "expected 6 biases", ln);
   int bias[6];
-  for (int i = 0; i < 6; ++i)
-    bias[i] = static_cast<int>(
-        ParseSigned(bias_tokens[static_cast<std::size_t>(i)], "a bias", label, ln));
+  for (int i = 0; i < 6; ++i) {
+    const std::int64_t b =
+        ParseSigned(bias_tokens[static_cast<std::size_t>(i)], "a bias", label, ln);
+    if (b < -kMaxPtmBias || b > kMaxPtmBias) {
+      throw InputError(label,
+                       "bias " + std::to_string(b) + " is not in [-" + std::to_string(kMaxPtmBias) +
+                           ", " + std::to_string(kMaxPtmBias) + "]",
+                       ln);
+    }
+    bias[i] = static_cast<int>(b);
+  }
 
   // Payload size check before allocating.
   const std::streampos here = in.tellg();

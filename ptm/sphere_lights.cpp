@@ -3,6 +3,7 @@
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "core/errors.h"
 #include "core/image_io.h"
@@ -115,6 +116,22 @@ void HighlightOptions::Check() const {
     throw OptionError("highlight search radius must be in (0, 1] of the sphere's");
 }
 
+// A circle given by the user must have its centre in the photos and a radius no
+// larger than they are wide, or every search below runs off the image.
+static void CheckCircleInPhotos(const SphereCircle& c, const cv::Size& size,
+                                const std::string& label) {
+  const bool inside = c.center_x >= 0.0 && c.center_x <= size.width && c.center_y >= 0.0 &&
+                      c.center_y <= size.height && c.radius > 0.0 &&
+                      c.radius <= std::max(size.width, size.height);
+  if (!inside) {
+    std::ostringstream message;
+    message << "the sphere's circle (" << c.center_x << ", " << c.center_y << ", radius "
+            << c.radius << ") does not lie in the " << size.width << " x " << size.height
+            << " photos of " << label;
+    throw OptionError(message.str());
+  }
+}
+
 std::vector<sfm::LpEntry> LightsFromSphere(const std::vector<std::filesystem::path>& files,
                                            std::optional<SphereCircle> circle,
                                            const HighlightOptions& options,
@@ -130,6 +147,7 @@ std::vector<sfm::LpEntry> LightsFromSphere(const std::vector<std::filesystem::pa
     gray.push_back(f);
   }
   const std::string label = files.empty() ? "images" : files[0].parent_path().string();
+  if (circle && !gray.empty()) CheckCircleInPhotos(*circle, gray[0].size(), label);
   const SphereCircle c = circle ? *circle : DetectSphere(gray, label);
   if (!(c.radius > 2.0)) throw InputError(label, "sphere radius must be more than 2 pixels");
   if (used_circle) *used_circle = c;

@@ -13,6 +13,7 @@
 #include "core/check.h"
 #include "core/errors.h"
 #include "core/file_util.h"
+#include "core/partial_output.h"
 #include "core/timing.h"
 
 namespace texlume::report {
@@ -395,25 +396,16 @@ ReportSummary WriteReport(const fs::path& dir, const ReportInputs& in,
   const auto start = std::chrono::steady_clock::now();
   fs::create_directories(dir);
   const fs::path pictures = dir / "report";
-  const fs::path tmp = dir / ("report.partial-" + std::to_string(::getpid()));
-  fs::remove_all(tmp);
-  fs::create_directories(tmp);
-  ReportWriter writer(in, pictures, tmp, progress);
+  PartialOutput output(pictures, PartialOutput::Kind::kFolder);
+  ReportWriter writer(in, pictures, output.path(), progress);
   std::string html;
   try {
     writer.Write();
     writer.summary().seconds = SecondsSince(start);
     html = writer.Finish(writer.summary().seconds);
-    fs::remove_all(pictures);
-    fs::rename(tmp, pictures);
+    output.Commit();
   } catch (const fs::filesystem_error& e) {
-    std::error_code ec;
-    fs::remove_all(tmp, ec);
     throw InputError(pictures.string(), std::string("cannot be written: ") + e.what());
-  } catch (...) {
-    std::error_code ec;
-    fs::remove_all(tmp, ec);
-    throw;
   }
   WriteFileAtomically(
       dir / "report.html", [&](std::ostream& o) { o << html; }, false);

@@ -16,6 +16,9 @@ constexpr std::uint64_t kInvalidPoint3DIdBinary = std::numeric_limits<std::uint6
 
 // Minimum sizes of binary records, used to bound counts before allocating.
 constexpr std::uint64_t kMinCameraBytes = 4 + 4 + 8 + 8;
+// Plausibility bounds of a camera's size (docs/robustness.md, "Limits").
+constexpr std::uint64_t kMaxCameraSide = 65535;
+constexpr std::uint64_t kMaxCameraPixels = 250'000'000;
 constexpr std::uint64_t kMinImageBytes = 4 + 4 * 8 + 3 * 8 + 4 + 1 + 8;
 constexpr std::uint64_t kPoint2DBytes = 8 + 8 + 8;
 constexpr std::uint64_t kMinPoint3DBytes = 8 + 3 * 8 + 3 + 8 + 8;
@@ -32,6 +35,12 @@ Eigen::Quaterniond QuaternionFromWxyz(double w, double x, double y, double z,
   return q;
 }
 
+// An image name is a path below the images folder: relative, no ".." component.
+void CheckImageName(const std::string& name, const std::string& label, std::size_t line) {
+  const std::string problem = ContainedNameProblem(name);
+  if (!problem.empty()) throw InputError(label, "image name '" + name + "' " + problem, line);
+}
+
 Camera MakeCamera(std::uint64_t camera_id, std::int64_t model_id, std::uint64_t width,
                   std::uint64_t height, const std::string& label, std::size_t line) {
   if (camera_id > std::numeric_limits<std::uint32_t>::max() - 1) {
@@ -43,10 +52,14 @@ Camera MakeCamera(std::uint64_t camera_id, std::int64_t model_id, std::uint64_t 
                          " (COLMAP 3.8 knows 0..10) for camera " + std::to_string(camera_id),
                      line);
   }
-  if (width == 0 || height == 0 || width > (1u << 20) || height > (1u << 20)) {
+  if (width == 0 || height == 0 || width > kMaxCameraSide || height > kMaxCameraSide ||
+      width * height > kMaxCameraPixels) {
     throw InputError(label,
                      "camera " + std::to_string(camera_id) + " has an implausible size " +
-                         std::to_string(width) + "x" + std::to_string(height),
+                         std::to_string(width) + "x" + std::to_string(height) +
+                         " (texlume reads photos of at most " + std::to_string(kMaxCameraSide) +
+                         " pixels a side and " + std::to_string(kMaxCameraPixels / 1000000) +
+                         " megapixels)",
                      line);
   }
   Camera camera;
@@ -159,6 +172,7 @@ std::map<ImageId, Image> ReadImagesText(std::istream& in, const std::string& lab
            (image.name.back() == '\r' || image.name.back() == ' ' || image.name.back() == '\t')) {
       image.name.pop_back();
     }
+    CheckImageName(image.name, label, ln);
     // The next line holds the 2D points, possibly none (an empty line).
     if (reader.NextRawLine()) {
       const std::size_t pln = reader.line_number;
@@ -282,12 +296,16 @@ std::map<ImageId, Image> ReadImagesBinary(std::istream& in, const std::string& l
     }
     image.camera_id = CameraId(reader.ReadU32());
     image.name = reader.ReadNulTerminatedString("the name of image " + std::to_string(id));
+    CheckImageName(image.name, label, 0);
     const std::uint64_t num_points2d = reader.ReadU64();
     reader.CheckCount(num_points2d, kPoint2DBytes, "2D point (image " + std::to_string(id) + ")");
     image.points2d.resize(num_points2d);
     for (Point2D& p : image.points2d) {
       p.xy.x() = reader.ReadF64();
       p.xy.y() = reader.ReadF64();
+      if (!p.xy.allFinite()) {
+        throw InputError(label, "image " + std::to_string(id) + " has a non-finite 2D point");
+      }
       const std::uint64_t point_id = reader.ReadU64();
       if (point_id != kInvalidPoint3DIdBinary) p.point3d_id = Point3DId(point_id);
     }
@@ -312,6 +330,9 @@ std::map<Point3DId, Point3D> ReadPoints3DBinary(std::istream& in, const std::str
     for (int k = 0; k < 3; ++k) point.xyz[k] = reader.ReadF64();
     for (auto& c : point.rgb) c = reader.ReadU8();
     point.error = reader.ReadF64();
+    if (!point.xyz.allFinite() || !std::isfinite(point.error)) {
+      throw InputError(label, "3D point " + std::to_string(id) + " has a non-finite value");
+    }
     const std::uint64_t track_length = reader.ReadU64();
     reader.CheckCount(track_length, kTrackElementBytes,
                       "track element (point " + std::to_string(id) + ")");

@@ -175,6 +175,8 @@ ObjectLights ReadObjectLights(std::istream& in, const std::string& label) {
         1 + static_cast<std::size_t>(
                 std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(byte), '\n'));
     throw InputError(label, std::string("invalid JSON: ") + e.what(), line);
+  } catch (const nlohmann::json::exception& e) {  // a number out of range, say
+    throw InputError(label, std::string("invalid JSON: ") + e.what());
   }
   if (!root.is_object() || !root.contains("images") || !root["images"].is_object()) {
     throw InputError(label, "expected an object with an 'images' object (see docs/lights.md)");

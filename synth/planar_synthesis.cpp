@@ -71,6 +71,10 @@ std::vector<int> VerticalSeam(const cv::Mat& error) {
 
 void PlanarSynthesisOptions::Check() const {
   if (width < 0 || height < 0) throw OptionError("width and height must be >= 0");
+  if (width > kMaxOutputSide || height > kMaxOutputSide) {
+    throw OptionError("width and height must be at most " + std::to_string(kMaxOutputSide) +
+                      " texels");
+  }
   if (block_size < 4) throw OptionError("block_size must be >= 4");
   if (overlap < 1 || overlap >= block_size) throw OptionError("overlap must be in [1, block_size)");
   if (top_k < 1) throw OptionError("top_k must be >= 1");

@@ -29,6 +29,8 @@ enum class Stitch {
 
 /// Settings of SynthesizePlanarPtm.
 struct PlanarSynthesisOptions {
+  /// The largest width or height Check() accepts (a 16k x 16k PTM is 2.3 GB).
+  static constexpr int kMaxOutputSide = 16384;
   int width = 0;   ///< PTM_out texels; 0 = photo width x scale
   int height = 0;  ///< PTM_out texels; 0 = photo height x scale
   /// PTM_out texels per photo pixel when width is 0 (photos are of lower

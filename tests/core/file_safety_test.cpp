@@ -1,0 +1,105 @@
+// Files named by other files stay inside their folder (ContainedPath), whole
+// files are read within a limit (ReadFileBytes), and outputs are written under a
+// partial name that is renamed when complete or removed (PartialOutput).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "core/errors.h"
+#include "core/file_util.h"
+#include "core/partial_output.h"
+#include "tests/test_util.h"
+
+namespace texlume {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::InputErrorMessage;
+using testing::TempDir;
+using testing::WriteText;
+
+TEST(ContainedPath, RefusesNamesThatLeaveTheFolder) {
+  const fs::path folder = "/models/a";
+  EXPECT_EQ(ContainedPath(folder, "ptm_atlas_0.exr", "manifest.json", "exr"),
+            folder / "ptm_atlas_0.exr");
+  EXPECT_EQ(ContainedPath(folder, "sub/x.png", "manifest.json", "exr"), folder / "sub/x.png");
+  const std::vector<std::string> bad_names = {
+      "../../../../etc/passwd", "/etc/passwd", "a/../../b", "..", "", "a\\..\\b",
+      std::string("a\0b", 3)};
+  for (const std::string& bad : bad_names) {
+    const std::string message =
+        InputErrorMessage([&] { ContainedPath(folder, bad, "manifest.json", "exr"); });
+    EXPECT_EQ(message.rfind("manifest.json: exr", 0), 0u) << bad << " -> " << message;
+  }
+}
+
+TEST(ReadFileBytes, ReadsWholeFilesAndRefusesMoreThanTheLimit) {
+  TempDir tmp;
+  WriteText(tmp / "f.bin", std::string("ab\0cd", 5));
+  EXPECT_EQ(ReadFileBytes(tmp / "f.bin", 5), std::string("ab\0cd", 5));
+  EXPECT_NE(InputErrorMessage([&] { ReadFileBytes(tmp / "f.bin", 4); }).find("more than"),
+            std::string::npos);
+  EXPECT_NE(InputErrorMessage([&] { ReadFileBytes(tmp / "none", 4); }).find("none"),
+            std::string::npos);
+}
+
+TEST(PartialOutput, CommitRenamesAndReplacesAFolderWhole) {
+  TempDir tmp;
+  const fs::path out = tmp / "out";
+  fs::create_directories(out / "old");
+  {
+    PartialOutput partial(out, PartialOutput::Kind::kFolder);
+    EXPECT_EQ(partial.path().filename().string(), "out.partial-" + std::to_string(::getpid()));
+    WriteText(partial.path() / "result.json", "{}");
+    EXPECT_FALSE(fs::exists(out / "result.json"));
+    partial.Commit();
+  }
+  EXPECT_TRUE(fs::exists(out / "result.json"));
+  EXPECT_FALSE(fs::exists(out / "old"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(tmp.path()), fs::directory_iterator()), 1);
+}
+
+TEST(PartialOutput, AnUncommittedOutputIsRemoved) {
+  TempDir tmp;
+  try {
+    PartialOutput partial(tmp / "out", PartialOutput::Kind::kFolder);
+    WriteText(partial.path() / "half.png", "x");
+    throw std::runtime_error("the job failed");
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_TRUE(fs::is_empty(tmp.path()));
+}
+
+TEST(PartialOutput, StalePartialsOfDeadProcessesAreRemoved) {
+  TempDir tmp;
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  ::waitpid(child, nullptr, 0);  // a process id that no longer runs
+  const std::string dead = std::to_string(child);
+  fs::create_directories(tmp / ("out.partial-" + dead));
+  WriteText(tmp / ("out.tmp-" + dead), "x");
+  fs::create_directories(tmp / "out.partial-1");  // process 1 runs: left alone
+  fs::create_directories(tmp / ("other.partial-" + dead));
+  RemoveStalePartials(tmp / "out");
+  EXPECT_FALSE(fs::exists(tmp / ("out.partial-" + dead)));
+  EXPECT_FALSE(fs::exists(tmp / ("out.tmp-" + dead)));
+  EXPECT_TRUE(fs::exists(tmp / "out.partial-1"));
+  EXPECT_TRUE(fs::exists(tmp / ("other.partial-" + dead)));
+}
+
+TEST(PartialOutput, RequireReplaceableFolderKeepsAUsersFiles) {
+  TempDir tmp;
+  EXPECT_NO_THROW(RequireReplaceableFolder(tmp / "absent", "render.json", "a render folder"));
+  EXPECT_NO_THROW(RequireReplaceableFolder(tmp.path(), "render.json", "a render folder"));
+  WriteText(tmp / "thesis.tex", "x");
+  EXPECT_NE(InputErrorMessage([&] {
+              RequireReplaceableFolder(tmp.path(), "render.json", "a render folder");
+            }).find("not replacing"),
+            std::string::npos);
+  WriteText(tmp / "render.json", "{}");
+  EXPECT_NO_THROW(RequireReplaceableFolder(tmp.path(), "render.json", "a render folder"));
+}
+
+}  // namespace
+}  // namespace texlume
