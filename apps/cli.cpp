@@ -10,6 +10,7 @@
 #include "apps/commands.h"
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/memory_budget.h"
 
 namespace texlume::apps {
 namespace {
@@ -91,7 +92,11 @@ int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostrea
     add(app, run);
   app.add_subcommand("help", "Print this help.");
   app.add_subcommand("version", "Print the version.");
-  for (CLI::App* sub : app.get_subcommands({})) sub->allow_extras();
+  std::string memory_limit;
+  app.add_option("--memory-limit", memory_limit,
+                 "the memory a run may use (bytes, or 512M, 8G; default: 3/4 of the machine's); "
+                 "larger inputs are refused up front");
+  for (CLI::App* sub : app.get_subcommands({})) sub->allow_extras()->fallthrough();
   const CLI::App* sub = nullptr;
   try {
     app.parse(argc, argv);
@@ -104,6 +109,7 @@ int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostrea
     if (const std::string extras = ExtrasMessage(app, sub); !extras.empty())
       throw UsageError(extras);
     if (!sub) throw UsageError("give a command");
+    SetMemoryLimitBytes(memory_limit.empty() ? 0 : ParseMemorySize(memory_limit));
     return run.at(sub)(out, err);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e, out, err);

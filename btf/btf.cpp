@@ -88,10 +88,7 @@ nlohmann::json DirectionsJson(const std::vector<Eigen::Vector3d>& directions) {
 
 }  // namespace
 
-BtfCapture ReadBtfCapture(const fs::path& dir) {
-  const fs::path json_path = dir / "btf.json";
-  const std::string label = json_path.string();
-  const nlohmann::json j = ReadJsonFile(json_path);
+BtfCapture ParseBtfJson(const nlohmann::json& j, const fs::path& dir, const std::string& label) {
   BtfCapture capture;
   auto integer = [&](const char* key) {
     if (!j.contains(key) || !j[key].is_number_integer())
@@ -102,6 +99,7 @@ BtfCapture ReadBtfCapture(const fs::path& dir) {
                                   std::to_string(kMaxSide) + "], not " + std::to_string(v));
     return static_cast<int>(v);
   };
+  if (!j.is_object()) throw InputError(label, "is not a JSON object");
   if (j.contains("size")) {
     capture.width = capture.height = integer("size");
   } else {
@@ -133,20 +131,31 @@ BtfCapture ReadBtfCapture(const fs::path& dir) {
                                     "' must be a file name with two integer fields %d (or "
                                     "%02d), the view's index then the light's");
       }
-      const fs::path file = ContainedPath(dir, name, label, "file_pattern");
-      if (!fs::exists(file))
-        throw InputError(file.string(), "is missing: the capture has no image for view " +
-                                            std::to_string(a) + " and light " + std::to_string(b));
-      cv::Mat rgb = ReadPhotoRgb(file);
-      if (rgb.cols != capture.width || rgb.rows != capture.height)
-        throw InputError(file.string(), "is " + std::to_string(rgb.cols) + " x " +
-                                            std::to_string(rgb.rows) + ", not " +
-                                            std::to_string(capture.width) + " x " +
-                                            std::to_string(capture.height) + " as btf.json says");
-      for (auto it = rgb.begin<cv::Vec3f>(); it != rgb.end<cv::Vec3f>(); ++it)
-        for (int c = 0; c < 3; ++c) (*it)[c] = SrgbToLinear((*it)[c]);
-      capture.images.push_back(std::move(rgb));
+      capture.files.push_back(ContainedPath(dir, name, label, "file_pattern"));
     }
+  return capture;
+}
+
+BtfCapture ReadBtfCapture(const fs::path& dir) {
+  const fs::path json_path = dir / "btf.json";
+  BtfCapture capture = ParseBtfJson(ReadJsonFile(json_path), dir, json_path.string());
+  for (std::size_t k = 0; k < capture.files.size(); ++k) {
+    const fs::path& file = capture.files[k];
+    if (!fs::exists(file))
+      throw InputError(file.string(), "is missing: the capture has no image for view " +
+                                          std::to_string(k / capture.lights.size()) +
+                                          " and light " +
+                                          std::to_string(k % capture.lights.size()));
+    cv::Mat rgb = ReadPhotoRgb(file);
+    if (rgb.cols != capture.width || rgb.rows != capture.height)
+      throw InputError(file.string(), "is " + std::to_string(rgb.cols) + " x " +
+                                          std::to_string(rgb.rows) + ", not " +
+                                          std::to_string(capture.width) + " x " +
+                                          std::to_string(capture.height) + " as btf.json says");
+    for (auto it = rgb.begin<cv::Vec3f>(); it != rgb.end<cv::Vec3f>(); ++it)
+      for (int c = 0; c < 3; ++c) (*it)[c] = SrgbToLinear((*it)[c]);
+    capture.images.push_back(std::move(rgb));
+  }
   return capture;
 }
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -19,6 +20,8 @@ struct BtfCapture {
   int width = 0, height = 0;
   double texel_size = 0.0;  ///< world units per texel
   std::vector<Eigen::Vector3d> views, lights;
+  /// The image file of (view a, light b) at a * lights.size() + b, inside the folder.
+  std::vector<std::filesystem::path> files;
   /// Image of (view a, light b) at a * lights.size() + b: CV_32FC3 linear RGB.
   std::vector<cv::Mat> images;
   const cv::Mat& Image(std::size_t view, std::size_t light) const {
@@ -26,9 +29,17 @@ struct BtfCapture {
   }
 };
 
-/// Reads a capture folder: `btf.json` (`size` or `width` / `height`,
-/// `texel_size`, `views`, `lights`, `file_pattern` with two printf integer
-/// fields, view then light) and one 8- or 16-bit sRGB image per (view, light),
+/// The capture that `btf.json` (already parsed, read from `label`) describes,
+/// with its image files inside `dir` and no images read: sizes, directions and
+/// the size in memory checked, `file_pattern` expanded by texlume (literal text,
+/// "%%", and two integer fields "%d" or "%0Nd", view then light; never printf).
+/// Throws InputError naming `label` on anything malformed.
+BtfCapture ParseBtfJson(const nlohmann::json& btf_json, const std::filesystem::path& dir,
+                        const std::string& label);
+
+/// Reads a capture folder: `btf.json` (ParseBtfJson: `size` or `width` / `height`,
+/// `texel_size`, `views`, `lights`, `file_pattern` with two integer fields, view
+/// then light) and one 8- or 16-bit sRGB image per (view, light),
 /// decoded to linear RGB. Throws InputError naming the file on a missing or
 /// unreadable image, a size that differs from the stated one, directions that
 /// are not unit vectors above the sample, or a malformed btf.json.

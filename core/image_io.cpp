@@ -10,6 +10,7 @@
 
 #include "core/errors.h"
 #include "core/file_util.h"
+#include "core/memory_budget.h"
 
 namespace texlume {
 namespace fs = std::filesystem;
@@ -44,6 +45,9 @@ std::unique_ptr<OIIO::ImageInput> OpenChecked(const fs::path& path) {
   if (spec.nchannels <= 0 || spec.nchannels > 64)
     throw InputError(path.string(),
                      "has an implausible channel count of " + std::to_string(spec.nchannels));
+  // As stored, then as float RGB.
+  RequireMemory(static_cast<double>(spec.width) * spec.height * (spec.nchannels * 4.0 + 12.0),
+                "reading the image", path.string());
   return in;
 }
 

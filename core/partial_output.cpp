@@ -95,6 +95,8 @@ void RemoveStalePartials(const fs::path& final_path) {
   if (!p.has_filename()) p = p.parent_path();
   const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
   const std::string name = p.filename().string();
+  // Inside a partial folder nothing is stale; it is not scanned once per file written.
+  if (parent.string().find(".partial-") != std::string::npos) return;
   std::error_code ec;
   if (!fs::is_directory(parent, ec)) return;
   for (const auto& entry : fs::directory_iterator(parent, ec)) {

@@ -11,6 +11,7 @@
 
 #include "core/errors.h"
 #include "core/file_util.h"
+#include "core/memory_budget.h"
 
 namespace texlume::mesh {
 namespace {
@@ -693,6 +694,11 @@ PolygonSoup ReadPolygonSoup(const std::filesystem::path& path) {
     throw InputError(
         label, "unsupported mesh format '" + ext + "' (texlume reads .ply, .obj, .off, .stl)");
   }
+  std::error_code ec;
+  const auto file_bytes = std::filesystem::file_size(path, ec);
+  // The bytes, the soup and the repair's maps: at most about 24 times the file.
+  if (!ec)
+    RequireMemory(24.0 * static_cast<double>(file_bytes), "reading and repairing the mesh", label);
   const std::string bytes = ReadFileBytes(path, MeshReadLimits::kMaxFileBytes);
   return parse(bytes, label);
 }

@@ -7,6 +7,7 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/memory_budget.h"
 #include "core/partial_output.h"
 #include "core/timing.h"
 #include "model/baselines.h"
@@ -112,6 +113,12 @@ class RenderJob {
 
   void LoadViews() {
     cameras_ = sfm::ReadModel(options_.cameras_dir);
+    // A view's buffers (colour, coverage, depth, rays and the truth): about 64 bytes a pixel.
+    for (const auto& [id, camera] : cameras_.reconstruction.cameras) {
+      RequireMemory(64.0 * static_cast<double>(camera.width) * static_cast<double>(camera.height),
+                    "rendering a view of camera " + std::to_string(id.value),
+                    options_.cameras_dir.string());
+    }
     lights_ = sfm::ReadObjectLightsFile(options_.lights_file);
     const sfm::LightsModelMatch match = sfm::CheckLightsAgainstModel(
         lights_, cameras_.reconstruction, options_.lights_file.string());

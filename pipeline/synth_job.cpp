@@ -11,6 +11,7 @@
 
 #include "core/errors.h"
 #include "core/file_util.h"
+#include "core/memory_budget.h"
 #include "core/timing.h"
 #include "mesh/mesh.h"
 #include "model/baselines.h"
@@ -68,6 +69,19 @@ void RefuseSampleLargerThanMesh(const mesh::TriangleMesh& mesh, double sample_te
   }
 }
 
+// The photos the job holds at once (float RGB, with their rectified copies: about
+// 32 bytes a pixel), against the memory limit.
+void RequirePhotoMemory(const sfm::Reconstruction& reconstruction, const sfm::ObjectLights& lights,
+                        const fs::path& images_dir) {
+  double pixels = 0.0;
+  for (const auto& [id, image] : reconstruction.images) {
+    if (!lights.contains(image.name)) continue;
+    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
+    pixels += static_cast<double>(camera.width) * static_cast<double>(camera.height);
+  }
+  RequireMemory(32.0 * pixels, "holding the photos", images_dir.string());
+}
+
 }  // namespace
 
 bool IsColourImage(const fs::path& path) {
@@ -111,6 +125,7 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
   mesh::TriangleMesh& mesh = inputs.mesh;
   mesh = std::move(loaded_mesh.mesh);
 
+  RequirePhotoMemory(reconstruction, lights, options.images_dir);
   std::vector<synth::MeshPhoto>& photos = inputs.photos;
   for (const auto& [id, image] : reconstruction.images) {
     const auto it = lights.find(image.name);

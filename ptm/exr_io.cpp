@@ -8,6 +8,7 @@
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/memory_budget.h"
 #include "core/partial_output.h"
 
 namespace texlume::ptm {
@@ -74,6 +75,8 @@ std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
                          std::to_string(kMaxExrValues >> 20) + " Mi values, " +
                          std::to_string((kMaxExrValues * 4) >> 30) + " GiB)");
   }
+  RequireMemory(8.0 * static_cast<double>(values), "reading the EXR (values and planes)",
+                path.string());
   std::vector<float> data(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data())) {
     throw InputError(path.string(), "cannot read pixels: " + in->geterror());

@@ -14,6 +14,8 @@ PACKAGES=(
   openimageio-tools  # its CMake package config refers to the OIIO tools
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # the fuzz targets: clang's libFuzzer, AddressSanitizer and UBSan (scripts/fuzz.sh)
+  clang libclang-rt-14-dev
   # the real COLMAP program, used by the cross-check tests
   colmap
   # the browser tests of the viewer (driven by playwright-core from npm)

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Installs the dependencies, builds texlume with warnings as errors, checks the
 # formatting and runs the whole test suite (unit tests, COLMAP cross-checks,
-# end-to-end CLI tests).
+# end-to-end CLI tests), then the fuzz smoke run: every libFuzzer target for 2 s
+# after replaying every kept finding (scripts/fuzz.sh, docs/robustness.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install_deps.sh
 TEXLUME_CMAKE_ARGS="-DTEXLUME_WERROR=ON" ./scripts/build.sh
 cmake --build build --target check-format
 ctest --test-dir build -j"$(nproc)" --output-on-failure
+./scripts/fuzz.sh --seconds 2

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/errors.h"
+#include "core/memory_budget.h"
 
 namespace texlume::sfm {
 namespace {
@@ -73,6 +74,25 @@ void RasteriseFace(const ProjectedFace& t, int width, int height, const Visit& v
 struct ImageViews {
   std::vector<std::pair<int, TriangleView>> records;
 };
+
+// The z-buffers of `threads` photos at once (depth and face, 8 bytes a pixel), for
+// the largest camera, against the memory limit.
+void RequireBufferMemory(const Reconstruction& reconstruction, const VisibilityOptions& options,
+                         int threads) {
+  for (const auto& [id, camera] : reconstruction.cameras) {
+    double pixels = static_cast<double>(camera.width) * static_cast<double>(camera.height);
+    if (options.max_buffer_dimension > 0) {
+      const double scale =
+          std::min(1.0, options.max_buffer_dimension /
+                            static_cast<double>(std::max(camera.width, camera.height)));
+      pixels *= scale * scale;
+    }
+    RequireMemory(8.0 * pixels * threads,
+                  "the visibility depth buffers of camera " + std::to_string(id.value) + " (" +
+                      std::to_string(threads) + " at once; --max-buffer-size makes them smaller)",
+                  "the COLMAP model");
+  }
+}
 
 ImageViews ComputeImageViews(const mesh::TriangleMesh& mesh,
                              const std::vector<Eigen::Vector3d>& normals,
@@ -233,6 +253,7 @@ VisibilityResult ComputeVisibility(const mesh::TriangleMesh& mesh,
   // Images are processed in chunks of one per thread; each chunk's records are
   // merged in image order, so the result does not depend on the thread count.
   const int chunk = std::max(1, omp_get_max_threads());
+  RequireBufferMemory(reconstruction, options, chunk);
   for (int first = 0; first < n_images; first += chunk) {
     const int last = std::min(n_images, first + chunk);
     std::vector<ImageViews> views(static_cast<std::size_t>(last - first));

@@ -58,6 +58,9 @@ struct BadInput {
   std::string output;  // relative to the workspace: must not exist afterwards
 };
 
+// gtest names a case by its name, not its bytes.
+void PrintTo(const BadInput& c, std::ostream* os) { *os << c.name; }
+
 std::string InspectMesh(const Workspace& w, const std::string& mesh_name, const std::string& text) {
   WriteText(w.dir() / mesh_name, text);
   return "inspect --model " + w("sparse") + " --mesh " + w(mesh_name) + " --json " + w("out.json");
@@ -516,6 +519,28 @@ std::vector<BadInput> Catalogue() {
                 w("lights.json") + " --out " + w("thesis");
        },
        1, "thesis", "thesis/render.json"},
+      // Memory: refused up front with the estimate, never ended by the allocator.
+      {"MeshLargerThanTheMemoryLimit",
+       [](const Workspace& w) {
+         return "--memory-limit 1K inspect --model " + w("sparse") + " --mesh " + w("mesh.ply") +
+                " --json " + w("out.json");
+       },
+       1, "mesh.ply", "out.json"},
+      {"CameraOfTwentyThousandPixelsASideUnderAOneGigabyteLimit",
+       [](const Workspace& w) {
+         RenderModel(w, Manifest("a.exr"), kGoodObj);
+         WithModel(w, [](sfm::Reconstruction& r) {
+           for (auto& [id, camera] : r.cameras) camera.width = camera.height = 15000;
+         });
+         return "render --memory-limit 1G --model " + w("model") + " --cameras " + w("sparse") +
+                " --lights " + w("lights.json") + " --out " + w("render");
+       },
+       1, "sparse", "render"},
+      {"MemoryLimitThatIsNotASize",
+       [](const Workspace& w) {
+         return "--memory-limit 12Q inspect --model " + w("sparse") + " --json " + w("out.json");
+       },
+       2, "--memory-limit", "out.json"},
       {"SphereCircleOfTenToThe308",
        [](const Workspace& w) {
          return "lights-from-sphere --images " + w("photos") +

@@ -7,6 +7,7 @@
 
 #include "core/errors.h"
 #include "core/file_util.h"
+#include "core/memory_budget.h"
 #include "core/partial_output.h"
 #include "tests/test_util.h"
 
@@ -99,6 +100,29 @@ TEST(PartialOutput, RequireReplaceableFolderKeepsAUsersFiles) {
             std::string::npos);
   WriteText(tmp / "render.json", "{}");
   EXPECT_NO_THROW(RequireReplaceableFolder(tmp.path(), "render.json", "a render folder"));
+}
+
+TEST(MemoryBudget, ParsesSizesWithBinaryUnits) {
+  EXPECT_EQ(ParseMemorySize("2000000000"), 2000000000u);
+  EXPECT_EQ(ParseMemorySize("512M"), 512u << 20);
+  EXPECT_EQ(ParseMemorySize("1.5GiB"), 3u << 29);
+  EXPECT_EQ(ParseMemorySize("8gb"), std::uint64_t{8} << 30);
+  for (const std::string bad : {"", "G", "12Q", "-1G", "0", "nan", "1e30T"}) {
+    EXPECT_THROW(ParseMemorySize(bad), OptionError) << bad;
+  }
+  EXPECT_EQ(MemorySizeText(1536.0 * (1 << 20)), "1.50 GiB");
+}
+
+TEST(MemoryBudget, RefusesAnEstimateOverTheLimitNamingTheFile) {
+  SetMemoryLimitBytes(1 << 20);
+  EXPECT_NO_THROW(RequireMemory(1 << 19, "half of it", "a.png"));
+  const std::string message =
+      InputErrorMessage([] { RequireMemory(3 << 20, "reading the image", "a.png"); });
+  SetMemoryLimitBytes(0);
+  EXPECT_EQ(message,
+            "a.png: reading the image needs about 3.00 MiB, more than the memory limit "
+            "of 1.00 MiB (--memory-limit)");
+  EXPECT_GT(MemoryLimitBytes(), std::uint64_t{1} << 28);  // the machine's: far more than 256 MiB
 }
 
 }  // namespace

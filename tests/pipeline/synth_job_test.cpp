@@ -3,11 +3,13 @@
 #include "pipeline/synth_job.h"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -50,7 +52,10 @@ class MeshPipelineTest : public ::testing::Test {
     datasets::GenerateScene(o, tmp_->path() / "scene");
     ptm::WritePtmExr(testing::FitSceneSample(tmp_->path() / "scene"), tmp_->path() / "sample.exr");
     job_ = new pipeline::SynthJobOptions(Job(tmp_->path() / "model"));
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(2);  // OutputsAreTheSameOnOneThreadAndOnTwo compares with one
     summary_ = new pipeline::SynthJobSummary(pipeline::RunSynthJob(*job_));
+    omp_set_num_threads(threads);
   }
   static void TearDownTestSuite() {
     delete summary_;
@@ -441,6 +446,49 @@ TEST_F(MeshPipelineTest, BadInputIsRefusedWithNothingWritten) {
 
 namespace texlume::synth {
 namespace {
+
+// A texlume output, what of it must not depend on the run: JSON without its
+// timings, HTML before its timings table, every other file as it is.
+std::string WithoutTimings(const fs::path& file) {
+  const std::string bytes = testing::ReadText(file);
+  if (file.extension() == ".json") {
+    nlohmann::json j = nlohmann::json::parse(bytes);
+    std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& v) {
+      if (v.is_object()) {
+        v.erase("timings_s");
+        for (auto& [key, value] : v.items()) strip(value);
+      } else if (v.is_array()) {
+        for (auto& value : v) strip(value);
+      }
+    };
+    strip(j);
+    return j.dump();
+  }
+  if (file.extension() == ".html") return bytes.substr(0, bytes.find("<h2>Timings</h2>"));
+  return bytes;
+}
+
+// The same inputs and seed give the same outputs, byte for byte but for the
+// timings, whether the job runs on one thread or two (issue 30).
+TEST_F(MeshPipelineTest, OutputsAreTheSameOnOneThreadAndOnTwo) {
+  // The fixture's model was made on two threads (SetUpTestSuite).
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  pipeline::RunSynthJob(Job(tmp_->path() / "model_1_thread"));
+  omp_set_num_threads(threads);
+  const fs::path one = tmp_->path() / "model_1_thread", two = tmp_->path() / "model";
+  // Every file the model folder lists (manifest.json "files"), on both sides.
+  const auto listed = [](const fs::path& dir) {
+    return nlohmann::json::parse(testing::ReadText(dir / "manifest.json"))["files"];
+  };
+  const nlohmann::json files = listed(one);
+  ASSERT_EQ(files, listed(two));
+  ASSERT_GE(files.size(), 10u);
+  for (const auto& name : files) {
+    const fs::path relative = name.get<std::string>();
+    EXPECT_TRUE(WithoutTimings(one / relative) == WithoutTimings(two / relative)) << relative;
+  }
+}
 
 // The browser viewer's model: every face corner in the vertex streams, charts as
 // the atlas built them, every channel within half a quantisation step, and the

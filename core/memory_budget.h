@@ -1,0 +1,29 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace texlume {
+
+/// The memory one texlume run may use, in bytes (docs/robustness.md, "Memory"):
+/// `--memory-limit`, or by default three quarters of the machine's physical memory
+/// (MemTotal in /proc/meminfo; 8 GiB where that cannot be read).
+std::uint64_t MemoryLimitBytes();
+/// Sets the limit; 0 restores the default.
+void SetMemoryLimitBytes(std::uint64_t bytes);
+
+/// Parses a memory size: bytes ("2000000000") or a number with a binary unit
+/// ("512M", "1.5G", "2T"; K, M, G, T are powers of 1024, a trailing "B" or "iB" is
+/// allowed). Throws OptionError for anything else, zero or more than 2^60 bytes.
+std::uint64_t ParseMemorySize(const std::string& text);
+
+/// "1.50 GiB", "512 MiB", ...
+std::string MemorySizeText(double bytes);
+
+/// Before a large allocation: throws InputError naming `label` (the file whose
+/// contents ask for it) when `estimated_bytes` exceed MemoryLimitBytes(), with the
+/// estimate, what it is for and the limit, so a run is refused up front rather than
+/// ended by the allocator.
+void RequireMemory(double estimated_bytes, const std::string& what, const std::string& label);
+
+}  // namespace texlume
