@@ -92,11 +92,17 @@ int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostrea
     add(app, run);
   app.add_subcommand("help", "Print this help.");
   app.add_subcommand("version", "Print the version.");
+  // --memory-limit before or after the command's name (docs/cli.md).
   std::string memory_limit;
-  app.add_option("--memory-limit", memory_limit,
-                 "the memory a run may use (bytes, or 512M, 8G; default: 3/4 of the machine's); "
-                 "larger inputs are refused up front");
-  for (CLI::App* sub : app.get_subcommands({})) sub->allow_extras()->fallthrough();
+  const char* memory_help =
+      "the memory a run may use (bytes, or 512M, 8G; default: 3/4 of the machine's); larger "
+      "inputs are refused up front";
+  app.add_option("--memory-limit", memory_limit, memory_help);
+  for (CLI::App* sub : app.get_subcommands({})) {
+    sub->allow_extras();
+    if (sub->get_name() != "help" && sub->get_name() != "version")
+      sub->add_option("--memory-limit", memory_limit, memory_help);
+  }
   const CLI::App* sub = nullptr;
   try {
     app.parse(argc, argv);

@@ -12,6 +12,7 @@
 
 #include "apps/http_server.h"
 #include "core/errors.h"
+#include "core/partial_output.h"
 #include "model/web_model.h"
 
 namespace texlume::apps {
@@ -102,10 +103,14 @@ void ServeViewer(const ViewOptions& options, std::ostream& out, std::ostream& er
       << "Serving " << options.model_dir.string() << " at http://" << options.host << ":"
       << server.port() << "/ (Ctrl-C stops)" << std::endl;
   g_stop_serving.store(false);
-  std::signal(SIGINT, StopServing);
-  std::signal(SIGTERM, StopServing);
+  // Ctrl-C stops serving (the interrupt watcher calls StopServing; without one, a handler).
+  if (!SetInterruptHandler(StopServing)) {
+    std::signal(SIGINT, StopServing);
+    std::signal(SIGTERM, StopServing);
+  }
   server.Serve([&](const std::string& path) { return Answer(web, model_files, path); },
                g_stop_serving);
+  SetInterruptHandler(nullptr);
   err << "texlume view: stopped\n";
 }
 

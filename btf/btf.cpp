@@ -25,6 +25,8 @@ constexpr int kMaxSide = 16384;
 constexpr std::size_t kMaxDirections = 4096;
 /// The data matrix (texels x views * lights * 3, doubles) must stay below this.
 constexpr double kMaxDataBytes = 8.0 * 1024 * 1024 * 1024;
+// The most view-light images a capture may hold (a dense BTF measurement has ~6,500).
+constexpr std::size_t kMaxImages = 65536;
 
 std::vector<Eigen::Vector3d> ReadDirections(const nlohmann::json& j, const char* key,
                                             const std::string& label) {
@@ -112,6 +114,10 @@ BtfCapture ParseBtfJson(const nlohmann::json& j, const fs::path& dir, const std:
   capture.texel_size = j["texel_size"].get<double>();
   capture.views = ReadDirections(j, "views", label);
   capture.lights = ReadDirections(j, "lights", label);
+  if (capture.views.size() * capture.lights.size() > kMaxImages)
+    throw InputError(label, std::to_string(capture.views.size()) + " views x " +
+                                std::to_string(capture.lights.size()) + " lights is more than " +
+                                std::to_string(kMaxImages) + " images");
   if (!j.contains("file_pattern") || !j["file_pattern"].is_string())
     throw InputError(label, "has no 'file_pattern' (for example view_%02d_light_%02d.png)");
   const std::string pattern = j["file_pattern"].get<std::string>();

@@ -16,8 +16,7 @@ namespace texlume {
 
 void WriteFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write, bool binary) {
-  std::filesystem::path tmp = path;
-  tmp += ".tmp-" + std::to_string(::getpid());
+  const std::filesystem::path tmp = TemporaryPathOf(path);
   RemoveStalePartials(path);
   RegisterPartial(tmp);
   try {
@@ -68,6 +67,12 @@ std::filesystem::path ContainedPath(const std::filesystem::path& folder, std::st
     throw InputError(label, std::string(what) + " '" + std::string(name) + "' " + problem);
   }
   return folder / std::filesystem::path(name);
+}
+
+std::string LowerCaseExtension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
 }
 
 std::string ReadFileBytes(const std::filesystem::path& path, std::uint64_t max_bytes) {
@@ -227,6 +232,7 @@ std::int64_t ParseSigned(std::string_view token, std::string_view what, const st
 
 double ParseDouble(std::string_view token, std::string_view what, const std::string& file,
                    std::size_t line) {
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);  // "+1.5"
   double v = 0;
   const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
   if (ec != std::errc() || ptr != token.data() + token.size() || !std::isfinite(v)) {

@@ -33,6 +33,9 @@ std::filesystem::path ContainedPath(const std::filesystem::path& folder, std::st
 /// empty when it can.
 std::string ContainedNameProblem(std::string_view name);
 
+/// The file's extension in lower case, with its dot (".ply"), or "".
+std::string LowerCaseExtension(const std::filesystem::path& path);
+
 /// Reads a whole file into memory; throws InputError naming it when it cannot be
 /// read or holds more than `max_bytes` (checked before anything is allocated).
 std::string ReadFileBytes(const std::filesystem::path& path, std::uint64_t max_bytes);

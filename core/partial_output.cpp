@@ -5,6 +5,7 @@
 
 #include <cerrno>
 #include <charconv>
+#include <chrono>
 #include <fstream>
 #include <mutex>
 #include <set>
@@ -18,28 +19,41 @@ namespace texlume {
 namespace fs = std::filesystem;
 namespace {
 
+constexpr const char* kPartialTag = ".texlume-partial-";
+constexpr const char* kTemporaryTag = ".texlume-tmp-";
+constexpr const char* kAsideTag = ".texlume-old-";
+
 // The partial outputs of this process not yet committed. The watcher thread
 // removes them under the same lock a Commit() renames under, so an output is
 // either whole under its final name or gone.
 struct Registry {
   std::mutex mutex;
   std::set<fs::path> paths;
+  void (*handler)(int) = nullptr;  // SetInterruptHandler's, instead of ending the process
+  bool watching = false;
 };
 Registry& Partials() {
   static Registry registry;
   return registry;
 }
 
-// The process id in "<name>.partial-<pid>" or "<name>.tmp-<pid>", or 0.
-pid_t PidOfSibling(const std::string& sibling, const std::string& name) {
-  for (const std::string tag : {".partial-", ".tmp-", ".old-"}) {
-    const std::string prefix = name + tag;
-    if (sibling.size() <= prefix.size() || sibling.compare(0, prefix.size(), prefix) != 0) continue;
-    pid_t pid = 0;
-    const char* begin = sibling.data() + prefix.size();
-    const char* end = sibling.data() + sibling.size();
-    const auto [ptr, ec] = std::from_chars(begin, end, pid);
-    if (ec == std::errc() && ptr == end && pid > 0) return pid;
+// The process id in "<name><tag><pid>" for one of texlume's tags, or in
+// "<stem><tag><pid><extension>" (an EXR's temporary, WriteExr), or 0.
+pid_t PidOfSibling(const std::string& sibling, const fs::path& name) {
+  const std::pair<std::string, std::string> forms[] = {
+      {name.string(), ""}, {name.stem().string(), name.extension().string()}};
+  for (const auto& [head, tail] : forms) {
+    for (const std::string tag : {kPartialTag, kTemporaryTag, kAsideTag}) {
+      const std::string prefix = head + tag;
+      if (sibling.size() <= prefix.size() + tail.size() || !sibling.starts_with(prefix) ||
+          !sibling.ends_with(tail))
+        continue;
+      pid_t pid = 0;
+      const char* begin = sibling.data() + prefix.size();
+      const char* end = sibling.data() + sibling.size() - tail.size();
+      const auto [ptr, ec] = std::from_chars(begin, end, pid);
+      if (ec == std::errc() && ptr == end && pid > 0) return pid;
+    }
   }
   return 0;
 }
@@ -58,13 +72,21 @@ bool ProcessRuns(pid_t pid) {
 
 void WatchForInterrupt(sigset_t signals) {
   int signal_number = 0;
-  while (::sigwait(&signals, &signal_number) != 0) {
-  }
-  {
+  while (true) {
+    if (::sigwait(&signals, &signal_number) != 0) continue;
     std::lock_guard<std::mutex> lock(Partials().mutex);
+    if (Partials().handler != nullptr) {
+      Partials().handler(signal_number);
+      continue;
+    }
+    // Other threads may still be writing into a partial folder: a few tries.
     for (const fs::path& p : Partials().paths) {
-      std::error_code ec;
-      fs::remove_all(p, ec);
+      for (int attempt = 0; attempt < 5; ++attempt) {
+        std::error_code ec;
+        fs::remove_all(p, ec);
+        if (!fs::exists(p, ec)) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
     }
     static const char kMessage[] = "\ntexlume: interrupted; partial outputs removed\n";
     [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
@@ -87,16 +109,22 @@ void RequireReplaceableFolder(const fs::path& dir, const std::string& marker,
 fs::path PartialPathOf(const fs::path& final_path) {
   fs::path p = final_path;
   if (!p.has_filename()) p = p.parent_path();  // "out/" names the folder "out"
-  return p.parent_path() / (p.filename().string() + ".partial-" + std::to_string(::getpid()));
+  return p.parent_path() / (p.filename().string() + kPartialTag + std::to_string(::getpid()));
+}
+
+fs::path TemporaryPathOf(const fs::path& path) {
+  fs::path tmp = path;
+  tmp += kTemporaryTag + std::to_string(::getpid());
+  return tmp;
 }
 
 void RemoveStalePartials(const fs::path& final_path) {
   fs::path p = final_path;
   if (!p.has_filename()) p = p.parent_path();
   const fs::path parent = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-  const std::string name = p.filename().string();
+  const fs::path name = p.filename();
   // Inside a partial folder nothing is stale; it is not scanned once per file written.
-  if (parent.string().find(".partial-") != std::string::npos) return;
+  if (parent.string().find(kPartialTag) != std::string::npos) return;
   std::error_code ec;
   if (!fs::is_directory(parent, ec)) return;
   for (const auto& entry : fs::directory_iterator(parent, ec)) {
@@ -146,7 +174,7 @@ void PartialOutput::Commit() {
   fs::path aside;
   if (replace_folder) {
     aside = final_path_.parent_path() /
-            (final_path_.filename().string() + ".old-" + std::to_string(::getpid()));
+            (final_path_.filename().string() + kAsideTag + std::to_string(::getpid()));
     fs::remove_all(aside, ec);
     fs::rename(final_path_, aside, ec);
     if (ec) {
@@ -173,6 +201,14 @@ void InstallInterruptCleanup() {
   sigaddset(&signals, SIGTERM);
   if (::pthread_sigmask(SIG_BLOCK, &signals, nullptr) != 0) return;
   std::thread(WatchForInterrupt, signals).detach();
+  std::lock_guard<std::mutex> lock(Partials().mutex);
+  Partials().watching = true;
+}
+
+bool SetInterruptHandler(void (*handler)(int)) {
+  std::lock_guard<std::mutex> lock(Partials().mutex);
+  Partials().handler = handler;
+  return Partials().watching;
 }
 
 }  // namespace texlume

@@ -6,7 +6,7 @@
 namespace texlume {
 
 /// An output (a file or a folder) written under a temporary sibling name,
-/// "<name>.partial-<pid>", and renamed to its final name only when complete, so
+/// "<name>.texlume-partial-<pid>", and renamed to its final name only when complete, so
 /// nothing that looks like a finished output ever holds half a result.
 ///
 /// Until Commit(), the partial is registered: the destructor removes it (an
@@ -46,12 +46,12 @@ class PartialOutput {
 void RequireReplaceableFolder(const std::filesystem::path& dir, const std::string& marker,
                               const std::string& kind);
 
-/// "<name>.partial-<pid>" of this process, beside `final_path`.
+/// "<name>.texlume-partial-<pid>" of this process, beside `final_path`.
 std::filesystem::path PartialPathOf(const std::filesystem::path& final_path);
 
-/// Removes the siblings "<name>.partial-<pid>" and "<name>.tmp-<pid>" of
-/// `final_path` whose process no longer runs (left by SIGKILL, a crash or a power
-/// cut). Partials of running processes are left alone.
+/// Removes the siblings "<name>.texlume-partial-<pid>", "<name>.texlume-tmp-<pid>"
+/// and "<name>.texlume-old-<pid>" of `final_path` whose process no longer runs (left by SIGKILL, a
+/// crash or a power cut). Partials of running processes are left alone.
 void RemoveStalePartials(const std::filesystem::path& final_path);
 
 /// Registers a temporary path to remove on SIGINT/SIGTERM (WriteFileAtomically's
@@ -64,5 +64,14 @@ void ForgetPartial(const std::filesystem::path& path);
 /// registered partial output and ends the process with 128 + the signal's number.
 /// Call once, first thing in main(), before any other thread exists.
 void InstallInterruptCleanup();
+
+/// While `handler` is set (not null), SIGINT and SIGTERM call it (on the watcher
+/// thread) instead of removing partials and ending the process: a server stops
+/// serving and returns. Returns false when no watcher runs (InstallInterruptCleanup
+/// was not called), in which case the caller installs its own signal handler.
+bool SetInterruptHandler(void (*handler)(int));
+
+/// "<path>.texlume-tmp-<pid>": the temporary name of a file written atomically.
+std::filesystem::path TemporaryPathOf(const std::filesystem::path& path);
 
 }  // namespace texlume

@@ -685,6 +685,7 @@ SceneSummary GenerateScene(const SceneOptions& options, const std::filesystem::p
   PartialOutput output(dir, PartialOutput::Kind::kFolder);
   SceneSummary summary = SceneGenerator(options, output.path(), progress).Run();
   output.Commit();
+  summary.dir = dir;
   return summary;
 }
 

@@ -143,6 +143,9 @@ class MeshCleaner {
       hi = hi.cwiseMax(vertices_[i]);
     }
     diagonal_ = vertices_.empty() ? 0.0 : (hi - lo_).norm();
+    if (!std::isfinite(diagonal_)) {
+      throw InputError(label_, "the mesh's extent overflows (coordinates near the double's limit)");
+    }
   }
 
   // 1. Weld duplicate vertices on a hash grid (cells of the tolerance size,

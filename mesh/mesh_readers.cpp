@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <charconv>
 #include <climits>
 #include <cmath>
 #include <cstring>
@@ -16,8 +17,9 @@
 namespace texlume::mesh {
 namespace {
 
-std::string Lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+std::string Lower(std::string_view text) {
+  std::string s(text);
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
 }
 
@@ -123,6 +125,9 @@ struct PlyElement {
   std::uint64_t count = 0;
   std::size_t line = 0;
   std::vector<PlyProperty> properties;
+  // Per property what its values are for: a coordinate (0..2), the face's corners
+  // (3), or nothing (-1); set once the header is read.
+  std::vector<int> roles;
   // The fewest bytes one instance takes (binary) or its fewest tokens (ascii).
   std::uint64_t MinBinaryBytes() const {
     std::uint64_t n = 0;
@@ -262,6 +267,11 @@ class PlyParser {
     if (face_element_ && FaceListIndex() < 0) {
       throw InputError(label_, "the 'face' element has no 'vertex_indices' list");
     }
+    for (std::size_t e = 0; e < elements_.size(); ++e) {
+      for (std::size_t p = 0; p < elements_[e].properties.size(); ++p) {
+        elements_[e].roles.push_back(RoleOf(e, p));
+      }
+    }
   }
 
   int PropertyIndex(std::size_t element, std::string_view name, bool is_list) const {
@@ -317,15 +327,19 @@ class PlyParser {
     Eigen::Vector3d position = Eigen::Vector3d::Zero();
     const auto& properties = elements_[e].properties;
     for (std::size_t p = 0; p < properties.size(); ++p) {
-      const int role = RoleOf(e, p);
+      const int role = elements_[e].roles[p];
       if (!properties[p].is_list) {
-        const double v = ParseDouble(NextToken(), "a PLY value", label_, ascii_line_);
-        if (role >= 0 && role < 3) position[role] = v;
+        const std::string_view token = NextToken();
+        if (role >= 0 && role < 3) {
+          position[role] = ParseDouble(token, "a coordinate", label_, ascii_line_);
+        } else {
+          AnyNumber(token);  // a normal or a colour may be nan: texlume does not read it
+        }
         continue;
       }
       const std::uint64_t n = ParseUnsigned(NextToken(), "a PLY list count", label_, ascii_line_);
-      CheckAnnouncedCount(n, MeshReadLimits::kMaxCornersPerFace, 2, bytes_.size() - ascii_pos_,
-                          "list items", label_, ascii_line_);
+      CheckAnnouncedCount(n, role == 3 ? MeshReadLimits::kMaxCornersPerFace : ~std::uint64_t{0}, 2,
+                          bytes_.size() - ascii_pos_, "list items", label_, ascii_line_);
       std::vector<int> polygon;
       if (role == 3) polygon.reserve(n);
       for (std::uint64_t k = 0; k < n; ++k) {
@@ -334,12 +348,23 @@ class PlyParser {
           polygon.push_back(IndexFromFile(ParseSigned(token, "a vertex index", label_, ascii_line_),
                                           soup_.polygons.size(), label_, ascii_line_));
         } else {
-          ParseDouble(token, "a PLY list value", label_, ascii_line_);
+          AnyNumber(token);
         }
       }
       if (role == 3) soup_.polygons.push_back(std::move(polygon));
     }
     if (vertex_element_ && e == *vertex_element_) soup_.vertices.push_back(position);
+  }
+
+  // A value texlume skips: any number, nan and inf included.
+  void AnyNumber(std::string_view token) const {
+    double v = 0;
+    const char* begin = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
+    const auto [ptr, ec] = std::from_chars(begin, token.data() + token.size(), v);
+    if (ptr != token.data() + token.size() ||
+        (ec != std::errc() && ec != std::errc::result_out_of_range)) {
+      throw InputError(label_, "expected a number, got '" + std::string(token) + "'", ascii_line_);
+    }
   }
 
   std::string_view NextToken() {
@@ -373,7 +398,7 @@ class PlyParser {
     Eigen::Vector3d position = Eigen::Vector3d::Zero();
     const auto& properties = elements_[e].properties;
     for (std::size_t p = 0; p < properties.size(); ++p) {
-      const int role = RoleOf(e, p);
+      const int role = elements_[e].roles[p];
       if (!properties[p].is_list) {
         const double v = ReadBinaryValue(properties[p].type);
         if (role >= 0 && role < 3) position[role] = v;
@@ -382,8 +407,9 @@ class PlyParser {
       const double count = ReadBinaryValue(properties[p].count_type);
       if (count < 0) throw BodyError("a negative list count");
       const auto n = static_cast<std::uint64_t>(count);
-      CheckAnnouncedCount(n, MeshReadLimits::kMaxCornersPerFace, PlyTypeBytes(properties[p].type),
-                          bytes_.size() - binary_pos_, "list items", label_, 0);
+      CheckAnnouncedCount(n, role == 3 ? MeshReadLimits::kMaxCornersPerFace : ~std::uint64_t{0},
+                          PlyTypeBytes(properties[p].type), bytes_.size() - binary_pos_,
+                          "list items", label_, 0);
       std::vector<int> polygon;
       if (role == 3) polygon.reserve(n);
       for (std::uint64_t k = 0; k < n; ++k) {
@@ -490,7 +516,14 @@ bool IsOffKeyword(std::string_view token) {
 // Corners of an STL are welded by exact position, as STL readers do.
 class StlSoupBuilder {
  public:
+  explicit StlSoupBuilder(const std::string& label) : label_(label) {}
   void AddTriangle(const std::array<Eigen::Vector3d, 3>& corners) {
+    for (const Eigen::Vector3d& p : corners) {
+      if (!p.allFinite()) {
+        throw InputError(label_, "triangle " + std::to_string(soup_.polygons.size()) +
+                                     " has a non-finite corner");
+      }
+    }
     std::vector<int> polygon;
     for (const Eigen::Vector3d& p : corners) {
       const auto [it, inserted] = index_.emplace(std::array<double, 3>{p.x(), p.y(), p.z()},
@@ -503,12 +536,13 @@ class StlSoupBuilder {
   PolygonSoup Take() { return std::move(soup_); }
 
  private:
+  const std::string& label_;
   PolygonSoup soup_;
   std::map<std::array<double, 3>, int> index_;
 };
 
-PolygonSoup ParseBinaryStl(std::string_view bytes, std::uint32_t count) {
-  StlSoupBuilder builder;
+PolygonSoup ParseBinaryStl(std::string_view bytes, std::uint32_t count, const std::string& label) {
+  StlSoupBuilder builder(label);
   for (std::uint32_t t = 0; t < count; ++t) {
     const char* record = bytes.data() + 84 + 50 * static_cast<std::size_t>(t);
     std::array<Eigen::Vector3d, 3> corners;
@@ -523,7 +557,7 @@ PolygonSoup ParseBinaryStl(std::string_view bytes, std::uint32_t count) {
 }
 
 PolygonSoup ParseAsciiStl(std::string_view bytes, const std::string& label) {
-  StlSoupBuilder builder;
+  StlSoupBuilder builder(label);
   LineCursor lines(bytes);
   std::string_view line;
   std::vector<Eigen::Vector3d> facet;
@@ -531,18 +565,19 @@ PolygonSoup ParseAsciiStl(std::string_view bytes, const std::string& label) {
   while (lines.Next(line)) {
     const std::vector<std::string_view> tokens = SplitWhitespace(line);
     if (tokens.empty()) continue;
-    if (tokens[0] == "facet") {
+    const std::string keyword = Lower(tokens[0]);  // STL writers differ in case
+    if (keyword == "facet") {
       if (in_facet) throw InputError(label, "'facet' inside a facet", lines.number());
       in_facet = true;
       facet.clear();
-    } else if (tokens[0] == "vertex") {
+    } else if (keyword == "vertex") {
       if (!in_facet || tokens.size() != 4 || facet.size() == 3) {
         throw InputError(label, "expected 'vertex x y z', three per facet", lines.number());
       }
       facet.emplace_back(ParseDouble(tokens[1], "x", label, lines.number()),
                          ParseDouble(tokens[2], "y", label, lines.number()),
                          ParseDouble(tokens[3], "z", label, lines.number()));
-    } else if (tokens[0] == "endfacet") {
+    } else if (keyword == "endfacet") {
       if (!in_facet || facet.size() != 3) {
         throw InputError(label, "a facet without three vertices", lines.number());
       }
@@ -565,7 +600,7 @@ PolygonSoup ParseObj(std::string_view bytes, const std::string& label) {
   LineCursor lines(bytes);
   std::string_view line;
   while (lines.Next(line)) {
-    const std::vector<std::string_view> tokens = SplitWhitespace(line);
+    const std::vector<std::string_view> tokens = SplitWhitespace(line.substr(0, line.find('#')));
     if (tokens.empty()) continue;
     if (tokens[0] == "v") {
       if (tokens.size() < 4) throw InputError(label, "expected 'v x y z'", lines.number());
@@ -658,32 +693,29 @@ PolygonSoup ParseOff(std::string_view bytes, const std::string& label) {
 }
 
 PolygonSoup ParseStl(std::string_view bytes, const std::string& label) {
+  // Binary when the count in its header fits its size; ASCII when it starts with
+  // "solid"; binary with padding after its triangles otherwise.
+  std::uint32_t count = 0;
   if (bytes.size() >= 84) {
-    std::uint32_t count = 0;
     std::memcpy(&count, bytes.data() + 80, 4);
     if constexpr (std::endian::native == std::endian::big) count = __builtin_bswap32(count);
-    if (84 + 50 * static_cast<std::uint64_t>(count) == bytes.size()) {
-      CheckAnnouncedCount(count, MeshReadLimits::kMaxFaces, 50, bytes.size() - 84, "triangles",
-                          label, 0);
-      return ParseBinaryStl(bytes, count);
-    }
   }
+  const std::uint64_t binary_size = 84 + 50 * static_cast<std::uint64_t>(count);
+  if (bytes.size() >= 84 && binary_size == bytes.size()) return ParseBinaryStl(bytes, count, label);
   const std::size_t first = bytes.find_first_not_of(" \t\r\n");
-  if (first != std::string_view::npos && bytes.substr(first, 5) == "solid") {
+  if (first != std::string_view::npos && Lower(bytes.substr(first, 5)) == "solid") {
     return ParseAsciiStl(bytes, label);
   }
   if (bytes.size() < 84) throw InputError(label, "too short for an STL file");
-  std::uint32_t count = 0;
-  std::memcpy(&count, bytes.data() + 80, 4);
+  if (binary_size < bytes.size()) return ParseBinaryStl(bytes, count, label);
   throw InputError(label, "binary STL announces " + std::to_string(count) + " triangles (" +
-                              std::to_string(84 + 50 * static_cast<std::uint64_t>(count)) +
-                              " bytes) but the file has " + std::to_string(bytes.size()) +
-                              " bytes");
+                              std::to_string(binary_size) + " bytes) but the file has " +
+                              std::to_string(bytes.size()) + " bytes");
 }
 
 PolygonSoup ReadPolygonSoup(const std::filesystem::path& path) {
   const std::string label = path.string();
-  const std::string ext = Lower(path.extension().string());
+  const std::string ext = LowerCaseExtension(path);
   using Parser = PolygonSoup (*)(std::string_view, const std::string&);
   Parser parse = nullptr;
   if (ext == ".ply") parse = ParsePly;

@@ -36,7 +36,7 @@ ModelBaselines ReadModelBaselines(const fs::path& model_folder, const TexturedMo
   for (std::size_t k = 0; k < b.size(); ++k) {
     if (!b[k].is_string())
       throw InputError(manifest_path.string(), "names a baked texture with no file name");
-    const fs::path file = model_folder / b[k].get<std::string>();
+    const fs::path file = model_folder / ManifestFileName(b[k], model_folder, "baked");
     out.baked.push_back(ReadPhotoRgb(file));
     if (out.baked.back().cols != model.atlases[k].width ||
         out.baked.back().rows != model.atlases[k].height)

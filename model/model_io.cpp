@@ -211,13 +211,7 @@ void WriteGlb(const fs::path& path, const TexturedModel& model,
 void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlohmann::json& record,
                       const std::vector<std::pair<std::string, cv::Mat>>& extra_images,
                       const std::function<void(const fs::path&)>& write_more) {
-  if (fs::exists(dir)) {
-    if (!fs::is_directory(dir)) throw InputError(dir.string(), "exists and is not a folder");
-    const bool ours = fs::exists(dir / "manifest.json");
-    if (!ours && !fs::is_empty(dir))
-      throw InputError(dir.string(),
-                       "exists, is not empty and is not a texlume model folder; not replacing it");
-  }
+  RequireReplaceableFolder(dir, "manifest.json", "a texlume model folder");
   PartialOutput output(dir, PartialOutput::Kind::kFolder);
   const fs::path& tmp = output.path();
   {
@@ -306,8 +300,9 @@ std::string ManifestFileName(const nlohmann::json& value, const fs::path& dir,
 nlohmann::json ReadModelManifest(const fs::path& dir) {
   const fs::path manifest_path = dir / "manifest.json";
   const nlohmann::json manifest = ReadJsonFile(manifest_path);
-  if (!manifest.is_object() || manifest.value("format", "") != kManifestFormat ||
-      !manifest.contains("atlases") || !manifest["atlases"].is_array())
+  if (!manifest.is_object() || !manifest.contains("format") || !manifest["format"].is_string() ||
+      manifest["format"].get<std::string>() != kManifestFormat || !manifest.contains("atlases") ||
+      !manifest["atlases"].is_array())
     throw InputError(manifest_path.string(), "is not a texlume model manifest");
   return manifest;
 }

@@ -60,9 +60,7 @@ void WriteRgbImage(const fs::path& path, const std::vector<float>& rgb, int widt
 
 // Refuses an output image name whose extension WriteRgbImage cannot encode.
 void RequireImageExtension(const fs::path& path, const char* what) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = LowerCaseExtension(path);
   for (const char* ok : {"", ".png", ".jpg", ".jpeg", ".tif", ".tiff"}) {
     if (ext == ok) return;
   }
@@ -157,6 +155,7 @@ nlohmann::json BtfJobOptions::ToJson() const {
 
 void RunBtfJob(const BtfJobOptions& options, std::ostream& out, const ProgressCallback& progress) {
   options.Check();
+  RequireReplaceableFolder(options.out_dir, "btf_svd.json", "a texlume btf folder");
   const auto t0 = std::chrono::steady_clock::now();
   const btf::BtfCapture capture = btf::ReadBtfCapture(options.capture_dir);
   const double read_seconds = SecondsSince(t0);
@@ -172,7 +171,6 @@ void RunBtfJob(const BtfJobOptions& options, std::ostream& out, const ProgressCa
   std::sort(counts.begin(), counts.end());
   counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
   const std::vector<btf::SvdError> errors = btf::SvdErrorTable(f, counts);
-  RequireReplaceableFolder(options.out_dir, "run.json", "a texlume btf folder");
   PartialOutput output(options.out_dir, PartialOutput::Kind::kFolder);
   btf::WriteBtfFactorisation(f, errors, output.path());
   out << "Factorised a " << capture.width << "x" << capture.height << " BTF of "
@@ -243,9 +241,7 @@ void RunSphereLightsJob(const SphereLightsJobOptions& options, std::ostream& out
     throw InputError(options.images_dir.string(), "image folder not found");
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(options.images_dir)) {
-    std::string ext = entry.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
+    const std::string ext = LowerCaseExtension(entry.path());
     if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff")
       files.push_back(entry.path());
   }
@@ -333,11 +329,11 @@ void WriteRelitPhotos(const synth::PlanarSynthesisResult& result,
 
 void RunSynth2dJob(const Synth2dJobOptions& options, std::ostream& out) {
   options.Check();
+  RequireReplaceableFolder(options.out_dir, "synth2d.json", "a texlume synth2d folder");
   const ptm::Ptm sample = ptm::ReadPtmAnyFormat(options.sample_file);
   const std::vector<synth::PlanarPhoto> photos = ReadPlanarPhotos(options);
   const synth::PlanarSynthesisResult result =
       synth::SynthesizePlanarPtm(sample, photos, options.synthesis);
-  RequireReplaceableFolder(options.out_dir, "synth2d.json", "a texlume synth2d folder");
   PartialOutput output(options.out_dir, PartialOutput::Kind::kFolder);
   const fs::path& out_dir = output.path();
   ptm::WritePtmFile(result.ptm, out_dir / "ptm_out.ptm");

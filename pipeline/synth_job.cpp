@@ -12,6 +12,7 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/memory_budget.h"
+#include "core/partial_output.h"
 #include "core/timing.h"
 #include "mesh/mesh.h"
 #include "model/baselines.h"
@@ -69,8 +70,8 @@ void RefuseSampleLargerThanMesh(const mesh::TriangleMesh& mesh, double sample_te
   }
 }
 
-// The photos the job holds at once (float RGB, with their rectified copies: about
-// 32 bytes a pixel), against the memory limit.
+// The photos the job holds at once (float RGB and a luminance plane: 16 bytes a
+// pixel), against the memory limit.
 void RequirePhotoMemory(const sfm::Reconstruction& reconstruction, const sfm::ObjectLights& lights,
                         const fs::path& images_dir) {
   double pixels = 0.0;
@@ -79,15 +80,13 @@ void RequirePhotoMemory(const sfm::Reconstruction& reconstruction, const sfm::Ob
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
     pixels += static_cast<double>(camera.width) * static_cast<double>(camera.height);
   }
-  RequireMemory(32.0 * pixels, "holding the photos", images_dir.string());
+  RequireMemory(16.0 * pixels, "holding the photos", images_dir.string());
 }
 
 }  // namespace
 
 bool IsColourImage(const fs::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = LowerCaseExtension(path);
   if (ext == ".ptm") return false;
   if (ext == ".exr") return ImageReader(path).channels() <= 4;  // a PTM EXR has 9 or 18
   return true;
@@ -277,9 +276,7 @@ nlohmann::json EngineSummaryJson(const synth::TriangleSynthesis& synthesis) {
 }
 
 void RefuseForeignModelFolder(const fs::path& out) {
-  if (fs::exists(out) &&
-      (!fs::is_directory(out) || (!fs::exists(out / "manifest.json") && !fs::is_empty(out))))
-    throw InputError(out.string(), "exists and is not a texlume model folder; not replacing it");
+  RequireReplaceableFolder(out, "manifest.json", "a texlume model folder");
 }
 
 model::TexturedModel TexturedModelOf(const mesh::TriangleMesh& mesh, std::vector<ptm::Ptm> atlases,

@@ -35,11 +35,20 @@ void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& pla
       }
     }
   }
-  const std::filesystem::path tmp =
-      path.parent_path() / (path.stem().string() + ".tmp-" + std::to_string(::getpid()) + ".exr");
+  // "<stem>.texlume-tmp-<pid>.exr": OpenImageIO picks the format by the extension.
+  const std::filesystem::path tmp = TemporaryPathOf(path.parent_path() / path.stem()) += ".exr";
+  RemoveStalePartials(path);
   auto out = OIIO::ImageOutput::create(tmp.string());
   if (!out) throw std::runtime_error(path.string() + ": OpenImageIO cannot write EXR");
   RegisterPartial(tmp);
+  struct Cleanup {  // the temporary goes, whatever throws
+    const std::filesystem::path& tmp;
+    ~Cleanup() {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      ForgetPartial(tmp);
+    }
+  } cleanup{tmp};
   OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
   spec.channelnames = channel_names;
   spec.attribute("compression", "zip");
@@ -47,14 +56,8 @@ void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& pla
   spec.attribute("DateTime", "");
   const bool ok = out->open(tmp.string(), spec) &&
                   out->write_image(OIIO::TypeDesc::FLOAT, interleaved.data()) && out->close();
-  if (!ok) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    ForgetPartial(tmp);
-    throw std::runtime_error(path.string() + ": cannot write EXR: " + out->geterror());
-  }
+  if (!ok) throw std::runtime_error(path.string() + ": cannot write EXR: " + out->geterror());
   std::filesystem::rename(tmp, path);
-  ForgetPartial(tmp);
 }
 
 std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,

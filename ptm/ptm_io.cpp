@@ -388,10 +388,7 @@ int WriteRelightWeb(const Ptm& ptm, const std::filesystem::path& dir, int jpeg_q
 }
 
 Ptm ReadPtmAnyFormat(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".exr" ? ReadPtmExr(path) : ReadPtmFile(path);
+  return LowerCaseExtension(path) == ".exr" ? ReadPtmExr(path) : ReadPtmFile(path);
 }
 
 }  // namespace texlume::ptm

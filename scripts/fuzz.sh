@@ -6,6 +6,7 @@
 # --seconds N  fuzz each target for N seconds (default 60)
 # --runs N     fuzz each target for N executions instead
 # New findings are written to fuzz/regressions/<target>/; the script then exits 1.
+# TEXLUME_FUZZ_OPT=-O0 builds faster and fuzzes slower (the test command's smoke run).
 # Prints a table: target, executions, findings.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,7 +16,7 @@ while [[ $# -gt 0 ]]; do
   case "$1" in
     --seconds) limit="-max_total_time=$2"; shift 2 ;;
     --runs) limit="-runs=$2"; shift 2 ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
     *) targets+=("$1"); shift ;;
   esac
 done
@@ -28,7 +29,7 @@ build=build-fuzz
 seeds_program=build/fuzz/fuzz_make_seeds
 [[ -x "$seeds_program" ]] || ./scripts/build.sh --target fuzz_make_seeds
 CC=clang CXX=clang++ cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_CXX_FLAGS_RELEASE="-O1 -gline-tables-only -DNDEBUG" \
+  -DCMAKE_CXX_FLAGS_RELEASE="${TEXLUME_FUZZ_OPT:--O1} -gline-tables-only -DNDEBUG" \
   -DTEXLUME_FUZZ=ON -DTEXLUME_BUILD_TESTS=OFF -DTEXLUME_BUILD_BENCHMARKS=OFF > /dev/null
 cmake --build "$build" --target fuzz_all -j"$(nproc)"
 rm -rf "$build/seeds"

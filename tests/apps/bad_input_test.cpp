@@ -519,6 +519,33 @@ std::vector<BadInput> Catalogue() {
                 w("lights.json") + " --out " + w("thesis");
        },
        1, "thesis", "thesis/render.json"},
+      {"ObjWhoseExtentOverflows",
+       [](const Workspace& w) {
+         return InspectMesh(w, "m.obj", "v 1e308 0 0\nv -1e308 0 0\nv 0 1 0\nf 1 2 3\n");
+       },
+       1, "m.obj", "out.json"},
+      {"StlWithANanCorner",
+       [](const Workspace& w) {
+         return InspectMesh(w, "m.stl",
+                            "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
+                            "vertex 1 0 nan\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n");
+       },
+       1, "m.stl", "out.json"},
+      {"ManifestFormatThatIsANumber",
+       [](const Workspace& w) {
+         return RenderModel(w, R"({"format": 1, "atlases": []})", kGoodObj);
+       },
+       1, "manifest.json", "render"},
+      {"ManifestBakedTextureLeavingTheFolder",
+       [](const Workspace& w) {
+         const std::string args =
+             RenderModel(w,
+                         R"({"format": "texlume-model", "atlases": [{"exr": "a.exr"}],
+                 "baselines": {"flat_albedo": [0.5, 0.5, 0.5], "baked": ["../../secret.png"]}})",
+                         kGoodObj);
+         return args + " --baseline baked";
+       },
+       1, "manifest.json", "render"},
       // Memory: refused up front with the estimate, never ended by the allocator.
       {"MeshLargerThanTheMemoryLimit",
        [](const Workspace& w) {

@@ -50,7 +50,8 @@ TEST(PartialOutput, CommitRenamesAndReplacesAFolderWhole) {
   fs::create_directories(out / "old");
   {
     PartialOutput partial(out, PartialOutput::Kind::kFolder);
-    EXPECT_EQ(partial.path().filename().string(), "out.partial-" + std::to_string(::getpid()));
+    EXPECT_EQ(partial.path().filename().string(),
+              "out.texlume-partial-" + std::to_string(::getpid()));
     WriteText(partial.path() / "result.json", "{}");
     EXPECT_FALSE(fs::exists(out / "result.json"));
     partial.Commit();
@@ -78,15 +79,19 @@ TEST(PartialOutput, StalePartialsOfDeadProcessesAreRemoved) {
   ASSERT_GT(child, 0);
   ::waitpid(child, nullptr, 0);  // a process id that no longer runs
   const std::string dead = std::to_string(child);
-  fs::create_directories(tmp / ("out.partial-" + dead));
-  WriteText(tmp / ("out.tmp-" + dead), "x");
-  fs::create_directories(tmp / "out.partial-1");  // process 1 runs: left alone
-  fs::create_directories(tmp / ("other.partial-" + dead));
-  RemoveStalePartials(tmp / "out");
-  EXPECT_FALSE(fs::exists(tmp / ("out.partial-" + dead)));
-  EXPECT_FALSE(fs::exists(tmp / ("out.tmp-" + dead)));
-  EXPECT_TRUE(fs::exists(tmp / "out.partial-1"));
-  EXPECT_TRUE(fs::exists(tmp / ("other.partial-" + dead)));
+  fs::create_directories(tmp / ("out.exr.texlume-partial-" + dead));
+  WriteText(tmp / ("out.exr.texlume-tmp-" + dead), "x");
+  WriteText(tmp / ("out.texlume-tmp-" + dead + ".exr"), "x");  // WriteExr's temporary
+  fs::create_directories(tmp / "out.exr.texlume-partial-1");   // process 1 runs: left alone
+  fs::create_directories(tmp / ("other.texlume-partial-" + dead));
+  fs::create_directories(tmp / ("out.exr.old-" + dead));  // a user's backup: not texlume's
+  RemoveStalePartials(tmp / "out.exr");
+  EXPECT_FALSE(fs::exists(tmp / ("out.exr.texlume-partial-" + dead)));
+  EXPECT_FALSE(fs::exists(tmp / ("out.exr.texlume-tmp-" + dead)));
+  EXPECT_FALSE(fs::exists(tmp / ("out.texlume-tmp-" + dead + ".exr")));
+  EXPECT_TRUE(fs::exists(tmp / "out.exr.texlume-partial-1"));
+  EXPECT_TRUE(fs::exists(tmp / ("other.texlume-partial-" + dead)));
+  EXPECT_TRUE(fs::exists(tmp / ("out.exr.old-" + dead)));
 }
 
 TEST(PartialOutput, RequireReplaceableFolderKeepsAUsersFiles) {
