@@ -13,8 +13,10 @@
 
 namespace texlume::ptm {
 namespace {
-// The most values (width x height x channels) ReadExr allocates: 1 Gi floats, 4 GiB.
-constexpr std::uint64_t kMaxExrValues = std::uint64_t{1} << 30;
+// The most values (width x height x channels) ReadExr accepts: 8 Gi floats, enough for
+// the largest atlas texlume writes (16,384 a side, 18 channels: 4.8 Gi); the memory
+// limit (8 bytes a value) decides below that.
+constexpr std::uint64_t kMaxExrValues = std::uint64_t{1} << 33;
 }  // namespace
 
 void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& planes,
