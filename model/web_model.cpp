@@ -30,6 +30,31 @@ std::vector<unsigned char> ReadBytes(const fs::path& path) {
   return std::vector<unsigned char>(std::istreambuf_iterator<char>(in), {});
 }
 
+// The web model's channels of a PTM (docs/viewer.md, "Web model"): LRGB, a0..a5
+// of the luminance times s, then r / s and g / s; RGB, coefficient k of channel c
+// at 3 k + c.
+std::vector<std::vector<float>> WebChannels(const ptm::Ptm& ptm) {
+  const std::size_t texels = ptm.NumTexels();
+  const bool lrgb = ptm.format == ptm::PtmFormat::kLrgb;
+  std::vector<std::vector<float>> channels(lrgb ? 8 : 18, std::vector<float>(texels));
+  for (std::size_t t = 0; t < texels; ++t) {
+    if (lrgb) {
+      // L (r, g, b) = (L s) (r, g, b) / s with s = (r + g + b) / 3 (eq. 2).
+      const float* colour = &ptm.colour[t * 3];
+      const float s = (colour[0] + colour[1] + colour[2]) / 3.0f;
+      for (int i = 0; i < 6; ++i)
+        channels[static_cast<std::size_t>(i)][t] = ptm.Coefficients(t)[i] * s;
+      channels[6][t] = s > 1e-6f ? colour[0] / s : 1.0f;  // black: any colour
+      channels[7][t] = s > 1e-6f ? colour[1] / s : 1.0f;
+    } else {
+      for (int i = 0; i < 6; ++i)
+        for (int c = 0; c < 3; ++c)
+          channels[static_cast<std::size_t>(3 * i + c)][t] = ptm.Coefficients(t, c)[i];
+    }
+  }
+  return channels;
+}
+
 }  // namespace
 
 std::vector<int> ChartsOfModel(const TexturedModel& model) {
@@ -187,27 +212,11 @@ WebModel BuildWebModel(const fs::path& model_dir) {
   for (std::size_t a = 0; a < model.atlases.size(); ++a) {
     const ptm::Ptm& ptm = model.atlases[a];
     const std::string k = std::to_string(a);
-    const std::size_t texels = ptm.NumTexels();
     const bool lrgb = ptm.format == ptm::PtmFormat::kLrgb;
     nlohmann::json entry = {
         {"width", ptm.width}, {"height", ptm.height}, {"format", lrgb ? "LRGB" : "RGB"}};
-    const std::size_t num_channels = lrgb ? 8 : 18;
-    std::vector<std::vector<float>> channels(num_channels, std::vector<float>(texels));
-    for (std::size_t t = 0; t < texels; ++t) {
-      if (lrgb) {
-        // L (r, g, b) = (L s) (r, g, b) / s with s = (r + g + b) / 3 (eq. 2).
-        const float* colour = &ptm.colour[t * 3];
-        const float s = (colour[0] + colour[1] + colour[2]) / 3.0f;
-        for (int i = 0; i < 6; ++i)
-          channels[static_cast<std::size_t>(i)][t] = ptm.Coefficients(t)[i] * s;
-        channels[6][t] = s > 1e-6f ? colour[0] / s : 1.0f;  // black: any colour
-        channels[7][t] = s > 1e-6f ? colour[1] / s : 1.0f;
-      } else {
-        for (int i = 0; i < 6; ++i)
-          for (int c = 0; c < 3; ++c)
-            channels[static_cast<std::size_t>(3 * i + c)][t] = ptm.Coefficients(t, c)[i];
-      }
-    }
+    const std::vector<std::vector<float>> channels = WebChannels(ptm);
+    const std::size_t num_channels = channels.size();
     std::vector<QuantisedPlane> quantised(num_channels);
     for (std::size_t c = 0; c < num_channels; ++c) quantised[c] = QuantisePlane(channels[c]);
     nlohmann::json textures = nlohmann::json::array();
