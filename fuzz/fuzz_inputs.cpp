@@ -107,7 +107,7 @@ void ParseInput(std::string_view target, std::string_view bytes) {
   else if (target == "ptm")
     ptm::ReadPtm(in, "sample.ptm");
   else if (target == "ptm_exr")
-    ptm::ReadPtmExr(WriteScratch("sample.exr", bytes));
+    ptm::ReadPtmExrBytes(bytes, "sample.exr");
   else if (target == "ply")
     CleanSoup(mesh::ParsePly(bytes, "mesh.ply"));
   else if (target == "obj")

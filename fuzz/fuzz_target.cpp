@@ -14,11 +14,14 @@
 #include <string_view>
 
 #include "core/errors.h"
+#include "core/memory_budget.h"
 #include "fuzz/fuzz_inputs.h"
 
 namespace {
 
 std::string g_target;  // the parser this run fuzzes
+
+constexpr std::uint64_t kFuzzMemoryLimitBytes = std::uint64_t{256} << 20;
 
 }  // namespace
 
@@ -33,6 +36,9 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
     std::cerr << "\n";
     std::exit(2);
   }
+  // A small memory limit, so that a header declaring a large image or mesh is refused
+  // by the readers' estimates (RequireMemory) rather than allocated on every run.
+  texlume::SetMemoryLimitBytes(kFuzzMemoryLimitBytes);
   (void)argc;
   return 0;
 }

@@ -1,9 +1,11 @@
 #include "ptm/exr_io.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 
 #include "core/check.h"
@@ -62,29 +64,51 @@ void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& pla
   std::filesystem::rename(tmp, path);
 }
 
-std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
-                             std::vector<std::string>* channel_names) {
-  auto in = OIIO::ImageInput::open(path.string());
-  if (!in) throw InputError(path.string(), "cannot open image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
+namespace {
+
+// The OpenEXR reader only, on a file or on bytes in memory: a damaged file is refused
+// by it rather than probed by every other format's reader.
+std::unique_ptr<OIIO::ImageInput> OpenExr(const std::string& label,
+                                          OIIO::Filesystem::IOProxy* proxy) {
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::create("openexr");
+  if (!in) throw std::runtime_error("OpenImageIO was built without its OpenEXR reader");
+  if (proxy && !in->set_ioproxy(proxy)) {
+    throw std::runtime_error("OpenImageIO's OpenEXR reader cannot read from memory");
+  }
+  OIIO::ImageSpec spec;
+  if (!in->open(proxy ? std::string() : label, spec)) {
+    std::string error = in->geterror();
+    if (error.empty()) error = OIIO::geterror();
+    throw InputError(label, "is not a readable OpenEXR file: " + error);
+  }
+  return in;
+}
+
+// The size the header declares, refused when implausible or beyond the memory limit.
+void RequirePlausibleSize(const OIIO::ImageSpec& spec, const std::string& label) {
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.width > (1 << 16) ||
       spec.height > (1 << 16) || spec.nchannels > 64) {
-    throw InputError(path.string(), "implausible image size or channel count");
+    throw InputError(label, "implausible image size or channel count");
   }
   const std::uint64_t values = static_cast<std::uint64_t>(spec.width) * spec.height *
                                static_cast<std::uint64_t>(spec.nchannels);
   if (values > kMaxExrValues) {
-    throw InputError(path.string(),
-                     std::to_string(spec.width) + " x " + std::to_string(spec.height) + " x " +
-                         std::to_string(spec.nchannels) + " channels is more than texlume reads (" +
-                         std::to_string(kMaxExrValues >> 20) + " Mi values, " +
-                         std::to_string((kMaxExrValues * 4) >> 30) + " GiB)");
+    throw InputError(label, std::to_string(spec.width) + " x " + std::to_string(spec.height) +
+                                " x " + std::to_string(spec.nchannels) +
+                                " channels is more than texlume reads (" +
+                                std::to_string(kMaxExrValues >> 20) + " Mi values, " +
+                                std::to_string((kMaxExrValues * 4) >> 30) + " GiB)");
   }
-  RequireMemory(8.0 * static_cast<double>(values), "reading the EXR (values and planes)",
-                path.string());
+  RequireMemory(8.0 * static_cast<double>(values), "reading the EXR (values and planes)", label);
+}
+
+std::vector<cv::Mat> ReadPlanes(OIIO::ImageInput& in, const std::string& label,
+                                std::vector<std::string>* channel_names) {
+  const OIIO::ImageSpec& spec = in.spec();
+  RequirePlausibleSize(spec, label);
   std::vector<float> data(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data())) {
-    throw InputError(path.string(), "cannot read pixels: " + in->geterror());
+  if (!in.read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data())) {
+    throw InputError(label, "cannot read pixels: " + in.geterror());
   }
   std::vector<cv::Mat> planes;
   for (int c = 0; c < spec.nchannels; ++c) {
@@ -99,6 +123,21 @@ std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
   }
   if (channel_names) *channel_names = spec.channelnames;
   return planes;
+}
+
+}  // namespace
+
+std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
+                             std::vector<std::string>* channel_names) {
+  const std::unique_ptr<OIIO::ImageInput> in = OpenExr(path.string(), nullptr);
+  return ReadPlanes(*in, path.string(), channel_names);
+}
+
+std::vector<cv::Mat> ReadExrBytes(std::string_view bytes, const std::string& label,
+                                  std::vector<std::string>* channel_names) {
+  OIIO::Filesystem::IOMemReader memory(bytes.data(), bytes.size());
+  const std::unique_ptr<OIIO::ImageInput> in = OpenExr(label, &memory);
+  return ReadPlanes(*in, label, channel_names);
 }
 
 }  // namespace texlume::ptm

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace texlume::ptm {
@@ -13,9 +14,14 @@ namespace texlume::ptm {
 void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& planes,
               const std::vector<std::string>& channel_names);
 
-/// Reads every channel of an EXR (or any OpenImageIO-readable) file as float
-/// planes, and their names. Throws InputError naming the file.
+/// Reads every channel of an OpenEXR file as float planes, and their names, through
+/// OpenImageIO's OpenEXR reader only. Throws InputError naming the file when it is not
+/// a readable OpenEXR file or declares an implausible size (docs/robustness.md).
 std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
                              std::vector<std::string>* channel_names = nullptr);
+
+/// ReadExr on the bytes of an OpenEXR file in memory; errors name `label`.
+std::vector<cv::Mat> ReadExrBytes(std::string_view bytes, const std::string& label,
+                                  std::vector<std::string>* channel_names = nullptr);
 
 }  // namespace texlume::ptm

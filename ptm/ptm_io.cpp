@@ -276,9 +276,11 @@ void WritePtmExr(const Ptm& ptm, const std::filesystem::path& path) {
   WriteExr(path, planes, names);
 }
 
-Ptm ReadPtmExr(const std::filesystem::path& path) {
-  std::vector<std::string> names;
-  const auto planes = ReadExr(path, &names);  // OpenEXR keeps channels sorted by name
+namespace {
+
+// The PTM in a PTM EXR's planes (named as ExrChannelNames); `label` names the file.
+Ptm PtmFromExrPlanes(const std::vector<cv::Mat>& planes, const std::vector<std::string>& names,
+                     const std::string& label) {
   PtmFormat format = PtmFormat::kLrgb;
   std::vector<std::string> expected;
   for (auto candidate : {PtmFormat::kLrgb, PtmFormat::kRgb}) {
@@ -291,7 +293,7 @@ Ptm ReadPtmExr(const std::filesystem::path& path) {
     }
   }
   if (expected.empty()) {
-    throw InputError(path.string(), "not a texlume PTM EXR: unexpected channel names");
+    throw InputError(label, "not a texlume PTM EXR: unexpected channel names");
   }
   Ptm ptm;
   ptm.Resize(format, planes[0].cols, planes[0].rows);
@@ -311,6 +313,20 @@ Ptm ReadPtmExr(const std::filesystem::path& path) {
     }
   }
   return ptm;
+}
+
+}  // namespace
+
+Ptm ReadPtmExr(const std::filesystem::path& path) {
+  std::vector<std::string> names;
+  const auto planes = ReadExr(path, &names);  // OpenEXR keeps channels sorted by name
+  return PtmFromExrPlanes(planes, names, path.string());
+}
+
+Ptm ReadPtmExrBytes(std::string_view bytes, const std::string& label) {
+  std::vector<std::string> names;
+  const auto planes = ReadExrBytes(bytes, label, &names);
+  return PtmFromExrPlanes(planes, names, label);
 }
 
 int WriteRelightWeb(const Ptm& ptm, const std::filesystem::path& dir, int jpeg_quality) {

@@ -4,6 +4,7 @@
 #include <istream>
 #include <ostream>
 #include <string>
+#include <string_view>
 
 #include "ptm/ptm.h"
 
@@ -28,6 +29,8 @@ Ptm ReadPtmFile(const std::filesystem::path& path);
 /// (LRGB) or `R.a0`..`R.a5`, `G.a0`.., `B.a0`.. (RGB).
 void WritePtmExr(const Ptm& ptm, const std::filesystem::path& path);
 Ptm ReadPtmExr(const std::filesystem::path& path);
+/// ReadPtmExr on the bytes of a PTM EXR in memory; errors name `label`.
+Ptm ReadPtmExrBytes(std::string_view bytes, const std::string& label);
 
 /// Reads a PTM by extension: .exr (lossless) or .ptm.
 Ptm ReadPtmAnyFormat(const std::filesystem::path& path);

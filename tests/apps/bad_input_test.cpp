@@ -1,8 +1,10 @@
 // The catalogue of bad inputs (issue 30), run through the texlume program as a
 // user runs it: each case must end with the documented exit code (1 for a bad
 // file, 2 for a bad setting), a message that names the offending file (or
-// option), and no output left behind, not even a partial one. One ctest per case.
+// option), and no output left behind, not even a partial one. One ctest for all
+// the cases, which share one prepared workspace.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <functional>
@@ -26,26 +28,48 @@ using testing::WriteText;
 
 // A folder with a small object scene (sparse/, sparse_txt/, mesh.ply,
 // lights.json), a PTM, two photos and a BTF capture's btf.json, for the cases
-// to damage.
+// to damage: made once per run, and copied into each case's folder.
 class Workspace {
  public:
   explicit Workspace(const fs::path& dir) : dir_(dir) {
-    datasets::ObjectSceneOptions options;
-    options.num_images = 4;
-    datasets::WriteObjectScene(datasets::MakeObjectScene(options), dir_);
-    ptm::Ptm ptm;
-    ptm.Resize(ptm::PtmFormat::kLrgb, 4, 4);
-    for (float& c : ptm.colour) c = 1.0f;
-    for (std::size_t t = 0; t < ptm.NumTexels(); ++t) ptm.Coefficients(t)[5] = 0.5f;
-    ptm::WritePtmFile(ptm, dir_ / "sample.ptm");
-    fs::create_directories(dir_ / "photos");
-    for (const char* name : {"a.png", "b.png"})
-      cv::imwrite((dir_ / "photos" / name).string(), cv::Mat(32, 32, CV_8UC3, cv::Scalar(9, 9, 9)));
+    fs::copy(Prepared(), dir_, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
   }
   std::string operator()(const std::string& name) const { return (dir_ / name).string(); }
   const fs::path& dir() const { return dir_; }
 
  private:
+  static void Make(const fs::path& dir) {
+    datasets::ObjectSceneOptions options;
+    options.num_images = 4;
+    datasets::WriteObjectScene(datasets::MakeObjectScene(options), dir);
+    ptm::Ptm ptm;
+    ptm.Resize(ptm::PtmFormat::kLrgb, 4, 4);
+    for (float& c : ptm.colour) c = 1.0f;
+    for (std::size_t t = 0; t < ptm.NumTexels(); ++t) ptm.Coefficients(t)[5] = 0.5f;
+    ptm::WritePtmFile(ptm, dir / "sample.ptm");
+    fs::create_directories(dir / "photos");
+    for (const char* name : {"a.png", "b.png"})
+      cv::imwrite((dir / "photos" / name).string(), cv::Mat(32, 32, CV_8UC3, cv::Scalar(9, 9, 9)));
+  }
+  static const fs::path& Prepared() {
+    struct Folder {  // removed at exit
+      Folder()
+          : path(fs::temp_directory_path() /
+                 ("texlume_bad_input_workspace_" + std::to_string(::getpid()))) {
+        fs::remove_all(path);
+        fs::create_directories(path);
+        Make(path);
+      }
+      ~Folder() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+      }
+      fs::path path;
+    };
+    static const Folder prepared;
+    return prepared.path;
+  }
+
   fs::path dir_;
 };
 

@@ -135,6 +135,28 @@ TEST(PtmFile, ExrRoundTripIsLossless) {
   }
 }
 
+TEST(PtmFile, ExrFromMemoryEqualsExrFromFileAndOtherFormatsAreRefused) {
+  testing::TempDir tmp;
+  const Ptm ptm = RandomPtm(PtmFormat::kLrgb, 5, 3, 7);
+  WritePtmExr(ptm, tmp / "p.exr");
+  const std::string bytes = testing::ReadText(tmp / "p.exr");
+  const Ptm back = ReadPtmExrBytes(bytes, "p.exr");
+  EXPECT_EQ(back.coefficients, ptm.coefficients);
+  EXPECT_EQ(back.colour, ptm.colour);
+  // Cut short, or a PNG under an EXR's name: refused by the OpenEXR reader, the file named.
+  for (const std::string& damaged :
+       {bytes.substr(0, bytes.size() / 2), std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16)}) {
+    testing::WriteText(tmp / "d.exr", damaged);
+    try {
+      ReadPtmExr(tmp / "d.exr");
+      ADD_FAILURE() << "a damaged EXR was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("d.exr"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(ReadPtmExrBytes(damaged, "d.exr"), InputError);
+  }
+}
+
 TEST(PtmFile, RelightWebExportWritesInfoAndPlanes) {
   testing::TempDir tmp;
   const Ptm ptm = RandomPtm(PtmFormat::kRgb, 16, 8, 5);

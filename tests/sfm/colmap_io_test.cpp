@@ -102,7 +102,9 @@ TEST(ColmapIoBadInput, EveryTruncationOfEveryBinaryFileIsACleanError) {
   WritePoints3DBinary(r, points);
   const std::vector<std::pair<std::string, std::string>> files = {
       {"cameras.bin", cameras.str()}, {"images.bin", images.str()}, {"points3D.bin", points.str()}};
-  for (const auto& [name, bytes] : files) {
+  for (const auto& file : files) {
+    const std::string& name = file.first;  // a plain name: lambdas capture it (clang 14)
+    const std::string& bytes = file.second;
     for (std::size_t len = 0; len < bytes.size(); ++len) {
       std::istringstream in(bytes.substr(0, len));
       const std::string error = testing::InputErrorMessage([&] {

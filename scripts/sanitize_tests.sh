@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Builds the unit tests of the libraries that read files (core, mesh, sfm, ptm, model,
+# the scene generator and the fuzz inputs: those marked SANITIZED in tests/CMakeLists.txt)
+# with clang, AddressSanitizer and UBSan in build-sanitize/, and runs them
+# (docs/robustness.md, "Sanitizers"). Extra arguments go to ctest, e.g. `-R Ptm`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+source scripts/lib/sanitizer_build.sh
+configure_sanitizer_build
+cmake --build "$sanitizer_build" --target sanitized_tests -j"$(nproc)"
+ctest --test-dir "$sanitizer_build" -L sanitize -j"$(nproc)" --output-on-failure "$@"
