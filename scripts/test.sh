@@ -14,4 +14,4 @@ ctest --test-dir build -j"$(nproc)" --output-on-failure
 # Both in build-sanitize/, at -O0: a shorter build, and neither needs speed.
 export TEXLUME_SANITIZE_OPT=-O0
 ./scripts/sanitize_tests.sh
-./scripts/fuzz.sh --seconds 1
+./scripts/fuzz.sh --seconds 1 --jobs "$(nproc)"
