@@ -164,7 +164,8 @@ TEST(PtmFile, ExrFromMemoryEqualsExrFromFileAndOtherFormatsAreRefused) {
 }
 
 // OpenEXR would allocate what a header attribute declares before finding the file
-// shorter (a 352-byte file declaring a 777 MB string took 893 MB): the header is checked
+// shorter (a 352-byte file declaring a 777 MB string took 893 MB), and reads typed
+// attributes by their type (a 725-byte file asked for 1.9 GB so): the header is checked
 // first, attribute by attribute, and so is the data window.
 TEST(PtmFile, ExrHeadersDeclaringMoreThanTheFileHoldsAreRefusedFirst) {
   const auto int32 = [](std::int32_t v) {
@@ -178,10 +179,19 @@ TEST(PtmFile, ExrHeadersDeclaringMoreThanTheFileHoldsAreRefusedFirst) {
   const std::string wide_window = head + std::string("dataWindow\0box2i\0", 17) + int32(16) +
                                   int32(0) + int32(0) + int32(1 << 20) + int32(9) + '\0';
   const std::string multi_part = int32(20000630) + int32(2 | 0x1000) + '\0';
+  // Typed attributes are read by their type: a declared size that differs would leave
+  // OpenEXR reading the rest of the header from another place than texlume's check.
+  const std::string long_channel_list = head + std::string("channels\0chlist\0", 16) + int32(40) +
+                                        std::string("R\0", 2) + std::string(17, '\0') +
+                                        std::string(21, 'x') + '\0';
+  const std::string long_compression =
+      head + std::string("compression\0compression\0", 24) + int32(5) + std::string(5, '\0') + '\0';
   const std::vector<std::pair<std::string, std::string>> cases = {
       {huge_string, "'capDate' declares 776732672 bytes"},
       {wide_window, "1048577 x 10 pixels"},
       {multi_part, "multi-part"},
+      {long_channel_list, "channel list does not take the bytes it declares"},
+      {long_compression, "declares 5 bytes, not 1"},
       {head + "dataWin", "cut short"}};
   for (const auto& c : cases) {
     const std::string& bytes = c.first;  // a plain name: lambdas capture it (clang 14)
