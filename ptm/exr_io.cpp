@@ -23,6 +23,8 @@ namespace {
 // the largest atlas texlume writes (16,384 a side, 18 channels: 4.8 Gi); the memory
 // limit (8 bytes a value) decides below that.
 constexpr std::uint64_t kMaxExrValues = std::uint64_t{1} << 33;
+// The widest and tallest EXR ReadExr accepts, checked in the header and in the spec.
+constexpr std::int64_t kMaxExrSide = 1 << 16;
 }  // namespace
 
 void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& planes,
@@ -196,7 +198,7 @@ void CheckExrHeader(std::istream& in, std::uint64_t size, const std::string& lab
       for (std::int32_t& v : box) v = header.Int32();
       const std::int64_t width = std::int64_t{box[2]} - box[0] + 1;
       const std::int64_t height = std::int64_t{box[3]} - box[1] + 1;
-      if (width < 1 || height < 1 || width > (1 << 16) || height > (1 << 16)) {
+      if (width < 1 || height < 1 || width > kMaxExrSide || height > kMaxExrSide) {
         header.Refuse("its data window of " + std::to_string(width) + " x " +
                       std::to_string(height) + " pixels is beyond 65536 a side");
       }
@@ -226,8 +228,8 @@ std::unique_ptr<OIIO::ImageInput> OpenExr(const std::string& label,
 
 // The size the header declares, refused when implausible or beyond the memory limit.
 void RequirePlausibleSize(const OIIO::ImageSpec& spec, const std::string& label) {
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.width > (1 << 16) ||
-      spec.height > (1 << 16) || spec.nchannels > 64) {
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.width > kMaxExrSide ||
+      spec.height > kMaxExrSide || spec.nchannels > 64) {
     throw InputError(label, "implausible image size or channel count");
   }
   const std::uint64_t values = static_cast<std::uint64_t>(spec.width) * spec.height *
