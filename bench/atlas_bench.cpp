@@ -55,7 +55,10 @@ mesh::TriangleMesh Jittered(mesh::TriangleMesh mesh) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
     const Eigen::Vector3d n = normal[v].normalized();
-    Eigen::Vector3d d(u(rng), u(rng), u(rng));
+    // Drawn one at a time, last first: a call's arguments are evaluated in an
+    // unspecified order (GCC right to left, clang left to right).
+    const double dz = u(rng), dy = u(rng), dx = u(rng);
+    Eigen::Vector3d d(dx, dy, dz);
     d -= d.dot(n) * n;  // along the surface
     mesh.vertices[v] += (edge / 3.0) * d;
   }

@@ -155,7 +155,10 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
         sfm::Image& image = scene.reconstruction.images.at(image_id);
         const auto projected = scene.reconstruction.Project(image, point.xyz);
         if (!projected) continue;
-        const Eigen::Vector2d observed = *projected + Eigen::Vector2d(noise(rng), noise(rng));
+        // Drawn one at a time, y first (as GCC evaluated the two draws in one call, whose
+        // order C++ leaves unspecified): the same model whichever compiler built texlume.
+        const double noise_y = noise(rng), noise_x = noise(rng);
+        const Eigen::Vector2d observed = *projected + Eigen::Vector2d(noise_x, noise_y);
         error_sum += (observed - *projected).norm();
         point.track.push_back({image_id, static_cast<std::uint32_t>(image.points2d.size())});
         image.points2d.push_back({observed, point.point3d_id});

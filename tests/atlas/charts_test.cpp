@@ -45,7 +45,10 @@ mesh::TriangleMesh JitteredIcosphere(unsigned seed) {
   const double edge = (mesh.Corner(0, 1) - mesh.Corner(0, 0)).norm();
   for (Eigen::Vector3d& v : mesh.vertices) {
     const Eigen::Vector3d n = v.normalized();
-    Eigen::Vector3d d(u(rng), u(rng), u(rng));
+    // Drawn one at a time, last first: a call's arguments are evaluated in an
+    // unspecified order (GCC right to left, clang left to right).
+    const double dz = u(rng), dy = u(rng), dx = u(rng);
+    const Eigen::Vector3d d(dx, dy, dz);
     v = (v + (edge / 3.0) * (d - d.dot(n) * n)).normalized();
   }
   return mesh;

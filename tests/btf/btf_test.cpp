@@ -42,7 +42,10 @@ BtfCapture RankCapture(int rank, unsigned seed) {
   for (std::size_t k = 0; k < c.views.size() * c.lights.size(); ++k) {
     cv::Mat image = cv::Mat::zeros(c.height, c.width, CV_32FC3);
     for (int i = 0; i < rank; ++i) {
-      const cv::Vec3f p(u(rng), u(rng), u(rng));
+      // Drawn one at a time, last first: a call's arguments are evaluated in an
+      // unspecified order (GCC right to left, clang left to right).
+      const float p2 = u(rng), p1 = u(rng), p0 = u(rng);
+      const cv::Vec3f p(p0, p1, p2);
       for (int y = 0; y < c.height; ++y)
         for (int x = 0; x < c.width; ++x)
           image.at<cv::Vec3f>(y, x) += g[static_cast<std::size_t>(i)].at<float>(y, x) * p;

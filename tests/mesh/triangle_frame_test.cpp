@@ -66,9 +66,13 @@ TEST(TriangleRowSpan, HoldsThePointsWithinTheMarginAndLittleMore) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-50.0, 50.0);
   for (int trial = 0; trial < 200; ++trial) {
-    std::array<Eigen::Vector2d, 3> c = {Eigen::Vector2d(u(rng), u(rng)),
-                                        Eigen::Vector2d(u(rng), u(rng)),
-                                        Eigen::Vector2d(u(rng), u(rng))};
+    // Drawn one at a time, last first: a call's arguments are evaluated in an
+    // unspecified order (GCC right to left, clang left to right).
+    std::array<Eigen::Vector2d, 3> c;
+    for (Eigen::Vector2d& corner : c) {
+      const double y = u(rng), x = u(rng);
+      corner = Eigen::Vector2d(x, y);
+    }
     if (trial % 4 == 0) c[2] = c[0] + 0.02 * (c[1] - c[0]) + Eigen::Vector2d(0.3, -0.2);  // sliver
     const double margin = trial % 3 == 0 ? 0.0 : 2.5;
     for (double y = -60.0; y <= 60.0; y += 1.7) {

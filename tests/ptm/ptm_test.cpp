@@ -14,7 +14,10 @@ namespace {
 Eigen::Vector2d RandomDisk(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1, 1);
   while (true) {
-    const Eigen::Vector2d p(u(rng), u(rng));
+    // Drawn one at a time, last first: a call's arguments are evaluated in an
+    // unspecified order (GCC right to left, clang left to right).
+    const double y = u(rng), x = u(rng);
+    const Eigen::Vector2d p(x, y);
     if (p.squaredNorm() < 1) return p;
   }
 }

@@ -62,7 +62,10 @@ TEST_P(CameraModelTest, ProjectUnprojectRoundTripBelowMicroPixel) {
   double worst_px = 0.0, worst_ray = 0.0;
   for (int i = 0; i < 2000; ++i) {
     const double z = depth(rng);
-    const Eigen::Vector3d point_in_cam(u(rng) * z, u(rng) * z * 0.75, z);
+    // Drawn one at a time, last first: a call's arguments are evaluated in an
+    // unspecified order (GCC right to left, clang left to right).
+    const double v = u(rng), w = u(rng);
+    const Eigen::Vector3d point_in_cam(w * z, v * z * 0.75, z);
     const auto pixel = camera.ImageFromCam(point_in_cam);
     ASSERT_TRUE(pixel.has_value());
     const Eigen::Vector3d ray = camera.CamRayFromImage(*pixel);

@@ -16,7 +16,12 @@ cv::Mat RandomColour(int width, int height, unsigned seed) {
   std::uniform_real_distribution<float> u(0.05f, 0.95f);
   cv::Mat image(height, width, CV_32FC3);
   for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) image.at<cv::Vec3f>(y, x) = cv::Vec3f(u(rng), u(rng), u(rng));
+    for (int x = 0; x < width; ++x) {
+      // Drawn one at a time, last first: a call's arguments are evaluated in an
+      // unspecified order (GCC right to left, clang left to right).
+      const float c2 = u(rng), c1 = u(rng), c0 = u(rng);
+      image.at<cv::Vec3f>(y, x) = cv::Vec3f(c0, c1, c2);
+    }
   return image;
 }
 

@@ -45,8 +45,12 @@ void AddFaces(PhotoBlurEstimator& estimator, std::size_t photo, double sigma, do
   std::mt19937 place(seed);
   std::uniform_int_distribution<int> at(0, kSize - kGrid);
   for (int face = 0; face < PhotoBlurEstimator::kFacesPerPhoto; ++face) {
-    const cv::Rect photo_window(at(place), at(place), kGrid, kGrid);
-    const cv::Rect sample_window(at(place), at(place), kGrid, kGrid);
+    // Drawn one at a time, last first: a call's arguments are evaluated in an
+    // unspecified order (GCC right to left, clang left to right).
+    const int photo_y = at(place), photo_x = at(place);
+    const int sample_y = at(place), sample_x = at(place);
+    const cv::Rect photo_window(photo_x, photo_y, kGrid, kGrid);
+    const cv::Rect sample_window(sample_x, sample_y, kGrid, kGrid);
     estimator.Add(photo, seen(photo_window).clone(), sample(sample_window).clone(), mask);
   }
 }
