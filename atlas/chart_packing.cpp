@@ -70,8 +70,11 @@ ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
     for (int y = std::max(0, static_cast<int>(clo.y()) - gutter - 1);
          y <= std::min(h - 1, static_cast<int>(chi.y()) + gutter + 1); ++y) {
       const auto [x_first, x_last] = TexelColumns(mesh::TriangleRowSpan(c, y + 0.5, reach), w);
+      // Centres on the row's chord of the triangle itself are within reach: no test.
+      const auto [chord_lo, chord_hi] = mesh::TriangleRowSpan(c, y + 0.5, 0.0);
       for (int x = x_first; x <= x_last; ++x)
-        if (mesh::SignedDistanceToTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5)) <= reach)
+        if ((x + 0.5 >= chord_lo && x + 0.5 <= chord_hi) ||
+            mesh::WithinReachOfTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5), reach))
           mask.at<std::uint8_t>(y, x) = 1;
     }
   }

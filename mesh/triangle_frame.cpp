@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace texlume::mesh {
@@ -34,19 +35,46 @@ double DistanceToSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
   return (a + s * ab - p).norm();
 }
 
-double SignedDistanceToTriangle(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
+namespace {
+
+double SquaredDistanceToSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                                const Eigen::Vector2d& p) {
+  const Eigen::Vector2d ab = b - a;
+  const double s = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+  return (a + s * ab - p).squaredNorm();
+}
+
+// Whether p is inside the triangle (edges included), either winding.
+bool InsideTriangle(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
   const double orientation =
       (c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x();
-  bool inside = true;
-  double nearest = std::numeric_limits<double>::max();
   for (std::size_t k = 0; k < 3; ++k) {
     const Eigen::Vector2d& a = c[k];
     const Eigen::Vector2d& b = c[(k + 1) % 3];
     const double cross = (b - a).x() * (p - a).y() - (b - a).y() * (p - a).x();
-    if (cross * orientation < 0) inside = false;
-    nearest = std::min(nearest, DistanceToSegment(a, b, p));
+    if (cross * orientation < 0) return false;
   }
-  return inside ? -nearest : nearest;
+  return true;
+}
+
+// The distance to the nearest edge: the square root of the least squared
+// distance, which is the least of the distances to the edges exactly.
+double DistanceToEdges(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
+  double nearest = std::numeric_limits<double>::max();
+  for (std::size_t k = 0; k < 3; ++k)
+    nearest = std::min(nearest, SquaredDistanceToSegment(c[k], c[(k + 1) % 3], p));
+  return std::sqrt(nearest);
+}
+
+}  // namespace
+
+double SignedDistanceToTriangle(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
+  return InsideTriangle(c, p) ? -DistanceToEdges(c, p) : DistanceToEdges(c, p);
+}
+
+bool WithinReachOfTriangle(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p,
+                           double reach) {
+  return InsideTriangle(c, p) || DistanceToEdges(c, p) <= reach;
 }
 
 std::pair<double, double> TriangleRowSpan(const std::array<Eigen::Vector2d, 3>& c, double y,

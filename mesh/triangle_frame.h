@@ -46,6 +46,11 @@ double DistanceToSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 double SignedDistanceToTriangle(const std::array<Eigen::Vector2d, 3>& corners,
                                 const Eigen::Vector2d& p);
 
+/// Whether SignedDistanceToTriangle(corners, p) <= reach, for reach >= 0: true
+/// inside without measuring the distance.
+bool WithinReachOfTriangle(const std::array<Eigen::Vector2d, 3>& corners, const Eigen::Vector2d& p,
+                           double reach);
+
 /// The x range [first, second] that holds every point of the line at height
 /// `y` within `margin` (>= 0) of a 2D triangle: the triangle's x range inside
 /// the slab |y' - y| <= margin, widened by margin. Empty (first > second) when
