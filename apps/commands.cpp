@@ -212,6 +212,10 @@ void AddDemoCommand(CLI::App& app, CommandRunners& run) {
       ->transform(Choice(MaterialWords()))
       ->default_str("stone");
   sub->add_option("--seed", o->seed, "random seed")->capture_default_str();
+  sub->add_option("--images", o->num_images, "object photos (a smaller demo: fewer)")
+      ->capture_default_str();
+  sub->add_option("--width", o->image_width, "photo width in pixels")->capture_default_str();
+  sub->add_option("--height", o->image_height, "photo height in pixels")->capture_default_str();
   BindSensor(sub, o->sensor);
   run[sub] = [o](std::ostream& out, std::ostream& err) {
     ProgressBar bar;

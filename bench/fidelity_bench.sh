@@ -14,7 +14,10 @@
 # COLMAP=1 it also builds the model from COLMAP's own cameras (a calibrated
 # camera: the scene's intrinsics held fixed), moved into the mesh's frame.
 # SCENE_ARGS adds options to both scenes (e.g. "--held-out-elevation 5,15" for
-# grazing held-out lights).
+# grazing held-out lights). With ABLATIONS=1 it also builds the model without each
+# of the main job's passes, one at a time (rows no_detail_transfer, shrink_0 and
+# shrink_1: the photo-consistency prior centred on the quilted patch or on the
+# sample's mean instead of the estimate, and no_correction).
 # Usage: bench/fidelity_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [SHAPES (sphere cylinder)]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -90,6 +93,15 @@ for shape in $shapes; do
       synth colmap "$dir/colmap_model"
       rows+=(texlume_colmap="$dir/render_colmap")
     fi
+  fi
+  if [ "${ABLATIONS:-0}" = 1 ]; then
+    synth no_detail_transfer "$object/sparse" --no-detail-transfer
+    synth shrink_0 "$object/sparse" --correction-prior-shrink 0
+    synth shrink_1 "$object/sparse" --correction-prior-shrink 1
+    synth no_correction "$object/sparse" --correction-iterations 0
+    for name in no_detail_transfer shrink_0 shrink_1 no_correction; do
+      rows+=("$name=$dir/render_$name")
+    done
   fi
   echo
   echo "### $shape${clean:+ (clean)}: held-out views x lights at 2x the photos' resolution"

@@ -29,6 +29,10 @@ class DemoJob {
     scene_.shape = options.shape;
     scene_.material.kind = options.material;
     scene_.sensor = options.sensor;
+    scene_.num_images = options.num_images;
+    scene_.image_width = options.image_width;
+    scene_.image_height = options.image_height;
+    scene_.focal_px *= options.image_width / 640.0;
     scene_.write_btf = false;
     scene_.write_surface = false;
     // Held-out views at twice the photos' resolution: metrics at full
@@ -267,6 +271,9 @@ nlohmann::json DemoJobOptions::ToJson() const {
   return {{"shape", std::string(datasets::SceneShapeName(shape))},
           {"material", std::string(datasets::MaterialKindName(material))},
           {"seed", seed},
+          {"num_images", num_images},
+          {"image_width", image_width},
+          {"image_height", image_height},
           {"sensor", sensor.ToJson()}};
 }
 

@@ -116,6 +116,11 @@ struct DemoJobOptions {
   datasets::SceneShape shape = datasets::SceneShape::kSphere;
   datasets::MaterialKind material = datasets::MaterialKind::kStone;
   std::uint32_t seed = 1;
+  /// The object photos: how many, and their size in pixels (the focal length
+  /// follows the width, so a smaller photo shows the same view).
+  int num_images = 36;
+  int image_width = 640;
+  int image_height = 480;
   /// What the camera adds to the scene's photos (off: the clean scene).
   datasets::SensorOptions sensor;
   void Check() const;

@@ -11,6 +11,7 @@
 #include "core/check.h"
 #include "core/errors.h"
 #include "core/image_io.h"
+#include "core/memory_budget.h"
 #include "core/timing.h"
 #include "synth/photo_blur.h"
 #include "synth/tangent_field.h"
@@ -138,6 +139,13 @@ void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
                                  std::to_string(options_.max_texels) +
                                  "; use a larger texel size or a finer mesh");
   }
+  // The patches' feature planes, the atlases baked from them and the bake's own
+  // buffers: about three copies of 4-byte features per texel (measured: 66-122
+  // bytes a texel with a PTM sample, docs/robustness.md "Memory").
+  RequireMemory(12.0 * static_cast<double>(geometry.total_texels) * sample_.NumFeatures(),
+                "the patches and atlases of " + std::to_string(geometry.total_texels) +
+                    " texels at a texel size of " + std::to_string(t) + " world units",
+                "mesh");
   if (geometry.widest > sample_.Width() || geometry.tallest > sample_.Height()) {
     throw InputError(
         "mesh", "the largest triangle needs a patch of " + std::to_string(geometry.widest) + " x " +

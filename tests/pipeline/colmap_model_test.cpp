@@ -1,4 +1,5 @@
-// The main job on what a user has (issue 29): photos with a real camera's noise,
+// COLMAP's own structure from motion (CPU) on generated photos, and the main job
+// on what a user has (issue 29): photos with a real camera's noise,
 // JPEG, vignetting and white balance, a glossy material with sheen and
 // interreflection, lights recorded a little off, and the cameras COLMAP's own
 // SfM estimated from those photos (moved into the mesh's frame), not the true
@@ -91,7 +92,15 @@ TEST(ColmapModel, RealisticPhotosAndColmapsOwnCamerasKeepTheStructureFlatLacks) 
   const sfm::Reconstruction truth = sfm::ReadModel(scene / "object/sparse").reconstruction;
   const sfm::Reconstruction estimate = sfm::ReadModel(sparse).reconstruction;
   const sfm::SimilarityAlignment a = sfm::AlignByCameraCenters(truth, estimate);
+  // COLMAP registers nearly every photo, and its cameras align to the truth: centres
+  // within 1 % of the camera distance, orientations within 1.5 degrees (measured:
+  // 36 of 36, 0.47 %, 0.89 degrees; bench/colmap_sfm_check.sh does the clean scenes
+  // of every shape with a free focal length).
+  const datasets::SceneOptions options = RealisticScene();
+  EXPECT_GE(estimate.images.size(), static_cast<std::size_t>(0.9 * options.num_images));
   ASSERT_GE(a.num_matched, 30u);
+  EXPECT_LT(a.rms_center_error, 0.01 * options.camera_distance);
+  EXPECT_LT(a.max_rotation_error_deg, 1.5);
   const sfm::Reconstruction aligned = sfm::TransformedIntoReference(estimate, a);
   sfm::WriteModel(aligned, tmp / "colmap_model", sfm::ModelFormat::kBinary);
   const double reprojection_px = RmsReprojectionDifference(truth, aligned);
