@@ -58,12 +58,14 @@ bool InsideTriangle(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector
 }
 
 // The distance to the nearest edge: the square root of the least squared
-// distance, which is the least of the distances to the edges exactly.
+// distance, which is the least of the distances to the edges exactly; the
+// largest double when no distance is finite (NaN or overflowing corners).
 double DistanceToEdges(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
-  double nearest = std::numeric_limits<double>::max();
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  double nearest = kInfinity;
   for (std::size_t k = 0; k < 3; ++k)
     nearest = std::min(nearest, SquaredDistanceToSegment(c[k], c[(k + 1) % 3], p));
-  return std::sqrt(nearest);
+  return nearest == kInfinity ? std::numeric_limits<double>::max() : std::sqrt(nearest);
 }
 
 }  // namespace

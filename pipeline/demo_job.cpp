@@ -264,6 +264,11 @@ class DemoJob {
 
 void DemoJobOptions::Check() const {
   if (out_dir.empty()) throw OptionError("give the demo's output folder");
+  if (num_images < 3 || num_images > 500)
+    throw OptionError("--images must be in [3, 500], got " + std::to_string(num_images));
+  if (image_width < 64 || image_width > 8192 || image_height < 64 || image_height > 8192)
+    throw OptionError("--width and --height must be in [64, 8192] pixels, got " +
+                      std::to_string(image_width) + " x " + std::to_string(image_height));
   sensor.Check();
 }
 

@@ -140,11 +140,12 @@ void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
                                  "; use a larger texel size or a finer mesh");
   }
   // The patches' feature planes, the atlases baked from them and the bake's own
-  // buffers: about three copies of 4-byte features per texel (measured: 66-122
-  // bytes a texel with a PTM sample, docs/robustness.md "Memory").
-  RequireMemory(12.0 * static_cast<double>(geometry.total_texels) * sample_.NumFeatures(),
+  // buffers: 20 bytes a texel per feature plane (measured: 66-122 bytes a texel
+  // with a 6-plane PTM sample, docs/robustness.md "Memory").
+  RequireMemory(20.0 * static_cast<double>(geometry.total_texels) * sample_.NumFeatures(),
                 "the patches and atlases of " + std::to_string(geometry.total_texels) +
-                    " texels at a texel size of " + std::to_string(t) + " world units",
+                    " texels at a texel size of " + std::to_string(t) +
+                    " world units (a larger --sample-texel-size needs fewer)",
                 "mesh");
   if (geometry.widest > sample_.Width() || geometry.tallest > sample_.Height()) {
     throw InputError(

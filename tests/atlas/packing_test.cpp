@@ -12,9 +12,13 @@ namespace {
 TEST(PackSkyline, RectanglesDoNotOverlapAndStayInTheirBins) {
   std::mt19937 rng(2);
   std::vector<std::pair<int, int>> sizes;
-  for (int i = 0; i < 300; ++i)
-    sizes.emplace_back(std::uniform_int_distribution<int>(3, 60)(rng),
-                       std::uniform_int_distribution<int>(3, 60)(rng));
+  std::uniform_int_distribution<int> side(3, 60);
+  for (int i = 0; i < 300; ++i) {
+    // Drawn one at a time, last first: a call's arguments are evaluated in an
+    // unspecified order (GCC right to left, clang left to right).
+    const int height = side(rng), width = side(rng);
+    sizes.emplace_back(width, height);
+  }
   const auto placed = PackSkyline(sizes, 256, 256);
   int bins = 0;
   for (const auto& p : placed) bins = std::max(bins, p[0] + 1);

@@ -94,8 +94,8 @@ TEST(ColmapModel, RealisticPhotosAndColmapsOwnCamerasKeepTheStructureFlatLacks) 
   const sfm::SimilarityAlignment a = sfm::AlignByCameraCenters(truth, estimate);
   // COLMAP registers nearly every photo, and its cameras align to the truth: centres
   // within 1 % of the camera distance, orientations within 1.5 degrees (measured:
-  // 36 of 36, 0.47 %, 0.89 degrees; bench/colmap_sfm_check.sh does the clean scenes
-  // of every shape with a free focal length).
+  // 36 of 36, 0.47 %, 0.89 degrees; bench/colmap_sfm_check.sh does every shape with a
+  // free focal length).
   const datasets::SceneOptions options = RealisticScene();
   EXPECT_GE(estimate.images.size(), static_cast<std::size_t>(0.9 * options.num_images));
   ASSERT_GE(a.num_matched, 30u);

@@ -2,6 +2,7 @@
 
 #include "core/errors.h"
 #include "model/baselines.h"
+#include "pipeline/jobs.h"
 #include "pipeline/render_job.h"
 #include "pipeline/synth_job.h"
 
@@ -18,6 +19,33 @@ pipeline::SynthJobOptions CompleteSynthJob() {
   o.out_dir = "model";
   o.synthesis.sample_texel_size = 0.002;
   return o;
+}
+
+// The demo's photo count and size: refused outside the scene's ranges, naming the option.
+TEST(DemoJobOptions, PhotoCountAndSizeOutsideTheirRangesNameTheirOption) {
+  pipeline::DemoJobOptions o;
+  EXPECT_NO_THROW(o.Check());
+  o.num_images = 2;
+  try {
+    o.Check();
+    ADD_FAILURE() << "2 photos were accepted";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("--images"), std::string::npos) << e.what();
+  }
+  o = pipeline::DemoJobOptions();
+  o.image_height = 8193;
+  try {
+    o.Check();
+    ADD_FAILURE() << "a photo 8193 pixels high was accepted";
+  } catch (const OptionError& e) {
+    EXPECT_NE(std::string(e.what()).find("--height"), std::string::npos) << e.what();
+  }
+  o = pipeline::DemoJobOptions();
+  o.image_width = 320;
+  o.image_height = 240;
+  o.num_images = 12;
+  EXPECT_NO_THROW(o.Check());
+  EXPECT_EQ(o.ToJson()["num_images"], 12);
 }
 
 TEST(SynthJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {

@@ -388,16 +388,20 @@ TEST_F(MeshPipelineTest, BadInputIsRefusedWithNothingWritten) {
   // the estimate (at half the texel size the patches take four times the texels).
   j = Job(tmp_->path() / "bad4");
   j.synthesis.sample_texel_size = 0.002;
-  SetMemoryLimitBytes(64 << 20);
-  try {
-    pipeline::RunSynthJob(j);
-    ADD_FAILURE() << "patches beyond the memory limit were accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("the patches and atlases of"), std::string::npos)
-        << e.what();
-    EXPECT_NE(std::string(e.what()).find("--memory-limit"), std::string::npos) << e.what();
+  {
+    struct MemoryLimit {  // the default again however the block ends
+      explicit MemoryLimit(std::uint64_t bytes) { SetMemoryLimitBytes(bytes); }
+      ~MemoryLimit() { SetMemoryLimitBytes(0); }
+    } limit(64 << 20);
+    try {
+      pipeline::RunSynthJob(j);
+      ADD_FAILURE() << "patches beyond the memory limit were accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("the patches and atlases of"), std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("--memory-limit"), std::string::npos) << e.what();
+    }
   }
-  SetMemoryLimitBytes(0);
   EXPECT_FALSE(fs::exists(tmp_->path() / "bad4"));
   // An existing folder that is not a model is not replaced.
   fs::create_directories(tmp_->path() / "keep");
