@@ -23,23 +23,22 @@ pipeline::SynthJobOptions CompleteSynthJob() {
 
 // The demo's photo count and size: refused outside the scene's ranges, naming the option.
 TEST(DemoJobOptions, PhotoCountAndSizeOutsideTheirRangesNameTheirOption) {
+  // The OptionError's message, or "" when Check() accepts the options.
+  const auto refusal = [](const pipeline::DemoJobOptions& options) {
+    try {
+      options.Check();
+    } catch (const OptionError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
   pipeline::DemoJobOptions o;
   EXPECT_NO_THROW(o.Check());
   o.num_images = 2;
-  try {
-    o.Check();
-    ADD_FAILURE() << "2 photos were accepted";
-  } catch (const OptionError& e) {
-    EXPECT_NE(std::string(e.what()).find("--images"), std::string::npos) << e.what();
-  }
+  EXPECT_NE(refusal(o).find("--images"), std::string::npos) << "2 photos: " << refusal(o);
   o = pipeline::DemoJobOptions();
   o.image_height = 8193;
-  try {
-    o.Check();
-    ADD_FAILURE() << "a photo 8193 pixels high was accepted";
-  } catch (const OptionError& e) {
-    EXPECT_NE(std::string(e.what()).find("--height"), std::string::npos) << e.what();
-  }
+  EXPECT_NE(refusal(o).find("--height"), std::string::npos) << "8193 high: " << refusal(o);
   o = pipeline::DemoJobOptions();
   o.image_width = 320;
   o.image_height = 240;
