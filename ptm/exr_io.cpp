@@ -4,6 +4,7 @@
 #include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <fstream>
 #include <map>
@@ -72,6 +73,24 @@ void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& pla
 
 namespace {
 
+// The size a header declares, refused when implausible or beyond the memory limit.
+void RequirePlausibleSize(std::int64_t width, std::int64_t height, std::int64_t channels,
+                          const std::string& label) {
+  if (width <= 0 || height <= 0 || channels <= 0 || width > kMaxExrSide || height > kMaxExrSide ||
+      channels > 64) {
+    throw InputError(label, "implausible image size or channel count");
+  }
+  const std::uint64_t values = static_cast<std::uint64_t>(width * height * channels);
+  if (values > kMaxExrValues) {
+    throw InputError(label, std::to_string(width) + " x " + std::to_string(height) + " x " +
+                                std::to_string(channels) +
+                                " channels is more than texlume reads (" +
+                                std::to_string(kMaxExrValues >> 20) + " Mi values, " +
+                                std::to_string((kMaxExrValues * 4) >> 30) + " GiB)");
+  }
+  RequireMemory(8.0 * static_cast<double>(values), "reading the EXR (values and planes)", label);
+}
+
 // The bytes of an OpenEXR header, read in order, each read checked against the bytes left.
 class ExrHeaderReader {
  public:
@@ -136,16 +155,20 @@ std::int32_t FixedAttributeBytes(const std::string& type) {
 
 // A channel list as OpenEXR reads it (names until an empty one, 16 bytes each after its
 // name), which must take exactly the bytes the attribute declares.
-void CheckChannelList(ExrHeaderReader& header, std::int32_t bytes) {
+// Returns the number of channels.
+int CheckChannelList(ExrHeaderReader& header, std::int32_t bytes) {
   std::int64_t read = 0;
+  int channels = 0;
   for (std::string name = header.Name();; name = header.Name()) {
     read += static_cast<std::int64_t>(name.size()) + 1;
     if (name.empty()) break;
     char layout[16];
     header.Read(layout, sizeof layout);
     read += 16;
+    ++channels;
   }
   if (read != bytes) header.Refuse("its channel list does not take the bytes it declares");
+  return channels;
 }
 
 // A string vector as OpenEXR reads it (a length, then the characters), within its bytes.
@@ -165,7 +188,8 @@ void CheckStringVector(ExrHeaderReader& header, std::int32_t bytes) {
 // took 893 MB and 2.9 s), reads typed attributes by their type rather than their declared
 // size, and sizes its chunk table by the data window. So: the magic number, version 2 of a
 // single-part image that is not deep, every attribute within the bytes that follow it and
-// its declared size the size OpenEXR reads, and a data window of at most 65,536 a side.
+// its declared size the size OpenEXR reads, and a data window of at most 65,536 a side
+// whose values, with its channels, fit texlume's limits and memory budget.
 void CheckExrHeader(std::istream& in, std::uint64_t size, const std::string& label) {
   ExrHeaderReader header(in, size, label);
   constexpr std::int32_t kMagic = 20000630;
@@ -178,6 +202,8 @@ void CheckExrHeader(std::istream& in, std::uint64_t size, const std::string& lab
     throw InputError(label, "is an OpenEXR file texlume does not read (version field " +
                                 std::to_string(version) + ": multi-part or deep)");
   }
+  std::int64_t width = 0, height = 0;
+  int channels = 0;
   for (std::string name = header.Name(); !name.empty(); name = header.Name()) {
     const std::string type = header.Name();
     const std::int32_t bytes = header.Int32();
@@ -190,14 +216,14 @@ void CheckExrHeader(std::istream& in, std::uint64_t size, const std::string& lab
       header.Refuse("attribute '" + name + "' is of type " + type +
                     ", which texlume does not read");
     } else if (type == "chlist") {
-      CheckChannelList(header, bytes);
+      channels = CheckChannelList(header, bytes);
     } else if (type == "stringvector") {
       CheckStringVector(header, bytes);
     } else if (name == "dataWindow" && type == "box2i") {
       std::int32_t box[4];
       for (std::int32_t& v : box) v = header.Int32();
-      const std::int64_t width = std::int64_t{box[2]} - box[0] + 1;
-      const std::int64_t height = std::int64_t{box[3]} - box[1] + 1;
+      width = std::int64_t{box[2]} - box[0] + 1;
+      height = std::int64_t{box[3]} - box[1] + 1;
       if (width < 1 || height < 1 || width > kMaxExrSide || height > kMaxExrSide) {
         header.Refuse("its data window of " + std::to_string(width) + " x " +
                       std::to_string(height) + " pixels is beyond 65536 a side");
@@ -206,7 +232,31 @@ void CheckExrHeader(std::istream& in, std::uint64_t size, const std::string& lab
       header.Skip(bytes, name);
     }
   }
+  // OpenEXR sizes its line buffers by the data window and channels when it opens the file.
+  if (width > 0 && height > 0 && channels > 0) RequirePlausibleSize(width, height, channels, label);
 }
+
+// OpenImageIO 2.4's memory reader copies from before its buffer when OpenEXR asks for a
+// negative offset (a damaged chunk table; found by fuzzing, fuzz/regressions/ptm_exr/crash-*):
+// this one reads nothing outside the buffer, as a file would.
+class BoundedMemoryReader final : public OIIO::Filesystem::IOMemReader {
+ public:
+  explicit BoundedMemoryReader(std::string_view bytes) : IOMemReader(bytes.data(), bytes.size()) {}
+  bool seek(std::int64_t offset) override {
+    if (offset < 0) return false;
+    m_pos = offset;
+    return true;
+  }
+  std::size_t read(void* buffer, std::size_t bytes) override {
+    const std::size_t got = pread(buffer, bytes, m_pos);
+    m_pos += static_cast<std::int64_t>(got);
+    return got;
+  }
+  std::size_t pread(void* buffer, std::size_t bytes, std::int64_t offset) override {
+    if (offset < 0 || static_cast<std::uint64_t>(offset) >= size()) return 0;
+    return IOMemReader::pread(buffer, std::min<std::uint64_t>(bytes, size() - offset), offset);
+  }
+};
 
 // The OpenEXR reader only, on a file or on bytes in memory: a damaged file is refused
 // by it rather than probed by every other format's reader.
@@ -226,28 +276,10 @@ std::unique_ptr<OIIO::ImageInput> OpenExr(const std::string& label,
   return in;
 }
 
-// The size the header declares, refused when implausible or beyond the memory limit.
-void RequirePlausibleSize(const OIIO::ImageSpec& spec, const std::string& label) {
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.width > kMaxExrSide ||
-      spec.height > kMaxExrSide || spec.nchannels > 64) {
-    throw InputError(label, "implausible image size or channel count");
-  }
-  const std::uint64_t values = static_cast<std::uint64_t>(spec.width) * spec.height *
-                               static_cast<std::uint64_t>(spec.nchannels);
-  if (values > kMaxExrValues) {
-    throw InputError(label, std::to_string(spec.width) + " x " + std::to_string(spec.height) +
-                                " x " + std::to_string(spec.nchannels) +
-                                " channels is more than texlume reads (" +
-                                std::to_string(kMaxExrValues >> 20) + " Mi values, " +
-                                std::to_string((kMaxExrValues * 4) >> 30) + " GiB)");
-  }
-  RequireMemory(8.0 * static_cast<double>(values), "reading the EXR (values and planes)", label);
-}
-
 std::vector<cv::Mat> ReadPlanes(OIIO::ImageInput& in, const std::string& label,
                                 std::vector<std::string>* channel_names) {
   const OIIO::ImageSpec& spec = in.spec();
-  RequirePlausibleSize(spec, label);
+  RequirePlausibleSize(spec.width, spec.height, spec.nchannels, label);
   std::vector<float> data(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
   if (!in.read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data())) {
     throw InputError(label, "cannot read pixels: " + in.geterror());
@@ -288,7 +320,7 @@ std::vector<cv::Mat> ReadExrBytes(std::string_view bytes, const std::string& lab
     std::istringstream header{std::string(bytes)};
     CheckExrHeader(header, bytes.size(), label);
   }
-  OIIO::Filesystem::IOMemReader memory(bytes.data(), bytes.size());
+  BoundedMemoryReader memory(bytes);
   const std::unique_ptr<OIIO::ImageInput> in = OpenExr(label, &memory);
   return ReadPlanes(*in, label, channel_names);
 }

@@ -57,7 +57,7 @@ fuzz_target() {
   fi
   local before log="$build/fuzz_$t.log"
   before=$(find "$regressions" -type f | wc -l)
-  # A single allocation over 512 MiB is a finding: the targets run under a 256 MiB
+  # A single allocation over 512 MiB is a finding: the targets run under a 4 MiB
   # memory limit (fuzz_target.cpp), so only an unchecked size from the input asks for it.
   "$exe" "$limit" -rss_limit_mb=4096 -malloc_limit_mb=512 -timeout=10 -max_len="$max_len" \
     -print_final_stats=1 \

@@ -1,8 +1,7 @@
 #!/usr/bin/env bash
-# Builds the unit tests of the file readers (the test files marked SANITIZED in
-# tests/CMakeLists.txt: images, COLMAP models, lights, meshes, PTMs, model folders) and
-# the libraries they link with clang, AddressSanitizer and UBSan in build-sanitize/, and
-# runs them (docs/robustness.md, "Sanitizers"). Extra arguments go to ctest, e.g. `-R ptm`.
+# Builds every unit suite and the libraries they link with clang, AddressSanitizer and UBSan
+# in build-sanitize/, and runs them, each test but those listed in tests/sanitizer_skip.txt
+# (docs/robustness.md, "Sanitizers"). Extra arguments go to ctest, e.g. `-R ptm`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/lib/sanitizer_build.sh

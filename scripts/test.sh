@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs the dependencies, builds texlume with warnings as errors, checks the
 # formatting and runs the whole test suite (unit tests, COLMAP cross-checks,
-# end-to-end CLI tests), then the unit tests of the file-reading libraries again under
-# AddressSanitizer + UBSan (scripts/sanitize_tests.sh) and the fuzz smoke run: every
+# end-to-end CLI tests), then the unit suites again under AddressSanitizer + UBSan
+# (scripts/sanitize_tests.sh) and the fuzz smoke run: every
 # libFuzzer target for 1 s after replaying every kept finding (scripts/fuzz.sh), both in
 # build-sanitize/ (docs/robustness.md).
 set -euo pipefail

@@ -186,12 +186,22 @@ TEST(PtmFile, ExrHeadersDeclaringMoreThanTheFileHoldsAreRefusedFirst) {
                                         std::string(21, 'x') + '\0';
   const std::string long_compression =
       head + std::string("compression\0compression\0", 24) + int32(5) + std::string(5, '\0') + '\0';
+  // A window within 65536 a side whose nine channels make more values than texlume reads:
+  // refused from the header, before OpenEXR sizes its line buffers by it.
+  std::string nine_channels;
+  for (char c = 'a'; c < 'a' + 9; ++c)
+    nine_channels += std::string{c, '\0'} + std::string(16, '\0');
+  const std::string large_image = head + std::string("channels\0chlist\0", 16) + int32(9 * 18 + 1) +
+                                  nine_channels + '\0' + std::string("dataWindow\0box2i\0", 17) +
+                                  int32(16) + int32(0) + int32(0) + int32(59999) + int32(59999) +
+                                  '\0';
   const std::vector<std::pair<std::string, std::string>> cases = {
       {huge_string, "'capDate' declares 776732672 bytes"},
       {wide_window, "1048577 x 10 pixels"},
       {multi_part, "multi-part"},
       {long_channel_list, "channel list does not take the bytes it declares"},
       {long_compression, "declares 5 bytes, not 1"},
+      {large_image, "60000 x 60000 x 9 channels is more than texlume reads"},
       {head + "dataWin", "cut short"}};
   for (const auto& c : cases) {
     const std::string& bytes = c.first;  // a plain name: lambdas capture it (clang 14)
