@@ -39,7 +39,7 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
   // A small memory limit, so that a header declaring a large image or mesh is refused
   // by the readers' estimates (RequireMemory) rather than allocated on every run. At 256 MiB
   // the PTM EXR target spent most of its time in AddressSanitizer's allocator, on the
-  // buffers of such images (120 runs a second; about 300 at 4 MiB).
+  // buffers of such images (120 runs a second; about 280 at 4 MiB).
   texlume::SetMemoryLimitBytes(kFuzzMemoryLimitBytes);
   (void)argc;
   return 0;

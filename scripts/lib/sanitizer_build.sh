@@ -1,6 +1,7 @@
 # Sourced by scripts/fuzz.sh and scripts/sanitize_tests.sh: configures build-sanitize/,
-# the build they share (clang; every library compiled with AddressSanitizer, UBSan and
-# libFuzzer's coverage; -DTEXLUME_FUZZ=ON), so that each builds only what it runs.
+# the build they share (clang; every library compiled with AddressSanitizer and UBSan, the
+# ones the fuzz targets run also with libFuzzer's coverage; -DTEXLUME_FUZZ=ON), so that each
+# builds only what it runs.
 # TEXLUME_SANITIZE_OPT sets its optimisation (default -O1).
 sanitizer_build=build-sanitize
 configure_sanitizer_build() {
