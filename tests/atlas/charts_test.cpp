@@ -702,5 +702,29 @@ TEST(Charts, PatchesOfAnotherMeshAreAnInternalError) {
   EXPECT_THROW(atlas::MakeStripCharts(mesh, g.patches, g.unfoldings, strips), InternalError);
 }
 
+// Every flattening of a small sphere (80 faces, about 8,000 texels) keeps its charts apart,
+// its stretch within the bound and its texture coordinates in agreement with the frames: what
+// the full-size layouts above check, at a size the sanitizer build (which skips those,
+// tests/sanitizer_skip.txt) runs in seconds.
+TEST(Charts, EveryFlatteningOfASmallSphereKeepsItsChartsApart) {
+  const mesh::TriangleMesh mesh = datasets::MakeIcosphere(1, 0.05);
+  const PatchGeometry g = Geometry(mesh);
+  atlas::AtlasOptions o;
+  for (const atlas::ChartFlattening kind :
+       {atlas::ChartFlattening::kRigid, atlas::ChartFlattening::kConformal,
+        atlas::ChartFlattening::kStrips, atlas::ChartFlattening::kAuto}) {
+    o.flattening = kind;
+    const atlas::AtlasLayout layout =
+        atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, kTexel, o);
+    SCOPED_TRACE(atlas::ChartFlatteningName(layout.flattening));
+    const atlas::AtlasCoverage coverage = ExpectNoTexelInTwoCharts(layout, o.gutter);
+    EXPECT_GT(coverage.inside_texels, 0);
+    const atlas::AtlasStretch stretch = atlas::MeasureStretch(g.patches, layout);
+    EXPECT_LE(stretch.max, o.max_chart_stretch + 1e-9);
+    EXPECT_GE(stretch.min, 1 / o.max_chart_stretch - 1e-9);
+    ExpectLayoutAgreesWithTextureCoordinates(mesh, g, layout);
+  }
+}
+
 }  // namespace
 }  // namespace texlume::synth
