@@ -80,9 +80,9 @@ void AddFitCommand(CLI::App& app, CommandRunners& run) {
   sub->add_option("--web", o->web_dir, "also write the relight/OpenLIME web format");
   sub->add_option("--band-rows", o->fit.band_rows, "rows decoded and fitted at a time")
       ->capture_default_str();
-  run[sub] = [o](std::ostream& out, std::ostream&) {
+  run[sub] = [o](std::ostream& out, std::ostream& err) {
     ProgressBar bar;
-    pipeline::RunFitJob(*o, out, bar.Callback());
+    pipeline::RunFitJob(*o, out, err, bar.Callback());
     return kExitOk;
   };
 }
@@ -173,10 +173,10 @@ void AddSynth2dCommand(CLI::App& app, CommandRunners& run) {
   auto seam = std::make_shared<bool>(false), unconstrained = std::make_shared<bool>(false);
   sub->add_flag("--seam", *seam, "cut seams instead of blending");
   sub->add_flag("--unconstrained", *unconstrained, "ignore the photos (needs --width --height)");
-  run[sub] = [o, seam, unconstrained](std::ostream& out, std::ostream&) {
+  run[sub] = [o, seam, unconstrained](std::ostream& out, std::ostream& err) {
     o->synthesis.stitch = *seam ? synth::Stitch::kSeamCut : synth::Stitch::kBlend;
     o->synthesis.use_photos = !*unconstrained;
-    pipeline::RunSynth2dJob(*o, out);
+    pipeline::RunSynth2dJob(*o, out, err);
     return kExitOk;
   };
 }

@@ -37,6 +37,18 @@ void WriteFileAtomically(const std::filesystem::path& path,
   }
 }
 
+void RequireWritableFilePath(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::path folder = path.parent_path().empty() ? "." : path.parent_path();
+  if (!std::filesystem::is_directory(folder, ec)) {
+    throw InputError(path.string(),
+                     "cannot be written: the folder " + folder.string() + " does not exist");
+  }
+  if (std::filesystem::is_directory(path, ec)) {
+    throw InputError(path.string(), "is a folder; expected the name of a file to write");
+  }
+}
+
 std::ifstream OpenForReading(const std::filesystem::path& path, bool binary) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(path.string(), "file not found");
@@ -69,10 +81,14 @@ std::filesystem::path ContainedPath(const std::filesystem::path& folder, std::st
   return folder / std::filesystem::path(name);
 }
 
+std::string LowerCase(std::string_view text) {
+  std::string s(text);
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
 std::string LowerCaseExtension(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
+  return LowerCase(path.extension().string());
 }
 
 std::string ReadFileBytes(const std::filesystem::path& path, std::uint64_t max_bytes) {

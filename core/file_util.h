@@ -19,6 +19,11 @@ namespace texlume {
 void WriteFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write, bool binary);
 
+/// Throws InputError naming `path` unless it can be written as a file: its folder
+/// exists and `path` is not a folder. Jobs call it before their work, so that a
+/// mistyped output path fails at once instead of after the work.
+void RequireWritableFilePath(const std::filesystem::path& path);
+
 /// Opens a file for reading; throws InputError naming it when it cannot be opened.
 /// The returned stream throws nothing; readers check it themselves.
 std::ifstream OpenForReading(const std::filesystem::path& path, bool binary);
@@ -32,6 +37,9 @@ std::filesystem::path ContainedPath(const std::filesystem::path& folder, std::st
 /// Why `name` cannot name a file inside a folder (as ContainedPath refuses it), or
 /// empty when it can.
 std::string ContainedNameProblem(std::string_view name);
+
+/// `text` with ASCII letters in lower case.
+std::string LowerCase(std::string_view text);
 
 /// The file's extension in lower case, with its dot (".ply"), or "".
 std::string LowerCaseExtension(const std::filesystem::path& path);

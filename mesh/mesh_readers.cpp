@@ -17,12 +17,6 @@
 namespace texlume::mesh {
 namespace {
 
-std::string Lower(std::string_view text) {
-  std::string s(text);
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 // Lines of a text file with their 1-based numbers; '\r' before '\n' is dropped.
 class LineCursor {
  public:
@@ -565,7 +559,7 @@ PolygonSoup ParseAsciiStl(std::string_view bytes, const std::string& label) {
   while (lines.Next(line)) {
     const std::vector<std::string_view> tokens = SplitWhitespace(line);
     if (tokens.empty()) continue;
-    const std::string keyword = Lower(tokens[0]);  // STL writers differ in case
+    const std::string keyword = LowerCase(tokens[0]);  // STL writers differ in case
     if (keyword == "facet") {
       if (in_facet) throw InputError(label, "'facet' inside a facet", lines.number());
       in_facet = true;
@@ -639,7 +633,7 @@ PolygonSoup ParseOff(std::string_view bytes, const std::string& label) {
   if (!NextOffLine(lines, tokens) || !IsOffKeyword(tokens[0])) {
     throw InputError(label, "not an OFF file (it does not start with 'OFF')", lines.number());
   }
-  if (tokens.size() > 1 && Lower(std::string(tokens[1])) == "binary") {
+  if (tokens.size() > 1 && LowerCase(std::string(tokens[1])) == "binary") {
     throw InputError(label, "binary OFF is not supported; write it as text OFF or PLY",
                      lines.number());
   }
@@ -703,7 +697,7 @@ PolygonSoup ParseStl(std::string_view bytes, const std::string& label) {
   const std::uint64_t binary_size = 84 + 50 * static_cast<std::uint64_t>(count);
   if (bytes.size() >= 84 && binary_size == bytes.size()) return ParseBinaryStl(bytes, count, label);
   const std::size_t first = bytes.find_first_not_of(" \t\r\n");
-  if (first != std::string_view::npos && Lower(bytes.substr(first, 5)) == "solid") {
+  if (first != std::string_view::npos && LowerCase(bytes.substr(first, 5)) == "solid") {
     return ParseAsciiStl(bytes, label);
   }
   if (bytes.size() < 84) throw InputError(label, "too short for an STL file");

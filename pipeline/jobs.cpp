@@ -113,9 +113,18 @@ nlohmann::json FitJobOptions::ToJson() const {
           {"robust_scale", fit.robust_scale}};
 }
 
-void RunFitJob(const FitJobOptions& options, std::ostream& out, const ProgressCallback& progress) {
+void RunFitJob(const FitJobOptions& options, std::ostream& out, std::ostream& err,
+               const ProgressCallback& progress) {
   options.Check();
+  RequireWritableFilePath(options.out_file);
+  if (!options.exr_file.empty()) RequireWritableFilePath(options.exr_file);
+  std::error_code ec;
+  if (!options.web_dir.empty() && fs::exists(options.web_dir, ec) &&
+      !fs::is_directory(options.web_dir, ec)) {
+    throw InputError(options.web_dir.string(), "exists and is not a folder");
+  }
   const ptm::RtiCapture capture = ptm::ReadRtiCapture(options.lights_file, options.images_dir);
+  for (const std::string& w : capture.warnings) err << "warning: " << w << "\n";
   ptm::CheckLightSet(capture.lights, options.fit, options.lights_file.string());
   const ptm::FitResult result =
       ptm::FitPtmFromFiles(capture.files, capture.lights, options.fit, progress);
@@ -137,6 +146,7 @@ void RunFitJob(const FitJobOptions& options, std::ostream& out, const ProgressCa
                       {"images", result.num_images},
                       {"mean_residual_rms", result.mean_residual_rms},
                       {"intensity_space", "display (sRGB-encoded) values in [0, 1]"}};
+  record["warnings"] = capture.warnings;
   record["timings_s"] = {{"fit", result.seconds}, {"write", write_seconds}};
   fs::path record_path = options.out_file;
   record_path += ".json";
@@ -210,6 +220,8 @@ nlohmann::json RelightJobOptions::ToJson() const {
 
 void RunRelightJob(const RelightJobOptions& options, std::ostream& out) {
   options.Check();
+  RequireWritableFilePath(options.out_file);
+  if (!options.normals_file.empty()) RequireWritableFilePath(options.normals_file);
   const Eigen::Vector3d light = options.light.normalized();
   const ptm::Ptm ptm = ptm::ReadPtmAnyFormat(options.ptm_file);
   WriteRgbImage(options.out_file, ptm::Relight(ptm, light, options.enhancement), ptm.width,
@@ -236,6 +248,7 @@ nlohmann::json SphereLightsJobOptions::ToJson() const {
 void RunSphereLightsJob(const SphereLightsJobOptions& options, std::ostream& out,
                         std::ostream& err) {
   options.Check();
+  RequireWritableFilePath(options.out_file);
   std::error_code ec;
   if (!fs::is_directory(options.images_dir, ec))
     throw InputError(options.images_dir.string(), "image folder not found");
@@ -284,10 +297,12 @@ nlohmann::json Synth2dJobOptions::ToJson() const {
 
 namespace {
 
-std::vector<synth::PlanarPhoto> ReadPlanarPhotos(const Synth2dJobOptions& options) {
+std::vector<synth::PlanarPhoto> ReadPlanarPhotos(const Synth2dJobOptions& options,
+                                                 std::ostream& err) {
   std::vector<synth::PlanarPhoto> photos;
   if (!options.synthesis.use_photos) return photos;
   const ptm::RtiCapture capture = ptm::ReadRtiCapture(options.lights_file, options.photos_dir);
+  for (const std::string& w : capture.warnings) err << "warning: " << w << "\n";
   for (std::size_t k = 0; k < capture.files.size(); ++k) {
     const cv::Mat f = ReadPhotoRgb(capture.files[k]);
     synth::PlanarPhoto photo;
@@ -327,11 +342,11 @@ void WriteRelitPhotos(const synth::PlanarSynthesisResult& result,
 
 }  // namespace
 
-void RunSynth2dJob(const Synth2dJobOptions& options, std::ostream& out) {
+void RunSynth2dJob(const Synth2dJobOptions& options, std::ostream& out, std::ostream& err) {
   options.Check();
   RequireReplaceableFolder(options.out_dir, "synth2d.json", "a texlume synth2d folder");
   const ptm::Ptm sample = ptm::ReadPtmAnyFormat(options.sample_file);
-  const std::vector<synth::PlanarPhoto> photos = ReadPlanarPhotos(options);
+  const std::vector<synth::PlanarPhoto> photos = ReadPlanarPhotos(options, err);
   const synth::PlanarSynthesisResult result =
       synth::SynthesizePlanarPtm(sample, photos, options.synthesis);
   PartialOutput output(options.out_dir, PartialOutput::Kind::kFolder);

@@ -44,7 +44,7 @@ struct FitJobOptions {
   void Check() const;
   nlohmann::json ToJson() const;
 };
-void RunFitJob(const FitJobOptions& options, std::ostream& out,
+void RunFitJob(const FitJobOptions& options, std::ostream& out, std::ostream& err,
                const ProgressCallback& progress = {});
 
 /// `texlume btf`: a BTF capture factorised by SVD (paper 004 §III), with the error table.
@@ -86,7 +86,7 @@ struct Synth2dJobOptions {
   void Check() const;
   nlohmann::json ToJson() const;
 };
-void RunSynth2dJob(const Synth2dJobOptions& options, std::ostream& out);
+void RunSynth2dJob(const Synth2dJobOptions& options, std::ostream& out, std::ostream& err);
 
 /// `texlume synth`: the main job with a PTM sample, or with a BTF sample when `btf`
 /// is set (the BTF job takes the PTM job's paths, layout and shared synthesis settings).

@@ -113,6 +113,7 @@ class RenderJob {
 
   void LoadViews() {
     cameras_ = sfm::ReadModel(options_.cameras_dir);
+    if (!cameras_.choice.empty()) summary_.warnings.push_back(cameras_.choice);
     // A view's buffers (colour, coverage, depth, rays and the truth): about 64 bytes a pixel.
     for (const auto& [id, camera] : cameras_.reconstruction.cameras) {
       RequireMemory(64.0 * static_cast<double>(camera.width) * static_cast<double>(camera.height),

@@ -107,7 +107,9 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   SynthInputs inputs;
   // Inputs.
-  inputs.reconstruction = sfm::ReadModel(options.model_dir).reconstruction;
+  sfm::LoadedModel loaded_model = sfm::ReadModel(options.model_dir);
+  if (!loaded_model.choice.empty()) inputs.warnings.push_back(loaded_model.choice);
+  inputs.reconstruction = std::move(loaded_model.reconstruction);
   const sfm::Reconstruction& reconstruction = inputs.reconstruction;
   const sfm::ObjectLights lights = sfm::ReadObjectLightsFile(options.lights_file);
   const sfm::LightsModelMatch match =

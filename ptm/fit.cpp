@@ -7,11 +7,14 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <iterator>
+#include <map>
 #include <memory>
 #include <thread>
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/file_util.h"
 #include "core/image_io.h"
 #include "sfm/lights.h"
 
@@ -225,6 +228,53 @@ void CheckLightSet(const std::vector<Eigen::Vector3d>& lights, const FitOptions&
   }
 }
 
+namespace {
+
+// The files of a capture folder by their lower-case names, read once.
+class CaptureFolder {
+ public:
+  explicit CaptureFolder(std::filesystem::path dir) : dir_(std::move(dir)) {}
+
+  // The file the .lp means by `name`: its exact name, else the one equal ignoring case.
+  std::filesystem::path Find(const std::string& name, const std::filesystem::path& lp_path,
+                             std::vector<std::string>& warnings) {
+    std::error_code ec;
+    const std::filesystem::path exact = dir_ / name;
+    if (std::filesystem::is_regular_file(exact, ec)) return exact;
+    const auto [first, last] = ByLowerCaseName().equal_range(LowerCase(name));
+    if (first == last) {
+      throw InputError(lp_path.string(),
+                       "names '" + name + "', but " + exact.string() + " does not exist");
+    }
+    if (std::next(first) != last) {
+      throw InputError(lp_path.string(), "names '" + name + "', which is not in " + dir_.string() +
+                                             "; several files match it ignoring case");
+    }
+    warnings.push_back(lp_path.string() + " names '" + name + "'; using " +
+                       first->second.filename().string() +
+                       ", the one file of that name ignoring case");
+    return first->second;
+  }
+
+ private:
+  const std::multimap<std::string, std::filesystem::path>& ByLowerCaseName() {
+    if (listed_) return by_lower_case_name_;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
+      if (entry.is_regular_file(ec))
+        by_lower_case_name_.emplace(LowerCase(entry.path().filename().string()), entry.path());
+    }
+    listed_ = true;
+    return by_lower_case_name_;
+  }
+
+  std::filesystem::path dir_;
+  bool listed_ = false;
+  std::multimap<std::string, std::filesystem::path> by_lower_case_name_;
+};
+
+}  // namespace
+
 RtiCapture ReadRtiCapture(const std::filesystem::path& lp_path,
                           const std::filesystem::path& images_dir) {
   std::error_code ec;
@@ -232,13 +282,9 @@ RtiCapture ReadRtiCapture(const std::filesystem::path& lp_path,
     throw InputError(images_dir.string(), "image folder not found");
   }
   RtiCapture capture;
+  CaptureFolder folder(images_dir);
   for (const auto& e : sfm::ReadLpFile(lp_path)) {
-    const std::filesystem::path file = images_dir / sfm::BaseName(e.filename);
-    if (!std::filesystem::is_regular_file(file, ec)) {
-      throw InputError(lp_path.string(),
-                       "names '" + e.filename + "', but " + file.string() + " does not exist");
-    }
-    capture.files.push_back(file);
+    capture.files.push_back(folder.Find(sfm::BaseName(e.filename), lp_path, capture.warnings));
     capture.lights.push_back(e.direction_in_image);
   }
   return capture;

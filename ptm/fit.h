@@ -82,10 +82,14 @@ FitResult FitPtmPerTexelLights(
 struct RtiCapture {
   std::vector<std::filesystem::path> files;
   std::vector<Eigen::Vector3d> lights;
+  /// Names the .lp gives that were found only ignoring case (a capture made on Windows).
+  std::vector<std::string> warnings;
 };
 
 /// Reads an .lp file and finds each image it names in `images_dir` (by file name).
-/// Throws InputError naming the .lp and the image when one is missing.
+/// A name with no file of that exact name takes the one file whose name matches it
+/// ignoring case, with a warning. Throws InputError naming the .lp and the image
+/// when there is none, or several.
 RtiCapture ReadRtiCapture(const std::filesystem::path& lp_path,
                           const std::filesystem::path& images_dir);
 

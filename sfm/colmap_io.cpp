@@ -1,10 +1,12 @@
 #include "sfm/colmap_io.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -454,23 +456,93 @@ void WritePoints3DBinary(const Reconstruction& reconstruction, std::ostream& out
 
 // ---------------------------------------------------------------------- folders
 
+namespace {
+
+bool HasModelFiles(const std::filesystem::path& dir, const char* ext) {
+  std::error_code ec;
+  for (const char* stem : {"cameras", "images", "points3D"}) {
+    if (!std::filesystem::is_regular_file(dir / (std::string(stem) + ext), ec)) return false;
+  }
+  return true;
+}
+
+// Subfolders in COLMAP's numbering order: numbered ones by number, then the rest by name.
+std::vector<std::filesystem::path> SubfoldersInOrder(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> folders;
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return folders;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    if (entry.is_directory(ec)) folders.push_back(entry.path());
+  }
+  auto key = [](const std::filesystem::path& p) {
+    const std::string name = p.filename().string();
+    const bool numbered = !name.empty() && name.size() < 10 &&
+                          name.find_first_not_of("0123456789") == std::string::npos;
+    return std::tuple(!numbered, numbered ? std::stoul(name) : 0ul, name);
+  };
+  std::sort(folders.begin(), folders.end(),
+            [&](const auto& a, const auto& b) { return key(a) < key(b); });
+  return folders;
+}
+
+std::size_t NumRegisteredImages(const std::filesystem::path& model_dir) {
+  const bool binary = DetectModelFormat(model_dir) == ModelFormat::kBinary;
+  const std::filesystem::path file = model_dir / (binary ? "images.bin" : "images.txt");
+  std::ifstream in = OpenForReading(file, binary);
+  return (binary ? ReadImagesBinary(in, file.string()) : ReadImagesText(in, file.string())).size();
+}
+
+}  // namespace
+
+bool IsModelFolder(const std::filesystem::path& dir) {
+  return HasModelFiles(dir, ".bin") || HasModelFiles(dir, ".txt");
+}
+
 ModelFormat DetectModelFormat(const std::filesystem::path& model_dir) {
   std::error_code ec;
   if (!std::filesystem::is_directory(model_dir, ec)) {
     throw InputError(model_dir.string(), "model folder not found");
   }
-  auto has_all = [&](const char* ext) {
-    for (const char* stem : {"cameras", "images", "points3D"}) {
-      if (!std::filesystem::is_regular_file(model_dir / (std::string(stem) + ext), ec)) {
-        return false;
-      }
-    }
-    return true;
-  };
-  if (has_all(".bin")) return ModelFormat::kBinary;
-  if (has_all(".txt")) return ModelFormat::kText;
+  if (HasModelFiles(model_dir, ".bin")) return ModelFormat::kBinary;
+  if (HasModelFiles(model_dir, ".txt")) return ModelFormat::kText;
   throw InputError(model_dir.string(),
                    "not a COLMAP model folder: needs cameras, images and points3D as .bin or .txt");
+}
+
+ModelFolderChoice FindModelFolder(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(path, ec)) {
+    throw InputError(path.string(), "COLMAP model folder not found");
+  }
+  if (IsModelFolder(path)) return {path, ""};
+  // A workspace root (`sparse/0`, ...), its `sparse/` folder, or a folder of models.
+  std::vector<std::filesystem::path> places = {path / "sparse"};
+  for (const auto& sub : SubfoldersInOrder(path / "sparse")) places.push_back(sub);
+  for (const auto& sub : SubfoldersInOrder(path)) {
+    if (sub.filename() != "sparse") places.push_back(sub);
+  }
+  std::vector<std::pair<std::filesystem::path, std::size_t>> models;
+  for (const auto& place : places) {
+    if (IsModelFolder(place)) models.emplace_back(place, NumRegisteredImages(place));
+  }
+  if (models.empty()) {
+    throw InputError(path.string(),
+                     "no COLMAP model found: looked for cameras, images and points3D (.bin or "
+                     ".txt) in this folder, in sparse/, and in the subfolders of both");
+  }
+  if (models.size() == 1) {
+    return {models[0].first, "using the COLMAP model in " + models[0].first.string()};
+  }
+  std::size_t best = 0;
+  std::string found;
+  for (std::size_t k = 0; k < models.size(); ++k) {
+    if (models[k].second > models[best].second) best = k;
+    found += (k ? ", " : "") + models[k].first.string() + " (" + std::to_string(models[k].second) +
+             " images)";
+  }
+  return {models[best].first,
+          "found " + std::to_string(models.size()) + " COLMAP models: " + found + "; using " +
+              models[best].first.string() + ", which registers the most images"};
 }
 
 Reconstruction ReadModel(const std::filesystem::path& model_dir, ModelFormat format) {
@@ -497,8 +569,12 @@ Reconstruction ReadModel(const std::filesystem::path& model_dir, ModelFormat for
   return r;
 }
 
-LoadedModel ReadModel(const std::filesystem::path& model_dir) {
+LoadedModel ReadModel(const std::filesystem::path& path) {
+  const ModelFolderChoice found = FindModelFolder(path);
+  const std::filesystem::path& model_dir = found.folder;
   LoadedModel loaded;
+  loaded.folder = model_dir;
+  loaded.choice = found.choice;
   loaded.format = DetectModelFormat(model_dir);
   loaded.reconstruction = ReadModel(model_dir, loaded.format);
   std::error_code ec;

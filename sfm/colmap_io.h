@@ -21,6 +21,10 @@ std::string ModelFormatName(ModelFormat format);
 struct LoadedModel {
   Reconstruction reconstruction;
   ModelFormat format = ModelFormat::kBinary;
+  /// The model folder read: the one given, or the one found under a workspace.
+  std::filesystem::path folder;
+  /// Why that folder was taken when it is not the one given (empty otherwise).
+  std::string choice;
   /// Files of newer COLMAP versions (rigs, frames) that were present and skipped.
   std::vector<std::filesystem::path> ignored_files;
 };
@@ -30,8 +34,24 @@ struct LoadedModel {
 /// files exist. Throws InputError naming the folder and the missing files otherwise.
 ModelFormat DetectModelFormat(const std::filesystem::path& model_dir);
 
-/// Reads a COLMAP 3.8 sparse model folder in the detected format and validates
-/// its cross references (ValidateReconstruction). Throws InputError on any problem.
+/// Whether `dir` holds cameras, images and points3D, all .bin or all .txt.
+bool IsModelFolder(const std::filesystem::path& dir);
+
+/// The model folder a user means by `path`, as COLMAP lays out a workspace:
+/// `path` itself when it is a model folder; else the model folders among `path`,
+/// `path/sparse`, and their subfolders (`sparse/0`, `sparse/1`, ...). With several,
+/// the one that registers the most images (the lowest-numbered of equals), and
+/// `choice` says which were found. Throws InputError naming `path` and every place
+/// looked at when there is none.
+struct ModelFolderChoice {
+  std::filesystem::path folder;
+  std::string choice;  ///< empty when `path` is the model folder
+};
+ModelFolderChoice FindModelFolder(const std::filesystem::path& path);
+
+/// Reads a COLMAP 3.8 sparse model (FindModelFolder: a model folder, `sparse/` or a
+/// workspace root) in the detected format and validates its cross references
+/// (ValidateReconstruction). Throws InputError on any problem.
 LoadedModel ReadModel(const std::filesystem::path& model_dir);
 /// Reads a model folder in the given format.
 Reconstruction ReadModel(const std::filesystem::path& model_dir, ModelFormat format);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/errors.h"
+#include "core/file_util.h"
 #include "sfm/lights.h"
 
 namespace texlume::sfm {
@@ -22,6 +23,8 @@ InspectReport RunInspect(const InspectOptions& options, const ProgressCallback& 
   LoadedModel model = ReadModel(options.model_dir);
   const Reconstruction& r = model.reconstruction;
   report.format = model.format;
+  report.model_folder = model.folder;
+  report.model_choice = model.choice;
   report.ignored_files = model.ignored_files;
   report.num_cameras = r.cameras.size();
   report.num_images = r.images.size();
@@ -36,10 +39,7 @@ InspectReport RunInspect(const InspectOptions& options, const ProgressCallback& 
 
   if (options.lights) {
     const std::filesystem::path& path = *options.lights;
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".lp") {
+    if (LowerCaseExtension(path) == ".lp") {
       report.lights_kind = ".lp";
       const auto entries = ReadLpFile(path);
       std::set<std::string> model_names;
@@ -93,6 +93,7 @@ InspectReport RunInspect(const InspectOptions& options, const ProgressCallback& 
 std::string FormatInspectReport(const InspectReport& rep) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(6);
+  if (!rep.model_choice.empty()) out << "Model: " << rep.model_choice << "\n";
   out << "Model format: " << ModelFormatName(rep.format) << "\n";
   for (const auto& f : rep.ignored_files) out << "Ignored (newer COLMAP): " << f.string() << "\n";
   out << "Cameras: " << rep.num_cameras;
@@ -155,6 +156,7 @@ std::string FormatInspectReport(const InspectReport& rep) {
 
 std::string InspectReportToJson(const InspectReport& rep) {
   nlohmann::json j;
+  j["model_folder"] = rep.model_folder.string();
   j["model_format"] = ModelFormatName(rep.format);
   j["cameras"] = rep.num_cameras;
   j["images"] = rep.num_images;

@@ -29,6 +29,8 @@ struct InspectOptions {
 /// Everything `texlume inspect` found.
 struct InspectReport {
   ModelFormat format = ModelFormat::kBinary;
+  std::filesystem::path model_folder;  ///< the model folder read (FindModelFolder)
+  std::string model_choice;            ///< why, when it is not the folder given
   std::vector<std::filesystem::path> ignored_files;
   std::size_t num_cameras = 0;
   std::size_t num_images = 0;

@@ -479,6 +479,14 @@ std::vector<BadInput> Catalogue() {
                 w("fit.ptm");
        },
        1, "lights.lp", "fit.ptm"},
+      {"FitIntoAFolderThatDoesNotExist",
+       [](const Workspace& w) {
+         // The damaged .lp is never read: the output is checked before the work.
+         WriteText(w.dir() / "photos/lights.lp", "2000000000\na.png 0 0 1\n");
+         return "fit --images " + w("photos") + " --lights " + w("photos/lights.lp") + " --out " +
+                w("no_such_folder/fit.ptm");
+       },
+       1, "no_such_folder does not exist", "no_such_folder"},
       // More PTM and EXR files.
       {"PtmOfAnUnknownFormat",
        [ok_scales, ok_biases](const Workspace& w) {

@@ -44,6 +44,20 @@ TEST(ReadFileBytes, ReadsWholeFilesAndRefusesMoreThanTheLimit) {
             std::string::npos);
 }
 
+TEST(RequireWritableFilePath, RefusesAMissingFolderAndAFolderNameBeforeAnyWork) {
+  TempDir tmp;
+  RequireWritableFilePath(tmp / "out.ptm");
+  RequireWritableFilePath("relative.ptm");  // the working folder
+  const std::string missing =
+      InputErrorMessage([&] { RequireWritableFilePath(tmp / "no/out.ptm"); });
+  EXPECT_NE(missing.find("the folder " + (tmp / "no").string() + " does not exist"),
+            std::string::npos)
+      << missing;
+  fs::create_directories(tmp / "dir");
+  EXPECT_NE(InputErrorMessage([&] { RequireWritableFilePath(tmp / "dir"); }).find("is a folder"),
+            std::string::npos);
+}
+
 TEST(PartialOutput, CommitRenamesAndReplacesAFolderWhole) {
   TempDir tmp;
   const fs::path out = tmp / "out";

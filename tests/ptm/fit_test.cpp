@@ -142,5 +142,35 @@ TEST(FitBadInput, FewDegenerateAndLowLightsAreRefused) {
   EXPECT_EQ(message(datasets::DomeLights(10, 20, 70, 0)), "");
 }
 
+TEST(RtiCapture, NamesOfAnotherCaseFindTheOneFileThatMatchesWithAWarning) {
+  testing::TempDir tmp;
+  testing::WriteText(tmp / "rti_000.png", "");
+  testing::WriteText(tmp / "rti_001.png", "");
+  testing::WriteText(tmp / "lights.lp", "2\nRTI_000.PNG 0 0 1\nrti_001.png 0.6 0 0.8\n");
+  const RtiCapture capture = ReadRtiCapture(tmp / "lights.lp", tmp.path());
+  ASSERT_EQ(capture.files.size(), 2u);
+  EXPECT_EQ(capture.files[0], tmp / "rti_000.png");
+  EXPECT_EQ(capture.files[1], tmp / "rti_001.png");
+  ASSERT_EQ(capture.warnings.size(), 1u);  // the exact name takes no warning
+  EXPECT_NE(capture.warnings[0].find("'RTI_000.PNG'; using rti_000.png"), std::string::npos)
+      << capture.warnings[0];
+}
+
+TEST(RtiCaptureBadInput, AmbiguousAndMissingNamesAreRefused) {
+  testing::TempDir tmp;
+  testing::WriteText(tmp / "rti_000.png", "");
+  testing::WriteText(tmp / "Rti_000.png", "");
+  testing::WriteText(tmp / "lights.lp", "1\nRTI_000.PNG 0 0 1\n");
+  EXPECT_NE(testing::InputErrorMessage([&] {
+              ReadRtiCapture(tmp / "lights.lp", tmp.path());
+            }).find("several files match it ignoring case"),
+            std::string::npos);
+  testing::WriteText(tmp / "lights.lp", "1\nrti_009.png 0 0 1\n");
+  EXPECT_NE(testing::InputErrorMessage([&] {
+              ReadRtiCapture(tmp / "lights.lp", tmp.path());
+            }).find("does not exist"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace texlume::ptm

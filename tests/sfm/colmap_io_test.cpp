@@ -236,6 +236,50 @@ TEST(ColmapIoBadInput, DanglingReferencesAreRefused) {
             std::string::npos);
 }
 
+// A COLMAP workspace as `colmap mapper` leaves it: models in sparse/0, sparse/1, ...
+TEST(ColmapWorkspace, RootSparseAndModelFolderAllFindTheModelWithTheMostImages) {
+  TempDir tmp;
+  const Reconstruction r = MakeTestReconstruction();
+  Reconstruction smaller = r;
+  smaller.images.erase(std::prev(smaller.images.end()));
+  for (auto& [id, point] : smaller.points3d) {
+    std::erase_if(point.track,
+                  [&](const TrackElement& e) { return !smaller.images.count(e.image_id); });
+  }
+  WriteModel(smaller, tmp / "ws/sparse/0", ModelFormat::kBinary);
+  WriteModel(r, tmp / "ws/sparse/1", ModelFormat::kText);
+  std::filesystem::create_directories(tmp / "ws/images");
+  for (const auto& given : {tmp / "ws", tmp / "ws/sparse"}) {
+    const LoadedModel loaded = ReadModel(given);
+    EXPECT_EQ(loaded.folder, tmp / "ws/sparse/1") << given;
+    EXPECT_EQ(loaded.reconstruction.images.size(), r.images.size());
+    EXPECT_NE(loaded.choice.find("found 2 COLMAP models"), std::string::npos) << loaded.choice;
+    EXPECT_NE(loaded.choice.find("registers the most images"), std::string::npos);
+  }
+  const LoadedModel direct = ReadModel(tmp / "ws/sparse/0");
+  EXPECT_EQ(direct.folder, tmp / "ws/sparse/0");
+  EXPECT_EQ(direct.choice, "");
+  // A model written straight into sparse/ (model_converter) is taken alone.
+  WriteModel(r, tmp / "ws2/sparse", ModelFormat::kBinary);
+  EXPECT_EQ(ReadModel(tmp / "ws2").folder, tmp / "ws2/sparse");
+}
+
+TEST(ColmapWorkspace, EqualModelsTakeTheLowestNumber) {
+  TempDir tmp;
+  const Reconstruction r = MakeTestReconstruction();
+  for (const char* n : {"10", "2", "3"}) WriteModel(r, tmp / "sparse" / n, ModelFormat::kBinary);
+  EXPECT_EQ(FindModelFolder(tmp.path()).folder, tmp / "sparse/2");
+}
+
+TEST(ColmapIoBadInput, AWorkspaceWithoutAModelSaysWhereItLooked) {
+  TempDir tmp;
+  std::filesystem::create_directories(tmp / "ws/sparse/0");
+  std::filesystem::create_directories(tmp / "ws/images");
+  const std::string message = testing::InputErrorMessage([&] { ReadModel(tmp / "ws"); });
+  EXPECT_NE(message.find("no COLMAP model found"), std::string::npos) << message;
+  EXPECT_NE(message.find("sparse/"), std::string::npos) << message;
+}
+
 TEST(ColmapIoBadInput, MissingFolderOrFilesAreNamed) {
   TempDir tmp;
   EXPECT_NE(
@@ -243,8 +287,12 @@ TEST(ColmapIoBadInput, MissingFolderOrFilesAreNamed) {
       std::string::npos);
   WriteText(tmp / "cameras.txt", "");
   EXPECT_NE(
-      testing::InputErrorMessage([&] { ReadModel(tmp.path()); }).find("not a COLMAP model folder"),
+      testing::InputErrorMessage([&] { ReadModel(tmp.path()); }).find("no COLMAP model found"),
       std::string::npos);
+  EXPECT_NE(testing::InputErrorMessage([&] {
+              DetectModelFormat(tmp.path());
+            }).find("not a COLMAP model folder"),
+            std::string::npos);
 }
 
 }  // namespace
