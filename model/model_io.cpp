@@ -5,12 +5,14 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/partial_output.h"
+#include "model/glb_writer.h"
 #include "ptm/ptm_io.h"
 #include "synth/mesh_synthesis.h"
 
@@ -32,6 +34,11 @@ void WriteObj(const fs::path& path, const TexturedModel& model) {
     std::snprintf(line, sizeof line, "v %.9g %.9g %.9g\n", v.x(), v.y(), v.z());
     out << line;
   }
+  // Smooth normals, one per vertex (vn k belongs to v k).
+  for (const Eigen::Vector3d& n : mesh::VertexNormals(model.mesh)) {
+    std::snprintf(line, sizeof line, "vn %.6f %.6f %.6f\n", n.x(), n.y(), n.z());
+    out << line;
+  }
   for (std::size_t f = 0; f < model.mesh.faces.size(); ++f) {
     const ptm::Ptm& atlas = model.atlases[static_cast<std::size_t>(model.face_atlas[f])];
     for (const Eigen::Vector2f& c : model.corner_px[f]) {
@@ -45,13 +52,48 @@ void WriteObj(const fs::path& path, const TexturedModel& model) {
     for (std::size_t f = 0; f < model.mesh.faces.size(); ++f) {
       if (model.face_atlas[f] != static_cast<int>(a)) continue;
       out << "f";
-      for (int k = 0; k < 3; ++k)
-        out << " " << model.mesh.faces[f][static_cast<std::size_t>(k)] + 1 << "/" << f * 3 + k + 1;
+      for (int k = 0; k < 3; ++k) {
+        const int v = model.mesh.faces[f][static_cast<std::size_t>(k)] + 1;
+        out << " " << v << "/" << f * 3 + k + 1 << "/" << v;
+      }
       out << "\n";
     }
   }
   out.close();
   if (!out) throw InputError(path.string(), "cannot be written (disk full?)");
+}
+
+nlohmann::json Rows(const Eigen::Matrix4d& m) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+  return rows;
+}
+
+nlohmann::json GltfFrameJson(const TexturedModel& model) {
+  const Eigen::Vector3d& up = model.orientation.up;
+  const Eigen::Vector3d& front = model.orientation.front;
+  return {{"up_in_model", {up.x(), up.y(), up.z()}},
+          {"front_in_model", {front.x(), front.y(), front.z()}},
+          {"gltf_from_model", Rows(GltfFromModel(model))},
+          {"meaning",
+           "model.glb's node matrix (rows here): glTF's +Y is up_in_model (up as the "
+           "photos were taken), +Z front_in_model (toward the photos), the lowest point at Y = 0; "
+           "model.obj keeps the model's (COLMAP's) frame"}};
+}
+
+// A unit direction the manifest records as [x, y, z]; InputError naming it otherwise.
+Eigen::Vector3d DirectionFromJson(const nlohmann::json& value, const std::string& file,
+                                  const std::string& key) {
+  Eigen::Vector3d d = Eigen::Vector3d::Zero();
+  if (value.is_array() && value.size() == 3) {
+    for (int k = 0; k < 3; ++k)
+      d[k] = value[static_cast<std::size_t>(k)].is_number()
+                 ? value[static_cast<std::size_t>(k)].get<double>()
+                 : NAN;
+  }
+  if (!d.allFinite() || std::abs(d.norm() - 1.0) > 1e-3)
+    throw InputError(file, "gltf_frame: " + key + " is not a unit vector [x, y, z]");
+  return d;
 }
 
 }  // namespace
@@ -65,6 +107,20 @@ cv::Mat BaseColourImage(const ptm::Ptm& ptm) {
         out.at<cv::Vec3b>(y, x)[2 - c] = cv::saturate_cast<std::uint8_t>(
             255.0f *
             rgb[(static_cast<std::size_t>(y) * ptm.width + x) * 3 + static_cast<std::size_t>(c)]);
+  return out;
+}
+
+cv::Mat NormalMapImage(const ptm::Ptm& ptm) {
+  const std::vector<float> normals = ptm::NormalMap(ptm);
+  cv::Mat out(ptm.height, ptm.width, CV_8UC3);
+  for (int y = 0; y < ptm.height; ++y) {
+    for (int x = 0; x < ptm.width; ++x) {
+      const std::size_t t = static_cast<std::size_t>(y) * ptm.width + x;
+      for (int c = 0; c < 3; ++c)
+        out.at<cv::Vec3b>(y, x)[2 - c] = cv::saturate_cast<std::uint8_t>(
+            127.5f * (normals[t * 3 + static_cast<std::size_t>(c)] + 1.0f));
+    }
+  }
   return out;
 }
 
@@ -83,129 +139,6 @@ cv::Mat AlbedoImage(const ptm::Ptm& ptm) {
     }
   }
   return out;
-}
-
-void WriteGlb(const fs::path& path, const TexturedModel& model,
-              const std::vector<std::vector<unsigned char>>& base_colour_png,
-              const std::vector<nlohmann::json>& material_extras) {
-  const std::vector<Eigen::Vector3d> normals = mesh::VertexNormals(model.mesh);
-  std::vector<unsigned char> bin;
-  auto align4 = [&]() {
-    while (bin.size() % 4) bin.push_back(0);
-  };
-  auto append = [&](const void* data, std::size_t bytes) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    bin.insert(bin.end(), p, p + bytes);
-  };
-  nlohmann::json gltf;
-  gltf["asset"] = {{"version", "2.0"}, {"generator", "texlume"}};
-  gltf["scene"] = 0;
-  gltf["scenes"] = {{{"nodes", {0}}}};
-  gltf["nodes"] = {{{"mesh", 0}, {"name", "model"}}};
-  nlohmann::json buffer_views = nlohmann::json::array(), accessors = nlohmann::json::array();
-  nlohmann::json primitives = nlohmann::json::array(), materials = nlohmann::json::array();
-  nlohmann::json images = nlohmann::json::array(), textures = nlohmann::json::array();
-  auto add_view = [&](std::size_t offset, std::size_t length, int target) {
-    nlohmann::json v = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}};
-    if (target) v["target"] = target;
-    buffer_views.push_back(v);
-    return static_cast<int>(buffer_views.size() - 1);
-  };
-  for (std::size_t a = 0; a < model.atlases.size(); ++a) {
-    // Unshared corners (texture seams everywhere between charts).
-    std::vector<float> positions, vertex_normals, uvs;
-    std::vector<std::uint32_t> indices;
-    Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), hi = -lo;
-    const ptm::Ptm& atlas = model.atlases[a];
-    for (std::size_t f = 0; f < model.mesh.faces.size(); ++f) {
-      if (model.face_atlas[f] != static_cast<int>(a)) continue;
-      for (int k = 0; k < 3; ++k) {
-        const int v = model.mesh.faces[f][static_cast<std::size_t>(k)];
-        const Eigen::Vector3f p = model.mesh.vertices[static_cast<std::size_t>(v)].cast<float>();
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
-        positions.insert(positions.end(), {p.x(), p.y(), p.z()});
-        const Eigen::Vector3f n = normals[static_cast<std::size_t>(v)].cast<float>();
-        vertex_normals.insert(vertex_normals.end(), {n.x(), n.y(), n.z()});
-        const Eigen::Vector2f c = model.corner_px[f][static_cast<std::size_t>(k)];
-        uvs.insert(uvs.end(), {c.x() / atlas.width, c.y() / atlas.height});
-        indices.push_back(static_cast<std::uint32_t>(indices.size()));
-      }
-    }
-    if (indices.empty()) continue;
-    const std::size_t count = indices.size();
-    align4();
-    const int pos_view = add_view(bin.size(), positions.size() * 4, 34962);
-    append(positions.data(), positions.size() * 4);
-    const int nrm_view = add_view(bin.size(), vertex_normals.size() * 4, 34962);
-    append(vertex_normals.data(), vertex_normals.size() * 4);
-    const int uv_view = add_view(bin.size(), uvs.size() * 4, 34962);
-    append(uvs.data(), uvs.size() * 4);
-    const int idx_view = add_view(bin.size(), indices.size() * 4, 34963);
-    append(indices.data(), indices.size() * 4);
-    align4();
-    const int img_view = add_view(bin.size(), base_colour_png[a].size(), 0);
-    append(base_colour_png[a].data(), base_colour_png[a].size());
-    const int first = static_cast<int>(accessors.size());
-    accessors.push_back({{"bufferView", pos_view},
-                         {"componentType", 5126},
-                         {"count", count},
-                         {"type", "VEC3"},
-                         {"min", {lo.x(), lo.y(), lo.z()}},
-                         {"max", {hi.x(), hi.y(), hi.z()}}});
-    accessors.push_back(
-        {{"bufferView", nrm_view}, {"componentType", 5126}, {"count", count}, {"type", "VEC3"}});
-    accessors.push_back(
-        {{"bufferView", uv_view}, {"componentType", 5126}, {"count", count}, {"type", "VEC2"}});
-    accessors.push_back(
-        {{"bufferView", idx_view}, {"componentType", 5125}, {"count", count}, {"type", "SCALAR"}});
-    images.push_back({{"bufferView", img_view},
-                      {"mimeType", "image/png"},
-                      {"name", "base_colour_" + std::to_string(a)}});
-    textures.push_back({{"source", images.size() - 1}, {"sampler", 0}});
-    nlohmann::json material = {{"name", "atlas_" + std::to_string(a)},
-                               {"pbrMetallicRoughness",
-                                {{"baseColorTexture", {{"index", textures.size() - 1}}},
-                                 {"metallicFactor", 0.0},
-                                 {"roughnessFactor", 1.0}}}};
-    if (a < material_extras.size()) material["extras"] = material_extras[a];
-    materials.push_back(material);
-    primitives.push_back(
-        {{"attributes", {{"POSITION", first}, {"NORMAL", first + 1}, {"TEXCOORD_0", first + 2}}},
-         {"indices", first + 3},
-         {"material", materials.size() - 1},
-         {"mode", 4}});
-  }
-  align4();
-  gltf["meshes"] = {{{"primitives", primitives}, {"name", "model"}}};
-  gltf["accessors"] = accessors;
-  gltf["bufferViews"] = buffer_views;
-  gltf["buffers"] = {{{"byteLength", bin.size()}}};
-  gltf["images"] = images;
-  gltf["textures"] = textures;
-  gltf["samplers"] = {
-      {{"magFilter", 9729}, {"minFilter", 9987}, {"wrapS", 33071}, {"wrapT", 33071}}};
-  gltf["materials"] = materials;
-  std::string json = gltf.dump();
-  while (json.size() % 4) json.push_back(' ');
-  const std::uint32_t total =
-      12 + 8 + static_cast<std::uint32_t>(json.size()) + 8 + static_cast<std::uint32_t>(bin.size());
-  WriteFileAtomically(
-      path,
-      [&](std::ostream& out) {
-        auto u32 = [&](std::uint32_t v) { WriteU32(out, v); };
-        u32(0x46546C67);  // "glTF"
-        u32(2);
-        u32(total);
-        u32(static_cast<std::uint32_t>(json.size()));
-        u32(0x4E4F534A);  // "JSON"
-        out.write(json.data(), static_cast<std::streamsize>(json.size()));
-        u32(static_cast<std::uint32_t>(bin.size()));
-        u32(0x004E4942);  // "BIN\0"
-        out.write(reinterpret_cast<const char*>(bin.data()),
-                  static_cast<std::streamsize>(bin.size()));
-      },
-      true);
 }
 
 void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlohmann::json& record,
@@ -232,45 +165,60 @@ void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlo
         {"below_horizon_elevation",
          "value at horizon_elevation_deg (same azimuth) times l_z / sin(horizon_elevation_deg)"},
         {"light_response", LightResponseJson(model.light_response)}};
+    manifest["gltf_frame"] = GltfFrameJson(model);
     manifest["atlases"] = nlohmann::json::array();
-    std::vector<std::vector<unsigned char>> pngs;
-    std::vector<nlohmann::json> extras;
+    std::vector<GlbAtlas> glb_atlases;
     std::ofstream mtl(tmp / "model.mtl");
-    mtl << "# texlume: base colour = PTM under a head-on light; albedo and PTM atlases alongside\n";
+    mtl << "# texlume: albedo and normal map from the PTM atlases (model.glb carries them too)\n";
     for (std::size_t a = 0; a < model.atlases.size(); ++a) {
       const std::string k = std::to_string(a);
       const std::string base = "base_colour_" + k + ".png", albedo = "albedo_" + k + ".png";
+      const std::string normal = "normal_" + k + ".png";
       const std::string ptm_file = "ptm_atlas_" + k + ".ptm", exr_file = "ptm_atlas_" + k + ".exr";
-      pngs.push_back(EncodePng(BaseColourImage(model.atlases[a]), base));
-      WriteBytesAtomically(tmp / base, pngs.back());
-      WriteBytesAtomically(tmp / albedo, EncodePng(AlbedoImage(model.atlases[a]), albedo));
+      GlbAtlas& glb = glb_atlases.emplace_back();
+      WriteBytesAtomically(tmp / base, EncodePng(BaseColourImage(model.atlases[a]), base));
+      glb.albedo_png = EncodePng(AlbedoImage(model.atlases[a]), albedo);
+      WriteBytesAtomically(tmp / albedo, glb.albedo_png);
+      glb.normal_png = EncodePng(NormalMapImage(model.atlases[a]), normal);
+      WriteBytesAtomically(tmp / normal, glb.normal_png);
       ptm::WritePtmFile(model.atlases[a], tmp / ptm_file);
       ptm::WritePtmExr(model.atlases[a], tmp / exr_file);
+      const ptm::WebPlanes web = ptm::QuantiseWebPlanes(model.atlases[a]);
+      for (const cv::Mat& plane : web.images)
+        glb.ptm_plane_pngs.push_back(EncodePng(plane, "a PTM plane of " + ptm_file));
       const std::string format = model.atlases[a].format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB";
       nlohmann::json entry = {{"ptm", ptm_file},
                               {"exr", exr_file},
                               {"base_colour", base},
                               {"albedo", albedo},
+                              {"normal", normal},
                               {"width", model.atlases[a].width},
                               {"height", model.atlases[a].height},
                               {"format", format}};
       manifest["atlases"].push_back(entry);
-      extras.push_back(
-          {{"texlume_ptm",
-            {{"ptm", ptm_file},
-             {"exr", exr_file},
-             {"format", format},
-             {"frame", manifest["ptm_frame"]},
-             {"evaluation", manifest["ptm_evaluation"]},
-             {"texcoord", "TEXCOORD_0 (glTF v down; the PTM's y axis points to -v)"}}}});
-      mtl << "newmtl atlas_" << k << "\nKa 0 0 0\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd " << base
-          << "\n# albedo: " << albedo << "; PTM: " << ptm_file << " (lossless " << exr_file
-          << ")\n\n";
+      const nlohmann::json ptm_fields = {
+          {"format", format},
+          {"frame", manifest["ptm_frame"]},
+          {"evaluation", manifest["ptm_evaluation"]},
+          {"texcoord", "TEXCOORD_0 (glTF v down; the PTM's y axis points to -v)"}};
+      glb.extras = {{"texlume_ptm", ptm_fields}};
+      glb.extras["texlume_ptm"]["ptm"] = ptm_file;
+      glb.extras["texlume_ptm"]["exr"] = exr_file;
+      glb.ptm_fields = ptm_fields;
+      glb.ptm_fields.update(web.Info(model.atlases[a]));
+      glb.ptm_fields["plane_order"] =
+          "relight's web format: value = (byte / 255 - bias) * scale per plane; planes "
+          "(1, u, v, u^2, uv, v^2), after R, G, B for LRGB, per channel for RGB";
+      // The albedo under the relief: norm (MTL's PBR extension) and map_Bump (which
+      // Blender reads as a normal map) give the normal map.
+      mtl << "newmtl atlas_" << k << "\nKa 0 0 0\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd " << albedo
+          << "\nnorm " << normal << "\nmap_Bump " << normal << "\n# head-on base colour: " << base
+          << "; PTM: " << ptm_file << " (lossless " << exr_file << ")\n\n";
     }
     mtl.close();
     if (!mtl) throw InputError((dir / "model.mtl").string(), "cannot be written (disk full?)");
     WriteObj(tmp / "model.obj", model);
-    WriteGlb(tmp / "model.glb", model, pngs, extras);
+    WriteGlb(tmp / "model.glb", model, glb_atlases);
     nlohmann::json files = nlohmann::json::array();
     for (const auto& [name, image] : extra_images) {
       WriteBytesAtomically(tmp / name, EncodePng(image, name));
@@ -376,6 +324,13 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
   if (evaluation.is_object() && evaluation.contains("light_response"))
     model.light_response =
         LightResponseFromJson(evaluation["light_response"], manifest_path.string());
+  if (manifest.contains("gltf_frame") && manifest["gltf_frame"].is_object()) {
+    const nlohmann::json& frame = manifest["gltf_frame"];
+    model.orientation.up = DirectionFromJson(frame.value("up_in_model", nlohmann::json()),
+                                             manifest_path.string(), "up_in_model");
+    model.orientation.front = DirectionFromJson(frame.value("front_in_model", nlohmann::json()),
+                                                manifest_path.string(), "front_in_model");
+  }
   for (const auto& entry : manifest["atlases"]) {
     if (!entry.is_object() || !entry.contains("exr") || !entry["exr"].is_string())
       throw InputError(manifest_path.string(), "an atlas entry has no \"exr\" file");
@@ -428,9 +383,10 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
         if (!(s >> corner))
           throw InputError(obj_path.string(), "a face needs 3 corners", line_number);
         std::istringstream cs(corner);
+        int normal = 0;
         if (!(cs >> v[static_cast<std::size_t>(k)] >> slash >> t[static_cast<std::size_t>(k)]) ||
-            slash != '/')
-          throw InputError(obj_path.string(), "face corners must be v/vt", line_number);
+            slash != '/' || (cs >> slash && (slash != '/' || !(cs >> normal) || normal < 1)))
+          throw InputError(obj_path.string(), "face corners must be v/vt or v/vt/vn", line_number);
         if (v[static_cast<std::size_t>(k)] < 1 ||
             v[static_cast<std::size_t>(k)] > static_cast<int>(model.mesh.vertices.size()) ||
             t[static_cast<std::size_t>(k)] < 1 ||

@@ -13,6 +13,7 @@
 #include "core/json_io.h"
 #include "mesh/mesh.h"
 #include "ptm/ptm.h"
+#include "sfm/alignment.h"
 
 namespace texlume::model {
 
@@ -30,6 +31,9 @@ struct TexturedModel {
   std::vector<int> face_atlas;
   std::vector<ptm::Ptm> atlases;
   ptm::LightResponse light_response;
+  /// Up and the photos' side in the model's frame (sfm::OrientationFromCameras): how
+  /// the GLB stands in glTF's frame. COLMAP's convention when not set.
+  sfm::ViewingOrientation orientation;
 };
 
 /// The light response as the manifest's and the glTF extras' "ptm_evaluation"
@@ -41,15 +45,14 @@ ptm::LightResponse LightResponseFromJson(const nlohmann::json& record, const std
 
 /// Writes the model into `dir` (created; an existing texlume model folder there
 /// is replaced, anything else is an error): model.obj + model.mtl with
-/// base_colour_K.png (the PTM at a head-on light) and albedo_K.png; the PTM
-/// atlases as ptm_atlas_K.ptm and lossless ptm_atlas_K.exr; model.glb (glTF
-/// 2.0 binary, base colour, the PTM atlases described in the material's
-/// `extras`); manifest.json listing every file with `record` (settings, timings)
-/// merged in. Everything is written under a temporary name first and renamed
-/// into place, so a failure leaves no half-written folder.
-/// `extra_images`: further PNGs to include (name -> 8-bit BGR image);
-/// `write_more`, when set, writes further files into the temporary folder it
-/// is given (listed in the manifest too, by their paths relative to `dir`).
+/// base_colour_K.png (the PTM at a head-on light), albedo_K.png and normal_K.png
+/// (the PTM normals; the MTL's `norm` and `map_Bump`), vertex normals (`vn`); the PTM
+/// atlases as ptm_atlas_K.ptm and lossless ptm_atlas_K.exr; model.glb (glb_writer.h:
+/// glTF's frame, albedo, normal map, the PTM atlases embedded); manifest.json listing every file
+/// with `record` (settings, timings) merged in. Everything is written under a temporary name first
+/// and renamed into place, so a failure leaves no half-written folder. `extra_images`: further PNGs
+/// to include (name -> 8-bit BGR image); `write_more`, when set, writes further files into the
+/// temporary folder it is given (listed in the manifest too, by their paths relative to `dir`).
 void WriteModelFolder(const std::filesystem::path& dir, const TexturedModel& model,
                       const nlohmann::json& record,
                       const std::vector<std::pair<std::string, cv::Mat>>& extra_images = {},
@@ -79,12 +82,9 @@ TexturedModel ReadModelFolder(const std::filesystem::path& dir);
 /// (head-on value over the PTM normal's z, linear domain), as 8-bit BGR images.
 cv::Mat BaseColourImage(const ptm::Ptm& ptm);
 cv::Mat AlbedoImage(const ptm::Ptm& ptm);
-
-/// Writes a glTF 2.0 binary: positions, smooth normals, TEXCOORD_0 (glTF's v
-/// down), one primitive and material per atlas with its base-colour PNG
-/// embedded; `material_extras[k]` goes into material k's extras.
-void WriteGlb(const std::filesystem::path& path, const TexturedModel& model,
-              const std::vector<std::vector<unsigned char>>& base_colour_png,
-              const std::vector<nlohmann::json>& material_extras);
+/// The PTM normals (ptm::NormalMap) as a tangent-space normal map in the atlas frame
+/// (x = dP/du, y = dP/dv with v up, z = the face normal): 8-bit BGR of (n + 1) / 2,
+/// linear, the convention of glTF's normalTexture and of Blender (+Y up the image).
+cv::Mat NormalMapImage(const ptm::Ptm& ptm);
 
 }  // namespace texlume::model

@@ -115,8 +115,8 @@ class BtfSynthJob {
                                     : "none";
     summary_.occupancy = atlases_.occupancy;
     t = std::chrono::steady_clock::now();
-    model_ = pipeline::TexturedModelOf(
-        inputs_.mesh, atlas::PreviewPtms(atlases_, sample_, progress_), atlases_.layout.faces);
+    model_ = pipeline::TexturedModelOf(inputs_, atlas::PreviewPtms(atlases_, sample_, progress_),
+                                       atlases_.layout.faces);
     model_.light_response = synthesis_.light_response;
     summary_.seconds_preview = SecondsSince(t);
     baked_ =

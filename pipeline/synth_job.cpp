@@ -1,5 +1,6 @@
 #include "pipeline/synth_job.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <fstream>
@@ -20,6 +21,7 @@
 #include "ptm/ptm_io.h"
 #include "render/model_render.h"
 #include "report/report.h"
+#include "sfm/alignment.h"
 #include "sfm/colmap_io.h"
 #include "sfm/lights.h"
 #include "synth/colour_sample.h"
@@ -281,10 +283,14 @@ void RefuseForeignModelFolder(const fs::path& out) {
   RequireReplaceableFolder(out, "manifest.json", "a texlume model folder");
 }
 
-model::TexturedModel TexturedModelOf(const mesh::TriangleMesh& mesh, std::vector<ptm::Ptm> atlases,
+model::TexturedModel TexturedModelOf(const SynthInputs& inputs, std::vector<ptm::Ptm> atlases,
                                      const std::vector<atlas::FacePlacement>& faces) {
   model::TexturedModel model;
-  model.mesh = mesh;
+  model.mesh = inputs.mesh;
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& v : inputs.mesh.vertices) box.extend(v);
+  if (!box.isEmpty())
+    model.orientation = sfm::OrientationFromCameras(inputs.reconstruction, box.center());
   model.atlases = std::move(atlases);
   for (const atlas::FacePlacement& fp : faces) {
     model.face_atlas.push_back(fp.atlas);
@@ -363,7 +369,7 @@ class SynthJob {
                                     : "none";
     summary_.occupancy = atlases.occupancy;
     summary_.stretch = atlases.stretch;
-    model_ = TexturedModelOf(inputs_.mesh, std::move(atlases.ptms), atlases.faces);
+    model_ = TexturedModelOf(inputs_, std::move(atlases.ptms), atlases.faces);
     model_.light_response = synthesis_.light_response;
   }
 

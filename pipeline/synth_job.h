@@ -118,9 +118,10 @@ nlohmann::json EngineSummaryJson(const synth::TriangleSynthesis& synthesis);
 /// (InputError naming it): a job never replaces anything else.
 void RefuseForeignModelFolder(const std::filesystem::path& out_dir);
 
-/// The textured model of a layout: the mesh, and per face its atlas and its
-/// corners' texture coordinates (FacePlacement), with the atlases.
-model::TexturedModel TexturedModelOf(const mesh::TriangleMesh& mesh, std::vector<ptm::Ptm> atlases,
+/// The textured model of a layout: the inputs' mesh, and per face its atlas and its
+/// corners' texture coordinates (FacePlacement), with the atlases; oriented by the
+/// inputs' cameras (sfm::OrientationFromCameras about the mesh's bounding box centre).
+model::TexturedModel TexturedModelOf(const SynthInputs& inputs, std::vector<ptm::Ptm> atlases,
                                      const std::vector<atlas::FacePlacement>& faces);
 
 /// Runs the whole job: reads and checks the inputs, visibility and best views,

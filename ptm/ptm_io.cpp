@@ -329,66 +329,65 @@ Ptm ReadPtmExrBytes(std::string_view bytes, const std::string& label) {
   return PtmFromExrPlanes(planes, names, label);
 }
 
-int WriteRelightWeb(const Ptm& ptm, const std::filesystem::path& dir, int jpeg_quality) {
-  std::filesystem::create_directories(dir);
-  // Web planes in OpenLIME's PTM basis order (1, x, y, x^2, xy, y^2).
+WebPlanes QuantiseWebPlanes(const Ptm& ptm) {
+  // OpenLIME's PTM basis order (1, x, y, x^2, xy, y^2) in texlume's coefficient indices.
   constexpr int kWebOrder[6] = {5, 3, 4, 0, 2, 1};
   std::vector<std::vector<float>> planes;  // each: one value per texel
+  auto add_plane = [&](auto value_of_texel) {
+    std::vector<float>& p = planes.emplace_back(ptm.NumTexels());
+    for (std::size_t t = 0; t < ptm.NumTexels(); ++t) p[t] = value_of_texel(t);
+  };
   if (ptm.format == PtmFormat::kLrgb) {
-    for (int c = 0; c < 3; ++c) {
-      std::vector<float> p(ptm.NumTexels());
-      for (std::size_t t = 0; t < ptm.NumTexels(); ++t)
-        p[t] = ptm.colour[t * 3 + static_cast<std::size_t>(c)];
-      planes.push_back(std::move(p));
-    }
-    for (int i : kWebOrder) {
-      std::vector<float> p(ptm.NumTexels());
-      for (std::size_t t = 0; t < ptm.NumTexels(); ++t) p[t] = ptm.Coefficients(t)[i];
-      planes.push_back(std::move(p));
-    }
+    for (std::size_t c = 0; c < 3; ++c)
+      add_plane([&](std::size_t t) { return ptm.colour[t * 3 + c]; });
+    for (int i : kWebOrder) add_plane([&](std::size_t t) { return ptm.Coefficients(t)[i]; });
   } else {
-    for (int i : kWebOrder) {
-      for (int c = 0; c < 3; ++c) {
-        std::vector<float> p(ptm.NumTexels());
-        for (std::size_t t = 0; t < ptm.NumTexels(); ++t) p[t] = ptm.Coefficients(t, c)[i];
-        planes.push_back(std::move(p));
-      }
-    }
+    for (int i : kWebOrder)
+      for (int c = 0; c < 3; ++c)
+        add_plane([&](std::size_t t) { return ptm.Coefficients(t, c)[i]; });
   }
-  nlohmann::json info;
-  info["width"] = ptm.width;
-  info["height"] = ptm.height;
-  info["format"] = "jpg";
-  info["type"] = "ptm";
-  info["colorspace"] = ptm.format == PtmFormat::kLrgb ? "lrgb" : "rgb";
-  info["nplanes"] = planes.size();
-  info["quality"] = jpeg_quality;
-  std::vector<float> scales, biases;
-  // value = (byte / 255 - bias) * scale
-  for (auto& p : planes) {
-    auto [lo_it, hi_it] = std::minmax_element(p.begin(), p.end());
+  WebPlanes web;
+  for (const auto& p : planes) {
+    const auto [lo_it, hi_it] = std::minmax_element(p.begin(), p.end());
     const float lo = *lo_it, hi = *hi_it;
-    const float scale = hi > lo ? hi - lo : 1.0f;
-    scales.push_back(scale);
-    biases.push_back(-lo / scale);
+    web.scales.push_back(hi > lo ? hi - lo : 1.0f);
+    web.biases.push_back(-lo / web.scales.back());
   }
-  info["materials"] = nlohmann::json::array({{{"scale", scales}, {"bias", biases}}});
-  int files = 0;
   for (std::size_t j = 0; j * 3 < planes.size(); ++j) {
-    cv::Mat image(ptm.height, ptm.width, CV_8UC3);
+    cv::Mat& image = web.images.emplace_back(ptm.height, ptm.width, CV_8UC3);
     for (int y = 0; y < ptm.height; ++y) {
       for (int x = 0; x < ptm.width; ++x) {
         const std::size_t t = static_cast<std::size_t>(y) * ptm.width + x;
         cv::Vec3b& px = image.at<cv::Vec3b>(y, x);
-        for (int c = 0; c < 3; ++c) {
-          const std::size_t plane = j * 3 + static_cast<std::size_t>(c);
-          const float v = (planes[plane][t] / scales[plane] + biases[plane]) * 255.0f;
+        for (std::size_t c = 0; c < 3; ++c) {
+          const std::size_t k = j * 3 + c;
+          const float v = (planes[k][t] / web.scales[k] + web.biases[k]) * 255.0f;
           px[2 - c] = static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L));  // BGR
         }
       }
     }
+  }
+  return web;
+}
+
+nlohmann::json WebPlanes::Info(const Ptm& ptm) const {
+  return {{"width", ptm.width},
+          {"height", ptm.height},
+          {"type", "ptm"},
+          {"colorspace", ptm.format == PtmFormat::kLrgb ? "lrgb" : "rgb"},
+          {"nplanes", scales.size()},
+          {"materials", nlohmann::json::array({{{"scale", scales}, {"bias", biases}}})}};
+}
+
+int WriteRelightWeb(const Ptm& ptm, const std::filesystem::path& dir, int jpeg_quality) {
+  std::filesystem::create_directories(dir);
+  const WebPlanes web = QuantiseWebPlanes(ptm);
+  nlohmann::json info = web.Info(ptm);
+  info["format"] = "jpg";
+  info["quality"] = jpeg_quality;
+  for (std::size_t j = 0; j < web.images.size(); ++j) {
     std::vector<unsigned char> bytes;
-    cv::imencode(".jpg", image, bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
+    cv::imencode(".jpg", web.images[j], bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
     WriteFileAtomically(
         dir / ("plane_" + std::to_string(j) + ".jpg"),
         [&](std::ostream& out) {
@@ -396,11 +395,10 @@ int WriteRelightWeb(const Ptm& ptm, const std::filesystem::path& dir, int jpeg_q
                     static_cast<std::streamsize>(bytes.size()));
         },
         true);
-    ++files;
   }
   WriteFileAtomically(
       dir / "info.json", [&](std::ostream& out) { out << info.dump(2) << "\n"; }, false);
-  return files + 1;
+  return static_cast<int>(web.images.size()) + 1;
 }
 
 Ptm ReadPtmAnyFormat(const std::filesystem::path& path) {

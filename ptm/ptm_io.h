@@ -2,9 +2,12 @@
 
 #include <filesystem>
 #include <istream>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 #include <ostream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "ptm/ptm.h"
 
@@ -34,6 +37,18 @@ Ptm ReadPtmExrBytes(std::string_view bytes, const std::string& label);
 
 /// Reads a PTM by extension: .exr (lossless) or .ptm.
 Ptm ReadPtmAnyFormat(const std::filesystem::path& path);
+
+/// The PTM as the relight / OpenLIME web format holds it: planes in OpenLIME's basis
+/// order (1, u, v, u^2, uv, v^2), after the colour for LRGB (per colour channel for
+/// RGB), three planes per 8-bit image, each plane quantised over its range:
+/// value = (byte / 255 - bias) * scale.
+struct WebPlanes {
+  std::vector<cv::Mat> images;  ///< 8-bit BGR, plane 3j + c in channel c of image j
+  std::vector<float> scales, biases;
+  /// info.json's fields: width, height, type, colorspace, nplanes, materials.
+  nlohmann::json Info(const Ptm& ptm) const;
+};
+WebPlanes QuantiseWebPlanes(const Ptm& ptm);
 
 /// Writes the relight / OpenLIME web format into `dir`: `info.json` (type "ptm",
 /// colorspace "rgb" or "lrgb", nplanes, per-plane scale and bias) and the

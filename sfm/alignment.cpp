@@ -1,5 +1,6 @@
 #include "sfm/alignment.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <map>
@@ -67,6 +68,41 @@ Reconstruction TransformedIntoReference(const Reconstruction& estimate,
   for (auto& [id, point] : out.points3d)
     point.xyz = a.scale * a.rotation * point.xyz + a.translation;
   return out;
+}
+
+ViewingOrientation OrientationFromCameras(const Reconstruction& reconstruction,
+                                          const Eigen::Vector3d& centre) {
+  ViewingOrientation o;
+  if (reconstruction.images.empty()) return o;
+  const auto n = static_cast<double>(reconstruction.images.size());
+  Eigen::Vector3d up_sum = Eigen::Vector3d::Zero(), toward_sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d right_scatter = Eigen::Matrix3d::Zero();
+  for (const auto& [id, image] : reconstruction.images) {
+    // Rows 0 and 1 of R_cam_from_world: the camera's x (right) and y (down) in the world.
+    const Eigen::Matrix3d rotation = image.cam_from_world.rotation.toRotationMatrix();
+    right_scatter += rotation.row(0).transpose() * rotation.row(0);
+    up_sum -= rotation.row(1).transpose();
+    toward_sum += (image.ProjectionCenter() - centre).stableNormalized();
+  }
+  if (!(up_sum.norm() > 1e-9)) return o;
+  // Upright photos have horizontal x axes whatever their pitch: up is the direction
+  // most orthogonal to all of them, when they turn enough to span a plane (about 6
+  // degrees RMS); otherwise the mean up, made orthogonal to their common x axis.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(right_scatter / n);
+  if (eigen.eigenvalues()(1) > 0.01) {
+    o.up = eigen.eigenvectors().col(0);
+    if (o.up.dot(up_sum) < 0.0) o.up = -o.up;
+  } else {
+    const Eigen::Vector3d right = eigen.eigenvectors().col(2);
+    o.up = (up_sum - right * right.dot(up_sum)).normalized();
+  }
+  Eigen::Vector3d toward = toward_sum / n;
+  if (toward.norm() < 0.5)
+    toward = (reconstruction.images.begin()->second.ProjectionCenter() - centre).stableNormalized();
+  Eigen::Vector3d front = toward - o.up * o.up.dot(toward);
+  if (!(front.norm() > 1e-6)) front = o.up.unitOrthogonal();  // seen from straight above
+  o.front = front.normalized();
+  return o;
 }
 
 }  // namespace texlume::sfm

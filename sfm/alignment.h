@@ -33,4 +33,25 @@ SimilarityAlignment AlignByCameraCenters(const Reconstruction& reference,
 Reconstruction TransformedIntoReference(const Reconstruction& estimate,
                                         const SimilarityAlignment& a);
 
+/// Which way is up in a model's frame, and from which side the photos saw the object,
+/// as the photos tell it. Both are unit vectors in the model's (world) frame.
+struct ViewingOrientation {
+  /// COLMAP's own convention when nothing better is known: its frame is the first
+  /// camera's, y pointing down the image and z along the view.
+  Eigen::Vector3d up = -Eigen::Vector3d::UnitY();
+  Eigen::Vector3d front = -Eigen::Vector3d::UnitZ();  ///< orthogonal to `up`
+};
+
+/// Up: photos are taken upright (landscape, little roll) whatever the frame SfM chose,
+/// so their x axes are horizontal: up is the direction most orthogonal to all of them
+/// (the least eigenvector of their scatter), on the side of the cameras' mean up (each
+/// camera's -y). When the x axes are nearly parallel (under about 6 degrees RMS apart),
+/// the mean up made orthogonal to them.
+/// Front: from `centre` toward the mean of the cameras' directions from it, made
+/// orthogonal to up; toward the first image (lowest id) when the cameras surround the
+/// object so that their mean is short (under half a unit vector's length). The
+/// defaults of ViewingOrientation when the model has no images or up is undefined.
+ViewingOrientation OrientationFromCameras(const Reconstruction& reconstruction,
+                                          const Eigen::Vector3d& centre);
+
 }  // namespace texlume::sfm
