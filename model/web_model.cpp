@@ -127,7 +127,7 @@ WebModel BuildWebModel(const fs::path& model_dir) {
   const nlohmann::json manifest = ReadModelManifest(model_dir);
   WebModel web;
   nlohmann::json& scene = web.scene;
-  scene["format"] = "texlume-web-2";
+  scene["format"] = "texlume-web-3";
   scene["faces"] = model.mesh.faces.size();
   scene["horizon_elevation_deg"] = ptm::kHorizonElevationDeg;
   scene["light_response"] = LightResponseJson(model.light_response);
@@ -142,9 +142,11 @@ WebModel BuildWebModel(const fs::path& model_dir) {
     return model.face_atlas[a] < model.face_atlas[b];
   });
   const std::size_t n = num_faces * 3;
-  std::vector<float> position, normal, tangent, uv, face_id, chart_id;
+  std::vector<float> position, normal, face_normal, tangent, uv, face_id, chart_id;
+  const std::vector<Eigen::Vector3d> vertex_normals = mesh::VertexNormals(model.mesh);
   position.reserve(n * 3);
   normal.reserve(n * 3);
+  face_normal.reserve(n * 3);
   tangent.reserve(n * 3);
   uv.reserve(n * 2);
   face_id.reserve(n);
@@ -164,9 +166,12 @@ WebModel BuildWebModel(const fs::path& model_dir) {
     const ptm::Ptm& atlas_ptm = model.atlases[static_cast<std::size_t>(atlas)];
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d p = model.mesh.Corner(f, k);
+      const Eigen::Vector3d& smooth =
+          vertex_normals[static_cast<std::size_t>(model.mesh.faces[f][static_cast<std::size_t>(k)])];
       for (int d = 0; d < 3; ++d) {
         position.push_back(static_cast<float>(p[d]));
-        normal.push_back(static_cast<float>(nrm[d]));
+        normal.push_back(static_cast<float>(smooth[d]));
+        face_normal.push_back(static_cast<float>(nrm[d]));
         tangent.push_back(static_cast<float>(x_axis[d]));
       }
       // Texture coordinates in [0, 1], v up (the image's first row at v = 1).
@@ -187,6 +192,7 @@ WebModel BuildWebModel(const fs::path& model_dir) {
   };
   append("position", position, 3);
   append("normal", normal, 3);
+  append("face_normal", face_normal, 3);
   append("tangent", tangent, 3);
   append("uv", uv, 2);
   append("face", face_id, 1);

@@ -21,4 +21,4 @@ object="$tmp/scene/object"
   --mesh "$object/mesh.ply" --sample "$tmp/sample.exr" --sample-texel-size 0.004 \
   --atlas-size 1024 --out "$tmp/model" > "$tmp/synth.log" 2>&1
 cd "$web"
-TEXLUME="$texlume" TEXLUME_MODEL="$tmp/model" node --test test/
+TEXLUME="$texlume" TEXLUME_MODEL="$tmp/model" TEXLUME_PHOTOS="$object" node --test test/

@@ -4,8 +4,9 @@
 //   TEXLUME=build/apps/texlume TEXLUME_MODEL=DIR node --test web/test/
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import { readFileSync } from 'node:fs';
+import { execFileSync, spawn } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { chromium } from 'playwright-core';
 import validator from 'gltf-validator';
@@ -123,7 +124,7 @@ test('the page loads the model with no console errors', async () => {
 
 test('the PTM textures reach WebGL byte for byte, the alpha channel included', async () => {
   const scene = await (await fetch(url + 'model/scene.json')).json();
-  assert.equal(scene.format, 'texlume-web-2');
+  assert.equal(scene.format, 'texlume-web-3');
   const atlas = scene.atlases[0];
   assert.equal(atlas.textures.length, atlas.format === 'LRGB' ? 2 : 5);
   for (let k = 0; k < atlas.textures.length; ++k) {
@@ -194,4 +195,93 @@ test('the exported GLB passes the Khronos glTF validator with no errors and no w
               `${report.issues.numInfos} infos`);
   assert.equal(report.issues.numErrors, 0, JSON.stringify(errors, null, 1));
   assert.equal(report.issues.numWarnings, 0, JSON.stringify(errors, null, 1));
+});
+
+// COLMAP's text model: cameras (PINHOLE) and images by name.
+function readColmapText(dir) {
+  const lines = (file) => readFileSync(join(dir, file), 'utf8').split('\n').filter((l) => l && l[0] !== '#');
+  const cameras = new Map();
+  for (const l of lines('cameras.txt')) {
+    const [id, model, width, height, ...params] = l.trim().split(/\s+/);
+    if (model !== 'PINHOLE') throw new Error(`camera ${id} is ${model}; the test needs PINHOLE`);
+    const [fx, fy, cx, cy] = params.map(Number);
+    cameras.set(id, { width: Number(width), height: Number(height), fx, fy, cx, cy });
+  }
+  const images = new Map();
+  const imageLines = readFileSync(join(dir, 'images.txt'), 'utf8').split('\n').filter((l) => l[0] !== '#');
+  for (let i = 0; i + 1 < imageLines.length; i += 2) {
+    const f = imageLines[i].trim().split(/\s+/);
+    if (f.length < 10) continue;
+    images.set(f[9], { ...cameras.get(f[8]), qvec: f.slice(1, 5).map(Number), tvec: f.slice(5, 8).map(Number) });
+  }
+  return images;
+}
+
+// The camera's axes in the world: rows of R_cam_from_world (x right, y down, z forward).
+function cameraAxes(view) {
+  const [w, x, y, z] = view.qvec;
+  return [
+    [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+    [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+    [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+  ];
+}
+
+test('the viewer draws what texlume render draws for the same camera and side light', async () => {
+  const photos = process.env.TEXLUME_PHOTOS;  // the scene's object/ folder
+  assert.ok(photos, 'set TEXLUME_PHOTOS to the scene\'s object folder');
+  const [name, view] = [...readColmapText(join(photos, 'sparse_txt')).entries()][0];
+  // A side light: from the camera's right and a little behind the object, so the
+  // terminator crosses the view where the coarse faces meet.
+  const [right, , forward] = cameraAxes(view);
+  const light = right.map((r, k) => 0.95 * r + 0.3 * forward[k]);
+  const work = mkdtempSync(join(tmpdir(), 'texlume-view-'));
+  try {
+    writeFileSync(join(work, 'lights.json'), JSON.stringify({
+      format: 'texlume-object-lights', frame: 'world',
+      images: { [name]: [{ type: 'directional', direction: light, intensity: 1.0 }] } }));
+    execFileSync(texlume, ['render', '--model', modelDir, '--cameras', join(photos, 'sparse'),
+                           '--lights', join(work, 'lights.json'), '--out', join(work, 'render'),
+                           '--samples', '1'], { stdio: 'ignore' });
+    const png = name.replace(/\.[^.]*$/, '.png');
+    const rendered = decodePng(readFileSync(join(work, 'render', png)));
+    const mask = decodePng(readFileSync(join(work, 'render', 'masks', png)));
+    const viewPage = await browser.newPage({ viewport: { width: view.width, height: view.height } });
+    await viewPage.goto(url);
+    await viewPage.waitForFunction(() => window.texlumeViewer && window.texlumeViewer.ready, null,
+                                   { timeout: 120000 });
+    await viewPage.evaluate(([v, l]) => {
+      document.getElementById('panel').style.visibility = 'hidden';
+      window.texlumeViewer.setView(v, l);
+    }, [view, light]);
+    const drawn = decodePng(await viewPage.screenshot());
+    await viewPage.close();
+    // Inside the object, away from its outline (a 3 x 3 neighbourhood all inside).
+    const w = view.width, h = view.height;
+    const diffs = [];
+    for (let y = 1; y + 1 < h; ++y) {
+      for (let x = 1; x + 1 < w; ++x) {
+        let inside = true;
+        for (let dy = -1; dy <= 1; ++dy)
+          for (let dx = -1; dx <= 1; ++dx) inside &&= mask.pixels[((y + dy) * w + x + dx) * mask.channels] === 255;
+        if (!inside) continue;
+        const i = y * w + x;
+        let d = 0;
+        for (let k = 0; k < 3; ++k) d = Math.max(d, Math.abs(drawn.rgb[i * 3 + k] - rendered.rgb[i * 3 + k]));
+        diffs.push(d);
+      }
+    }
+    diffs.sort((a, b) => a - b);
+    const mean = diffs.reduce((s, d) => s + d, 0) / diffs.length;
+    const p99 = diffs[Math.floor(0.99 * (diffs.length - 1))];
+    console.log(`viewer against texlume render (${name}, side light): ${diffs.length} pixels, ` +
+                `mean difference ${mean.toFixed(2)} levels, 99th percentile ${p99}`);
+    assert.ok(diffs.length > 0.05 * w * h, 'the object covers the view');
+    // With the light taken in the face frame alone (before): mean 1.78, 99th percentile 17.
+    assert.ok(mean < 1.2, `mean difference ${mean.toFixed(2)} levels`);
+    assert.ok(p99 <= 8, `99th percentile ${p99} levels`);
+  } finally {
+    rmSync(work, { recursive: true, force: true });
+  }
+  assert.deepEqual(consoleErrors, []);
 });

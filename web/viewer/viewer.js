@@ -14,6 +14,7 @@ window.texlumeViewer = api;
 const varyings = /* glsl */ `
 varying vec2 vUv;
 varying vec3 vNormal;
+varying vec3 vFaceNormal;
 varying vec3 vTangent;
 varying vec3 vBarycentric;
 varying float vChart;
@@ -22,12 +23,14 @@ varying vec3 vWorldPosition;
 
 const vertexShader = /* glsl */ `
 attribute vec3 ptmTangent;
+attribute vec3 faceNormal;
 attribute vec3 barycentric;
 attribute float chartId;
 ${varyings}
 void main() {
   vUv = uv;
   vNormal = normalize(mat3(modelMatrix) * normal);
+  vFaceNormal = normalize(mat3(modelMatrix) * faceNormal);
   vTangent = normalize(mat3(modelMatrix) * ptmTangent);
   vBarycentric = barycentric;
   vChart = chartId;
@@ -151,9 +154,21 @@ vec3 chartColour(float id) {
   return 0.5 + 0.5 * cos(6.2831853 * (fract(id * 0.618034) + vec3(0.0, 0.33, 0.67)));
 }
 
+// x turned by the smallest rotation that takes the unit vector a to the unit vector b
+// (Rodrigues; a and b are never opposite: a face normal and a vertex normal of it).
+vec3 turned(vec3 x, vec3 a, vec3 b) {
+  vec3 axis = cross(a, b);
+  float c = dot(a, b);
+  return x * c + cross(axis, x) + axis * (dot(axis, x) / max(1.0 + c, 1e-6));
+}
+
 void main() {
+  // The atlas frame of the face turned so that its z is the interpolated vertex
+  // normal: shading varies smoothly across the coarse mesh's faces, per fragment,
+  // as in texlume's renderer (render/model_render.cpp).
   vec3 n = normalize(vNormal);
-  vec3 t = normalize(vTangent - n * dot(n, vTangent));
+  vec3 t = normalize(turned(normalize(vTangent), normalize(vFaceNormal), n));
+  t = normalize(t - n * dot(n, t));
   vec3 b = cross(n, t);  // the atlas frame's y (v up)
   vec3 l = vec3(dot(lightWorld, t), dot(lightWorld, b), dot(lightWorld, n));
   vec3 colour;
@@ -228,7 +243,7 @@ async function main() {
   if (!prefetch) throw new Error('/viewer/prefetch.js did not run');
   api.marks.prefetchStart = prefetch.started;
   const scene = await prefetch.scene;
-  if (scene.format !== 'texlume-web-2') throw new Error('scene.json: unknown format ' + scene.format);
+  if (scene.format !== 'texlume-web-3') throw new Error('scene.json: unknown format ' + scene.format);
   api.marks.scene = performance.now();
   const bytes = await prefetch.geometry;
   api.marks.geometry = performance.now();
@@ -238,7 +253,8 @@ async function main() {
     return new Float32Array(bytes, a.byte_offset, g.vertices * a.components);
   };
   const position = attribute('position'), normal = attribute('normal'),
-        tangent = attribute('tangent'), uv = attribute('uv'), chart = attribute('chart');
+        faceNormal = attribute('face_normal'), tangent = attribute('tangent'), uv = attribute('uv'),
+        chart = attribute('chart');
   const barycentric = new Float32Array(g.vertices * 3);
   for (let v = 0; v < g.vertices; ++v) barycentric[v * 3 + (v % 3)] = 1;
 
@@ -285,6 +301,7 @@ async function main() {
         components);
     geometry.setAttribute('position', slice(position, 3));
     geometry.setAttribute('normal', slice(normal, 3));
+    geometry.setAttribute('faceNormal', slice(faceNormal, 3));
     geometry.setAttribute('ptmTangent', slice(tangent, 3));
     geometry.setAttribute('uv', slice(uv, 2));
     geometry.setAttribute('chartId', slice(chart, 1));
@@ -305,6 +322,9 @@ async function main() {
   // The light is held in the camera's frame (x right, y up, z towards the viewer),
   // as on an RTI viewer's light sphere, so it stays put while the model turns.
   const lightView = new THREE.Vector3(-0.5, 0.5, Math.sqrt(0.5));
+  // A COLMAP camera and a light in the world, when set (setView): what `texlume render`
+  // draws for that image and light.
+  let colmapView = null;
   const render = () => {
     const w = canvas.clientWidth, h = canvas.clientHeight;
     if (canvas.width !== Math.floor(w * renderer.getPixelRatio()) ||
@@ -313,8 +333,33 @@ async function main() {
       camera.aspect = w / Math.max(h, 1);
       camera.updateProjectionMatrix();
     }
-    uniformsShared.lightWorld.value.copy(lightView).applyQuaternion(camera.quaternion).normalize();
+    if (colmapView) {
+      camera.projectionMatrix.copy(colmapView.projection);
+      camera.projectionMatrixInverse.copy(colmapView.projection).invert();
+      uniformsShared.lightWorld.value.copy(colmapView.lightWorld);
+    } else {
+      uniformsShared.lightWorld.value.copy(lightView).applyQuaternion(camera.quaternion).normalize();
+    }
     renderer.render(world, camera);
+  };
+  // A pinhole camera as COLMAP gives it (cam_from_world: qvec w, x, y, z and tvec;
+  // fx, fy, cx, cy in pixels of a width x height image, pixel centres at +0.5) and a
+  // unit light direction in the world. COLMAP's camera looks along +z with y down;
+  // three.js's along -z with y up.
+  const setView = (c, lightWorld) => {
+    const camFromWorld = new THREE.Quaternion(c.qvec[1], c.qvec[2], c.qvec[3], c.qvec[0]).normalize();
+    const worldFromCam = camFromWorld.clone().invert();
+    camera.position.set(...c.tvec).applyQuaternion(worldFromCam).multiplyScalar(-1);
+    camera.quaternion.copy(worldFromCam).multiply(new THREE.Quaternion(1, 0, 0, 0));  // turn about x by 180 degrees
+    camera.updateMatrixWorld();
+    const n = camera.near, f = camera.far;
+    const projection = new THREE.Matrix4().set(
+        2 * c.fx / c.width, 0, 1 - 2 * c.cx / c.width, 0,
+        0, 2 * c.fy / c.height, 2 * c.cy / c.height - 1, 0,
+        0, 0, -(f + n) / (f - n), -2 * f * n / (f - n),
+        0, 0, -1, 0);
+    colmapView = { projection, lightWorld: new THREE.Vector3(...lightWorld).normalize() };
+    render();
   };
   let pending = false;
   const requestRender = () => {
@@ -406,6 +451,7 @@ async function main() {
       (api.softwareRenderer ? ' (software WebGL: no multisampling)' : '');
   Object.assign(api, {
     setLight,
+    setView,
     renderNow: render,
     // Blocks until the GPU has drawn everything (reads a pixel back; for timing frames).
     finish: () => {
