@@ -5,11 +5,13 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync, spawn } from 'node:child_process';
-import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { copyFileSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { chromium } from 'playwright-core';
 import validator from 'gltf-validator';
+import * as esbuild from 'esbuild';
 import { decodePng } from './png.mjs';
 
 const texlume = process.env.TEXLUME;
@@ -284,4 +286,106 @@ test('the viewer draws what texlume render draws for the same camera and side li
     rmSync(work, { recursive: true, force: true });
   }
   assert.deepEqual(consoleErrors, []);
+});
+
+// Luminance minus its 7 x 7 box mean: the relief's detail, at pixels whose 7 x 7
+// neighbourhood lies inside `inside`.
+function detail(image, inside) {
+  const w = image.width, h = image.height, r = 3;
+  const luma = new Float64Array(w * h);
+  for (let i = 0; i < w * h; ++i)
+    luma[i] = 0.2126 * image.rgb[i * 3] + 0.7152 * image.rgb[i * 3 + 1] + 0.0722 * image.rgb[i * 3 + 2];
+  const out = new Map();
+  for (let y = r; y + r < h; ++y) {
+    for (let x = r; x + r < w; ++x) {
+      let sum = 0, all = true;
+      for (let dy = -r; dy <= r && all; ++dy)
+        for (let dx = -r; dx <= r; ++dx) {
+          const j = (y + dy) * w + x + dx;
+          if (!inside[j]) { all = false; break; }
+          sum += luma[j];
+        }
+      if (all) out.set(y * w + x, luma[y * w + x] - sum / 49);
+    }
+  }
+  return out;
+}
+
+function correlation(a, b) {
+  let sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0, n = 0;
+  for (const [i, va] of a) {
+    const vb = b.get(i);
+    if (vb === undefined) continue;
+    sa += va; sb += vb; saa += va * va; sbb += vb * vb; sab += va * vb; ++n;
+  }
+  const cov = sab / n - (sa / n) * (sb / n);
+  return cov / Math.sqrt((saa / n - (sa / n) ** 2) * (sbb / n - (sb / n) ** 2));
+}
+
+test('three.js shows the GLB\'s relief where texlume render shows the PTM\'s', async () => {
+  const photos = process.env.TEXLUME_PHOTOS;
+  const [name, view] = [...readColmapText(join(photos, 'sparse_txt')).entries()][0];
+  const [right, , forward] = cameraAxes(view);
+  const light = right.map((r, k) => 0.95 * r + 0.3 * forward[k]);
+  const work = mkdtempSync(join(tmpdir(), 'texlume-glb-'));
+  const server = createServer((request, response) => {
+    const file = { '/': 'index.html', '/page.js': 'page.js', '/model.glb': 'model.glb' }[request.url];
+    if (!file) { response.writeHead(404).end(); return; }
+    const type = { html: 'text/html', js: 'text/javascript', glb: 'model/gltf-binary' }[file.split('.').pop()];
+    response.writeHead(200, { 'Content-Type': type }).end(readFileSync(join(work, file)));
+  });
+  try {
+    await esbuild.build({ entryPoints: [join(import.meta.dirname, '..', 'test_pages', 'glb_page.js')], bundle: true,
+                          format: 'esm', outfile: join(work, 'page.js'), logLevel: 'silent' });
+    writeFileSync(join(work, 'index.html'), '<!doctype html><body style="margin:0">' +
+        `<canvas id="view" width="${view.width}" height="${view.height}"></canvas>` +
+        '<script type="module" src="/page.js"></script></body>');
+    copyFileSync(join(modelDir, 'model.glb'), join(work, 'model.glb'));
+    writeFileSync(join(work, 'lights.json'), JSON.stringify({
+      format: 'texlume-object-lights', frame: 'world',
+      images: { [name]: [{ type: 'directional', direction: light, intensity: 1.0 }] } }));
+    execFileSync(texlume, ['render', '--model', modelDir, '--cameras', join(photos, 'sparse'),
+                           '--lights', join(work, 'lights.json'), '--out', join(work, 'render'),
+                           '--samples', '1'], { stdio: 'ignore' });
+    const png = name.replace(/\.[^.]*$/, '.png');
+    const rendered = decodePng(readFileSync(join(work, 'render', png)));
+    const mask = decodePng(readFileSync(join(work, 'render', 'masks', png)));
+    await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+    const glbPage = await browser.newPage({ viewport: { width: view.width, height: view.height } });
+    await glbPage.goto(`http://127.0.0.1:${server.address().port}/`);
+    await glbPage.waitForFunction(() => window.glbPageReady, null, { timeout: 60000 });
+    const draw = async (normalMap, flipGreen = false) => {
+      const state = await glbPage.evaluate(
+          ([v, l, m, f]) => window.drawGlb('/model.glb', v, l, { normalMap: m, flipGreen: f }),
+          [view, light, normalMap, flipGreen]);
+      assert.equal(state.tangents, true, 'the GLB\'s own tangents are used');
+      const shotPng = await glbPage.screenshot();
+      if (process.env.TEXLUME_SCREENSHOTS)
+        writeFileSync(join(process.env.TEXLUME_SCREENSHOTS, `glb_${normalMap ? 'relief' : 'flat'}.png`), shotPng);
+      return decodePng(shotPng);
+    };
+    const withRelief = await draw(true), withoutRelief = await draw(false);
+    const flippedRelief = await draw(true, true);
+    await glbPage.close();
+    if (process.env.TEXLUME_SCREENSHOTS)
+      copyFileSync(join(work, 'render', png), join(process.env.TEXLUME_SCREENSHOTS, 'render.png'));
+    // The lit part (the rendering adds the model's ambient light on the dark side,
+    // which a plain glTF viewer has no reason to know).
+    const inside = new Uint8Array(view.width * view.height);
+    for (let i = 0; i < inside.length; ++i)
+      inside[i] = mask.pixels[i * mask.channels] === 255 && withoutRelief.rgb[i * 3 + 1] > 40 ? 1 : 0;
+    const truth = detail(rendered, inside);
+    const relief = correlation(detail(withRelief, inside), truth);
+    const albedoOnly = correlation(detail(withoutRelief, inside), truth);
+    const flipped = correlation(detail(flippedRelief, inside), truth);
+    console.log(`GLB in three.js against texlume render (${name}, side light): detail correlation ` +
+                `${relief.toFixed(3)} with the normal map, ${albedoOnly.toFixed(3)} without, ` +
+                `${flipped.toFixed(3)} with its green read the other way`);
+    assert.ok(relief > 0.45, `with the normal map: ${relief.toFixed(3)}`);
+    assert.ok(relief > albedoOnly + 0.15, `the normal map adds the relief (${albedoOnly.toFixed(3)} without)`);
+    assert.ok(relief > flipped + 0.1, `the map's convention is glTF's (${flipped.toFixed(3)} flipped)`);
+  } finally {
+    server.close();
+    rmSync(work, { recursive: true, force: true });
+  }
 });
