@@ -616,6 +616,29 @@ class SceneGenerator {
     ++files_;
   }
 
+  // The texlume commands that use the scene, run from its folder.
+  void WriteCommands(std::ostream& out) const {
+    out << "\n## Commands\n\nRun from this folder: fit the sample, synthesise the model from "
+           "the photos, then render it at the held-out views under the held-out lights and "
+           "measure it against the truth (at full resolution, and reduced to the photos' "
+           "resolution).\n\n```\n"
+        << "texlume fit --images material/capture --lights material/capture/lights.lp "
+           "--out sample.ptm --exr sample.exr\n"
+        << "texlume synth --model object/sparse --images object/images --lights "
+           "object/lights.json --mesh object/mesh.ply --sample sample.exr --sample-texel-size "
+        << texel_ << " --out model\n";
+    if (options_.num_held_out_views > 0)
+      out << "texlume render --model model --cameras object/held_out/sparse --lights "
+             "object/held_out/lights.json --out render --truth object/held_out/images "
+             "--truth-masks object/held_out/masks --reduced-factor "
+          << options_.held_out_scale << "\n";
+    out << "texlume view model\n";
+    if (options_.write_btf)
+      out << "texlume synth --model object/sparse --images object/images --lights "
+             "object/lights.json --mesh object/mesh.ply --btf material/btf --out model_btf\n";
+    out << "```\n";
+  }
+
   // MANIFEST.md: what each path of the scene holds.
   void WriteManifest() {
     std::ostringstream manifest;
@@ -648,6 +671,7 @@ class SceneGenerator {
            "model, lights |\n\n"
         << "Light directions point from the surface to the light. In `.lp` files: x right, y "
            "up, z out of the sample. In JSON: world frame (Z up).\n";
+    WriteCommands(manifest);
     WriteFileAtomically(
         dir_ / "MANIFEST.md", [&](std::ostream& o) { o << manifest.str(); }, false);
     ++files_;

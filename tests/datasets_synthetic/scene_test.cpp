@@ -120,7 +120,14 @@ TEST_P(SceneShapesTest, MasksOfEveryViewMatchTheCoarseMeshProjectedWithTheColmap
   EXPECT_EQ(sfm::ReadLpFile(tmp / "material/capture/lights.lp").size(), 8u);
   EXPECT_EQ(sfm::ReadLpFile(tmp / "material/held_out/lights.lp").size(), 3u);
   EXPECT_TRUE(fs::exists(tmp / "material/btf/view_01_light_01.png"));
-  EXPECT_TRUE(fs::exists(tmp / "MANIFEST.md"));
+  // The commands that use the scene name its own paths (they run from its folder).
+  const std::string manifest = testing::ReadText(tmp / "MANIFEST.md");
+  for (const char* path : {"material/capture/lights.lp", "object/sparse", "object/mesh.ply",
+                           "object/held_out/lights.json", "--btf material/btf"}) {
+    EXPECT_NE(manifest.find(path), std::string::npos) << path;
+    const std::string name = std::string(path).substr(std::string(path).rfind(' ') + 1);
+    EXPECT_TRUE(fs::exists(tmp / name)) << name;
+  }
   std::vector<std::string> names;
   const auto height = ptm::ReadExr(tmp / "material/ground_truth/height.exr", &names);
   ASSERT_EQ(height.size(), 1u);
