@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
+#include "core/bounded_memory_reader.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/memory_budget.h"
@@ -75,6 +77,33 @@ double ScaleToUnit(int depth) {
 }
 
 }  // namespace
+
+cv::Mat DecodeGreyImageBytes(std::string_view bytes, const char* format, int width, int height,
+                             const std::string& label) {
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::create(format);
+  if (!in)
+    throw std::runtime_error(std::string("OpenImageIO was built without its ") + format +
+                             " reader");
+  BoundedMemoryReader memory(bytes);
+  if (!in->set_ioproxy(&memory))
+    throw std::runtime_error(std::string("OpenImageIO's ") + format +
+                             " reader cannot read from memory");
+  OIIO::ImageSpec spec;
+  if (!in->open(std::string(), spec)) {
+    std::string error = in->geterror();
+    if (error.empty()) error = OIIO::geterror();
+    throw InputError(label, std::string("is not a readable ") + format + " stream: " + error);
+  }
+  if (spec.width != width || spec.height != height || spec.nchannels != 1)
+    throw InputError(label, "is a " + std::to_string(spec.width) + " x " +
+                                std::to_string(spec.height) + " image of " +
+                                std::to_string(spec.nchannels) + " channel(s); expected " +
+                                std::to_string(width) + " x " + std::to_string(height) + " grey");
+  cv::Mat image(height, width, CV_8UC1);
+  if (!in->read_image(0, 0, 0, 1, OIIO::TypeDesc::UINT8, image.data))
+    throw InputError(label, "cannot decode its pixels: " + in->geterror());
+  return image;
+}
 
 struct ImageReader::Input {
   std::unique_ptr<OIIO::ImageInput> in;

@@ -4,6 +4,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace texlume {
@@ -45,6 +46,14 @@ class ImageReader {
   std::filesystem::path path_;
   int width_ = 0, height_ = 0, channels_ = 0;
 };
+
+/// An 8-bit grey image of exactly `width` x `height` pixels decoded from `bytes`
+/// held in memory by OpenImageIO's reader for `format` ("jpeg", "png"), as
+/// CV_8UC1 in the order the stream stores its rows. The size and channel count are
+/// checked before anything is decoded; InputError naming `label` when the bytes are
+/// not such an image.
+cv::Mat DecodeGreyImageBytes(std::string_view bytes, const char* format, int width, int height,
+                             const std::string& label);
 
 /// A photo as CV_32FC3 RGB display values in [0, 1] (ImageReader; grey
 /// repeated, alpha dropped).

@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 
 #include "datasets_synthetic/object_scene.h"
@@ -65,6 +67,27 @@ void PtmSeeds(const fs::path& out, const fs::path& scratch) {
     Copy(scratch / (name + ".ptm"), out, "ptm", name + ".ptm");
     Copy(scratch / (name + ".exr"), out, "ptm_exr", name + ".exr");
   }
+  // PTM_FORMAT_JPEG_LRGB, 4 x 4: nine grey JPEG streams; plane 1 predicted from plane 0,
+  // plane 2 from plane 0 inverted; one side-information record on plane 3.
+  std::ostringstream jpeg_ptm;
+  jpeg_ptm << "PTM_1.2\nPTM_FORMAT_JPEG_LRGB\n4 4\n2 2 2 1 1 1\n128 128 128 0 0 0\n75\n"
+           << "0 0 1 0 0 0 0 0 0\n0 0 0 0 0 0 0 0 0\n0 0 0 0 0 0 0 0 0\n"
+           << "0 1 2 3 4 5 6 7 8\n-1 0 0 -1 -1 -1 -1 -1 -1\n";
+  std::string streams;
+  std::string sizes, side_sizes;
+  for (int p = 0; p < 9; ++p) {
+    std::vector<unsigned char> jpeg;
+    cv::imencode(".jpg", cv::Mat(4, 4, CV_8UC1, cv::Scalar(40 + 20 * p)), jpeg,
+                 {cv::IMWRITE_JPEG_QUALITY, 75});
+    streams.append(jpeg.begin(), jpeg.end());
+    const std::string side = p == 3 ? std::string("\0\0\0\5\x07", 5) : std::string();
+    streams += side;
+    sizes += (p ? " " : "") + std::to_string(jpeg.size());
+    side_sizes += (p ? " " : "") + std::to_string(side.size());
+  }
+  jpeg_ptm << sizes << "\n" << side_sizes << "\n" << streams;
+  fs::create_directories(out / "ptm");
+  std::ofstream(out / "ptm" / "jpeg_lrgb.ptm", std::ios::binary) << jpeg_ptm.str();
 }
 
 void MeshSeeds(const fs::path& out, const fs::path& scratch) {

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/bounded_memory_reader.h"
 #include "core/check.h"
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -235,28 +236,6 @@ void CheckExrHeader(std::istream& in, std::uint64_t size, const std::string& lab
   // OpenEXR sizes its line buffers by the data window and channels when it opens the file.
   if (width > 0 && height > 0 && channels > 0) RequirePlausibleSize(width, height, channels, label);
 }
-
-// OpenImageIO 2.4's memory reader copies from before its buffer when OpenEXR asks for a
-// negative offset (a damaged chunk table; found by fuzzing, fuzz/regressions/ptm_exr/crash-*):
-// this one reads nothing outside the buffer, as a file would.
-class BoundedMemoryReader final : public OIIO::Filesystem::IOMemReader {
- public:
-  explicit BoundedMemoryReader(std::string_view bytes) : IOMemReader(bytes.data(), bytes.size()) {}
-  bool seek(std::int64_t offset) override {
-    if (offset < 0) return false;
-    m_pos = offset;
-    return true;
-  }
-  std::size_t read(void* buffer, std::size_t bytes) override {
-    const std::size_t got = pread(buffer, bytes, m_pos);
-    m_pos += static_cast<std::int64_t>(got);
-    return got;
-  }
-  std::size_t pread(void* buffer, std::size_t bytes, std::int64_t offset) override {
-    if (offset < 0 || static_cast<std::uint64_t>(offset) >= size()) return 0;
-    return IOMemReader::pread(buffer, std::min<std::uint64_t>(bytes, size() - offset), offset);
-  }
-};
 
 // The OpenEXR reader only, on a file or on bytes in memory: a damaged file is refused
 // by it rather than probed by every other format's reader.

@@ -12,6 +12,8 @@
 
 #include "core/errors.h"
 #include "core/file_util.h"
+#include "core/image_io.h"
+#include "core/memory_budget.h"
 #include "ptm/exr_io.h"
 
 namespace texlume::ptm {
@@ -74,6 +76,280 @@ std::string ReadHeaderLine(std::istream& in, const std::string& label, std::size
   return line;
 }
 
+// What a .ptm file's header says (PTM format 1.2, Malzbender and Gelb, HP Labs 2001).
+struct PtmHeader {
+  std::string format_name;
+  PtmFormat format = PtmFormat::kLrgb;
+  bool jpeg = false;  // PTM_FORMAT_JPEG_*: one JPEG stream per plane
+  int width = 0, height = 0;
+  float scale[6] = {};
+  int bias[6] = {};
+  std::size_t line = 0;  // the last header line read
+  // Byte planes: LRGB a0..a5 then R, G, B; RGB a0..a5 of R, then of G, then of B.
+  int NumPlanes() const { return format == PtmFormat::kLrgb ? 9 : 18; }
+  std::size_t Texels() const { return static_cast<std::size_t>(width) * height; }
+};
+
+// One plane per PtmHeader::NumPlanes, width x height bytes in the file's row order
+// (the bottom row first).
+using BytePlanes = std::vector<std::vector<unsigned char>>;
+
+// Before the planes are allocated: they, the PTM's floats, and (JPEG) one decoded plane.
+void RequirePlaneMemory(const PtmHeader& h, const std::string& label) {
+  RequireMemory(static_cast<double>(h.Texels()) * (h.NumPlanes() * 5.0 + 1.0),
+                "reading the " + h.format_name + " PTM", label);
+}
+
+PtmHeader ReadPtmHeader(std::istream& in, const std::string& label) {
+  PtmHeader h;
+  const std::string version = ReadHeaderLine(in, label, 1);
+  if (version != "PTM_1.2" && version != "PTM_1.1") {
+    throw InputError(label,
+                     "not a PTM file: first line is '" + version.substr(0, 40) +
+                         "', expected PTM_1.2 or PTM_1.1",
+                     1);
+  }
+  h.format_name = ReadHeaderLine(in, label, 2);
+  if (h.format_name == "PTM_FORMAT_LRGB" || h.format_name == "PTM_FORMAT_JPEG_LRGB") {
+    h.format = PtmFormat::kLrgb;
+  } else if (h.format_name == "PTM_FORMAT_RGB" || h.format_name == "PTM_FORMAT_JPEG_RGB") {
+    h.format = PtmFormat::kRgb;
+  } else {
+    throw InputError(label,
+                     "unsupported PTM format '" + h.format_name.substr(0, 40) +
+                         "' (texlume reads PTM_FORMAT_RGB, PTM_FORMAT_LRGB, PTM_FORMAT_JPEG_RGB "
+                         "and PTM_FORMAT_JPEG_LRGB)",
+                     2);
+  }
+  h.jpeg = h.format_name.rfind("PTM_FORMAT_JPEG_", 0) == 0;
+  // Width and height may share a line or take one each.
+  std::string line3 = ReadHeaderLine(in, label, 3);
+  std::size_t ln = 3;
+  auto tokens = SplitWhitespace(line3);
+  std::string line4;
+  if (tokens.size() == 1) {
+    line4 = ReadHeaderLine(in, label, ++ln);
+    const auto more = SplitWhitespace(line4);
+    if (more.size() != 1) throw InputError(label, "expected the height", ln);
+    tokens.push_back(more[0]);
+  }
+  if (tokens.size() != 2) throw InputError(label, "expected width and height", ln);
+  const std::uint64_t width = ParseUnsigned(tokens[0], "width", label, ln);
+  const std::uint64_t height = ParseUnsigned(tokens[1], "height", label, ln);
+  if (width == 0 || height == 0 || width > 65536 || height > 65536) {
+    throw InputError(
+        label, "implausible size " + std::to_string(width) + "x" + std::to_string(height), ln);
+  }
+  h.width = static_cast<int>(width);
+  h.height = static_cast<int>(height);
+  const std::string scales_line = ReadHeaderLine(in, label, ++ln);
+  const auto scale_tokens = SplitWhitespace(scales_line);
+  if (scale_tokens.size() != 6) throw InputError(label, "expected 6 scales", ln);
+  for (int i = 0; i < 6; ++i) {
+    const double s = ParseDouble(scale_tokens[static_cast<std::size_t>(i)], "a scale", label, ln);
+    if (!(s > 0.0 && s <= kMaxPtmScale)) {
+      throw InputError(
+          label,
+          "scale " + std::string(scale_tokens[static_cast<std::size_t>(i)]) + " is not in (0, 1e6]",
+          ln);
+    }
+    h.scale[i] = static_cast<float>(s);
+  }
+  const std::string bias_line = ReadHeaderLine(in, label, ++ln);
+  const auto bias_tokens = SplitWhitespace(bias_line);
+  if (bias_tokens.size() != 6) throw InputError(label, "expected 6 biases", ln);
+  for (int i = 0; i < 6; ++i) {
+    const std::int64_t b =
+        ParseSigned(bias_tokens[static_cast<std::size_t>(i)], "a bias", label, ln);
+    if (b < -kMaxPtmBias || b > kMaxPtmBias) {
+      throw InputError(label,
+                       "bias " + std::to_string(b) + " is not in [-" + std::to_string(kMaxPtmBias) +
+                           ", " + std::to_string(kMaxPtmBias) + "]",
+                       ln);
+    }
+    h.bias[i] = static_cast<int>(b);
+  }
+  h.line = ln;
+  return h;
+}
+
+std::uint64_t BytesLeft(std::istream& in) {
+  const std::streampos here = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streampos end = in.tellg();
+  in.seekg(here);
+  return static_cast<std::uint64_t>(end - here);
+}
+
+// Uncompressed: RGB, three blocks (R, G, B) of six interleaved coefficients per texel;
+// LRGB, a block of six coefficients per texel, then one of R, G, B per texel.
+BytePlanes ReadRawPlanes(std::istream& in, const PtmHeader& h, const std::string& label) {
+  const std::uint64_t expected = static_cast<std::uint64_t>(h.Texels()) * h.NumPlanes();
+  const std::uint64_t available = BytesLeft(in);
+  if (available < expected) {
+    throw InputError(label, "truncated payload: " + std::to_string(h.width) + "x" +
+                                std::to_string(h.height) + " " + h.format_name + " needs " +
+                                std::to_string(expected) + " bytes, the file has " +
+                                std::to_string(available));
+  }
+  RequirePlaneMemory(h, label);
+  BytePlanes planes(static_cast<std::size_t>(h.NumPlanes()),
+                    std::vector<unsigned char>(h.Texels()));
+  std::vector<unsigned char> block;
+  for (int first = 0; first < h.NumPlanes(); first += 6) {
+    const int interleaved = std::min(6, h.NumPlanes() - first);
+    block.resize(h.Texels() * static_cast<std::size_t>(interleaved));
+    in.read(reinterpret_cast<char*>(block.data()), static_cast<std::streamsize>(block.size()));
+    if (!in) throw InputError(label, "read error in the coefficients");
+    for (std::size_t t = 0; t < h.Texels(); ++t)
+      for (int k = 0; k < interleaved; ++k)
+        planes[static_cast<std::size_t>(first + k)][t] =
+            block[t * static_cast<std::size_t>(interleaved) + static_cast<std::size_t>(k)];
+  }
+  return planes;
+}
+
+// The JPEG header's lines after the biases: the compression parameter, then per plane
+// its transform, motion vector x and y, decoding order, reference plane, compressed
+// size and side-information size.
+struct JpegLayout {
+  std::vector<std::int64_t> transform, motion_x, motion_y, order, reference, size, side_size;
+};
+
+std::vector<std::int64_t> ReadIntegers(std::istream& in, int count, const std::string& what,
+                                       const std::string& label, std::size_t& ln) {
+  const std::string line = ReadHeaderLine(in, label, ++ln);
+  const auto tokens = SplitWhitespace(line);
+  if (static_cast<int>(tokens.size()) != count)
+    throw InputError(label, "expected " + std::to_string(count) + " " + what, ln);
+  std::vector<std::int64_t> values;
+  for (const auto& token : tokens) values.push_back(ParseSigned(token, what, label, ln));
+  return values;
+}
+
+JpegLayout ReadJpegLayout(std::istream& in, const PtmHeader& h, const std::string& label) {
+  std::size_t ln = h.line;
+  ReadIntegers(in, 1, "compression parameter", label, ln);
+  const int n = h.NumPlanes();
+  JpegLayout j;
+  j.transform = ReadIntegers(in, n, "transforms", label, ln);
+  j.motion_x = ReadIntegers(in, n, "motion vectors (x)", label, ln);
+  j.motion_y = ReadIntegers(in, n, "motion vectors (y)", label, ln);
+  j.order = ReadIntegers(in, n, "decoding orders", label, ln);
+  j.reference = ReadIntegers(in, n, "reference planes", label, ln);
+  j.size = ReadIntegers(in, n, "compressed sizes", label, ln);
+  j.side_size = ReadIntegers(in, n, "side-information sizes", label, ln);
+  std::vector<bool> rank_seen(static_cast<std::size_t>(n), false);
+  for (int p = 0; p < n; ++p) {
+    const auto k = static_cast<std::size_t>(p);
+    const std::string plane = "plane " + std::to_string(p);
+    if (j.transform[k] != 0 && j.transform[k] != 1)
+      throw InputError(label, plane + ": transform " + std::to_string(j.transform[k]) +
+                                  " (texlume reads none and plane inversion, 0 and 1)");
+    if (j.motion_x[k] != 0 || j.motion_y[k] != 0)
+      throw InputError(label, plane + ": motion-compensated prediction is not supported");
+    if (j.order[k] < 0 || j.order[k] >= n || rank_seen[static_cast<std::size_t>(j.order[k])])
+      throw InputError(label,
+                       "the decoding orders are not a permutation of 0.." + std::to_string(n - 1));
+    rank_seen[static_cast<std::size_t>(j.order[k])] = true;
+    if (j.size[k] < 0 || j.side_size[k] < 0 || j.side_size[k] % 5 != 0)
+      throw InputError(label,
+                       plane + ": a negative size, or side information not in 5-byte records");
+  }
+  for (int p = 0; p < n; ++p) {
+    const std::int64_t r = j.reference[static_cast<std::size_t>(p)];
+    if (r != -1 && (r < 0 || r >= n ||
+                    j.order[static_cast<std::size_t>(r)] >= j.order[static_cast<std::size_t>(p)]))
+      throw InputError(label, "plane " + std::to_string(p) + " is predicted from plane " +
+                                  std::to_string(r) + ", which is not decoded before it");
+  }
+  return j;
+}
+
+// PTM_FORMAT_JPEG_*: per plane a grey JPEG stream and its side information, in plane
+// order. A plane predicted from a reference is the reference (inverted when its
+// transform is 1) plus the decoded values minus 128; the side information then sets
+// single bytes exactly (5-byte records: a big-endian texel offset and the value).
+BytePlanes ReadJpegPlanes(std::istream& in, const PtmHeader& h, const std::string& label) {
+  const JpegLayout j = ReadJpegLayout(in, h, label);
+  std::uint64_t total = 0;
+  for (int p = 0; p < h.NumPlanes(); ++p)
+    total += static_cast<std::uint64_t>(j.size[static_cast<std::size_t>(p)]) +
+             static_cast<std::uint64_t>(j.side_size[static_cast<std::size_t>(p)]);
+  const std::uint64_t available = BytesLeft(in);
+  if (available < total)
+    throw InputError(label, "truncated payload: its JPEG streams need " + std::to_string(total) +
+                                " bytes, the file has " + std::to_string(available));
+  RequirePlaneMemory(h, label);
+  std::string payload(total, '\0');
+  in.read(payload.data(), static_cast<std::streamsize>(total));
+  if (!in) throw InputError(label, "read error in the JPEG streams");
+  const int n = h.NumPlanes();
+  std::vector<std::string_view> stream(static_cast<std::size_t>(n)),
+      side(static_cast<std::size_t>(n));
+  std::size_t at = 0;
+  for (std::size_t p = 0; p < static_cast<std::size_t>(n); ++p) {
+    stream[p] = std::string_view(payload).substr(at, static_cast<std::size_t>(j.size[p]));
+    at += static_cast<std::size_t>(j.size[p]);
+    side[p] = std::string_view(payload).substr(at, static_cast<std::size_t>(j.side_size[p]));
+    at += static_cast<std::size_t>(j.side_size[p]);
+  }
+  std::vector<int> by_rank(static_cast<std::size_t>(n));
+  for (int p = 0; p < n; ++p)
+    by_rank[static_cast<std::size_t>(j.order[static_cast<std::size_t>(p)])] = p;
+  BytePlanes planes(static_cast<std::size_t>(n));
+  for (const int p : by_rank) {
+    const auto k = static_cast<std::size_t>(p);
+    const cv::Mat decoded =
+        DecodeGreyImageBytes(stream[k], "jpeg", h.width, h.height,
+                             label + " (JPEG stream of plane " + std::to_string(p) + ")");
+    planes[k].assign(decoded.data, decoded.data + h.Texels());
+    if (j.reference[k] >= 0) {
+      const std::vector<unsigned char>& ref = planes[static_cast<std::size_t>(j.reference[k])];
+      const bool invert = j.transform[k] == 1;
+      for (std::size_t t = 0; t < h.Texels(); ++t)
+        planes[k][t] =
+            static_cast<unsigned char>(planes[k][t] + (invert ? 255 - ref[t] : ref[t]) - 128);
+    }
+    for (std::size_t r = 0; r + 5 <= side[k].size(); r += 5) {
+      const auto byte = [&](std::size_t i) {
+        return static_cast<std::uint64_t>(static_cast<unsigned char>(side[k][r + i]));
+      };
+      const std::uint64_t offset = byte(0) << 24 | byte(1) << 16 | byte(2) << 8 | byte(3);
+      if (offset >= h.Texels())
+        throw InputError(label, "plane " + std::to_string(p) + "'s side information names texel " +
+                                    std::to_string(offset) + " of " + std::to_string(h.Texels()));
+      planes[k][offset] = static_cast<unsigned char>(side[k][r + 4]);
+    }
+  }
+  return planes;
+}
+
+// Coefficient = (byte - bias) * scale / 255 (display values in [0, 1]); colour byte / 255.
+// The file's rows run from the bottom up.
+Ptm PtmFromPlanes(const PtmHeader& h, const BytePlanes& planes) {
+  Ptm ptm;
+  ptm.Resize(h.format, h.width, h.height);
+  for (int y = 0; y < h.height; ++y) {
+    const std::size_t file_row = static_cast<std::size_t>(h.height - 1 - y) * h.width;
+    for (int x = 0; x < h.width; ++x) {
+      const std::size_t t = static_cast<std::size_t>(y) * h.width + x;
+      for (int q = 0; q < ptm.NumPolynomials(); ++q) {
+        float* a = ptm.Coefficients(t, q);
+        for (int i = 0; i < 6; ++i)
+          a[i] = (static_cast<float>(planes[static_cast<std::size_t>(q * 6 + i)][file_row + x]) -
+                  h.bias[i]) *
+                 h.scale[i] / 255.0f;
+      }
+      if (h.format == PtmFormat::kLrgb)
+        for (int c = 0; c < 3; ++c)
+          ptm.colour[t * 3 + static_cast<std::size_t>(c)] =
+              planes[static_cast<std::size_t>(6 + c)][file_row + x] / 255.0f;
+    }
+  }
+  return ptm;
+}
+
 }  // namespace
 
 void WritePtm(const Ptm& ptm, std::ostream& out) {
@@ -122,117 +398,10 @@ void WritePtmFile(const Ptm& ptm, const std::filesystem::path& path) {
 }
 
 Ptm ReadPtm(std::istream& in, const std::string& label) {
-  const std::string version = ReadHeaderLine(in, label, 1);
-  if (version != "PTM_1.2" && version != "PTM_1.1") {
-    throw InputError(label,
-                     "not a PTM file: first line is '" + version.substr(0, 40) +
-                         "', expected PTM_1.2 or PTM_1.1",
-                     1);
-  }
-  const std::string format_name = ReadHeaderLine(in, label, 2);
-  PtmFormat format;
-  if (format_name == "PTM_FORMAT_LRGB") {
-    format = PtmFormat::kLrgb;
-  } else if (format_name == "PTM_FORMAT_RGB") {
-    format = PtmFormat::kRgb;
-  } else {
-    throw InputError(label,
-                     "unsupported PTM format '" + format_name.substr(0, 40) +
-                         "' (texlume reads PTM_FORMAT_RGB and PTM_FORMAT_LRGB)",
-                     2);
-  }
-  // Width and height may share a line or take one each.
-  std::vector<std::string_view> dims;
-  std::string line3 = ReadHeaderLine(in, label, 3);
-  std::size_t ln = 3;
-  auto tokens = SplitWhitespace(line3);
-  std::string line4;
-  if (tokens.size() == 1) {
-    line4 = ReadHeaderLine(in, label, ++ln);
-    const auto more = SplitWhitespace(line4);
-    if (more.size() != 1) throw InputError(label, "expected the height", ln);
-    tokens.push_back(more[0]);
-  }
-  if (tokens.size() != 2) throw InputError(label, "expected width and height", ln);
-  const std::uint64_t width = ParseUnsigned(tokens[0], "width", label, ln);
-  const std::uint64_t height = ParseUnsigned(tokens[1], "height", label, ln);
-  if (width == 0 || height == 0 || width > 65536 || height > 65536) {
-    throw InputError(
-        label, "implausible size " + std::to_string(width) + "x" + std::to_string(height), ln);
-  }
-  const std::string scales_line = ReadHeaderLine(in, label, ++ln);
-  const auto scale_tokens = SplitWhitespace(scales_line);
-  if (scale_tokens.size() != 6) throw InputError(label, "expected 6 scales", ln);
-  float scale[6];
-  for (int i = 0; i < 6; ++i) {
-    const double s = ParseDouble(scale_tokens[static_cast<std::size_t>(i)], "a scale", label, ln);
-    if (!(s > 0.0 && s <= kMaxPtmScale)) {
-      throw InputError(
-          label,
-          "scale " + std::string(scale_tokens[static_cast<std::size_t>(i)]) + " is not in (0, 1e6]",
-          ln);
-    }
-    scale[i] = static_cast<float>(s);
-  }
-  const std::string bias_line = ReadHeaderLine(in, label, ++ln);
-  const auto bias_tokens = SplitWhitespace(bias_line);
-  if (bias_tokens.size() != 6) throw InputError(label, "expected 6 biases", ln);
-  int bias[6];
-  for (int i = 0; i < 6; ++i) {
-    const std::int64_t b =
-        ParseSigned(bias_tokens[static_cast<std::size_t>(i)], "a bias", label, ln);
-    if (b < -kMaxPtmBias || b > kMaxPtmBias) {
-      throw InputError(label,
-                       "bias " + std::to_string(b) + " is not in [-" + std::to_string(kMaxPtmBias) +
-                           ", " + std::to_string(kMaxPtmBias) + "]",
-                       ln);
-    }
-    bias[i] = static_cast<int>(b);
-  }
-
-  // Payload size check before allocating.
-  const std::streampos here = in.tellg();
-  in.seekg(0, std::ios::end);
-  const std::streampos end = in.tellg();
-  in.seekg(here);
-  const std::uint64_t texels = width * height;
-  const std::uint64_t expected = format == PtmFormat::kLrgb ? texels * 9 : texels * 18;
-  const std::uint64_t available = static_cast<std::uint64_t>(end - here);
-  if (available < expected) {
-    throw InputError(label, "truncated payload: " + std::to_string(width) + "x" +
-                                std::to_string(height) + " " + format_name + " needs " +
-                                std::to_string(expected) + " bytes, the file has " +
-                                std::to_string(available));
-  }
-  Ptm ptm;
-  ptm.Resize(format, static_cast<int>(width), static_cast<int>(height));
-  std::vector<unsigned char> row(static_cast<std::size_t>(width) * 6);
-  for (int p = 0; p < ptm.NumPolynomials(); ++p) {
-    for (int y = ptm.height - 1; y >= 0; --y) {
-      in.read(reinterpret_cast<char*>(row.data()), static_cast<std::streamsize>(row.size()));
-      if (!in) throw InputError(label, "read error in the coefficients");
-      for (int x = 0; x < ptm.width; ++x) {
-        float* a = ptm.Coefficients(static_cast<std::size_t>(y) * ptm.width + x, p);
-        for (int i = 0; i < 6; ++i) {
-          a[i] = (static_cast<float>(
-                      row[static_cast<std::size_t>(x) * 6 + static_cast<std::size_t>(i)]) -
-                  bias[i]) *
-                 scale[i] / 255.0f;
-        }
-      }
-    }
-  }
-  if (format == PtmFormat::kLrgb) {
-    std::vector<unsigned char> rgb(static_cast<std::size_t>(width) * 3);
-    for (int y = ptm.height - 1; y >= 0; --y) {
-      in.read(reinterpret_cast<char*>(rgb.data()), static_cast<std::streamsize>(rgb.size()));
-      if (!in) throw InputError(label, "read error in the colour block");
-      for (std::size_t i = 0; i < rgb.size(); ++i) {
-        ptm.colour[static_cast<std::size_t>(y) * width * 3 + i] = rgb[i] / 255.0f;
-      }
-    }
-  }
-  return ptm;
+  const PtmHeader header = ReadPtmHeader(in, label);
+  const BytePlanes planes =
+      header.jpeg ? ReadJpegPlanes(in, header, label) : ReadRawPlanes(in, header, label);
+  return PtmFromPlanes(header, planes);
 }
 
 Ptm ReadPtmFile(const std::filesystem::path& path) {

@@ -109,7 +109,7 @@ TEST(PtmFile, CorruptHeadersAndTruncatedPayloadsAreCleanErrors) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"", "truncated header"},
       {"PTM_9.9\n", "not a PTM file"},
-      {"PTM_1.2\nPTM_FORMAT_JPEG_LRGB\n", "unsupported PTM format"},
+      {"PTM_1.2\nPTM_FORMAT_JPEGLS_LRGB\n", "unsupported PTM format"},
       {"PTM_1.2\nPTM_FORMAT_RGB\n0\n4\n", "implausible size"},
       {"PTM_1.2\nPTM_FORMAT_RGB\n4\n4\n1 2 3\n", "expected 6 scales"},
       {"PTM_1.2\nPTM_FORMAT_RGB\n4\n4\n1 1 1 1 1 1\n0 0 0 x 0 0\n", "integer"},
@@ -122,6 +122,137 @@ TEST(PtmFile, CorruptHeadersAndTruncatedPayloadsAreCleanErrors) {
     EXPECT_NE(error.find(expected), std::string::npos)
         << "'" << text.substr(0, 30) << "' gave " << error;
   }
+}
+
+// A PTM_FORMAT_JPEG_LRGB file as HP's format lays it out: one grey JPEG stream per
+// plane, planes predicted from others (one inverted), side information that sets
+// bytes exactly, and a decoding order that is not the plane order.
+struct JpegPtmFile {
+  std::string bytes;
+  std::vector<std::vector<unsigned char>> planes;  // what each plane decodes to, file row order
+};
+
+JpegPtmFile MakeJpegLrgb(int w, int h) {
+  JpegPtmFile f;
+  const int n = 9;
+  for (int p = 0; p < n; ++p) {
+    std::vector<unsigned char> plane(static_cast<std::size_t>(w) * h);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)  // smooth, so a quality-100 JPEG is within a level or two
+        plane[static_cast<std::size_t>(y) * w + x] =
+            static_cast<unsigned char>(40 + 20 * p + 2 * x + y);
+    f.planes.push_back(plane);
+  }
+  // Plane 1 is predicted from plane 0, plane 2 from plane 0 inverted.
+  const std::vector<int> reference = {-1, 0, 0, -1, -1, -1, -1, -1, -1};
+  const std::vector<int> transform = {0, 0, 1, 0, 0, 0, 0, 0, 0};
+  const std::vector<int> order = {2, 3, 4, 0, 1, 5, 6, 7, 8};
+  std::string streams;
+  std::vector<std::size_t> sizes, side_sizes;
+  for (int p = 0; p < n; ++p) {
+    cv::Mat stored(h, w, CV_8UC1);
+    for (std::size_t t = 0; t < f.planes[0].size(); ++t) {
+      int v = f.planes[static_cast<std::size_t>(p)][t];
+      if (reference[static_cast<std::size_t>(p)] >= 0) {
+        const int r = f.planes[0][t];
+        v = v - (transform[static_cast<std::size_t>(p)] ? 255 - r : r) + 128;
+      }
+      stored.data[t] = static_cast<unsigned char>(v);
+    }
+    std::vector<unsigned char> jpeg;
+    cv::imencode(".jpg", stored, jpeg, {cv::IMWRITE_JPEG_QUALITY, 100});
+    streams.append(jpeg.begin(), jpeg.end());
+    sizes.push_back(jpeg.size());
+    std::string side;
+    if (p == 4) {  // two texels set exactly: offset (big-endian), value
+      f.planes[4][3] = 7;
+      f.planes[4][static_cast<std::size_t>(w) * h - 1] = 250;
+      side = std::string("\0\0\0\3\x07", 5) + std::string("\0\0", 2);
+      const std::uint32_t last = static_cast<std::uint32_t>(w * h - 1);
+      side += static_cast<char>(last >> 8 & 0xff);
+      side += static_cast<char>(last & 0xff);
+      side += static_cast<char>(250);
+    }
+    streams += side;
+    side_sizes.push_back(side.size());
+  }
+  std::ostringstream out;
+  auto line = [&](const auto& values) {
+    for (std::size_t i = 0; i < values.size(); ++i) out << (i ? " " : "") << values[i];
+    out << "\n";
+  };
+  out << "PTM_1.2\nPTM_FORMAT_JPEG_LRGB\n" << w << "\n" << h << "\n";
+  line(std::vector<float>{2, 2, 2, 1, 1, 1});
+  line(std::vector<int>{128, 128, 128, 0, 0, 0});
+  out << "100\n";
+  line(transform);
+  line(std::vector<int>(n, 0));
+  line(std::vector<int>(n, 0));
+  line(order);
+  line(reference);
+  line(sizes);
+  line(side_sizes);
+  f.bytes = out.str() + streams;
+  return f;
+}
+
+TEST(PtmFile, JpegLrgbDecodesPredictedInvertedAndCorrectedPlanes) {
+  const int w = 24, h = 16;
+  const JpegPtmFile f = MakeJpegLrgb(w, h);
+  std::istringstream in(f.bytes);
+  const Ptm ptm = ReadPtm(in, "jpeg.ptm");
+  ASSERT_EQ(ptm.format, PtmFormat::kLrgb);
+  ASSERT_EQ(ptm.width, w);
+  float worst = 0.0f;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t t = static_cast<std::size_t>(y) * w + x;
+      const std::size_t file_t = static_cast<std::size_t>(h - 1 - y) * w + x;  // rows bottom up
+      const float scale[6] = {2, 2, 2, 1, 1, 1};
+      const int bias[6] = {128, 128, 128, 0, 0, 0};
+      for (int i = 0; i < 6; ++i) {
+        const float expected =
+            (f.planes[static_cast<std::size_t>(i)][file_t] - bias[i]) * scale[i] / 255.0f;
+        const float error = std::abs(ptm.Coefficients(t)[i] - expected) * 255.0f / scale[i];
+        worst = std::max(worst, error);
+        if (i == 4 && (file_t == 3 || file_t == static_cast<std::size_t>(w * h - 1))) {
+          EXPECT_EQ(error, 0.0f) << "side information is exact";
+        }
+      }
+      for (int c = 0; c < 3; ++c)
+        worst = std::max(worst, std::abs(ptm.colour[t * 3 + static_cast<std::size_t>(c)] * 255.0f -
+                                         f.planes[static_cast<std::size_t>(6 + c)][file_t]));
+    }
+  }
+  EXPECT_LE(worst, 2.5f) << "levels of the 8-bit planes";  // JPEG at quality 100
+}
+
+TEST(PtmFile, JpegPtmsWithBadLayoutsAreRefusedNamingTheProblem) {
+  const JpegPtmFile f = MakeJpegLrgb(24, 16);
+  auto refused = [&](const std::string& from, const std::string& to) {
+    std::string bytes = f.bytes;
+    const std::size_t at = bytes.find(from);
+    bytes.replace(at, from.size(), to);
+    std::istringstream in(bytes);
+    return testing::InputErrorMessage([&] { ReadPtm(in, "jpeg.ptm"); });
+  };
+  EXPECT_NE(refused("2 3 4 0 1 5 6 7 8", "2 3 4 0 1 5 6 7 7").find("permutation"),
+            std::string::npos);
+  EXPECT_NE(refused("-1 0 0 -1", "-1 5 0 -1").find("not decoded before"), std::string::npos);
+  EXPECT_NE(refused("\n0 0 1 0 0 0 0 0 0\n", "\n0 0 2 0 0 0 0 0 0\n").find("transform 2"),
+            std::string::npos);
+  std::string truncated = f.bytes.substr(0, f.bytes.size() - 100);
+  std::istringstream in(truncated);
+  EXPECT_NE(testing::InputErrorMessage([&] { ReadPtm(in, "jpeg.ptm"); }).find("truncated"),
+            std::string::npos);
+  // A stream that is not the announced size of grey image.
+  std::string wide = MakeJpegLrgb(24, 16).bytes;
+  wide.replace(wide.find("\n24\n"), 4, "\n25\n");
+  std::istringstream wide_in(wide);
+  EXPECT_NE(testing::InputErrorMessage([&] {
+              ReadPtm(wide_in, "jpeg.ptm");
+            }).find("expected 25 x 16 grey"),
+            std::string::npos);
 }
 
 TEST(PtmFile, ExrRoundTripIsLossless) {
