@@ -166,8 +166,8 @@ WebModel BuildWebModel(const fs::path& model_dir) {
     const ptm::Ptm& atlas_ptm = model.atlases[static_cast<std::size_t>(atlas)];
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d p = model.mesh.Corner(f, k);
-      const Eigen::Vector3d& smooth =
-          vertex_normals[static_cast<std::size_t>(model.mesh.faces[f][static_cast<std::size_t>(k)])];
+      const Eigen::Vector3d& smooth = vertex_normals[static_cast<std::size_t>(
+          model.mesh.faces[f][static_cast<std::size_t>(k)])];
       for (int d = 0; d < 3; ++d) {
         position.push_back(static_cast<float>(p[d]));
         normal.push_back(static_cast<float>(smooth[d]));
