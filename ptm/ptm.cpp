@@ -141,6 +141,18 @@ std::vector<float> Relight(const Ptm& ptm, const Eigen::Vector3d& light,
   return out;
 }
 
+Ptm AsRgb(const Ptm& ptm) {
+  if (ptm.format == PtmFormat::kRgb) return ptm;
+  Ptm rgb;
+  rgb.Resize(PtmFormat::kRgb, ptm.width, ptm.height);
+  for (std::size_t t = 0; t < ptm.NumTexels(); ++t)
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < 6; ++i)
+        rgb.Coefficients(t, c)[i] =
+            ptm.colour[t * 3 + static_cast<std::size_t>(c)] * ptm.Coefficients(t)[i];
+  return rgb;
+}
+
 std::vector<float> NormalMap(const Ptm& ptm) {
   std::vector<float> out(ptm.NumTexels() * 3);
   for (std::size_t t = 0; t < ptm.NumTexels(); ++t) {

@@ -57,6 +57,10 @@ struct Ptm {
   Eigen::Vector3f Evaluate(std::size_t texel, double lu, double lv) const;
 };
 
+/// The same PTM as RGB: each channel's polynomial is the LRGB colour's channel times
+/// the luminance polynomial (eq. 2), so it relights identically. An RGB PTM is copied.
+Ptm AsRgb(const Ptm& ptm);
+
 /// The six monomials of eq. 1 at (lu, lv): (lu^2, lv^2, lu lv, lu, lv, 1).
 std::array<double, 6> PtmBasis(double lu, double lv);
 /// L(lu, lv) = a0 lu^2 + a1 lv^2 + a2 lu lv + a3 lu + a4 lv + a5 (paper 003 eq. 1).

@@ -550,8 +550,12 @@ nlohmann::json WebPlanes::Info(const Ptm& ptm) const {
 
 int WriteRelightWeb(const Ptm& ptm, const std::filesystem::path& dir, int jpeg_quality) {
   std::filesystem::create_directories(dir);
-  const WebPlanes web = QuantiseWebPlanes(ptm);
-  nlohmann::json info = web.Info(ptm);
+  // Always RGB: OpenLIME (1.2.6 and before) draws an "lrgb" PTM with its luminance as
+  // the pixel's alpha (LRGB.render returns l * vec4(basecolor, 1)), so every texel whose
+  // luminance is under 1 comes out partly transparent and dark (docs/ptm_format.md).
+  const Ptm rgb = AsRgb(ptm);
+  const WebPlanes web = QuantiseWebPlanes(rgb);
+  nlohmann::json info = web.Info(rgb);
   info["format"] = "jpg";
   info["quality"] = jpeg_quality;
   for (std::size_t j = 0; j < web.images.size(); ++j) {

@@ -51,9 +51,10 @@ struct WebPlanes {
 WebPlanes QuantiseWebPlanes(const Ptm& ptm);
 
 /// Writes the relight / OpenLIME web format into `dir`: `info.json` (type "ptm",
-/// colorspace "rgb" or "lrgb", nplanes, per-plane scale and bias) and the
-/// coefficient planes as `plane_N.jpg`, three coefficients per JPEG
-/// (docs/ptm_format.md). Returns the number of files written.
+/// colorspace "rgb", nplanes, per-plane scale and bias) and the coefficient planes as
+/// `plane_N.jpg`, three coefficients per JPEG (docs/ptm_format.md). An LRGB PTM is
+/// written as its RGB equivalent (AsRgb), which OpenLIME draws correctly. Returns the
+/// number of files written.
 int WriteRelightWeb(const Ptm& ptm, const std::filesystem::path& dir, int jpeg_quality = 95);
 
 }  // namespace texlume::ptm

@@ -352,8 +352,26 @@ TEST(PtmFile, RelightWebExportWritesInfoAndPlanes) {
   EXPECT_EQ(info["nplanes"], 18);
   EXPECT_EQ(info["materials"][0]["scale"].size(), 18u);
   EXPECT_TRUE(std::filesystem::exists(tmp / "web/plane_5.jpg"));
+  // LRGB goes out as its RGB equivalent, which OpenLIME draws right (its "lrgb" shader
+  // makes the luminance the pixel's alpha).
   const Ptm lrgb = RandomPtm(PtmFormat::kLrgb, 16, 8, 6);
-  EXPECT_EQ(WriteRelightWeb(lrgb, tmp / "web2"), 4);
+  EXPECT_EQ(WriteRelightWeb(lrgb, tmp / "web2"), 7);
+  const auto info2 = nlohmann::json::parse(testing::ReadText(tmp / "web2/info.json"));
+  EXPECT_EQ(info2["colorspace"], "rgb");
+  EXPECT_EQ(info2["nplanes"], 18);
+}
+
+TEST(Ptm, AnLrgbPtmAsRgbRelightsTheSame) {
+  const Ptm lrgb = RandomPtm(PtmFormat::kLrgb, 6, 5, 7);
+  const Ptm rgb = AsRgb(lrgb);
+  ASSERT_EQ(rgb.format, PtmFormat::kRgb);
+  for (const Eigen::Vector3d& light :
+       {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.6, -0.3, 0.74)}) {
+    const std::vector<float> a = Relight(lrgb, light.normalized()),
+                             b = Relight(rgb, light.normalized());
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-5f) << i;
+  }
 }
 
 }  // namespace
