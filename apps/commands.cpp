@@ -70,12 +70,18 @@ void AddFitCommand(CLI::App& app, CommandRunners& run) {
   auto o = std::make_shared<pipeline::FitJobOptions>();
   sub->add_option("--images", o->images_dir, "the capture's photos")->required();
   sub->add_option("--lights", o->lights_file, "the capture's .lp file")->required();
-  sub->add_option("--out", o->out_file, "the .ptm file to write")->required();
+  sub->add_option("--out", o->out_file, "the .ptm (or, with --basis hsh, .rti) file to write")
+      ->required();
   sub->add_option("--format", o->fit.format, "PTM format")
       ->transform(Choice(std::map<std::string, ptm::PtmFormat>(
           {{"lrgb", ptm::PtmFormat::kLrgb}, {"rgb", ptm::PtmFormat::kRgb}})))
       ->default_str("lrgb");
   sub->add_flag("--robust", o->fit.robust, "Ceres fit ignoring shadows and highlights");
+  sub->add_option("--basis", o->basis, "ptm, or hsh (hemispherical harmonics; --out FILE.rti)")
+      ->check(CLI::IsMember({"ptm", "hsh"}))
+      ->capture_default_str();
+  sub->add_option("--order", o->hsh_order, "HSH order: 2 (4 terms) or 3 (9 terms)")
+      ->capture_default_str();
   sub->add_option("--exr", o->exr_file, "also write the lossless EXR");
   sub->add_option("--web", o->web_dir, "also write the relight/OpenLIME web format");
   sub->add_option("--band-rows", o->fit.band_rows, "rows decoded and fitted at a time")

@@ -6,6 +6,7 @@
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "btf/btf.h"
 #include "core/errors.h"
@@ -15,6 +16,7 @@
 #include "core/timing.h"
 #include "model/model_io.h"
 #include "pipeline/btf_synth_job.h"
+#include "ptm/hsh.h"
 #include "ptm/ptm_io.h"
 #include "sfm/lights.h"
 
@@ -100,18 +102,95 @@ bool RunInspectJob(const InspectJobOptions& options, std::ostream& out, std::ost
 void FitJobOptions::Check() const {
   RequirePath(images_dir, "the capture's image folder");
   RequirePath(lights_file, "the capture's .lp file");
-  RequirePath(out_file, "the .ptm file to write");
+  RequirePath(out_file, basis == "hsh" ? "the .rti file to write" : "the .ptm file to write");
   fit.Check();
+  if (basis != "ptm" && basis != "hsh") throw OptionError("--basis must be ptm or hsh");
+  if (basis == "hsh") {
+    if (hsh_order < ptm::kHshMinOrder || hsh_order > ptm::kHshMaxOrder)
+      throw OptionError("--order must be 2 or 3 (4 or 9 HSH terms)");
+    if (!exr_file.empty()) throw OptionError("--exr holds a PTM; an HSH fit writes .rti and --web");
+    if (fit.robust) throw OptionError("--robust fits PTMs only");
+    if (LowerCaseExtension(out_file) != ".rti")
+      throw OptionError("an HSH fit writes RTIViewer's .rti: name --out FILE.rti");
+  }
 }
 
 nlohmann::json FitJobOptions::ToJson() const {
+  if (basis == "hsh")
+    return {{"images", images_dir.string()},
+            {"lights", lights_file.string()},
+            {"basis", "hsh"},
+            {"order", hsh_order},
+            {"band_rows", fit.band_rows}};
   return {{"images", images_dir.string()},
           {"lights", lights_file.string()},
+          {"basis", "ptm"},
           {"format", fit.format == ptm::PtmFormat::kLrgb ? "lrgb" : "rgb"},
           {"robust", fit.robust},
           {"band_rows", fit.band_rows},
           {"robust_scale", fit.robust_scale}};
 }
+
+namespace {
+
+// What a fit wrote: the line it prints and its record.
+struct FitOutcome {
+  std::string summary;
+  nlohmann::json result;
+  double fit_seconds = 0, write_seconds = 0;
+};
+
+FitOutcome FitAndWritePtm(const FitJobOptions& options, const ptm::RtiCapture& capture,
+                          const ProgressCallback& progress) {
+  ptm::CheckLightSet(capture.lights, options.fit, options.lights_file.string());
+  const ptm::FitResult result =
+      ptm::FitPtmFromFiles(capture.files, capture.lights, options.fit, progress);
+  const auto t0 = std::chrono::steady_clock::now();
+  ptm::WritePtmFile(result.ptm, options.out_file);
+  if (!options.exr_file.empty()) ptm::WritePtmExr(result.ptm, options.exr_file);
+  if (!options.web_dir.empty()) ptm::WriteRelightWeb(result.ptm, options.web_dir);
+  FitOutcome o;
+  o.write_seconds = SecondsSince(t0);
+  o.fit_seconds = result.seconds;
+  std::ostringstream line;
+  line << "Fitted a " << result.ptm.width << "x" << result.ptm.height << " "
+       << (options.fit.format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB") << " PTM to "
+       << result.num_images << " images in " << result.seconds << " s"
+       << (options.fit.robust ? " (robust)" : "") << "; mean RMS residual "
+       << result.mean_residual_rms * 255.0 << " / 255. Wrote " << options.out_file.string();
+  o.summary = line.str();
+  o.result = {{"width", result.ptm.width},
+              {"height", result.ptm.height},
+              {"images", result.num_images},
+              {"mean_residual_rms", result.mean_residual_rms}};
+  return o;
+}
+
+FitOutcome FitAndWriteHsh(const FitJobOptions& options, const ptm::RtiCapture& capture,
+                          const ProgressCallback& progress) {
+  const ptm::HshFitResult result = ptm::FitHshFromFiles(
+      capture.files, capture.lights, options.hsh_order, options.fit.band_rows, progress);
+  const auto t0 = std::chrono::steady_clock::now();
+  ptm::WriteRtiFile(result.hsh, options.out_file);
+  if (!options.web_dir.empty()) ptm::WriteHshRelightWeb(result.hsh, options.web_dir);
+  FitOutcome o;
+  o.write_seconds = SecondsSince(t0);
+  o.fit_seconds = result.seconds;
+  std::ostringstream line;
+  line << "Fitted a " << result.hsh.width << "x" << result.hsh.height << " order-"
+       << result.hsh.order << " HSH (" << result.hsh.Terms() << " terms per channel) to "
+       << capture.files.size() << " images in " << result.seconds << " s; mean RMS residual "
+       << result.mean_residual_rms * 255.0 << " / 255. Wrote " << options.out_file.string();
+  o.summary = line.str();
+  o.result = {{"width", result.hsh.width},
+              {"height", result.hsh.height},
+              {"images", capture.files.size()},
+              {"terms", result.hsh.Terms()},
+              {"mean_residual_rms", result.mean_residual_rms}};
+  return o;
+}
+
+}  // namespace
 
 void RunFitJob(const FitJobOptions& options, std::ostream& out, std::ostream& err,
                const ProgressCallback& progress) {
@@ -125,29 +204,16 @@ void RunFitJob(const FitJobOptions& options, std::ostream& out, std::ostream& er
   }
   const ptm::RtiCapture capture = ptm::ReadRtiCapture(options.lights_file, options.images_dir);
   for (const std::string& w : capture.warnings) err << "warning: " << w << "\n";
-  ptm::CheckLightSet(capture.lights, options.fit, options.lights_file.string());
-  const ptm::FitResult result =
-      ptm::FitPtmFromFiles(capture.files, capture.lights, options.fit, progress);
-  const auto t0 = std::chrono::steady_clock::now();
-  ptm::WritePtmFile(result.ptm, options.out_file);
-  if (!options.exr_file.empty()) ptm::WritePtmExr(result.ptm, options.exr_file);
-  if (!options.web_dir.empty()) ptm::WriteRelightWeb(result.ptm, options.web_dir);
-  const double write_seconds = SecondsSince(t0);
-  out << "Fitted a " << result.ptm.width << "x" << result.ptm.height << " "
-      << (options.fit.format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB") << " PTM to "
-      << result.num_images << " images in " << result.seconds << " s"
-      << (options.fit.robust ? " (robust)" : "") << "; mean RMS residual "
-      << result.mean_residual_rms * 255.0 << " / 255. Wrote " << options.out_file.string() << "\n";
+  const FitOutcome fit = options.basis == "hsh" ? FitAndWriteHsh(options, capture, progress)
+                                                : FitAndWritePtm(options, capture, progress);
+  out << fit.summary << "\n";
   nlohmann::json record;
   record["command"] = "fit";
   record["settings"] = options.ToJson();
-  record["result"] = {{"width", result.ptm.width},
-                      {"height", result.ptm.height},
-                      {"images", result.num_images},
-                      {"mean_residual_rms", result.mean_residual_rms},
-                      {"intensity_space", "display (sRGB-encoded) values in [0, 1]"}};
+  record["result"] = fit.result;
+  record["result"]["intensity_space"] = "display (sRGB-encoded) values in [0, 1]";
   record["warnings"] = capture.warnings;
-  record["timings_s"] = {{"fit", result.seconds}, {"write", write_seconds}};
+  record["timings_s"] = {{"fit", fit.fit_seconds}, {"write", fit.write_seconds}};
   fs::path record_path = options.out_file;
   record_path += ".json";
   WriteJson(record_path, record);

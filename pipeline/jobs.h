@@ -41,6 +41,10 @@ struct FitJobOptions {
   std::filesystem::path images_dir, lights_file, out_file;
   std::filesystem::path exr_file, web_dir;  ///< empty: not written
   ptm::FitOptions fit;
+  /// "ptm" (out_file: .ptm) or "hsh" (hemispherical harmonics of `hsh_order`; out_file:
+  /// RTIViewer's .rti; the web format of an HSH; no EXR, no robust fit).
+  std::string basis = "ptm";
+  int hsh_order = 3;
   void Check() const;
   nlohmann::json ToJson() const;
 };

@@ -16,6 +16,7 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "ptm/image_bands.h"
 #include "sfm/lights.h"
 
 namespace texlume::ptm {
@@ -326,60 +327,18 @@ FitResult FitPtmFromFiles(const std::vector<std::filesystem::path>& files,
   TEXLUME_CHECK(files.size() == lights.size(), "one light per file");
   const std::string label = files.empty() ? "images" : files[0].parent_path().string();
   CheckLightSet(lights, options, label);
-  // The one image reader (core/image_io.h), streamed by bands of rows.
-  std::vector<ImageReader> inputs;
-  int width = 0, height = 0;
-  for (const auto& file : files) {
-    ImageReader in(file);
-    if (inputs.empty()) {
-      width = in.width();
-      height = in.height();
-    } else if (in.width() != width || in.height() != height) {
-      throw InputError(file.string(), "is " + std::to_string(in.width()) + "x" +
-                                          std::to_string(in.height()) + " but " +
-                                          files[0].string() + " is " + std::to_string(width) + "x" +
-                                          std::to_string(height));
-    }
-    inputs.push_back(std::move(in));
-  }
+  ImageBands bands(files);
   FitResult result;
-  result.ptm.Resize(options.format, width, height);
+  result.ptm.Resize(options.format, bands.width(), bands.height());
   result.residual_rms.assign(result.ptm.NumTexels(), 0.0f);
   result.num_images = files.size();
   const BandFitter fitter(lights, options);
-  const std::size_t band_floats = static_cast<std::size_t>(options.band_rows) * width * 3;
-  // Two bands: the next one is decoded while the current one is fitted.
-  std::vector<std::vector<float>> bands[2];
-  for (auto& set : bands) set.assign(files.size(), std::vector<float>(band_floats));
-  auto read_band = [&](int y0, std::vector<std::vector<float>>& band) {
-    const int rows = std::min(options.band_rows, height - y0);
-    for (std::size_t k = 0; k < inputs.size(); ++k)
-      inputs[k].ReadRows(y0, y0 + rows, 3, band[k].data());
-  };
-  read_band(0, bands[0]);
-  for (int b = 0, y0 = 0; y0 < height; ++b, y0 += options.band_rows) {
-    const int rows = std::min(options.band_rows, height - y0);
-    const int next = y0 + options.band_rows;
-    std::exception_ptr read_error;
-    std::thread reader;
-    if (next < height) {
-      reader = std::thread([&, next, b] {
-        try {
-          read_band(next, bands[(b + 1) % 2]);
-        } catch (...) {
-          read_error = std::current_exception();
-        }
-      });
-    }
-    std::vector<const float*> pixels;
-    for (const auto& image_band : bands[b % 2]) pixels.push_back(image_band.data());
-    fitter.Fit(pixels, rows, width, y0, result.ptm, result.residual_rms);
-    if (reader.joinable()) reader.join();
-    if (read_error) std::rethrow_exception(read_error);
-    if (progress) {
-      progress("fit", static_cast<std::size_t>(y0 + rows), static_cast<std::size_t>(height));
-    }
-  }
+  bands.ForEach(
+      options.band_rows,
+      [&](const std::vector<const float*>& pixels, int y0, int rows) {
+        fitter.Fit(pixels, rows, bands.width(), y0, result.ptm, result.residual_rms);
+      },
+      progress, "fit");
   Finish(result, start);
   return result;
 }

@@ -498,6 +498,31 @@ Ptm ReadPtmExrBytes(std::string_view bytes, const std::string& label) {
   return PtmFromExrPlanes(planes, names, label);
 }
 
+WebPlanes QuantisePlanes(const std::vector<std::vector<float>>& planes, int width, int height) {
+  WebPlanes web;
+  for (const auto& p : planes) {
+    const auto [lo_it, hi_it] = std::minmax_element(p.begin(), p.end());
+    const float lo = *lo_it, hi = *hi_it;
+    web.scales.push_back(hi > lo ? hi - lo : 1.0f);
+    web.biases.push_back(-lo / web.scales.back());
+  }
+  for (std::size_t j = 0; j * 3 < planes.size(); ++j) {
+    cv::Mat& image = web.images.emplace_back(height, width, CV_8UC3, cv::Scalar::all(0));
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const std::size_t t = static_cast<std::size_t>(y) * width + x;
+        cv::Vec3b& px = image.at<cv::Vec3b>(y, x);
+        for (std::size_t c = 0; c < 3 && j * 3 + c < planes.size(); ++c) {
+          const std::size_t k = j * 3 + c;
+          const float v = (planes[k][t] / web.scales[k] + web.biases[k]) * 255.0f;
+          px[2 - c] = static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L));  // BGR
+        }
+      }
+    }
+  }
+  return web;
+}
+
 WebPlanes QuantiseWebPlanes(const Ptm& ptm) {
   // OpenLIME's PTM basis order (1, x, y, x^2, xy, y^2) in texlume's coefficient indices.
   constexpr int kWebOrder[6] = {5, 3, 4, 0, 2, 1};
@@ -515,28 +540,21 @@ WebPlanes QuantiseWebPlanes(const Ptm& ptm) {
       for (int c = 0; c < 3; ++c)
         add_plane([&](std::size_t t) { return ptm.Coefficients(t, c)[i]; });
   }
-  WebPlanes web;
-  for (const auto& p : planes) {
-    const auto [lo_it, hi_it] = std::minmax_element(p.begin(), p.end());
-    const float lo = *lo_it, hi = *hi_it;
-    web.scales.push_back(hi > lo ? hi - lo : 1.0f);
-    web.biases.push_back(-lo / web.scales.back());
+  return QuantisePlanes(planes, ptm.width, ptm.height);
+}
+
+void WriteWebPlaneJpegs(const WebPlanes& web, const std::filesystem::path& dir, int jpeg_quality) {
+  for (std::size_t j = 0; j < web.images.size(); ++j) {
+    std::vector<unsigned char> bytes;
+    cv::imencode(".jpg", web.images[j], bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
+    WriteFileAtomically(
+        dir / ("plane_" + std::to_string(j) + ".jpg"),
+        [&](std::ostream& out) {
+          out.write(reinterpret_cast<const char*>(bytes.data()),
+                    static_cast<std::streamsize>(bytes.size()));
+        },
+        true);
   }
-  for (std::size_t j = 0; j * 3 < planes.size(); ++j) {
-    cv::Mat& image = web.images.emplace_back(ptm.height, ptm.width, CV_8UC3);
-    for (int y = 0; y < ptm.height; ++y) {
-      for (int x = 0; x < ptm.width; ++x) {
-        const std::size_t t = static_cast<std::size_t>(y) * ptm.width + x;
-        cv::Vec3b& px = image.at<cv::Vec3b>(y, x);
-        for (std::size_t c = 0; c < 3; ++c) {
-          const std::size_t k = j * 3 + c;
-          const float v = (planes[k][t] / web.scales[k] + web.biases[k]) * 255.0f;
-          px[2 - c] = static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L));  // BGR
-        }
-      }
-    }
-  }
-  return web;
 }
 
 nlohmann::json WebPlanes::Info(const Ptm& ptm) const {
@@ -558,17 +576,7 @@ int WriteRelightWeb(const Ptm& ptm, const std::filesystem::path& dir, int jpeg_q
   nlohmann::json info = web.Info(rgb);
   info["format"] = "jpg";
   info["quality"] = jpeg_quality;
-  for (std::size_t j = 0; j < web.images.size(); ++j) {
-    std::vector<unsigned char> bytes;
-    cv::imencode(".jpg", web.images[j], bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
-    WriteFileAtomically(
-        dir / ("plane_" + std::to_string(j) + ".jpg"),
-        [&](std::ostream& out) {
-          out.write(reinterpret_cast<const char*>(bytes.data()),
-                    static_cast<std::streamsize>(bytes.size()));
-        },
-        true);
-  }
+  WriteWebPlaneJpegs(web, dir, jpeg_quality);
   WriteFileAtomically(
       dir / "info.json", [&](std::ostream& out) { out << info.dump(2) << "\n"; }, false);
   return static_cast<int>(web.images.size()) + 1;

@@ -49,6 +49,11 @@ struct WebPlanes {
   nlohmann::json Info(const Ptm& ptm) const;
 };
 WebPlanes QuantiseWebPlanes(const Ptm& ptm);
+/// Planes of width x height values (row-major) quantised and packed three to an image
+/// as QuantiseWebPlanes does; the last image's unused channels are 0.
+WebPlanes QuantisePlanes(const std::vector<std::vector<float>>& planes, int width, int height);
+/// Writes `web.images` into `dir` as `plane_N.jpg`, each atomically.
+void WriteWebPlaneJpegs(const WebPlanes& web, const std::filesystem::path& dir, int jpeg_quality);
 
 /// Writes the relight / OpenLIME web format into `dir`: `info.json` (type "ptm",
 /// colorspace "rgb", nplanes, per-plane scale and bias) and the coefficient planes as

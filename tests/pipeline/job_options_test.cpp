@@ -87,6 +87,33 @@ TEST(RenderJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
   EXPECT_THROW(pipeline::RunRenderJob(o), OptionError);
 }
 
+TEST(FitJobOptions, AnHshFitWritesRtiOfOrderTwoOrThreeWithoutExrOrRobustFit) {
+  pipeline::FitJobOptions o;
+  o.images_dir = "capture";
+  o.lights_file = "capture/lights.lp";
+  o.out_file = "sample.ptm";
+  EXPECT_NO_THROW(o.Check());
+  EXPECT_EQ(o.ToJson()["basis"], "ptm");
+  o.basis = "hsh";
+  EXPECT_THROW(o.Check(), OptionError);  // .ptm holds no HSH
+  o.out_file = "sample.RTI";
+  EXPECT_NO_THROW(o.Check());
+  EXPECT_EQ(o.ToJson()["order"], 3);
+  for (const int order : {1, 4}) {
+    o.hsh_order = order;
+    EXPECT_THROW(o.Check(), OptionError) << order;
+  }
+  o.hsh_order = 2;
+  o.exr_file = "sample.exr";
+  EXPECT_THROW(o.Check(), OptionError);
+  o.exr_file.clear();
+  o.fit.robust = true;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.fit.robust = false;
+  o.basis = "sh";
+  EXPECT_THROW(o.Check(), OptionError);
+}
+
 TEST(RenderJobOptions, SettingsNameEveryChoice) {
   pipeline::RenderJobOptions o;
   o.model_folder = "model";
