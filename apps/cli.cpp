@@ -11,6 +11,7 @@
 #include "core/check.h"
 #include "core/errors.h"
 #include "core/memory_budget.h"
+#include "core/provenance.h"
 
 namespace texlume::apps {
 namespace {
@@ -77,11 +78,12 @@ std::string HelpHint(const CLI::App* sub) {
 }  // namespace
 
 int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  RecordCommandLine(argc, argv);
   CLI::App app("texlume: relightable PTM models from photos and a material sample", "texlume");
   app.footer(
       "Exit codes: 0 success, 1 bad input (the message names the file), 2 bad command line, "
       "3 internal error (a bug in texlume). docs/cli.md has the details.");
-  app.set_version_flag("--version", "texlume 0.1.0");
+  app.set_version_flag("--version", std::string("texlume ") + TexlumeVersion());
   app.allow_extras();
   // An option given twice takes its last value, as the command line always has.
   app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
@@ -111,7 +113,8 @@ int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostrea
     if (sub && sub->get_name() == "help")
       return (out << app.get_formatter()->make_help(&app, "texlume", CLI::AppFormatMode::Normal),
               kExitOk);
-    if (sub && sub->get_name() == "version") return (out << "texlume 0.1.0\n", kExitOk);
+    if (sub && sub->get_name() == "version")
+      return (out << "texlume " << TexlumeVersion() << "\n", kExitOk);
     if (const std::string extras = ExtrasMessage(app, sub); !extras.empty())
       throw UsageError(extras);
     if (!sub) throw UsageError("give a command");

@@ -49,10 +49,13 @@ class BtfSynthJob {
   BtfSynthJobSummary Run() {
     const auto start = std::chrono::steady_clock::now();
     pipeline::RefuseForeignModelFolder(job_.out_dir);
+    AnnounceStep(progress_, "reading the inputs");
     inputs_ = pipeline::LoadSynthInputs(job_);
+    AnnounceStep(progress_, "reading the BTF sample");
     LoadSample();
     Synthesize();
     LayOut();
+    AnnounceStep(progress_, "writing the model folder");
     nlohmann::json record = Record();
     // The geometry maps baked per atlas texel, for export (docs/btf.md).
     const auto t = std::chrono::steady_clock::now();

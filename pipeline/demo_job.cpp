@@ -215,6 +215,9 @@ class DemoJob {
                      {"fit", seconds_["fit"]},
                      {"synth (with the model's report)", seconds_["synth"]},
                      {"render (3 models)", seconds_["render"]}};
+    rep.inputs = InputFiles(job_);
+    rep.inputs.emplace_back("sample", options_.out_dir / "sample.ptm");
+    rep.view_folder = (options_.out_dir / "model").string();
     rep.links = {{"model.glb", "model/model.glb"},
                  {"model.obj", "model/model.obj"},
                  {"manifest.json", "model/manifest.json"},

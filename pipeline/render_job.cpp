@@ -74,6 +74,7 @@ class RenderJob {
 
   RenderJobSummary Run() {
     const auto start = std::chrono::steady_clock::now();
+    AnnounceStep(progress_, "reading the model folder");
     LoadModel();
     LoadViews();
     RequireReplaceableFolder(options_.out_dir, "render.json", "a texlume render folder");

@@ -105,6 +105,19 @@ Sample ReadSample(const fs::path& path) {
   return sample;
 }
 
+std::vector<std::pair<std::string, fs::path>> InputFiles(const SynthJobOptions& options) {
+  std::vector<std::pair<std::string, fs::path>> files;
+  const fs::path model = sfm::FindModelFolder(options.model_dir).folder;
+  const std::string ext =
+      sfm::DetectModelFormat(model) == sfm::ModelFormat::kBinary ? ".bin" : ".txt";
+  for (const char* stem : {"cameras", "images", "points3D"})
+    files.emplace_back("COLMAP " + std::string(stem), model / (stem + ext));
+  files.emplace_back("lights", options.lights_file);
+  files.emplace_back("mesh", options.mesh_file);
+  if (!options.sample_file.empty()) files.emplace_back("sample", options.sample_file);
+  return files;
+}
+
 SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   SynthInputs inputs;
@@ -312,10 +325,13 @@ class SynthJob {
   SynthJobSummary Run() {
     const auto start = std::chrono::steady_clock::now();
     RefuseForeignModelFolder(options_.out_dir);
+    AnnounceStep(progress_, "reading the inputs");
     Load();
     Synthesize();
     LayOut();
+    AnnounceStep(progress_, "photo baselines");
     Baselines();
+    AnnounceStep(progress_, "writing the model folder");
     const auto t = std::chrono::steady_clock::now();
     std::function<void(const fs::path&)> write_report;
     if (options_.write_report)
@@ -495,6 +511,8 @@ class SynthJob {
         {"atlases", std::to_string(s.atlases) + " of " + std::to_string(options_.atlas.atlas_size) +
                         " texels, " + std::to_string(s.charts) + " charts"}};
     for (const std::string& w : s.warnings) report.facts.emplace_back("warning", w);
+    report.inputs = InputFiles(options_);
+    report.view_folder = options_.out_dir.string();
     report.timings_s = {{"load", s.seconds_load},
                         {"visibility", s.seconds_visibility},
                         {"synthesis", s.seconds_synthesis},

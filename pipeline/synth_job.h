@@ -114,6 +114,11 @@ void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int s
 /// not measured).
 nlohmann::json EngineSummaryJson(const synth::TriangleSynthesis& synthesis);
 
+/// The input files a report's provenance names (with their checksums): the COLMAP
+/// model's files, the lights, the mesh and the sample file when there is one.
+std::vector<std::pair<std::string, std::filesystem::path>> InputFiles(
+    const SynthJobOptions& options);
+
 /// Refuses an output folder that exists and is not a texlume model folder
 /// (InputError naming it): a job never replaces anything else.
 void RefuseForeignModelFolder(const std::filesystem::path& out_dir);

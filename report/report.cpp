@@ -3,9 +3,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
+#include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -14,6 +16,7 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/partial_output.h"
+#include "core/provenance.h"
 #include "core/timing.h"
 
 namespace texlume::report {
@@ -63,6 +66,17 @@ cv::Mat ErrorMap(const cv::Mat& a, const cv::Mat& b, const cv::Mat& inside, doub
   cv::Mat colour;
   cv::applyColorMap(scaled, colour, cv::COLORMAP_INFERNO);
   colour.setTo(cv::Scalar(60, 60, 60), inside == 0);
+  return colour;
+}
+
+// The error maps' colour scale: 256 x 24, from 0 at the left to the maximum at the
+// right (the caption gives the values), with a white tick every quarter.
+cv::Mat ErrorScale() {
+  cv::Mat ramp(24, 256, CV_8UC1);
+  for (int x = 0; x < ramp.cols; ++x) ramp.col(x).setTo(x);
+  cv::Mat colour;
+  cv::applyColorMap(ramp, colour, cv::COLORMAP_INFERNO);
+  for (int q = 1; q < 4; ++q) colour(cv::Rect(q * 64, 16, 1, 8)).setTo(cv::Scalar(255, 255, 255));
   return colour;
 }
 
@@ -196,6 +210,23 @@ class ReportWriter {
               << HtmlEscape(in_.links[i].first) << "</a>";
       html_ << ".</p>\n";
     }
+    if (!in_.view_folder.empty())
+      html_ << "<p>Preview the model under any light: <code>texlume view "
+            << HtmlEscape(in_.view_folder) << "</code> (a page at http://127.0.0.1:8080/).</p>\n";
+    Provenance();
+  }
+
+  // texlume's version, the command line and the inputs' checksums.
+  void Provenance() {
+    html_ << "<details><summary>Provenance</summary><table>"
+          << "<tr><th>texlume</th><td>" << HtmlEscape(TexlumeVersion()) << "</td></tr>";
+    if (!RecordedCommandLine().empty())
+      html_ << "<tr><th>command</th><td><code>" << HtmlEscape(RecordedCommandLine())
+            << "</code></td></tr>";
+    for (const auto& [name, file] : in_.inputs)
+      html_ << "<tr><th>" << HtmlEscape(name) << "</th><td><code>" << HtmlEscape(file.string())
+            << "</code>, CRC-32 " << FileCrc32(file) << "</td></tr>";
+    html_ << "</table></details>\n";
   }
 
   // The material sample relit: head-on, then four lights around it.
@@ -239,7 +270,13 @@ class ReportWriter {
              "from black (0) to bright yellow ("
           << Fixed(in_.error_map_max, 2)
           << " or more, display values in [0, 1]); grey outside. PSNR (dB) and SSIM at the "
-             "pictures' resolution.</p>\n<table><tr><th>reference</th>";
+             "pictures' resolution.</p>\n";
+    html_ << "<p>"
+          << Figure(WritePicture("error_scale.png", ErrorScale()),
+                    "error scale: 0 (left) to " + Fixed(in_.error_map_max, 2) +
+                        " or more (right), in steps of " + Fixed(in_.error_map_max / 4, 4),
+                    256)
+          << "</p>\n<table><tr><th>reference</th>";
     for (const auto& drawn : in_.views.front().drawn)
       html_ << "<th>" << drawn.model << " (and its error)</th>";
     html_ << "</tr>\n";
@@ -367,6 +404,7 @@ class ReportWriter {
       }
       html_ << "</table>\n";
     }
+    BaselineNotes();
     if (!summary_.rows.empty()) {
       html_ << "<p>On the pictures above (their resolution, inside the mask):</p>\n<table "
                "class=\"m\" "
@@ -376,6 +414,43 @@ class ReportWriter {
               << Fixed(r.psnr, 2) << "</td><td>" << Fixed(r.ssim, 3) << "</td></tr>\n";
       html_ << "</table>\n";
     }
+  }
+
+  // Says so where a baseline measures better than texlume (the first metrics row),
+  // or, without metrics tables, on the pictures' own means.
+  void BaselineNotes() {
+    std::vector<std::pair<std::string, std::array<double, 4>>> means;
+    if (!in_.metrics.empty()) {
+      for (const ReportMetrics& m : in_.metrics)
+        means.push_back(
+            {m.label, {m.mean_psnr, m.mean_ssim, m.mean_psnr_reduced, m.mean_ssim_reduced}});
+    } else {
+      std::map<std::string, std::array<double, 3>> sums;  // psnr, ssim, count
+      std::vector<std::string> order;
+      for (const ReportSummary::Row& r : summary_.rows) {
+        if (!sums.count(r.model)) order.push_back(r.model);
+        auto& s = sums[r.model];
+        s[0] += r.psnr, s[1] += r.ssim, s[2] += 1;
+      }
+      for (const std::string& model : order) {
+        const auto& s = sums[model];
+        means.push_back({model, {s[0] / s[2], s[1] / s[2], NAN, NAN}});
+      }
+    }
+    if (means.size() < 2) return;
+    static const char* kWhat[4] = {"PSNR", "SSIM", "PSNR at the photos' resolution",
+                                   "SSIM at the photos' resolution"};
+    std::vector<std::string> notes;
+    for (std::size_t b = 1; b < means.size(); ++b)
+      for (int k = 0; k < 4; ++k)
+        if (std::isfinite(means[b].second[k]) && means[b].second[k] > means[0].second[k])
+          notes.push_back(means[b].first + " beats " + means[0].first + " in " + kWhat[k] + " (" +
+                          Fixed(means[b].second[k], k % 2 ? 3 : 2) + " against " +
+                          Fixed(means[0].second[k], k % 2 ? 3 : 2) + ")");
+    html_ << "<p><b>Against the baselines:</b> ";
+    if (notes.empty()) html_ << HtmlEscape(means[0].first) << " measures best in every figure.";
+    for (std::size_t i = 0; i < notes.size(); ++i) html_ << (i ? "; " : "") << HtmlEscape(notes[i]);
+    html_ << (notes.empty() ? "" : ".") << "</p>\n";
   }
 
   const ReportInputs& in_;

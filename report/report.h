@@ -56,6 +56,12 @@ struct ReportInputs {
   std::vector<std::pair<std::string, std::string>> facts;  ///< summary lines (name, value)
   std::vector<std::pair<std::string, double>> timings_s;   ///< stage, seconds
   std::vector<std::pair<std::string, std::string>> links;  ///< label, href relative to the report
+  /// Where the results came from: the inputs (name, file) whose CRC-32 the page shows,
+  /// beside texlume's version and the recorded command line (core/provenance.h).
+  std::vector<std::pair<std::string, std::filesystem::path>> inputs;
+  /// The model folder as the command that previews it names it (`texlume view DIR`);
+  /// empty = no pointer.
+  std::string view_folder;
   double occupancy = 0.0;  ///< of the whole layout (atlas texels inside triangles)
   /// Error maps run from black (0) to white at this mean absolute difference
   /// (display values in [0, 1]).
@@ -76,11 +82,13 @@ struct ReportSummary {
   double seconds = 0;
 };
 
-/// Writes `dir`/report.html and its pictures in `dir`/report/: the sample
+/// Writes `dir`/report.html and its pictures in `dir`/report/: provenance (version,
+/// command line, input checksums) and a pointer to `texlume view`, the sample
 /// relit at a few lights, the constraint photos, the model from the views
 /// beside the reference and the baselines, error maps (mean absolute
 /// difference over the channels), the light-sweep strip, atlas thumbnails with
-/// the triangle outlines and occupancy, and the metrics and timings tables. The
+/// the triangle outlines and occupancy, and the metrics and timings tables, saying
+/// where a baseline does better than texlume. The
 /// pictures are written to a temporary folder renamed into place, then the
 /// page atomically; relative links only, so the folder opens from disk.
 ReportSummary WriteReport(const std::filesystem::path& dir, const ReportInputs& inputs,

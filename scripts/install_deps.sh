@@ -11,6 +11,7 @@ PACKAGES=(
   nlohmann-json3-dev libembree-dev
   libcli11-dev  # the command line (BSD)
   libcpp-httplib-dev  # the viewer's local HTTP server (MIT)
+  zlib1g-dev  # CRC-32 checksums of the inputs in reports (zlib licence)
   openimageio-tools  # its CMake package config refers to the OIIO tools
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev

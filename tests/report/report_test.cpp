@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/provenance.h"
 #include "tests/test_util.h"
 
 namespace texlume::report {
@@ -71,8 +72,9 @@ TEST(WriteReport, ShowsTheGivenPicturesAndMetricsAndLinksOnlyWhatItWrote) {
   EXPECT_NE(html.find("31.25 dB, SSIM 0.875"), std::string::npos);
   EXPECT_NE(html.find("22.50"), std::string::npos);
   for (const std::string& link : Links(html)) EXPECT_TRUE(fs::exists(out.path() / link)) << link;
-  // 2 sample, 2 x (reference + 2 models + 2 errors), the sweep, 1 atlas.
-  EXPECT_EQ(s.pictures, 2u + 2u * 5u + 1u + 1u);
+  // 2 sample, the error scale, 2 x (reference + 2 models + 2 errors), the sweep, 1 atlas.
+  EXPECT_EQ(s.pictures, 2u + 1u + 2u * 5u + 1u + 1u);
+  EXPECT_EQ(cv::imread((out.path() / "report/error_scale.png").string()).cols, 256);
   ASSERT_EQ(s.rows.size(), 4u);
   EXPECT_EQ(s.rows[0].psnr, 31.25);
   EXPECT_EQ(s.rows[1].model, "flat");
@@ -83,6 +85,37 @@ TEST(WriteReport, ShowsTheGivenPicturesAndMetricsAndLinksOnlyWhatItWrote) {
   // texel beyond the triangle grown by one texel (1 + ... + 16).
   EXPECT_GE(occupancy[0], 105.0 / 256.0);
   EXPECT_LE(occupancy[0], 136.0 / 256.0);
+}
+
+// The page says where a baseline measures better than texlume, points to texlume view,
+// and names texlume's version and the inputs with their checksums.
+TEST(WriteReport, SaysWhereABaselineWinsAndWhereTheResultsCameFrom) {
+  const model::TexturedModel model = OneTriangle();
+  testing::TempDir out;
+  testing::WriteText(out / "lights.json", "123456789");  // CRC-32 check value cbf43926
+  ReportInputs in;
+  in.model = &model;
+  in.inputs = {{"lights", out / "lights.json"}};
+  in.view_folder = "model dir";
+  in.metrics = {{"texlume", {}, 22.5, 0.60, 23.5, 0.70}, {"flat", {}, 23.0, 0.40, 23.0, 0.30}};
+  WriteReport(out.path(), in);
+  std::string html = testing::ReadText(out.path() / "report.html");
+  EXPECT_NE(html.find("flat beats texlume in PSNR (23.00 against 22.50)"), std::string::npos)
+      << html;
+  EXPECT_EQ(html.find("flat beats texlume in SSIM"), std::string::npos);
+  EXPECT_NE(html.find("texlume view model dir"), std::string::npos);
+  EXPECT_NE(html.find(std::string("<td>") + TexlumeVersion() + "</td>"), std::string::npos);
+  EXPECT_NE(html.find("CRC-32 cbf43926"), std::string::npos);
+  in.metrics[1].mean_psnr = 20.0;
+  WriteReport(out.path(), in);
+  html = testing::ReadText(out.path() / "report.html");
+  EXPECT_NE(html.find("texlume measures best in every figure"), std::string::npos);
+}
+
+TEST(Provenance, TheCommandLineIsRecordedQuotedAsAShellReadsIt) {
+  const char* argv[] = {"texlume", "synth", "--out", "my model", "it's"};
+  RecordCommandLine(5, argv);
+  EXPECT_EQ(RecordedCommandLine(), "texlume synth --out 'my model' 'it'\\''s'");
 }
 
 // A photo that cannot be read: an error naming it, the earlier report kept.
