@@ -96,6 +96,7 @@ class DemoJob {
          << (capture / "lights.lp").string() << " --out " << sample.string() << "\n";
     const ptm::RtiCapture rti = ptm::ReadRtiCapture(capture / "lights.lp", capture);
     sample_ = ptm::FitPtmFromFiles(rti.files, rti.lights, {}, progress_).ptm;
+    capture_lights_ = rti.lights;
     ptm::WritePtmFile(sample_, sample);
     ptm::WritePtmExr(sample_, options_.out_dir / "sample.exr");
   }
@@ -200,6 +201,12 @@ class DemoJob {
     scene.baked = baselines.baked;
     scene.sample = &sample_;
     AddReportViews(rep, scene);
+    std::vector<std::vector<sfm::ObjectLight>> photo_lights, held_out_lights;
+    for (const report::ReportPhoto& p : rep.photos) photo_lights.push_back(p.lights);
+    for (const render::PictureView& v : scene.views) held_out_lights.push_back(v.lights);
+    rep.light_plots = {CaptureLightPlot(capture_lights_),
+                       LightPlotOfModel("the photos' lights", photo_lights, model),
+                       LightPlotOfModel("the held-out lights", held_out_lights, model)};
     DrawReportPictures(scene, rep, progress_);
     rep.metrics = {MetricsOf("texlume (PTM atlases)", ours_), MetricsOf("flat baseline", flat_),
                    MetricsOf("baked baseline", baked_)};
@@ -257,6 +264,7 @@ class DemoJob {
   std::string shape_, material_;
   sfm::InspectReport inspect_report_;
   ptm::Ptm sample_;
+  std::vector<Eigen::Vector3d> capture_lights_;  ///< the sample capture's (.lp)
   pipeline::SynthJobOptions job_;
   pipeline::SynthJobSummary synthesis_;
   pipeline::RenderJobSummary ours_, flat_, baked_;

@@ -1,5 +1,6 @@
 #include "pipeline/report_pictures.h"
 
+#include <Eigen/Geometry>
 #include <string>
 #include <utility>
 
@@ -49,6 +50,36 @@ void DrawReportPictures(const ReportScene& scene, report::ReportInputs& report,
   report.sweep_view = first.name;
   report.sweep_elevation_deg = scene.light_elevation_deg;
   if (progress) progress("report pictures", steps, steps);
+}
+
+report::LightPlot LightPlotOfModel(const std::string& title,
+                                   const std::vector<std::vector<sfm::ObjectLight>>& lights,
+                                   const model::TexturedModel& model) {
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& v : model.mesh.vertices) box.extend(v);
+  const Eigen::Vector3d centre =
+      box.isEmpty() ? Eigen::Vector3d(Eigen::Vector3d::Zero()) : Eigen::Vector3d(box.center());
+  const Eigen::Vector3d z = model.orientation.up.normalized();
+  const Eigen::Vector3d x =
+      (model.orientation.front - z * z.dot(model.orientation.front)).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  report::LightPlot plot{title,
+                         "up as the photos were taken (estimated from the cameras), azimuth 0 "
+                         "toward the side they were taken from",
+                         {}};
+  for (const auto& list : lights)
+    for (const sfm::ObjectLight& l : list) {
+      const Eigen::Vector3d d = l.DirectionFrom(centre);
+      plot.directions.emplace_back(d.dot(x), d.dot(y), d.dot(z));
+    }
+  return plot;
+}
+
+report::LightPlot CaptureLightPlot(const std::vector<Eigen::Vector3d>& lights) {
+  return {"the sample capture's lights",
+          "the sample's frame: up out of the sample, azimuth 0 to "
+          "its right (x), 90 degrees up its image (y)",
+          lights};
 }
 
 }  // namespace texlume::pipeline

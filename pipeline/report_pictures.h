@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "core/progress.h"
@@ -9,6 +10,7 @@
 #include "ptm/ptm.h"
 #include "render/view_pictures.h"
 #include "report/report.h"
+#include "sfm/lights.h"
 
 namespace texlume::pipeline {
 
@@ -30,6 +32,16 @@ struct ReportScene {
   /// Throws OptionError when a count or size is out of range.
   void Check() const;
 };
+
+/// Lights seen by the model (directional as they are, point lights from the mesh's
+/// bounding box centre) on the hemisphere of the model's orientation: up as the photos
+/// were taken (sfm::OrientationFromCameras), azimuth 0 toward the photos' side.
+report::LightPlot LightPlotOfModel(const std::string& title,
+                                   const std::vector<std::vector<sfm::ObjectLight>>& lights,
+                                   const model::TexturedModel& model);
+
+/// An RTI capture's lights (.lp: x right, y up the sample, z out of it).
+report::LightPlot CaptureLightPlot(const std::vector<Eigen::Vector3d>& lights);
 
 /// Renders the report's pictures into `report` (sample_relit, views,
 /// views_total, sweep): the model in its own shading and the flat (and baked)

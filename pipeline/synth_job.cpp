@@ -499,6 +499,9 @@ class SynthJob {
     scene.baked = baked_;
     scene.sample = &sample_.ptm;
     AddPhotoViews(report, scene);
+    std::vector<std::vector<sfm::ObjectLight>> photo_lights;
+    for (const report::ReportPhoto& p : report.photos) photo_lights.push_back(p.lights);
+    report.light_plots = {LightPlotOfModel("the photos' lights", photo_lights, model_)};
     DrawReportPictures(scene, report, progress_);
     report.occupancy = s.occupancy;
     report.facts = {

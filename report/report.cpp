@@ -155,6 +155,7 @@ class ReportWriter {
   void Write() {
     Header();
     Sample();
+    Lights();
     Photos();
     Views();
     Sweep();
@@ -259,6 +260,34 @@ class ReportWriter {
       Advance();
     }
     html_ << "\n";
+  }
+
+  // Each set of lights on the hemisphere seen from above: the zenith at the centre, the
+  // horizon on the outer circle, radius proportional to the angle from the zenith.
+  void Lights() {
+    if (in_.light_plots.empty()) return;
+    html_ << "<h2>Lights</h2>\n<p>Seen from above: the zenith at the centre, rings at 60&deg;, "
+             "30&deg; and 0&deg; elevation (the horizon), the distance from the centre "
+             "proportional to the angle from the zenith; azimuth 0 to the right, growing "
+             "counter-clockwise.</p>\n";
+    for (const LightPlot& plot : in_.light_plots) {
+      constexpr double kR = 100.0, kC = 110.0;
+      html_ << "<figure><svg width=\"220\" height=\"220\" viewBox=\"0 0 220 220\">";
+      for (const double ring : {1.0 / 3.0, 2.0 / 3.0, 1.0})
+        html_ << "<circle cx=\"110\" cy=\"110\" r=\"" << Fixed(ring * kR, 1)
+              << "\" fill=\"none\" stroke=\"#999\"/>";
+      html_ << "<line x1=\"110\" y1=\"110\" x2=\"215\" y2=\"110\" stroke=\"#ccc\"/>";
+      for (const Eigen::Vector3d& d : plot.directions) {
+        const Eigen::Vector3d l = d.normalized();
+        const double from_zenith = std::acos(std::clamp(l.z(), -1.0, 1.0)) / (M_PI / 2);
+        const double azimuth = std::atan2(l.y(), l.x());
+        html_ << "<circle cx=\"" << Fixed(kC + kR * from_zenith * std::cos(azimuth), 1)
+              << "\" cy=\"" << Fixed(kC - kR * from_zenith * std::sin(azimuth), 1)
+              << "\" r=\"3.5\" fill=\"" << (l.z() > 0 ? "#d93025" : "#999") << "\"/>";
+      }
+      html_ << "</svg><figcaption>" << HtmlEscape(plot.title) << " (" << plot.directions.size()
+            << "): " << HtmlEscape(plot.frame) << "</figcaption></figure>\n";
+    }
   }
 
   // The model from the views, beside the reference, the baselines and error maps.

@@ -24,6 +24,14 @@ struct ReportPhoto {
   cv::Mat image;  ///< CV_32FC3 display RGB when already in memory; else `file` is read
 };
 
+/// Light directions to plot on the hemisphere, in a frame whose z is up (the zenith)
+/// and whose x is azimuth 0; azimuth grows counter-clockwise seen from above (toward y).
+struct LightPlot {
+  std::string title;
+  std::string frame;  ///< what z and x are, in words
+  std::vector<Eigen::Vector3d> directions;
+};
+
 /// Mean metrics of one model over the held-out views, as `texlume render`
 /// measured them (full resolution and reduced).
 struct ReportMetrics {
@@ -44,6 +52,7 @@ struct ReportInputs {
   std::vector<std::pair<Eigen::Vector3d, cv::Mat>> sample_relit;
   int sample_width = 0, sample_height = 0;
   std::vector<ReportPhoto> photos;          ///< the constraint photos
+  std::vector<LightPlot> light_plots;       ///< hemisphere plots of lights (capture, photos)
   int max_photos = 12;                      ///< at most this many are shown, evenly spread
   std::vector<render::ViewPictures> views;  ///< the views drawn (render::DrawView)
   std::size_t views_total = 0;              ///< of how many views they were picked

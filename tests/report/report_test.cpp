@@ -97,6 +97,10 @@ TEST(WriteReport, SaysWhereABaselineWinsAndWhereTheResultsCameFrom) {
   in.model = &model;
   in.inputs = {{"lights", out / "lights.json"}};
   in.view_folder = "model dir";
+  // The zenith at the centre; azimuth 90 degrees at 30 degrees of elevation, up the plot.
+  in.light_plots = {{"capture",
+                     "sample frame",
+                     {Eigen::Vector3d::UnitZ(), Eigen::Vector3d(0, std::cos(M_PI / 6), 0.5)}}};
   in.metrics = {{"texlume", {}, 22.5, 0.60, 23.5, 0.70}, {"flat", {}, 23.0, 0.40, 23.0, 0.30}};
   WriteReport(out.path(), in);
   std::string html = testing::ReadText(out.path() / "report.html");
@@ -106,6 +110,9 @@ TEST(WriteReport, SaysWhereABaselineWinsAndWhereTheResultsCameFrom) {
   EXPECT_NE(html.find("texlume view model dir"), std::string::npos);
   EXPECT_NE(html.find(std::string("<td>") + TexlumeVersion() + "</td>"), std::string::npos);
   EXPECT_NE(html.find("CRC-32 cbf43926"), std::string::npos);
+  EXPECT_NE(html.find("<circle cx=\"110.0\" cy=\"110.0\" r=\"3.5\""), std::string::npos) << html;
+  EXPECT_NE(html.find("<circle cx=\"110.0\" cy=\"43.3\" r=\"3.5\""), std::string::npos) << html;
+  EXPECT_NE(html.find("capture (2): sample frame"), std::string::npos);
   in.metrics[1].mean_psnr = 20.0;
   WriteReport(out.path(), in);
   html = testing::ReadText(out.path() / "report.html");
