@@ -14,8 +14,9 @@ namespace texlume::apps {
 
 /// Draws progress on stderr: a bar with the estimated time left on a terminal,
 /// plain lines at most every few seconds otherwise (logs, CI). Every line gives the
-/// time since the bar was made (the whole command). A stage that restarts (packing
-/// tries several atlas sizes) keeps its one bar. A watcher thread makes sure a piped
+/// time since the bar was made (the whole command). A finished bar ends its line; a
+/// stage that restarts (packing tries several atlas sizes) redraws its bar in place.
+/// A watcher thread makes sure a piped
 /// log never stays silent for more than 4.5 s: while no update comes, it repeats the
 /// current stage with the time spent in it.
 class ProgressBar {

@@ -80,11 +80,11 @@ double ScaleToUnit(int depth) {
 
 cv::Mat DecodeGreyImageBytes(std::string_view bytes, const char* format, int width, int height,
                              const std::string& label) {
+  BoundedMemoryReader memory(bytes);  // outlives the reader, which reads it when it closes
   std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::create(format);
   if (!in)
     throw std::runtime_error(std::string("OpenImageIO was built without its ") + format +
                              " reader");
-  BoundedMemoryReader memory(bytes);
   if (!in->set_ioproxy(&memory))
     throw std::runtime_error(std::string("OpenImageIO's ") + format +
                              " reader cannot read from memory");

@@ -119,6 +119,7 @@ class GlbBuilder {
 
   // The GLB container (glTF 2.0 §4.4): header, JSON chunk, BIN chunk.
   void Write(const fs::path& path) {
+    while (bin_.size() % 4) bin_.push_back(0);  // the BIN chunk's length is a multiple of 4
     gltf_["meshes"] = {{{"primitives", primitives_}, {"name", "model"}}};
     gltf_["buffers"] = {{{"byteLength", bin_.size()}}};
     gltf_["extensionsUsed"] = {kGltfPtmExtension};

@@ -330,6 +330,10 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
                                              manifest_path.string(), "up_in_model");
     model.orientation.front = DirectionFromJson(frame.value("front_in_model", nlohmann::json()),
                                                 manifest_path.string(), "front_in_model");
+    if (std::abs(model.orientation.up.dot(model.orientation.front)) > 0.99)
+      throw InputError(manifest_path.string(),
+                       "gltf_frame: up_in_model and front_in_model are "
+                       "(nearly) parallel");
   }
   for (const auto& entry : manifest["atlases"]) {
     if (!entry.is_object() || !entry.contains("exr") || !entry["exr"].is_string())

@@ -222,7 +222,7 @@ class DemoJob {
                      {"fit", seconds_["fit"]},
                      {"synth (with the model's report)", seconds_["synth"]},
                      {"render (3 models)", seconds_["render"]}};
-    rep.inputs = InputFiles(job_);
+    rep.inputs = InputFiles(job_, job_.model_dir);
     rep.inputs.emplace_back("sample", options_.out_dir / "sample.ptm");
     rep.view_folder = (options_.out_dir / "model").string();
     rep.links = {{"model.glb", "model/model.glb"},

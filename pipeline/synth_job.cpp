@@ -105,9 +105,9 @@ Sample ReadSample(const fs::path& path) {
   return sample;
 }
 
-std::vector<std::pair<std::string, fs::path>> InputFiles(const SynthJobOptions& options) {
+std::vector<std::pair<std::string, fs::path>> InputFiles(const SynthJobOptions& options,
+                                                         const fs::path& model) {
   std::vector<std::pair<std::string, fs::path>> files;
-  const fs::path model = sfm::FindModelFolder(options.model_dir).folder;
   const std::string ext =
       sfm::DetectModelFormat(model) == sfm::ModelFormat::kBinary ? ".bin" : ".txt";
   for (const char* stem : {"cameras", "images", "points3D"})
@@ -124,6 +124,7 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
   // Inputs.
   sfm::LoadedModel loaded_model = sfm::ReadModel(options.model_dir);
   if (!loaded_model.choice.empty()) inputs.warnings.push_back(loaded_model.choice);
+  inputs.model_folder = loaded_model.folder;
   inputs.reconstruction = std::move(loaded_model.reconstruction);
   const sfm::Reconstruction& reconstruction = inputs.reconstruction;
   const sfm::ObjectLights lights = sfm::ReadObjectLightsFile(options.lights_file);
@@ -514,7 +515,7 @@ class SynthJob {
         {"atlases", std::to_string(s.atlases) + " of " + std::to_string(options_.atlas.atlas_size) +
                         " texels, " + std::to_string(s.charts) + " charts"}};
     for (const std::string& w : s.warnings) report.facts.emplace_back("warning", w);
-    report.inputs = InputFiles(options_);
+    report.inputs = InputFiles(options_, inputs_.model_folder);
     report.view_folder = options_.out_dir.string();
     report.timings_s = {{"load", s.seconds_load},
                         {"visibility", s.seconds_visibility},

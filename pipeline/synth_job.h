@@ -90,6 +90,7 @@ Sample ReadSample(const std::filesystem::path& path);
 /// The main job's inputs, read and checked (shared with the BTF job, btf/).
 struct SynthInputs {
   sfm::Reconstruction reconstruction;
+  std::filesystem::path model_folder;    ///< the COLMAP model folder read (sfm::FindModelFolder)
   mesh::TriangleMesh mesh;               ///< subdivided as needed
   std::vector<synth::MeshPhoto> photos;  ///< those with a light and a file
   sfm::VisibilityResult visibility;
@@ -117,7 +118,7 @@ nlohmann::json EngineSummaryJson(const synth::TriangleSynthesis& synthesis);
 /// The input files a report's provenance names (with their checksums): the COLMAP
 /// model's files, the lights, the mesh and the sample file when there is one.
 std::vector<std::pair<std::string, std::filesystem::path>> InputFiles(
-    const SynthJobOptions& options);
+    const SynthJobOptions& options, const std::filesystem::path& model_folder);
 
 /// Refuses an output folder that exists and is not a texlume model folder
 /// (InputError naming it): a job never replaces anything else.

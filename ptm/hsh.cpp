@@ -122,18 +122,23 @@ HshFitResult FitHshFromFiles(const std::vector<std::filesystem::path>& files,
   bands.ForEach(
       band_rows,
       [&](const std::vector<const float*>& pixels, int y0, int rows) {
-        Eigen::VectorXd y(n);
-        for (std::size_t i = 0; i < static_cast<std::size_t>(rows) * hsh.width; ++i) {
-          const std::size_t t = static_cast<std::size_t>(y0) * hsh.width + i;
+        const auto texels = static_cast<std::int64_t>(rows) * hsh.width;
+        double band_residual = 0;
+#pragma omp parallel for schedule(static) reduction(+ : band_residual)
+        for (std::int64_t i = 0; i < texels; ++i) {
+          const auto t = static_cast<std::size_t>(y0) * hsh.width + static_cast<std::size_t>(i);
+          Eigen::VectorXd y(n);
           for (int c = 0; c < 3; ++c) {
             for (Eigen::Index k = 0; k < n; ++k)
-              y(k) = pixels[static_cast<std::size_t>(k)][i * 3 + static_cast<std::size_t>(c)];
+              y(k) = pixels[static_cast<std::size_t>(k)]
+                           [static_cast<std::size_t>(i) * 3 + static_cast<std::size_t>(c)];
             const Eigen::VectorXd coefficients = solve * y;
             for (int j = 0; j < terms; ++j) hsh.At(t, c)[j] = static_cast<float>(coefficients(j));
-            residual_sum +=
+            band_residual +=
                 std::sqrt((a * coefficients - y).squaredNorm() / static_cast<double>(n));
           }
         }
+        residual_sum += band_residual;
       },
       progress, "fit");
   result.mean_residual_rms =

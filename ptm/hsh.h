@@ -45,16 +45,18 @@ struct HshFitResult {
   double seconds = 0;
 };
 
-/// Least-squares HSH fit of an RTI capture, streamed by bands of `band_rows` rows.
-/// The light set is checked as for PTMs (ptm::CheckLightSet: at least as many
-/// lights as terms, none at or below the horizon, not degenerate for the basis).
+/// Least-squares HSH fit of an RTI capture, streamed by bands of `band_rows` rows (in
+/// parallel over the texels). The light set is refused (InputError) with fewer lights
+/// than terms, a light at or below the horizon, or a normal matrix of the basis with
+/// a condition number over 1e7 (PTMs: ptm::CheckLightSet, with at least 6 lights).
 HshFitResult FitHshFromFiles(const std::vector<std::filesystem::path>& files,
                              const std::vector<Eigen::Vector3d>& lights, int order, int band_rows,
                              const ProgressCallback& progress = {});
 
 /// The texture relit under a unit light (texel frame), RGB display values clamped to
-/// [0, 1], as ptm::Relight: a light below kHorizonElevationDeg is evaluated at that
-/// elevation (same azimuth) and faded by l_z / sin(kHorizonElevationDeg).
+/// [0, 1]. As texlume evaluates PTMs (ptm::Effective), a light below
+/// kHorizonElevationDeg is evaluated at that elevation (same azimuth) and faded by
+/// l_z / sin(kHorizonElevationDeg).
 std::vector<float> RelightHsh(const Hsh& hsh, const Eigen::Vector3d& light);
 
 /// RTIViewer's universal `.rti` (HSH): the header lines `#HSH1.2`, `3` (HSH), `W H 3`,

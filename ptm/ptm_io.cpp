@@ -94,12 +94,6 @@ struct PtmHeader {
 // (the bottom row first).
 using BytePlanes = std::vector<std::vector<unsigned char>>;
 
-// Before the planes are allocated: they, the PTM's floats, and (JPEG) one decoded plane.
-void RequirePlaneMemory(const PtmHeader& h, const std::string& label) {
-  RequireMemory(static_cast<double>(h.Texels()) * (h.NumPlanes() * 5.0 + 1.0),
-                "reading the " + h.format_name + " PTM", label);
-}
-
 PtmHeader ReadPtmHeader(std::istream& in, const std::string& label) {
   PtmHeader h;
   const std::string version = ReadHeaderLine(in, label, 1);
@@ -182,8 +176,9 @@ std::uint64_t BytesLeft(std::istream& in) {
 }
 
 // Uncompressed: RGB, three blocks (R, G, B) of six interleaved coefficients per texel;
-// LRGB, a block of six coefficients per texel, then one of R, G, B per texel.
-BytePlanes ReadRawPlanes(std::istream& in, const PtmHeader& h, const std::string& label) {
+// LRGB, a block of six coefficients per texel, then one of R, G, B per texel. Streamed a
+// row at a time into the PTM's floats; the file's size bounds the allocation.
+Ptm ReadRawPtm(std::istream& in, const PtmHeader& h, const std::string& label) {
   const std::uint64_t expected = static_cast<std::uint64_t>(h.Texels()) * h.NumPlanes();
   const std::uint64_t available = BytesLeft(in);
   if (available < expected) {
@@ -192,21 +187,31 @@ BytePlanes ReadRawPlanes(std::istream& in, const PtmHeader& h, const std::string
                                 std::to_string(expected) + " bytes, the file has " +
                                 std::to_string(available));
   }
-  RequirePlaneMemory(h, label);
-  BytePlanes planes(static_cast<std::size_t>(h.NumPlanes()),
-                    std::vector<unsigned char>(h.Texels()));
-  std::vector<unsigned char> block;
-  for (int first = 0; first < h.NumPlanes(); first += 6) {
-    const int interleaved = std::min(6, h.NumPlanes() - first);
-    block.resize(h.Texels() * static_cast<std::size_t>(interleaved));
-    in.read(reinterpret_cast<char*>(block.data()), static_cast<std::streamsize>(block.size()));
-    if (!in) throw InputError(label, "read error in the coefficients");
-    for (std::size_t t = 0; t < h.Texels(); ++t)
-      for (int k = 0; k < interleaved; ++k)
-        planes[static_cast<std::size_t>(first + k)][t] =
-            block[t * static_cast<std::size_t>(interleaved) + static_cast<std::size_t>(k)];
+  Ptm ptm;
+  ptm.Resize(h.format, h.width, h.height);
+  std::vector<unsigned char> row(static_cast<std::size_t>(h.width) * 6);
+  for (int q = 0; q < ptm.NumPolynomials(); ++q) {
+    for (int y = h.height - 1; y >= 0; --y) {  // rows bottom to top
+      in.read(reinterpret_cast<char*>(row.data()), static_cast<std::streamsize>(row.size()));
+      if (!in) throw InputError(label, "read error in the coefficients");
+      for (int x = 0; x < h.width; ++x) {
+        float* a = ptm.Coefficients(static_cast<std::size_t>(y) * h.width + x, q);
+        for (std::size_t i = 0; i < 6; ++i)
+          a[i] = (static_cast<float>(row[static_cast<std::size_t>(x) * 6 + i]) - h.bias[i]) *
+                 h.scale[i] / 255.0f;
+      }
+    }
   }
-  return planes;
+  if (h.format == PtmFormat::kLrgb) {
+    std::vector<unsigned char> rgb(static_cast<std::size_t>(h.width) * 3);
+    for (int y = h.height - 1; y >= 0; --y) {
+      in.read(reinterpret_cast<char*>(rgb.data()), static_cast<std::streamsize>(rgb.size()));
+      if (!in) throw InputError(label, "read error in the colour block");
+      for (std::size_t i = 0; i < rgb.size(); ++i)
+        ptm.colour[static_cast<std::size_t>(y) * h.width * 3 + i] = rgb[i] / 255.0f;
+    }
+  }
+  return ptm;
 }
 
 // The JPEG header's lines after the biases: the compression parameter, then per plane
@@ -272,15 +277,20 @@ JpegLayout ReadJpegLayout(std::istream& in, const PtmHeader& h, const std::strin
 // single bytes exactly (5-byte records: a big-endian texel offset and the value).
 BytePlanes ReadJpegPlanes(std::istream& in, const PtmHeader& h, const std::string& label) {
   const JpegLayout j = ReadJpegLayout(in, h, label);
-  std::uint64_t total = 0;
-  for (int p = 0; p < h.NumPlanes(); ++p)
-    total += static_cast<std::uint64_t>(j.size[static_cast<std::size_t>(p)]) +
-             static_cast<std::uint64_t>(j.side_size[static_cast<std::size_t>(p)]);
   const std::uint64_t available = BytesLeft(in);
-  if (available < total)
-    throw InputError(label, "truncated payload: its JPEG streams need " + std::to_string(total) +
-                                " bytes, the file has " + std::to_string(available));
-  RequirePlaneMemory(h, label);
+  // Each size is bounded by the bytes left before any sum, so no sum can wrap.
+  std::uint64_t total = 0;
+  for (int p = 0; p < h.NumPlanes(); ++p) {
+    const auto size = static_cast<std::uint64_t>(j.size[static_cast<std::size_t>(p)]);
+    const auto side = static_cast<std::uint64_t>(j.side_size[static_cast<std::size_t>(p)]);
+    if (size > available || side > available || (total += size + side) > available)
+      throw InputError(label, "truncated payload: its JPEG streams need more than the " +
+                                  std::to_string(available) + " bytes the file has left");
+  }
+  // The planes, the PTM's floats, the payload and one decoded plane.
+  RequireMemory(
+      static_cast<double>(h.Texels()) * (h.NumPlanes() * 5.0 + 1.0) + static_cast<double>(total),
+      "reading the " + h.format_name + " PTM", label);
   std::string payload(total, '\0');
   in.read(payload.data(), static_cast<std::streamsize>(total));
   if (!in) throw InputError(label, "read error in the JPEG streams");
@@ -399,9 +409,8 @@ void WritePtmFile(const Ptm& ptm, const std::filesystem::path& path) {
 
 Ptm ReadPtm(std::istream& in, const std::string& label) {
   const PtmHeader header = ReadPtmHeader(in, label);
-  const BytePlanes planes =
-      header.jpeg ? ReadJpegPlanes(in, header, label) : ReadRawPlanes(in, header, label);
-  return PtmFromPlanes(header, planes);
+  if (!header.jpeg) return ReadRawPtm(in, header, label);
+  return PtmFromPlanes(header, ReadJpegPlanes(in, header, label));
 }
 
 Ptm ReadPtmFile(const std::filesystem::path& path) {

@@ -485,11 +485,17 @@ std::vector<std::filesystem::path> SubfoldersInOrder(const std::filesystem::path
   return folders;
 }
 
+// The images a model registers: images.bin's count, or images.txt's image lines (every
+// other line that is not a comment). Throws InputError when the file cannot be read.
 std::size_t NumRegisteredImages(const std::filesystem::path& model_dir) {
   const bool binary = DetectModelFormat(model_dir) == ModelFormat::kBinary;
   const std::filesystem::path file = model_dir / (binary ? "images.bin" : "images.txt");
   std::ifstream in = OpenForReading(file, binary);
-  return (binary ? ReadImagesBinary(in, file.string()) : ReadImagesText(in, file.string())).size();
+  if (binary) return BinaryReader(in, file.string()).ReadU64();
+  std::size_t lines = 0;
+  for (std::string line; std::getline(in, line);)
+    if (line.empty() || line[0] != '#') ++lines;
+  return (lines + 1) / 2;
 }
 
 }  // namespace
@@ -522,16 +528,24 @@ ModelFolderChoice FindModelFolder(const std::filesystem::path& path) {
     if (sub.filename() != "sparse") places.push_back(sub);
   }
   std::vector<std::pair<std::filesystem::path, std::size_t>> models;
+  std::string unreadable;
   for (const auto& place : places) {
-    if (IsModelFolder(place)) models.emplace_back(place, NumRegisteredImages(place));
+    if (!IsModelFolder(place)) continue;
+    try {
+      models.emplace_back(place, NumRegisteredImages(place));
+    } catch (const InputError& e) {  // a damaged model does not hide the others
+      unreadable += std::string(unreadable.empty() ? "" : "; ") + e.what();
+    }
   }
   if (models.empty()) {
     throw InputError(path.string(),
                      "no COLMAP model found: looked for cameras, images and points3D (.bin or "
-                     ".txt) in this folder, in sparse/, and in the subfolders of both");
+                     ".txt) in this folder, in sparse/, and in the subfolders of both" +
+                         (unreadable.empty() ? "" : " (unreadable: " + unreadable + ")"));
   }
+  const std::string skipped = unreadable.empty() ? "" : "; skipped " + unreadable;
   if (models.size() == 1) {
-    return {models[0].first, "using the COLMAP model in " + models[0].first.string()};
+    return {models[0].first, "using the COLMAP model in " + models[0].first.string() + skipped};
   }
   std::size_t best = 0;
   std::string found;
@@ -542,7 +556,7 @@ ModelFolderChoice FindModelFolder(const std::filesystem::path& path) {
   }
   return {models[best].first,
           "found " + std::to_string(models.size()) + " COLMAP models: " + found + "; using " +
-              models[best].first.string() + ", which registers the most images"};
+              models[best].first.string() + ", which registers the most images" + skipped};
 }
 
 Reconstruction ReadModel(const std::filesystem::path& model_dir, ModelFormat format) {

@@ -241,6 +241,14 @@ TEST(PtmFile, JpegPtmsWithBadLayoutsAreRefusedNamingTheProblem) {
   EXPECT_NE(refused("-1 0 0 -1", "-1 5 0 -1").find("not decoded before"), std::string::npos);
   EXPECT_NE(refused("\n0 0 1 0 0 0 0 0 0\n", "\n0 0 2 0 0 0 0 0 0\n").find("transform 2"),
             std::string::npos);
+  // Sizes whose sum wraps a 64-bit count are refused, not summed.
+  const std::size_t sizes_line = f.bytes.find("\n", f.bytes.find("-1 0 0 -1")) + 1;
+  std::string huge = f.bytes;
+  huge.replace(sizes_line, huge.find("\n", sizes_line) - sizes_line,
+               "9223372036854775807 9223372036854775807 1 1 1 1 1 1 1");
+  std::istringstream huge_in(huge);
+  EXPECT_NE(testing::InputErrorMessage([&] { ReadPtm(huge_in, "jpeg.ptm"); }).find("truncated"),
+            std::string::npos);
   std::string truncated = f.bytes.substr(0, f.bytes.size() - 100);
   std::istringstream in(truncated);
   EXPECT_NE(testing::InputErrorMessage([&] { ReadPtm(in, "jpeg.ptm"); }).find("truncated"),

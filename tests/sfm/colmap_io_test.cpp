@@ -264,6 +264,17 @@ TEST(ColmapWorkspace, RootSparseAndModelFolderAllFindTheModelWithTheMostImages) 
   EXPECT_EQ(ReadModel(tmp / "ws2").folder, tmp / "ws2/sparse");
 }
 
+TEST(ColmapWorkspace, ADamagedModelIsSkippedAndNamed) {
+  TempDir tmp;
+  WriteModel(MakeTestReconstruction(), tmp / "sparse/0", ModelFormat::kBinary);
+  WriteModel(MakeTestReconstruction(), tmp / "sparse/1", ModelFormat::kBinary);
+  WriteText(tmp / "sparse/1/images.bin", "");
+  const ModelFolderChoice found = FindModelFolder(tmp.path());
+  EXPECT_EQ(found.folder, tmp / "sparse/0");
+  EXPECT_NE(found.choice.find("skipped"), std::string::npos) << found.choice;
+  EXPECT_NE(found.choice.find("sparse/1/images.bin"), std::string::npos) << found.choice;
+}
+
 TEST(ColmapWorkspace, EqualModelsTakeTheLowestNumber) {
   TempDir tmp;
   const Reconstruction r = MakeTestReconstruction();
