@@ -446,7 +446,14 @@ std::string WithoutTimings(const fs::path& file) {
     strip(j);
     return j.dump();
   }
-  if (file.extension() == ".html") return bytes.substr(0, bytes.find("<h2>Timings</h2>"));
+  if (file.extension() == ".html") {
+    // The page names its own folder (the texlume view command), which differs by design.
+    std::string page = bytes.substr(0, bytes.find("<h2>Timings</h2>"));
+    const std::string folder = file.parent_path().string();
+    for (std::size_t at; (at = page.find(folder)) != std::string::npos;)
+      page.replace(at, folder.size(), "MODEL");
+    return page;
+  }
   return bytes;
 }
 
@@ -481,7 +488,8 @@ TEST_F(MeshPipelineTest, WebModelKeepsChartsAndThePtmWithinQuantisation) {
   const nlohmann::json& scene = web.scene;
   ASSERT_EQ(scene["faces"].get<std::size_t>(), model.mesh.faces.size());
   const std::size_t vertices = model.mesh.faces.size() * 3;
-  EXPECT_EQ(web.files.at("geometry.bin").size(), vertices * (3 + 3 + 3 + 2 + 1 + 1) * 4);
+  // position, normal, face_normal, tangent, uv, face, chart.
+  EXPECT_EQ(web.files.at("geometry.bin").size(), vertices * (3 + 3 + 3 + 3 + 2 + 1 + 1) * 4);
   const nlohmann::json manifest =
       nlohmann::json::parse(testing::ReadText(tmp_->path() / "model/manifest.json"));
   EXPECT_EQ(scene["charts"].get<int>(), manifest["summary"]["charts"].get<int>());
