@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <Eigen/Geometry>
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
@@ -491,6 +492,12 @@ std::vector<int> BreadthFirstFaceOrder(const TriangleMesh& mesh,
     if (!visited[static_cast<std::size_t>(f)]) run(f);
   }
   return order;
+}
+
+Eigen::Vector3d BoundingBoxCentre(const TriangleMesh& mesh) {
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& v : mesh.vertices) box.extend(v);
+  return box.isEmpty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(box.center());
 }
 
 MeshStats ComputeMeshStats(const TriangleMesh& mesh) {

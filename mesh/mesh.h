@@ -118,6 +118,9 @@ struct MeshStats {
 };
 MeshStats ComputeMeshStats(const TriangleMesh& mesh);
 
+/// The centre of the vertices' bounding box; the origin for a mesh without vertices.
+Eigen::Vector3d BoundingBoxCentre(const TriangleMesh& mesh);
+
 /// Smooth (area-weighted) vertex normals.
 std::vector<Eigen::Vector3d> VertexNormals(const TriangleMesh& mesh);
 

@@ -202,13 +202,10 @@ class GlbBuilder {
 }  // namespace
 
 Eigen::Matrix4d GltfFromModel(const TexturedModel& model) {
-  const Eigen::Vector3d up = model.orientation.up.normalized();
-  const Eigen::Vector3d front =
-      (model.orientation.front - up * up.dot(model.orientation.front)).normalized();
+  // glTF's x, y (up), z (front) are the hemisphere frame's y, z, x.
+  const Eigen::Matrix3d hemisphere = model.orientation.HemisphereFromWorld();
   Eigen::Matrix3d rotation;
-  rotation.row(0) = up.cross(front);
-  rotation.row(1) = up;
-  rotation.row(2) = front;
+  rotation << hemisphere.row(1), hemisphere.row(2), hemisphere.row(0);
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), hi = -lo;
   for (const Eigen::Vector3d& v : model.mesh.vertices) {
     lo = lo.cwiseMin(rotation * v);

@@ -1,6 +1,5 @@
 #include "pipeline/report_pictures.h"
 
-#include <Eigen/Geometry>
 #include <string>
 #include <utility>
 
@@ -55,22 +54,15 @@ void DrawReportPictures(const ReportScene& scene, report::ReportInputs& report,
 report::LightPlot LightPlotOfModel(const std::string& title,
                                    const std::vector<std::vector<sfm::ObjectLight>>& lights,
                                    const model::TexturedModel& model) {
-  Eigen::AlignedBox3d box;
-  for (const Eigen::Vector3d& v : model.mesh.vertices) box.extend(v);
-  const Eigen::Vector3d centre =
-      box.isEmpty() ? Eigen::Vector3d(Eigen::Vector3d::Zero()) : Eigen::Vector3d(box.center());
-  const Eigen::Vector3d z = model.orientation.up.normalized();
-  const Eigen::Vector3d x =
-      (model.orientation.front - z * z.dot(model.orientation.front)).normalized();
-  const Eigen::Vector3d y = z.cross(x);
+  const Eigen::Vector3d centre = mesh::BoundingBoxCentre(model.mesh);
+  const Eigen::Matrix3d hemisphere_from_world = model.orientation.HemisphereFromWorld();
   report::LightPlot plot{title,
                          "up as the photos were taken (estimated from the cameras), azimuth 0 "
                          "toward the side they were taken from",
                          {}};
   for (const auto& list : lights)
     for (const sfm::ObjectLight& l : list) {
-      const Eigen::Vector3d d = l.DirectionFrom(centre);
-      plot.directions.emplace_back(d.dot(x), d.dot(y), d.dot(z));
+      plot.directions.push_back(hemisphere_from_world * l.DirectionFrom(centre));
     }
   return plot;
 }

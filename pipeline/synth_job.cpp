@@ -301,10 +301,9 @@ model::TexturedModel TexturedModelOf(const SynthInputs& inputs, std::vector<ptm:
                                      const std::vector<atlas::FacePlacement>& faces) {
   model::TexturedModel model;
   model.mesh = inputs.mesh;
-  Eigen::AlignedBox3d box;
-  for (const Eigen::Vector3d& v : inputs.mesh.vertices) box.extend(v);
-  if (!box.isEmpty())
-    model.orientation = sfm::OrientationFromCameras(inputs.reconstruction, box.center());
+  if (!inputs.mesh.vertices.empty())
+    model.orientation =
+        sfm::OrientationFromCameras(inputs.reconstruction, mesh::BoundingBoxCentre(inputs.mesh));
   model.atlases = std::move(atlases);
   for (const atlas::FacePlacement& fp : faces) {
     model.face_atlas.push_back(fp.atlas);

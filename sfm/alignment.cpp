@@ -70,6 +70,16 @@ Reconstruction TransformedIntoReference(const Reconstruction& estimate,
   return out;
 }
 
+Eigen::Matrix3d ViewingOrientation::HemisphereFromWorld() const {
+  const Eigen::Vector3d z = up.normalized();
+  const Eigen::Vector3d x = (front - z * z.dot(front)).normalized();
+  Eigen::Matrix3d rows;
+  rows.row(0) = x;
+  rows.row(1) = z.cross(x);
+  rows.row(2) = z;
+  return rows;
+}
+
 ViewingOrientation OrientationFromCameras(const Reconstruction& reconstruction,
                                           const Eigen::Vector3d& centre) {
   ViewingOrientation o;

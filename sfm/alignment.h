@@ -40,6 +40,10 @@ struct ViewingOrientation {
   /// camera's, y pointing down the image and z along the view.
   Eigen::Vector3d up = -Eigen::Vector3d::UnitY();
   Eigen::Vector3d front = -Eigen::Vector3d::UnitZ();  ///< orthogonal to `up`
+
+  /// The frame of the photos' hemisphere, as rows in the world frame: x toward the
+  /// photos' side (front, made orthogonal to up), y = up x front, z = up.
+  Eigen::Matrix3d HemisphereFromWorld() const;
 };
 
 /// Up: photos are taken upright (landscape, little roll) whatever the frame SfM chose,

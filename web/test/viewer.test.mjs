@@ -229,25 +229,31 @@ function cameraAxes(view) {
   ];
 }
 
-test('the viewer draws what texlume render draws for the same camera and side light', async () => {
+// The first photo's camera, a side light (from the camera's right and a little behind
+// the object, so the terminator crosses the view where the coarse faces meet), and
+// `texlume render --samples 1` of that view under it, in `work`.
+function renderFirstPhotoUnderASideLight(work) {
   const photos = process.env.TEXLUME_PHOTOS;  // the scene's object/ folder
   assert.ok(photos, 'set TEXLUME_PHOTOS to the scene\'s object folder');
   const [name, view] = [...readColmapText(join(photos, 'sparse_txt')).entries()][0];
-  // A side light: from the camera's right and a little behind the object, so the
-  // terminator crosses the view where the coarse faces meet.
   const [right, , forward] = cameraAxes(view);
   const light = right.map((r, k) => 0.95 * r + 0.3 * forward[k]);
+  writeFileSync(join(work, 'lights.json'), JSON.stringify({
+    format: 'texlume-object-lights', frame: 'world',
+    images: { [name]: [{ type: 'directional', direction: light, intensity: 1.0 }] } }));
+  execFileSync(texlume, ['render', '--model', modelDir, '--cameras', join(photos, 'sparse'),
+                         '--lights', join(work, 'lights.json'), '--out', join(work, 'render'),
+                         '--samples', '1'], { stdio: 'ignore' });
+  const png = name.replace(/\.[^.]*$/, '.png');
+  return { name, view, light, png,
+           rendered: decodePng(readFileSync(join(work, 'render', png))),
+           mask: decodePng(readFileSync(join(work, 'render', 'masks', png))) };
+}
+
+test('the viewer draws what texlume render draws for the same camera and side light', async () => {
   const work = mkdtempSync(join(tmpdir(), 'texlume-view-'));
   try {
-    writeFileSync(join(work, 'lights.json'), JSON.stringify({
-      format: 'texlume-object-lights', frame: 'world',
-      images: { [name]: [{ type: 'directional', direction: light, intensity: 1.0 }] } }));
-    execFileSync(texlume, ['render', '--model', modelDir, '--cameras', join(photos, 'sparse'),
-                           '--lights', join(work, 'lights.json'), '--out', join(work, 'render'),
-                           '--samples', '1'], { stdio: 'ignore' });
-    const png = name.replace(/\.[^.]*$/, '.png');
-    const rendered = decodePng(readFileSync(join(work, 'render', png)));
-    const mask = decodePng(readFileSync(join(work, 'render', 'masks', png)));
+    const { name, view, light, rendered, mask } = renderFirstPhotoUnderASideLight(work);
     const viewPage = await browser.newPage({ viewport: { width: view.width, height: view.height } });
     await viewPage.goto(url);
     await viewPage.waitForFunction(() => window.texlumeViewer && window.texlumeViewer.ready, null,
@@ -323,10 +329,6 @@ function correlation(a, b) {
 }
 
 test('three.js shows the GLB\'s relief where texlume render shows the PTM\'s', async () => {
-  const photos = process.env.TEXLUME_PHOTOS;
-  const [name, view] = [...readColmapText(join(photos, 'sparse_txt')).entries()][0];
-  const [right, , forward] = cameraAxes(view);
-  const light = right.map((r, k) => 0.95 * r + 0.3 * forward[k]);
   const work = mkdtempSync(join(tmpdir(), 'texlume-glb-'));
   const server = createServer((request, response) => {
     const file = { '/': 'index.html', '/page.js': 'page.js', '/model.glb': 'model.glb' }[request.url];
@@ -335,21 +337,13 @@ test('three.js shows the GLB\'s relief where texlume render shows the PTM\'s', a
     response.writeHead(200, { 'Content-Type': type }).end(readFileSync(join(work, file)));
   });
   try {
+    const { name, view, light, png, rendered, mask } = renderFirstPhotoUnderASideLight(work);
     await esbuild.build({ entryPoints: [join(import.meta.dirname, '..', 'test_pages', 'glb_page.js')], bundle: true,
                           format: 'esm', outfile: join(work, 'page.js'), logLevel: 'silent' });
     writeFileSync(join(work, 'index.html'), '<!doctype html><body style="margin:0">' +
         `<canvas id="view" width="${view.width}" height="${view.height}"></canvas>` +
         '<script type="module" src="/page.js"></script></body>');
     copyFileSync(join(modelDir, 'model.glb'), join(work, 'model.glb'));
-    writeFileSync(join(work, 'lights.json'), JSON.stringify({
-      format: 'texlume-object-lights', frame: 'world',
-      images: { [name]: [{ type: 'directional', direction: light, intensity: 1.0 }] } }));
-    execFileSync(texlume, ['render', '--model', modelDir, '--cameras', join(photos, 'sparse'),
-                           '--lights', join(work, 'lights.json'), '--out', join(work, 'render'),
-                           '--samples', '1'], { stdio: 'ignore' });
-    const png = name.replace(/\.[^.]*$/, '.png');
-    const rendered = decodePng(readFileSync(join(work, 'render', png)));
-    const mask = decodePng(readFileSync(join(work, 'render', 'masks', png)));
     await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
     const glbPage = await browser.newPage({ viewport: { width: view.width, height: view.height } });
     await glbPage.goto(`http://127.0.0.1:${server.address().port}/`);
