@@ -5,6 +5,7 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "apps/progress_bar.h"
+#include "core/units.h"
 #include "pipeline/jobs.h"
 
 namespace texlume::apps {
@@ -12,14 +13,14 @@ namespace {
 
 // What the synth command reads besides the Options it binds directly.
 struct SynthWords {
-  std::string tangent_frame, prior_shrink;
+  std::string tangent_frame, prior_shrink, world_unit;
   std::vector<double> tangent_field;
   bool best_view_only = false, no_additive = false, no_channel = false, no_detail = false,
        no_report = false, no_light_response = false, no_white_balance = false,
        no_photo_blur = false;
 };
 
-void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o) {
+void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords& w) {
   pipeline::SynthJobOptions& j = o.job;
   sub->add_option("--model", j.model_dir, "COLMAP model folder")->required();
   sub->add_option("--images", j.images_dir, "the object photos")->required();
@@ -35,6 +36,9 @@ void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o) {
       ->capture_default_str();
   sub->add_option("--sample-texel-size", j.synthesis.sample_texel_size,
                   "world units per sample texel (required with --sample; BTF: the capture's)");
+  sub->add_option("--world-unit", w.world_unit,
+                  "how long one world unit is (1m, 10cm, 25.4mm, 1in): the report gives "
+                  "millimetres");
   sub->add_option("--seam-band", o.seam_band,
                   "BTF graph-cut band half-width in texels [min(4, "
                   "strip)]");
@@ -149,6 +153,7 @@ void Resolve(const CLI::App* sub, const SynthWords& w, pipeline::SynthCommandOpt
   }
   o.job.atlas.blend_strip = s.strip;
   o.job.write_report = !w.no_report;
+  if (!w.world_unit.empty()) o.job.mm_per_world_unit = ParseLengthMm(w.world_unit, "--world-unit");
 }
 
 }  // namespace
@@ -161,7 +166,7 @@ void AddSynthCommand(CLI::App& app, CommandRunners& run) {
       "with report.html (docs/synth.md).");
   auto o = std::make_shared<pipeline::SynthCommandOptions>();
   auto w = std::make_shared<SynthWords>();
-  BindSynthInputs(sub, *o);
+  BindSynthInputs(sub, *o, *w);
   BindEngine(sub, o->job.synthesis, *w);
   BindCorrection(sub, *o, *w);
   BindAtlas(sub, o->job.atlas, *w);

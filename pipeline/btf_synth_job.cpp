@@ -132,6 +132,7 @@ class BtfSynthJob {
 
   nlohmann::json Settings() const {
     nlohmann::json settings = {{"sample_texel_size", so_.sample_texel_size},
+                               {"world_unit_mm", WorldUnitJson(job_.mm_per_world_unit)},
                                {"components", sample_.Components()},
                                {"strip", so_.strip},
                                {"seam_band", so_.seam_band},

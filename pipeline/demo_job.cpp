@@ -1,4 +1,5 @@
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <string>
 
@@ -9,6 +10,7 @@
 #include "model/model_io.h"
 #include "pipeline/jobs.h"
 #include "pipeline/report_pictures.h"
+#include "pipeline/synth_job.h"
 #include "ptm/ptm_io.h"
 #include "report/report.h"
 #include "sfm/colmap_io.h"
@@ -110,11 +112,13 @@ class DemoJob {
     job_.sample = &sample_;  // as fitted: sample.exr holds it for the command line
     job_.out_dir = options_.out_dir / "model";
     job_.synthesis.sample_texel_size = scene_.material.texel_size;
+    job_.mm_per_world_unit = options_.mm_per_world_unit;
     out_ << "\n4. texlume synth --model " << job_.model_dir.string() << " --images "
          << job_.images_dir.string() << " --lights " << job_.lights_file.string() << " --mesh "
          << job_.mesh_file.string() << " --sample " << job_.sample_file.string()
-         << " --sample-texel-size " << job_.synthesis.sample_texel_size << " --out "
-         << job_.out_dir.string() << "\n";
+         << " --sample-texel-size " << job_.synthesis.sample_texel_size;
+    if (job_.mm_per_world_unit > 0.0) out_ << " --world-unit " << job_.mm_per_world_unit << "mm";
+    out_ << " --out " << job_.out_dir.string() << "\n";
     synthesis_ = pipeline::RunSynthJob(job_, progress_);
     for (const std::string& w : synthesis_.warnings) err_ << "warning: " << w << "\n";
     out_ << "   " << synthesis_.faces << " triangles (" << synthesis_.from_photos
@@ -225,6 +229,8 @@ class DemoJob {
     rep.inputs = InputFiles(job_, job_.model_dir);
     rep.inputs.emplace_back("sample", options_.out_dir / "sample.ptm");
     rep.view_folder = (options_.out_dir / "model").string();
+    rep.texel_size = job_.synthesis.sample_texel_size;
+    rep.mm_per_world_unit = job_.mm_per_world_unit;
     rep.links = {{"model.glb", "model/model.glb"},
                  {"model.obj", "model/model.obj"},
                  {"manifest.json", "model/manifest.json"},
@@ -281,6 +287,8 @@ void DemoJobOptions::Check() const {
     throw OptionError("--width and --height must be in [64, 8192] pixels, got " +
                       std::to_string(image_width) + " x " + std::to_string(image_height));
   sensor.Check();
+  if (!(mm_per_world_unit >= 0.0 && std::isfinite(mm_per_world_unit)))
+    throw OptionError("the world unit's length must be positive and finite");
 }
 
 nlohmann::json DemoJobOptions::ToJson() const {
@@ -290,7 +298,8 @@ nlohmann::json DemoJobOptions::ToJson() const {
           {"num_images", num_images},
           {"image_width", image_width},
           {"image_height", image_height},
-          {"sensor", sensor.ToJson()}};
+          {"sensor", sensor.ToJson()},
+          {"world_unit_mm", WorldUnitJson(mm_per_world_unit)}};
 }
 
 void RunDemoJob(const DemoJobOptions& options, std::ostream& out, std::ostream& err,

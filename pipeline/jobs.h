@@ -127,6 +127,9 @@ struct DemoJobOptions {
   int image_height = 480;
   /// What the camera adds to the scene's photos (off: the clean scene).
   datasets::SensorOptions sensor;
+  /// How long one world unit is, in millimetres (`--world-unit`, passed to synth); 0 = not
+  /// stated.
+  double mm_per_world_unit = 0.0;
   void Check() const;
   nlohmann::json ToJson() const;
 };

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -15,6 +16,7 @@
 #include "core/memory_budget.h"
 #include "core/partial_output.h"
 #include "core/timing.h"
+#include "core/units.h"
 #include "mesh/mesh.h"
 #include "model/baselines.h"
 #include "pipeline/report_pictures.h"
@@ -175,6 +177,10 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
   return inputs;
 }
 
+nlohmann::json WorldUnitJson(double mm_per_world_unit) {
+  return mm_per_world_unit > 0.0 ? nlohmann::json(mm_per_world_unit) : nlohmann::json(nullptr);
+}
+
 nlohmann::json AtlasSettingsJson(const atlas::AtlasOptions& atlas) {
   return {{"atlas_mode", atlas.mode == atlas::AtlasMode::kCharts ? "charts" : "per_triangle"},
           {"atlas_size", atlas.atlas_size},
@@ -247,6 +253,8 @@ void SynthJobOptions::CheckInputsAndLayout() const {
   visibility.Check();
   if (max_subdivisions < 0 || max_subdivisions > 6)
     throw OptionError("max subdivisions must be in [0, 6]");
+  if (!(mm_per_world_unit >= 0.0 && std::isfinite(mm_per_world_unit)))
+    throw OptionError("the world unit's length must be positive and finite");
 }
 
 nlohmann::json SynthJobOptions::InputsJson() const {
@@ -406,6 +414,7 @@ class SynthJob {
     nlohmann::json settings = {
         {"sample_texel_size", so.sample_texel_size},
         {"output_texel_size", so.sample_texel_size},
+        {"world_unit_mm", WorldUnitJson(options_.mm_per_world_unit)},
         {"strip", so.strip},
         {"top_k", so.top_k},
         {"all_views", so.all_views},
@@ -509,13 +518,15 @@ class SynthJob {
                           " constrained by photos, " + std::to_string(s.from_neighbours) +
                           " by neighbours only)"},
         {"photos used", std::to_string(s.photos_used)},
-        {"sample texel size",
-         std::to_string(options_.synthesis.sample_texel_size) + " world units"},
+        {"sample and atlas texel size",
+         WorldLengthText(options_.synthesis.sample_texel_size, options_.mm_per_world_unit)},
         {"atlases", std::to_string(s.atlases) + " of " + std::to_string(options_.atlas.atlas_size) +
                         " texels, " + std::to_string(s.charts) + " charts"}};
     for (const std::string& w : s.warnings) report.facts.emplace_back("warning", w);
     report.inputs = InputFiles(options_, inputs_.model_folder);
     report.view_folder = options_.out_dir.string();
+    report.texel_size = options_.synthesis.sample_texel_size;
+    report.mm_per_world_unit = options_.mm_per_world_unit;
     report.timings_s = {{"load", s.seconds_load},
                         {"visibility", s.seconds_visibility},
                         {"synthesis", s.seconds_synthesis},

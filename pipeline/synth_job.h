@@ -39,6 +39,9 @@ struct SynthJobOptions {
   /// the photos, the model from photo views beside the photos and the
   /// baselines, a light sweep, the atlases, timings (synth/report.h).
   bool write_report = true;
+  /// How long one world unit is, in millimetres (`--world-unit`); 0 = not stated. The
+  /// report then gives texel and pixel sizes in millimetres as well as world units.
+  double mm_per_world_unit = 0.0;
 
   /// Throws OptionError when a path is missing or a setting is out of range.
   void Check() const;
@@ -141,5 +144,7 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
 
 /// The atlas settings as the manifests record them (shared by the PTM and BTF jobs).
 nlohmann::json AtlasSettingsJson(const atlas::AtlasOptions& atlas);
+/// The world unit's length in millimetres as the manifests record it: null when not stated.
+nlohmann::json WorldUnitJson(double mm_per_world_unit);
 
 }  // namespace texlume::pipeline

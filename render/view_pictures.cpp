@@ -8,6 +8,7 @@
 
 #include "core/errors.h"
 #include "core/image_io.h"
+#include "mesh/mesh.h"
 #include "render/metrics.h"
 
 namespace texlume::render {
@@ -68,7 +69,15 @@ ViewPictures DrawView(const ModelRenderer& renderer,
     }
     out.drawn.push_back(std::move(drawn));
   }
+  out.world_per_pixel =
+      WorldPerPixelAt(camera, view.cam_from_world, mesh::BoundingBoxCentre(renderer.model().mesh));
   return out;
+}
+
+double WorldPerPixelAt(const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
+                       const Eigen::Vector3d& point_in_world) {
+  const double depth = (cam_from_world * point_in_world).z();
+  return depth > 0.0 ? depth / camera.FocalLength().mean() : 0.0;
 }
 
 std::vector<cv::Mat> DrawLightSweep(const ModelRenderer& renderer, const PictureView& view,

@@ -46,7 +46,16 @@ struct ViewPictures {
     double psnr = 0, ssim = 0;
   };
   std::vector<Drawn> drawn;
+  /// World units one picture pixel spans at the depth of the model's bounding-box
+  /// centre (WorldPerPixelAt); 0 when the centre is not in front of the camera.
+  double world_per_pixel = 0.0;
 };
+
+/// World units one pixel of `camera` spans, across the viewing direction, at the depth
+/// of `point_in_world`: its depth over the mean focal length (pinhole approximation,
+/// distortion ignored). 0 when the point is not in front of the camera.
+double WorldPerPixelAt(const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
+                       const Eigen::Vector3d& point_in_world);
 
 /// Draws `view` at most `width` pixels wide (the camera scaled down) in each
 /// (name, mode), 2 x 2 rays per pixel, and measures each against the reference

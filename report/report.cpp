@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
@@ -18,6 +19,7 @@
 #include "core/partial_output.h"
 #include "core/provenance.h"
 #include "core/timing.h"
+#include "core/units.h"
 
 namespace texlume::report {
 namespace fs = std::filesystem;
@@ -78,6 +80,36 @@ cv::Mat ErrorScale() {
   cv::applyColorMap(ramp, colour, cv::COLORMAP_INFERNO);
   for (int q = 1; q < 4; ++q) colour(cv::Rect(q * 64, 16, 1, 8)).setTo(cv::Scalar(255, 255, 255));
   return colour;
+}
+
+// A length for a scale bar: millimetre units when the world unit is known, else world units.
+std::string ScaleBarLabel(double world_units, double mm_per_world_unit) {
+  if (mm_per_world_unit > 0.0) return MillimetreText(world_units * mm_per_world_unit);
+  char text[48];
+  std::snprintf(text, sizeof text, "%.3g units", world_units);
+  return text;
+}
+
+// `bgr8` with a scale bar at its lower left: the longest 1-2-5 length (in mm when
+// `mm_per_world_unit` > 0, else in world units) that fits in a quarter of its width, given
+// that one pixel spans `world_per_px` world units. Unchanged when that is not positive.
+cv::Mat WithScaleBar(const cv::Mat& bgr8, double world_per_px, double mm_per_world_unit) {
+  cv::Mat out = bgr8.clone();
+  if (!(world_per_px > 0.0) || out.cols < 40 || out.rows < 30) return out;
+  const double unit = mm_per_world_unit > 0.0 ? mm_per_world_unit : 1.0;  // display per world
+  const double length = NiceLengthAtMost(0.25 * out.cols * world_per_px * unit);
+  const int bar_px = static_cast<int>(std::lround(length / (world_per_px * unit)));
+  if (bar_px < 4) return out;
+  const std::string label = ScaleBarLabel(length / unit, mm_per_world_unit);
+  const cv::Point left(6, out.rows - 8), right(6 + bar_px, out.rows - 8);
+  cv::line(out, left, right, cv::Scalar(0, 0, 0), 5);
+  cv::line(out, left, right, cv::Scalar(255, 255, 255), 3);
+  const cv::Point text_at(6, out.rows - 14);
+  cv::putText(out, label, text_at, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 3,
+              cv::LINE_AA);
+  cv::putText(out, label, text_at, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(255, 255, 255), 1,
+              cv::LINE_AA);
+  return out;
 }
 
 std::string Figure(const std::string& src, const std::string& caption, int width) {
@@ -182,6 +214,15 @@ class ReportWriter {
     if (progress_) progress_("report", step_, steps_);
   }
 
+  // ", whose texel is 0.002 world units (2 mm) on the object; the bar..." for the sample
+  // and atlas sections (`whose`: "its", "an atlas"); empty when the texel size is unknown.
+  std::string ScaleText(const std::string& whose) const {
+    if (!(in_.texel_size > 0.0)) return "";
+    return "; " + whose + " texel spans " + WorldLengthText(in_.texel_size, in_.mm_per_world_unit) +
+           " on the object, the bar at the lower left gives the scale" +
+           (in_.mm_per_world_unit > 0.0 ? "" : " (no --world-unit was given: world units)");
+  }
+
   std::string WritePicture(const std::string& name, const cv::Mat& bgr8) {
     WriteBytesAtomically(tmp_ / name, EncodePng(bgr8, (pictures_ / name).string()));
     ++summary_.pictures;
@@ -234,11 +275,14 @@ class ReportWriter {
   void Sample() {
     if (in_.sample_relit.empty()) return;
     html_ << "<h2>Material sample</h2>\n<p>The sample PTM (" << in_.sample_width << " &times; "
-          << in_.sample_height << " texels) relit in its own frame.</p>\n";
+          << in_.sample_height << " texels) relit in its own frame" << ScaleText("its")
+          << ".</p>\n";
     for (std::size_t k = 0; k < in_.sample_relit.size(); ++k) {
       const auto& [light, image] = in_.sample_relit[k];
-      const std::string src =
-          WritePicture("sample_light_" + std::to_string(k) + ".png", ToBgr8(image));
+      const double world_per_px = in_.texel_size * in_.sample_width / std::max(1, image.cols);
+      const cv::Mat bgr8 =
+          k == 0 ? WithScaleBar(ToBgr8(image), world_per_px, in_.mm_per_world_unit) : ToBgr8(image);
+      const std::string src = WritePicture("sample_light_" + std::to_string(k) + ".png", bgr8);
       html_ << Figure(src, "light " + DirectionText(light), image.cols);
     }
     html_ << "\n";
@@ -299,7 +343,10 @@ class ReportWriter {
              "from black (0) to bright yellow ("
           << Fixed(in_.error_map_max, 2)
           << " or more, display values in [0, 1]); grey outside. PSNR (dB) and SSIM at the "
-             "pictures' resolution.</p>\n";
+             "pictures' resolution. The bar on each reference gives the scale at the depth of the "
+             "model's centre"
+          << (in_.mm_per_world_unit > 0.0 ? "" : " (in world units: no --world-unit was given)")
+          << ".</p>\n";
     html_ << "<p>"
           << Figure(WritePicture("error_scale.png", ErrorScale()),
                     "error scale: 0 (left) to " + Fixed(in_.error_map_max, 2) +
@@ -321,8 +368,10 @@ class ReportWriter {
     html_ << "<tr>";
     if (!v.reference.empty()) {
       html_ << "<td>"
-            << Figure(WritePicture(stem + "_reference.png", ToBgr8(v.reference)),
-                      HtmlEscape(v.name) + "<br>" + LightsText(v.lights), width)
+            << Figure(WritePicture(stem + "_reference.png",
+                                   WithScaleBar(ToBgr8(v.reference), v.world_per_pixel,
+                                                in_.mm_per_world_unit)),
+                      HtmlEscape(v.name) + "<br>" + LightsText(v.lights) + PixelText(v), width)
             << "</td>";
     } else {
       html_ << "<td>" << HtmlEscape(v.name) << "<br>" << LightsText(v.lights) << "</td>";
@@ -342,6 +391,13 @@ class ReportWriter {
       summary_.rows.push_back({v.name, d.model, d.psnr, d.ssim});
     }
     html_ << "</tr>\n";
+  }
+
+  // "<br>1 pixel: 0.0123 world units (1.23 mm) at the model's centre", or nothing.
+  std::string PixelText(const render::ViewPictures& v) const {
+    if (!(v.world_per_pixel > 0.0)) return "";
+    return "<br>1 pixel: " + WorldLengthText(v.world_per_pixel, in_.mm_per_world_unit) +
+           " at the model's centre";
   }
 
   // A light circling the first view.
@@ -368,7 +424,8 @@ class ReportWriter {
     html_ << "<h2>Atlases</h2>\n<p>" << in_.model->atlases.size()
           << " atlas(es), occupancy of the layout " << Fixed(in_.occupancy, 3)
           << " (atlas texels inside triangles); the PTM under a head-on light, triangle outlines "
-             "in green.</p>\n";
+             "in green"
+          << ScaleText("an atlas") << ".</p>\n";
     for (std::size_t a = 0; a < in_.model->atlases.size(); ++a) {
       const ptm::Ptm& atlas = in_.model->atlases[a];
       const int width = std::min(480, atlas.width);
@@ -399,7 +456,7 @@ class ReportWriter {
       cv::polylines(outlines, corners, true, cv::Scalar(60, 220, 60), 1, cv::LINE_AA, kShift);
     }
     cv::addWeighted(thumb, 0.7, outlines, 0.3, 0.0, thumb);
-    return thumb;
+    return WithScaleBar(thumb, in_.texel_size / s, in_.mm_per_world_unit);
   }
 
   // The full-resolution tables given, and the pictures' own measurements.

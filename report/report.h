@@ -72,6 +72,12 @@ struct ReportInputs {
   /// empty = no pointer.
   std::string view_folder;
   double occupancy = 0.0;  ///< of the whole layout (atlas texels inside triangles)
+  /// Physical scale: the sample's and the atlases' texel size in world units (0 = unknown:
+  /// no scale shown), and how long one world unit is in millimetres (`--world-unit`; 0 =
+  /// not stated: lengths in world units only). The views' scale is their
+  /// `world_per_pixel`.
+  double texel_size = 0.0;
+  double mm_per_world_unit = 0.0;
   /// Error maps run from black (0) to white at this mean absolute difference
   /// (display values in [0, 1]).
   double error_map_max = 0.25;

@@ -600,6 +600,13 @@ std::vector<BadInput> Catalogue() {
          return "--memory-limit 12Q inspect --model " + w("sparse") + " --json " + w("out.json");
        },
        2, "--memory-limit", "out.json"},
+      {"WorldUnitThatIsNotALength",
+       [](const Workspace& w) {
+         return "synth --model " + w("sparse") + " --images " + w("photos") + " --lights " +
+                w("lights.json") + " --mesh " + w("mesh.ply") + " --sample " + w("sample.ptm") +
+                " --sample-texel-size 0.01 --world-unit 3parsec --out " + w("model");
+       },
+       2, "--world-unit", "model"},
       {"SphereCircleOfTenToThe308",
        [](const Workspace& w) {
          return "lights-from-sphere --images " + w("photos") +

@@ -73,6 +73,7 @@ class MeshPipelineTest : public ::testing::Test {
     j.sample_file = tmp_->path() / "sample.exr";
     j.out_dir = out;
     j.synthesis.sample_texel_size = 0.004;
+    j.mm_per_world_unit = 1000.0;  // --world-unit 1m
     j.atlas.atlas_size = 1024;
     return j;
   }
@@ -115,6 +116,7 @@ TEST_F(MeshPipelineTest, EveryTriangleGetsAPatchMostFromThePhotos) {
   }
   EXPECT_TRUE(manifest["timings_s"].contains("synthesis"));
   EXPECT_EQ(manifest["settings"]["sample_texel_size"].get<double>(), 0.004);
+  EXPECT_EQ(manifest["settings"]["world_unit_mm"].get<double>(), 1000.0);
   // The photos' blur, one per photo (synth/photo_blur.h), within the candidates.
   EXPECT_TRUE(manifest["settings"]["photo_blur"].get<bool>());
   const nlohmann::json& blur = manifest["summary"]["photo_blur"];
@@ -581,6 +583,9 @@ TEST_F(MeshPipelineTest, SynthReportShowsEveryPictureItLinks) {
   for (const char* section : {"Material sample", "Constraint photos", "Photo views under the",
                               "Light sweep", "Atlases", "Metrics", "Timings"})
     EXPECT_NE(html.find(section), std::string::npos) << section;
+  // The physical scale: 0.004 world units of 1 m per texel.
+  EXPECT_NE(html.find("texel spans 0.004 world units (4 mm) on the object"), std::string::npos);
+  EXPECT_NE(html.find(" mm) at the model's centre"), std::string::npos);
   const std::vector<std::string> links = ReportLinks(html);
   EXPECT_GE(links.size(), 5u + 12u + 4u * 6u + 1u + 1u + 3u);
   for (const std::string& link : links) {

@@ -87,6 +87,51 @@ TEST(WriteReport, ShowsTheGivenPicturesAndMetricsAndLinksOnlyWhatItWrote) {
   EXPECT_LE(occupancy[0], 136.0 / 256.0);
 }
 
+// With the texel size and the world unit given, the page gives each texel's and each view
+// pixel's length on the object, and the pictures carry a scale bar of a 1-2-5 length.
+TEST(WriteReport, GivesThePhysicalScaleOfTheSampleTheAtlasesAndTheViews) {
+  const model::TexturedModel model = OneTriangle();
+  ReportInputs in;
+  in.model = &model;
+  in.texel_size = 0.5;
+  in.mm_per_world_unit = 1.0;
+  // 400 sample texels shown in 200 pixels: 1 world unit (1 mm) per pixel, so a quarter of
+  // the width (50 pixels) holds a bar of 50 mm.
+  const cv::Mat grey(100, 200, CV_32FC3, cv::Scalar::all(0.4));
+  in.sample_relit = {{Eigen::Vector3d::UnitZ(), grey}};
+  in.sample_width = 400;
+  in.sample_height = 200;
+  render::ViewPictures view;
+  view.name = "view_0.png";
+  view.reference = grey;
+  view.inside = cv::Mat(100, 200, CV_8UC1, cv::Scalar(255));
+  view.drawn = {{"texlume", grey, 20.0, 0.5}};
+  view.world_per_pixel = 0.25;
+  in.views = {view};
+  testing::TempDir out;
+  WriteReport(out.path(), in);
+  std::string html = testing::ReadText(out.path() / "report.html");
+  EXPECT_NE(html.find("texel spans 0.5 world units (0.5 mm) on the object"), std::string::npos);
+  EXPECT_NE(html.find("1 pixel: 0.25 world units (0.25 mm) at the model's centre"),
+            std::string::npos);
+  const cv::Mat sample = cv::imread((out.path() / "report/sample_light_0.png").string());
+  const int bar_row = sample.rows - 8;
+  EXPECT_EQ(sample.at<cv::Vec3b>(bar_row, 7), cv::Vec3b(255, 255, 255));
+  EXPECT_EQ(sample.at<cv::Vec3b>(bar_row, 55), cv::Vec3b(255, 255, 255));
+  EXPECT_NE(sample.at<cv::Vec3b>(bar_row, 60), cv::Vec3b(255, 255, 255));  // 50 pixels long
+  EXPECT_NE(sample.at<cv::Vec3b>(20, 150), cv::Vec3b(255, 255, 255));
+  const cv::Mat reference = cv::imread((out.path() / "report/view_0_reference.png").string());
+  // 0.25 mm per pixel: 12.5 mm fit in a quarter, the bar is 10 mm = 40 pixels.
+  EXPECT_EQ(reference.at<cv::Vec3b>(bar_row, 45), cv::Vec3b(255, 255, 255));
+  EXPECT_NE(reference.at<cv::Vec3b>(bar_row, 50), cv::Vec3b(255, 255, 255));
+  // Without the world unit, lengths are in world units and the page says why.
+  in.mm_per_world_unit = 0.0;
+  WriteReport(out.path(), in);
+  html = testing::ReadText(out.path() / "report.html");
+  EXPECT_NE(html.find("texel spans 0.5 world units on the object"), std::string::npos);
+  EXPECT_NE(html.find("no --world-unit was given"), std::string::npos);
+}
+
 // The page says where a baseline measures better than texlume, points to texlume view,
 // and names texlume's version and the inputs with their checksums.
 TEST(WriteReport, SaysWhereABaselineWinsAndWhereTheResultsCameFrom) {
