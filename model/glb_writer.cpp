@@ -32,35 +32,28 @@ struct PrimitiveData {
   std::size_t NumCorners() const { return positions.size() / 3; }
 };
 
-// Corners of the faces of atlas `a`. The tangent is the atlas frame's x made
-// orthogonal to the corner's smooth normal; w makes N x T point along the frame's y.
-PrimitiveData CornersOfAtlas(const TexturedModel& model, int a,
-                             const std::vector<Eigen::Vector3d>& vertex_normals) {
-  PrimitiveData d;
-  const ptm::Ptm& atlas = model.atlases[static_cast<std::size_t>(a)];
-  for (std::size_t f = 0; f < model.mesh.faces.size(); ++f) {
-    if (model.face_atlas[f] != a) continue;
-    const Eigen::Matrix3d frame = AtlasFaceFrame(model, f);
-    for (int k = 0; k < 3; ++k) {
-      const auto v = static_cast<std::size_t>(model.mesh.faces[f][static_cast<std::size_t>(k)]);
-      const Eigen::Vector3f p = model.mesh.vertices[v].cast<float>();
-      d.lo = d.lo.cwiseMin(p);
-      d.hi = d.hi.cwiseMax(p);
-      d.positions.insert(d.positions.end(), {p.x(), p.y(), p.z()});
-      const Eigen::Vector3d n = vertex_normals[v];
-      d.normals.insert(d.normals.end(), {static_cast<float>(n.x()), static_cast<float>(n.y()),
-                                         static_cast<float>(n.z())});
-      Eigen::Vector3d t = frame.col(0) - n * n.dot(frame.col(0));
-      t = t.norm() > 1e-9 ? t.normalized() : n.unitOrthogonal();
-      const float w = n.cross(t).dot(frame.col(1)) >= 0.0 ? 1.0f : -1.0f;
-      d.tangents.insert(d.tangents.end(), {static_cast<float>(t.x()), static_cast<float>(t.y()),
-                                           static_cast<float>(t.z()), w});
-      const Eigen::Vector2f c = model.corner_px[f][static_cast<std::size_t>(k)];
-      d.texcoords.insert(d.texcoords.end(), {c.x() / static_cast<float>(atlas.width),
-                                             c.y() / static_cast<float>(atlas.height)});
-    }
-  }
-  return d;
+// The corners of each atlas's faces (ForEachCornerByAtlas). The tangent is the atlas
+// frame's x made orthogonal to the corner's smooth normal; w makes N x T point along the
+// frame's y.
+std::vector<PrimitiveData> PrimitivesByAtlas(const TexturedModel& model) {
+  std::vector<PrimitiveData> primitives(model.atlases.size());
+  ForEachCornerByAtlas(model, [&](const ModelCorner& c) {
+    PrimitiveData& d = primitives[static_cast<std::size_t>(c.atlas)];
+    const Eigen::Vector3f p = c.position.cast<float>();
+    d.lo = d.lo.cwiseMin(p);
+    d.hi = d.hi.cwiseMax(p);
+    d.positions.insert(d.positions.end(), {p.x(), p.y(), p.z()});
+    const Eigen::Vector3d& n = c.smooth_normal;
+    d.normals.insert(d.normals.end(), {static_cast<float>(n.x()), static_cast<float>(n.y()),
+                                       static_cast<float>(n.z())});
+    Eigen::Vector3d t = c.frame.col(0) - n * n.dot(c.frame.col(0));
+    t = t.norm() > 1e-9 ? t.normalized() : n.unitOrthogonal();
+    const float w = n.cross(t).dot(c.frame.col(1)) >= 0.0 ? 1.0f : -1.0f;
+    d.tangents.insert(d.tangents.end(), {static_cast<float>(t.x()), static_cast<float>(t.y()),
+                                         static_cast<float>(t.z()), w});
+    d.texcoords.insert(d.texcoords.end(), {c.uv_down.x(), c.uv_down.y()});
+  });
+  return primitives;
 }
 
 // The glTF document and its binary chunk, filled a primitive at a time.
@@ -222,13 +215,12 @@ Eigen::Matrix4d GltfFromModel(const TexturedModel& model) {
 void WriteGlb(const fs::path& path, const TexturedModel& model,
               const std::vector<GlbAtlas>& atlases) {
   TEXLUME_CHECK(atlases.size() == model.atlases.size(), "one GLB entry per atlas");
-  const std::vector<Eigen::Vector3d> vertex_normals = mesh::VertexNormals(model.mesh);
   GlbBuilder glb;
   glb.SetNode(GltfFromModel(model));
-  for (std::size_t a = 0; a < model.atlases.size(); ++a) {
-    const PrimitiveData data = CornersOfAtlas(model, static_cast<int>(a), vertex_normals);
-    if (data.NumCorners() > 0) glb.AddPrimitive(data, atlases[a], static_cast<int>(a));
-  }
+  const std::vector<PrimitiveData> primitives = PrimitivesByAtlas(model);
+  for (std::size_t a = 0; a < primitives.size(); ++a)
+    if (primitives[a].NumCorners() > 0)
+      glb.AddPrimitive(primitives[a], atlases[a], static_cast<int>(a));
   glb.Write(path);
 }
 

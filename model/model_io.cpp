@@ -2,10 +2,12 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <numeric>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
@@ -141,97 +143,131 @@ cv::Mat AlbedoImage(const ptm::Ptm& ptm) {
   return out;
 }
 
-void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlohmann::json& record,
-                      const std::vector<std::pair<std::string, cv::Mat>>& extra_images,
-                      const std::function<void(const fs::path&)>& write_more) {
-  RequireReplaceableFolder(dir, "manifest.json", "a texlume model folder");
-  PartialOutput output(dir, PartialOutput::Kind::kFolder);
-  const fs::path& tmp = output.path();
-  {
-    nlohmann::json manifest = record;
-    manifest["format"] = kManifestFormat;
-    manifest["version"] = 1;
-    manifest["mesh"] = {{"obj", "model.obj"},
-                        {"mtl", "model.mtl"},
-                        {"glb", "model.glb"},
-                        {"vertices", model.mesh.vertices.size()},
-                        {"faces", model.mesh.faces.size()}};
-    manifest["ptm_frame"] =
+namespace {
+
+// The model folder's files, written into the temporary folder `tmp` (WriteModelFolder):
+// the atlases first, then the meshes that name them, the manifest last.
+class ModelFolderWriter {
+ public:
+  ModelFolderWriter(const TexturedModel& model, const fs::path& tmp, const nlohmann::json& record)
+      : model_(model), tmp_(tmp), manifest_(record) {
+    manifest_["format"] = kManifestFormat;
+    manifest_["version"] = 1;
+    manifest_["mesh"] = {{"obj", "model.obj"},
+                         {"mtl", "model.mtl"},
+                         {"glb", "model.glb"},
+                         {"vertices", model.mesh.vertices.size()},
+                         {"faces", model.mesh.faces.size()}};
+    manifest_["ptm_frame"] =
         "per texel: x = dP/du, y = dP/dv (v up, as in OBJ), z = face normal; light directions "
         "point from the surface to the light";
-    manifest["ptm_evaluation"] = {
+    manifest_["ptm_evaluation"] = {
         {"domain", "display (sRGB-encoded); several lights sum in the linear domain"},
         {"horizon_elevation_deg", ptm::kHorizonElevationDeg},
         {"below_horizon_elevation",
          "value at horizon_elevation_deg (same azimuth) times l_z / sin(horizon_elevation_deg)"},
         {"light_response", LightResponseJson(model.light_response)}};
-    manifest["gltf_frame"] = GltfFrameJson(model);
-    manifest["atlases"] = nlohmann::json::array();
-    std::vector<GlbAtlas> glb_atlases;
-    std::ofstream mtl(tmp / "model.mtl");
-    mtl << "# texlume: albedo and normal map from the PTM atlases (model.glb carries them too)\n";
-    for (std::size_t a = 0; a < model.atlases.size(); ++a) {
-      const std::string k = std::to_string(a);
-      const std::string base = "base_colour_" + k + ".png", albedo = "albedo_" + k + ".png";
-      const std::string normal = "normal_" + k + ".png";
-      const std::string ptm_file = "ptm_atlas_" + k + ".ptm", exr_file = "ptm_atlas_" + k + ".exr";
-      GlbAtlas& glb = glb_atlases.emplace_back();
-      WriteBytesAtomically(tmp / base, EncodePng(BaseColourImage(model.atlases[a]), base));
-      glb.albedo_png = EncodePng(AlbedoImage(model.atlases[a]), albedo);
-      WriteBytesAtomically(tmp / albedo, glb.albedo_png);
-      glb.normal_png = EncodePng(NormalMapImage(model.atlases[a]), normal);
-      WriteBytesAtomically(tmp / normal, glb.normal_png);
-      ptm::WritePtmFile(model.atlases[a], tmp / ptm_file);
-      ptm::WritePtmExr(model.atlases[a], tmp / exr_file);
-      const ptm::WebPlanes web = ptm::QuantiseWebPlanes(model.atlases[a]);
-      for (const cv::Mat& plane : web.images)
-        glb.ptm_plane_pngs.push_back(EncodePng(plane, "a PTM plane of " + ptm_file));
-      const std::string format = model.atlases[a].format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB";
-      nlohmann::json entry = {{"ptm", ptm_file},
-                              {"exr", exr_file},
-                              {"base_colour", base},
-                              {"albedo", albedo},
-                              {"normal", normal},
-                              {"width", model.atlases[a].width},
-                              {"height", model.atlases[a].height},
-                              {"format", format}};
-      manifest["atlases"].push_back(entry);
-      const nlohmann::json ptm_fields = {
-          {"format", format},
-          {"frame", manifest["ptm_frame"]},
-          {"evaluation", manifest["ptm_evaluation"]},
-          {"texcoord", "TEXCOORD_0 (glTF v down; the PTM's y axis points to -v)"}};
-      glb.extras = {{"texlume_ptm", ptm_fields}};
-      glb.extras["texlume_ptm"]["ptm"] = ptm_file;
-      glb.extras["texlume_ptm"]["exr"] = exr_file;
-      glb.ptm_fields = ptm_fields;
-      glb.ptm_fields.update(web.Info(model.atlases[a]));
-      glb.ptm_fields["plane_order"] =
-          "relight's web format: value = (byte / 255 - bias) * scale per plane; planes "
-          "(1, u, v, u^2, uv, v^2), after R, G, B for LRGB, per channel for RGB";
-      // The albedo under the relief: norm (MTL's PBR extension) and map_Bump (which
-      // Blender reads as a normal map) give the normal map.
-      mtl << "newmtl atlas_" << k << "\nKa 0 0 0\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd " << albedo
-          << "\nnorm " << normal << "\nmap_Bump " << normal << "\n# head-on base colour: " << base
-          << "; PTM: " << ptm_file << " (lossless " << exr_file << ")\n\n";
-    }
-    mtl.close();
-    if (!mtl) throw InputError((dir / "model.mtl").string(), "cannot be written (disk full?)");
-    WriteObj(tmp / "model.obj", model);
-    WriteGlb(tmp / "model.glb", model, glb_atlases);
+    manifest_["gltf_frame"] = GltfFrameJson(model);
+    manifest_["atlases"] = nlohmann::json::array();
+    mtl_ << "# texlume: albedo and normal map from the PTM atlases (model.glb carries them too)\n";
+  }
+
+  // Per atlas: its pictures, the PTM and EXR, its manifest entry, MTL material and GLB data.
+  void WriteAtlases() {
+    for (std::size_t a = 0; a < model_.atlases.size(); ++a) WriteAtlas(a);
+  }
+
+  // model.mtl, model.obj and model.glb.
+  void WriteMeshes() {
+    const std::string mtl = mtl_.str();
+    WriteFileAtomically(
+        tmp_ / "model.mtl", [&](std::ostream& o) { o << mtl; }, false);
+    WriteObj(tmp_ / "model.obj", model_);
+    WriteGlb(tmp_ / "model.glb", model_, glb_atlases_);
+  }
+
+  // The manifest, listing every file in the folder; last, so that a folder with a
+  // manifest is a finished model.
+  void WriteManifest() {
     nlohmann::json files = nlohmann::json::array();
-    for (const auto& [name, image] : extra_images) {
-      WriteBytesAtomically(tmp / name, EncodePng(image, name));
-    }
-    if (write_more) write_more(tmp);
-    for (const auto& entry : fs::recursive_directory_iterator(tmp))
-      if (entry.is_regular_file()) files.push_back(entry.path().lexically_relative(tmp).string());
+    for (const auto& entry : fs::recursive_directory_iterator(tmp_))
+      if (entry.is_regular_file()) files.push_back(entry.path().lexically_relative(tmp_).string());
     files.push_back("manifest.json");
     std::sort(files.begin(), files.end());
-    manifest["files"] = files;
-    // The manifest last: a folder with a manifest is a finished model.
+    manifest_["files"] = files;
     WriteFileAtomically(
-        tmp / "manifest.json", [&](std::ostream& o) { o << manifest.dump(2) << "\n"; }, false);
+        tmp_ / "manifest.json", [&](std::ostream& o) { o << manifest_.dump(2) << "\n"; }, false);
+  }
+
+ private:
+  void WriteAtlas(std::size_t a) {
+    const ptm::Ptm& atlas = model_.atlases[a];
+    const std::string k = std::to_string(a);
+    const std::string base = "base_colour_" + k + ".png", albedo = "albedo_" + k + ".png";
+    const std::string normal = "normal_" + k + ".png";
+    const std::string ptm_file = "ptm_atlas_" + k + ".ptm", exr_file = "ptm_atlas_" + k + ".exr";
+    GlbAtlas& glb = glb_atlases_.emplace_back();
+    WriteBytesAtomically(tmp_ / base, EncodePng(BaseColourImage(atlas), base));
+    glb.albedo_png = EncodePng(AlbedoImage(atlas), albedo);
+    WriteBytesAtomically(tmp_ / albedo, glb.albedo_png);
+    glb.normal_png = EncodePng(NormalMapImage(atlas), normal);
+    WriteBytesAtomically(tmp_ / normal, glb.normal_png);
+    ptm::WritePtmFile(atlas, tmp_ / ptm_file);
+    ptm::WritePtmExr(atlas, tmp_ / exr_file);
+    const std::string format = atlas.format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB";
+    manifest_["atlases"].push_back({{"ptm", ptm_file},
+                                    {"exr", exr_file},
+                                    {"base_colour", base},
+                                    {"albedo", albedo},
+                                    {"normal", normal},
+                                    {"width", atlas.width},
+                                    {"height", atlas.height},
+                                    {"format", format}});
+    const nlohmann::json ptm_fields = {
+        {"format", format},
+        {"frame", manifest_["ptm_frame"]},
+        {"evaluation", manifest_["ptm_evaluation"]},
+        {"texcoord", "TEXCOORD_0 (glTF v down; the PTM's y axis points to -v)"}};
+    glb.extras = {{"texlume_ptm", ptm_fields}};
+    glb.extras["texlume_ptm"]["ptm"] = ptm_file;
+    glb.extras["texlume_ptm"]["exr"] = exr_file;
+    const ptm::WebPlanes web = ptm::QuantiseWebPlanes(atlas);
+    for (const cv::Mat& plane : web.images)
+      glb.ptm_plane_pngs.push_back(EncodePng(plane, "a PTM plane of " + ptm_file));
+    glb.ptm_fields = ptm_fields;
+    glb.ptm_fields.update(web.Info());
+    glb.ptm_fields["plane_order"] =
+        "relight's web format: value = (byte / 255 - bias) * scale per plane; planes "
+        "(1, u, v, u^2, uv, v^2), after R, G, B for LRGB, per channel for RGB";
+    // The albedo under the relief: norm (MTL's PBR extension) and map_Bump (which
+    // Blender reads as a normal map) give the normal map.
+    mtl_ << "newmtl atlas_" << k << "\nKa 0 0 0\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd " << albedo
+         << "\nnorm " << normal << "\nmap_Bump " << normal << "\n# head-on base colour: " << base
+         << "; PTM: " << ptm_file << " (lossless " << exr_file << ")\n\n";
+  }
+
+  const TexturedModel& model_;
+  const fs::path& tmp_;
+  nlohmann::json manifest_;
+  std::ostringstream mtl_;
+  std::vector<GlbAtlas> glb_atlases_;
+};
+
+}  // namespace
+
+void WriteModelFolder(const fs::path& dir, const TexturedModel& model, const nlohmann::json& record,
+                      const std::vector<std::pair<std::string, cv::Mat>>& extra_images,
+                      const std::function<void(const fs::path&)>& write_more) {
+  RequireReplaceableFolder(dir, "manifest.json", "a texlume model folder");
+  PartialOutput output(dir, PartialOutput::Kind::kFolder);
+  {
+    ModelFolderWriter writer(model, output.path(), record);
+    writer.WriteAtlases();
+    writer.WriteMeshes();
+    for (const auto& [name, image] : extra_images)
+      WriteBytesAtomically(output.path() / name, EncodePng(image, name));
+    if (write_more) write_more(output.path());
+    writer.WriteManifest();
   }
   output.Commit();
 }
@@ -275,6 +311,32 @@ Eigen::Matrix3d AtlasFaceFrame(const TexturedModel& model, std::size_t f) {
   frame.col(1) = n.cross(x);
   frame.col(2) = n;
   return frame;
+}
+
+void ForEachCornerByAtlas(const TexturedModel& model,
+                          const std::function<void(const ModelCorner&)>& visit) {
+  std::vector<std::size_t> order(model.mesh.faces.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return model.face_atlas[a] < model.face_atlas[b];
+  });
+  const std::vector<Eigen::Vector3d> vertex_normals = mesh::VertexNormals(model.mesh);
+  ModelCorner corner;
+  for (const std::size_t f : order) {
+    corner.face = f;
+    corner.atlas = model.face_atlas[f];
+    corner.frame = AtlasFaceFrame(model, f);
+    const ptm::Ptm& atlas = model.atlases[static_cast<std::size_t>(corner.atlas)];
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto v = static_cast<std::size_t>(model.mesh.faces[f][k]);
+      corner.position = model.mesh.vertices[v];
+      corner.smooth_normal = vertex_normals[v];
+      const Eigen::Vector2f& px = model.corner_px[f][k];
+      corner.uv_down = Eigen::Vector2f(px.x() / static_cast<float>(atlas.width),
+                                       px.y() / static_cast<float>(atlas.height));
+      visit(corner);
+    }
+  }
 }
 
 nlohmann::json LightResponseJson(const ptm::LightResponse& response) {

@@ -74,6 +74,23 @@ std::string ManifestFileName(const nlohmann::json& value, const std::filesystem:
 /// coordinates).
 Eigen::Matrix3d AtlasFaceFrame(const TexturedModel& model, std::size_t f);
 
+/// One face corner as the exporters write it (every corner on its own: charts meet at
+/// seams).
+struct ModelCorner {
+  std::size_t face = 0;
+  int atlas = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();        ///< model frame
+  Eigen::Vector3d smooth_normal = Eigen::Vector3d::UnitZ();  ///< mesh::VertexNormals
+  Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();       ///< AtlasFaceFrame of the face
+  /// Texture coordinates in [0, 1] of the face's atlas: x right, y down (the atlas's first
+  /// row at 0, as glTF has them; v up is 1 - y).
+  Eigen::Vector2f uv_down = Eigen::Vector2f::Zero();
+};
+/// Visits every face corner, the faces in order of their atlas (by face index within
+/// one), a face's three corners in turn.
+void ForEachCornerByAtlas(const TexturedModel& model,
+                          const std::function<void(const ModelCorner&)>& visit);
+
 /// Reads a model folder written by WriteModelFolder (its manifest, OBJ and EXR
 /// atlases). Throws InputError naming the file on anything malformed.
 TexturedModel ReadModelFolder(const std::filesystem::path& dir);

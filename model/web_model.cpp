@@ -135,15 +135,8 @@ WebModel BuildWebModel(const fs::path& model_dir) {
   scene["charts"] = chart.empty() ? 0 : *std::max_element(chart.begin(), chart.end()) + 1;
 
   // Geometry: per face corner, faces grouped by atlas.
-  const std::size_t num_faces = model.mesh.faces.size();
-  std::vector<std::size_t> order(num_faces);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return model.face_atlas[a] < model.face_atlas[b];
-  });
-  const std::size_t n = num_faces * 3;
+  const std::size_t n = model.mesh.faces.size() * 3;
   std::vector<float> position, normal, face_normal, tangent, uv, face_id, chart_id;
-  const std::vector<Eigen::Vector3d> vertex_normals = mesh::VertexNormals(model.mesh);
   position.reserve(n * 3);
   normal.reserve(n * 3);
   face_normal.reserve(n * 3);
@@ -154,34 +147,24 @@ WebModel BuildWebModel(const fs::path& model_dir) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), hi = -lo;
   for (const Eigen::Vector3d& v : model.mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
   nlohmann::json ranges = nlohmann::json::array();
-  for (std::size_t i = 0; i < num_faces; ++i) {
-    const std::size_t f = order[i];
-    const int atlas = model.face_atlas[f];
-    if (ranges.empty() || ranges.back()["atlas"].get<int>() != atlas)
-      ranges.push_back({{"atlas", atlas}, {"first_vertex", i * 3}, {"vertices", 0}});
-    ranges.back()["vertices"] = ranges.back()["vertices"].get<std::size_t>() + 3;
-    const Eigen::Matrix3d frame = AtlasFaceFrame(model, f);
-    const Eigen::Vector3d x_axis = frame.col(0), nrm = frame.col(2);
-    const auto& c = model.corner_px[f];
-    const ptm::Ptm& atlas_ptm = model.atlases[static_cast<std::size_t>(atlas)];
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d p = model.mesh.Corner(f, k);
-      const Eigen::Vector3d& smooth = vertex_normals[static_cast<std::size_t>(
-          model.mesh.faces[f][static_cast<std::size_t>(k)])];
-      for (int d = 0; d < 3; ++d) {
-        position.push_back(static_cast<float>(p[d]));
-        normal.push_back(static_cast<float>(smooth[d]));
-        face_normal.push_back(static_cast<float>(nrm[d]));
-        tangent.push_back(static_cast<float>(x_axis[d]));
-      }
-      // Texture coordinates in [0, 1], v up (the image's first row at v = 1).
-      uv.push_back(c[static_cast<std::size_t>(k)].x() / static_cast<float>(atlas_ptm.width));
-      uv.push_back(1.0f -
-                   c[static_cast<std::size_t>(k)].y() / static_cast<float>(atlas_ptm.height));
-      face_id.push_back(static_cast<float>(f));
-      chart_id.push_back(static_cast<float>(chart[f]));
+  std::size_t corners = 0;
+  ForEachCornerByAtlas(model, [&](const ModelCorner& c) {
+    if (ranges.empty() || ranges.back()["atlas"].get<int>() != c.atlas)
+      ranges.push_back({{"atlas", c.atlas}, {"first_vertex", corners}, {"vertices", 0}});
+    ranges.back()["vertices"] = ranges.back()["vertices"].get<std::size_t>() + 1;
+    ++corners;
+    for (int d = 0; d < 3; ++d) {
+      position.push_back(static_cast<float>(c.position[d]));
+      normal.push_back(static_cast<float>(c.smooth_normal[d]));
+      face_normal.push_back(static_cast<float>(c.frame(d, 2)));
+      tangent.push_back(static_cast<float>(c.frame(d, 0)));
     }
-  }
+    // Texture coordinates in [0, 1], v up (the image's first row at v = 1).
+    uv.push_back(c.uv_down.x());
+    uv.push_back(1.0f - c.uv_down.y());
+    face_id.push_back(static_cast<float>(c.face));
+    chart_id.push_back(static_cast<float>(chart[c.face]));
+  });
   std::vector<unsigned char> geometry;
   nlohmann::json attributes;
   auto append = [&](const char* name, const std::vector<float>& values, int components) {

@@ -204,10 +204,21 @@ void FitOptions::Check() const {
 
 void CheckLightSet(const std::vector<Eigen::Vector3d>& lights, const FitOptions& options,
                    const std::string& label) {
-  if (static_cast<int>(lights.size()) < options.min_lights) {
-    throw InputError(label, std::to_string(lights.size()) +
-                                " usable lights; a PTM needs at least " +
-                                std::to_string(options.min_lights));
+  CheckLightsForBasis(lights, LightMatrix(lights), static_cast<std::size_t>(options.min_lights),
+                      options.max_condition_number, "a PTM", label);
+}
+
+void CheckLightsForBasis(const std::vector<Eigen::Vector3d>& lights,
+                         const Eigen::MatrixXd& basis_rows, std::size_t min_lights,
+                         double max_condition_number, const std::string& basis,
+                         const std::string& label) {
+  TEXLUME_CHECK(basis_rows.rows() == static_cast<Eigen::Index>(lights.size()) &&
+                    basis_rows.cols() >= 1 &&
+                    min_lights >= static_cast<std::size_t>(basis_rows.cols()),
+                "a row of the basis per light, at least as many lights as terms");
+  if (lights.size() < min_lights) {
+    throw InputError(label, std::to_string(lights.size()) + " usable lights; " + basis +
+                                " needs at least " + std::to_string(min_lights));
   }
   for (std::size_t k = 0; k < lights.size(); ++k) {
     if (!lights[k].allFinite() || std::abs(lights[k].norm() - 1.0) > 1e-6) {
@@ -218,12 +229,13 @@ void CheckLightSet(const std::vector<Eigen::Vector3d>& lights, const FitOptions&
                        "light " + std::to_string(k) + " is at or below the horizon (z <= 0)");
     }
   }
-  const MatrixX6 a = LightMatrix(lights);
-  const Eigen::JacobiSVD<MatrixX6> svd(a);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(basis_rows);
   const auto s = svd.singularValues();
-  const double condition = s(5) > 0 ? (s(0) / s(5)) * (s(0) / s(5)) : INFINITY;
-  if (!(condition <= options.max_condition_number)) {
-    throw InputError(label, "degenerate light set: the normal equations are singular (condition " +
+  const Eigen::Index last = s.size() - 1;
+  const double condition = s(last) > 0 ? (s(0) / s(last)) * (s(0) / s(last)) : INFINITY;
+  if (!(condition <= max_condition_number)) {
+    throw InputError(label, "degenerate light set for " + basis +
+                                ": the normal equations are singular (condition " +
                                 std::to_string(condition) +
                                 "); spread the lights over the dome in azimuth and elevation");
   }

@@ -98,6 +98,16 @@ RtiCapture ReadRtiCapture(const std::filesystem::path& lp_path,
 void CheckLightSet(const std::vector<Eigen::Vector3d>& lights, const FitOptions& options,
                    const std::string& label);
 
+/// The same for any basis of the hemisphere (PTM, HSH): `basis_rows` holds the basis at
+/// each light (a row per light). At least `min_lights` lights, each a unit vector above
+/// the horizon, and the normal equations' condition number (the rows' squared) at most
+/// `max_condition_number`. `basis` names it in the messages ("a PTM", "an order-3 HSH").
+/// Throws InputError(label, ...).
+void CheckLightsForBasis(const std::vector<Eigen::Vector3d>& lights,
+                         const Eigen::MatrixXd& basis_rows, std::size_t min_lights,
+                         double max_condition_number, const std::string& basis,
+                         const std::string& label);
+
 /// Ceres residual of one sample, r = b(l) . a - I (paper 003 eq. 1), exposed for
 /// the gradient check in the tests.
 struct PtmSampleResidual {

@@ -9,7 +9,9 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/timing.h"
+#include "ptm/fit.h"
 #include "ptm/image_bands.h"
+#include "ptm/light_response.h"
 #include "ptm/ptm.h"
 #include "ptm/ptm_io.h"
 
@@ -31,27 +33,6 @@ BasisMatrix BasisRows(const std::vector<Eigen::Vector3d>& lights, int terms) {
       a(static_cast<Eigen::Index>(k), j) = b[static_cast<std::size_t>(j)];
   }
   return a;
-}
-
-void CheckHshLightSet(const std::vector<Eigen::Vector3d>& lights, int terms,
-                      const std::string& label) {
-  if (static_cast<int>(lights.size()) < terms)
-    throw InputError(label, "an order-" +
-                                std::to_string(static_cast<int>(std::lround(std::sqrt(terms)))) +
-                                " HSH has " + std::to_string(terms) +
-                                " terms and needs at least as many lights; the capture has " +
-                                std::to_string(lights.size()));
-  for (std::size_t k = 0; k < lights.size(); ++k)
-    if (!(lights[k].z() > 0.0))
-      throw InputError(label, "light " + std::to_string(k) + " is at or below the horizon");
-  const Eigen::JacobiSVD<BasisMatrix> svd(BasisRows(lights, terms));
-  const auto s = svd.singularValues();
-  const double condition =
-      s(terms - 1) > 0 ? (s(0) / s(terms - 1)) * (s(0) / s(terms - 1)) : INFINITY;
-  if (!(condition <= kMaxConditionNumber))
-    throw InputError(label, "degenerate light set for the HSH basis (condition " +
-                                std::to_string(condition) +
-                                "); spread the lights over the dome in azimuth and elevation");
 }
 
 // Per term, over texels and channels: value = byte / 255 * scale + bias (the .rti convention).
@@ -106,9 +87,10 @@ HshFitResult FitHshFromFiles(const std::vector<std::filesystem::path>& files,
   if (band_rows < 1) throw OptionError("band rows must be at least 1");
   const std::string label = files.empty() ? "images" : files[0].parent_path().string();
   const int terms = HshTerms(order);
-  CheckHshLightSet(lights, terms, label);
   // c = (A^T A)^-1 A^T y for every texel and channel: one solve matrix for all.
   const BasisMatrix a = BasisRows(lights, terms);
+  CheckLightsForBasis(lights, a, static_cast<std::size_t>(terms), kMaxConditionNumber,
+                      "an order-" + std::to_string(order) + " HSH", label);
   const Eigen::MatrixXd solve = (a.transpose() * a).ldlt().solve(a.transpose());
   ImageBands bands(files);
   HshFitResult result;
@@ -148,23 +130,16 @@ HshFitResult FitHshFromFiles(const std::vector<std::filesystem::path>& files,
 }
 
 std::vector<float> RelightHsh(const Hsh& hsh, const Eigen::Vector3d& light) {
-  // The PTM's evaluation horizon: below it, the value at it faded to 0 at the horizon.
-  const double horizon_z = std::sin(kHorizonElevationDeg * kPi / 180.0);
-  Eigen::Vector3d l = light.normalized();
-  double fade = 1.0;
-  if (l.z() < horizon_z) {
-    fade = std::max(0.0, l.z()) / horizon_z;
-    const double r = std::max(l.head<2>().norm(), 1e-12);
-    l = Eigen::Vector3d(l.x() * std::sqrt(1 - horizon_z * horizon_z) / r,
-                        l.y() * std::sqrt(1 - horizon_z * horizon_z) / r, horizon_z);
-  }
-  const std::array<double, 9> b = HshBasis(l);
+  // As texlume evaluates a PTM: below the horizon elevation, the value there fading to 0.
+  const EffectiveLight effective = Effective(light.normalized(), 1.0, LightResponse{});
+  const std::array<double, 9> b = HshBasis(effective.direction);
   std::vector<float> out(hsh.NumTexels() * 3);
   for (std::size_t t = 0; t < hsh.NumTexels(); ++t) {
     for (int c = 0; c < 3; ++c) {
       double v = 0;
       for (int j = 0; j < hsh.Terms(); ++j) v += b[static_cast<std::size_t>(j)] * hsh.At(t, c)[j];
-      out[t * 3 + static_cast<std::size_t>(c)] = static_cast<float>(std::clamp(v * fade, 0.0, 1.0));
+      out[t * 3 + static_cast<std::size_t>(c)] =
+          static_cast<float>(std::clamp(v * effective.weight, 0.0, 1.0));
     }
   }
   return out;
@@ -197,7 +172,6 @@ void WriteRtiFile(const Hsh& hsh, const std::filesystem::path& path) {
 }
 
 int WriteHshRelightWeb(const Hsh& hsh, const std::filesystem::path& dir, int jpeg_quality) {
-  std::filesystem::create_directories(dir);
   std::vector<std::vector<float>> planes;  // plane 3j + c: term j of channel c
   for (int j = 0; j < hsh.Terms(); ++j) {
     for (int c = 0; c < 3; ++c) {
@@ -205,20 +179,9 @@ int WriteHshRelightWeb(const Hsh& hsh, const std::filesystem::path& dir, int jpe
       for (std::size_t t = 0; t < hsh.NumTexels(); ++t) p[t] = hsh.At(t, c)[j];
     }
   }
-  const WebPlanes web = QuantisePlanes(planes, hsh.width, hsh.height);
-  const nlohmann::json info = {
-      {"width", hsh.width},
-      {"height", hsh.height},
-      {"format", "jpg"},
-      {"quality", jpeg_quality},
-      {"type", "hsh"},
-      {"colorspace", "rgb"},
-      {"nplanes", planes.size()},
-      {"materials", nlohmann::json::array({{{"scale", web.scales}, {"bias", web.biases}}})}};
-  WriteWebPlaneJpegs(web, dir, jpeg_quality);
-  WriteFileAtomically(
-      dir / "info.json", [&](std::ostream& out) { out << info.dump(2) << "\n"; }, false);
-  return static_cast<int>(web.images.size()) + 1;
+  WebPlanes web = QuantisePlanes(planes, hsh.width, hsh.height);
+  web.type = "hsh";
+  return WriteWebPlanes(web, dir, jpeg_quality);
 }
 
 }  // namespace texlume::ptm

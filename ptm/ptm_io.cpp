@@ -509,6 +509,8 @@ Ptm ReadPtmExrBytes(std::string_view bytes, const std::string& label) {
 
 WebPlanes QuantisePlanes(const std::vector<std::vector<float>>& planes, int width, int height) {
   WebPlanes web;
+  web.width = width;
+  web.height = height;
   for (const auto& p : planes) {
     const auto [lo_it, hi_it] = std::minmax_element(p.begin(), p.end());
     const float lo = *lo_it, hi = *hi_it;
@@ -549,10 +551,13 @@ WebPlanes QuantiseWebPlanes(const Ptm& ptm) {
       for (int c = 0; c < 3; ++c)
         add_plane([&](std::size_t t) { return ptm.Coefficients(t, c)[i]; });
   }
-  return QuantisePlanes(planes, ptm.width, ptm.height);
+  WebPlanes web = QuantisePlanes(planes, ptm.width, ptm.height);
+  web.colorspace = ptm.format == PtmFormat::kLrgb ? "lrgb" : "rgb";
+  return web;
 }
 
-void WriteWebPlaneJpegs(const WebPlanes& web, const std::filesystem::path& dir, int jpeg_quality) {
+int WriteWebPlanes(const WebPlanes& web, const std::filesystem::path& dir, int jpeg_quality) {
+  std::filesystem::create_directories(dir);
   for (std::size_t j = 0; j < web.images.size(); ++j) {
     std::vector<unsigned char> bytes;
     cv::imencode(".jpg", web.images[j], bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
@@ -564,31 +569,28 @@ void WriteWebPlaneJpegs(const WebPlanes& web, const std::filesystem::path& dir, 
         },
         true);
   }
+  nlohmann::json info = web.Info();
+  info["format"] = "jpg";
+  info["quality"] = jpeg_quality;
+  WriteFileAtomically(
+      dir / "info.json", [&](std::ostream& out) { out << info.dump(2) << "\n"; }, false);
+  return static_cast<int>(web.images.size()) + 1;
 }
 
-nlohmann::json WebPlanes::Info(const Ptm& ptm) const {
-  return {{"width", ptm.width},
-          {"height", ptm.height},
-          {"type", "ptm"},
-          {"colorspace", ptm.format == PtmFormat::kLrgb ? "lrgb" : "rgb"},
+nlohmann::json WebPlanes::Info() const {
+  return {{"width", width},
+          {"height", height},
+          {"type", type},
+          {"colorspace", colorspace},
           {"nplanes", scales.size()},
           {"materials", nlohmann::json::array({{{"scale", scales}, {"bias", biases}}})}};
 }
 
 int WriteRelightWeb(const Ptm& ptm, const std::filesystem::path& dir, int jpeg_quality) {
-  std::filesystem::create_directories(dir);
   // Always RGB: OpenLIME (1.2.6 and before) draws an "lrgb" PTM with its luminance as
   // the pixel's alpha (LRGB.render returns l * vec4(basecolor, 1)), so every texel whose
   // luminance is under 1 comes out partly transparent and dark (docs/ptm_format.md).
-  const Ptm rgb = AsRgb(ptm);
-  const WebPlanes web = QuantiseWebPlanes(rgb);
-  nlohmann::json info = web.Info(rgb);
-  info["format"] = "jpg";
-  info["quality"] = jpeg_quality;
-  WriteWebPlaneJpegs(web, dir, jpeg_quality);
-  WriteFileAtomically(
-      dir / "info.json", [&](std::ostream& out) { out << info.dump(2) << "\n"; }, false);
-  return static_cast<int>(web.images.size()) + 1;
+  return WriteWebPlanes(QuantiseWebPlanes(AsRgb(ptm)), dir, jpeg_quality);
 }
 
 Ptm ReadPtmAnyFormat(const std::filesystem::path& path) {

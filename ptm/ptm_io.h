@@ -43,17 +43,22 @@ Ptm ReadPtmAnyFormat(const std::filesystem::path& path);
 /// RGB), three planes per 8-bit image, each plane quantised over its range:
 /// value = (byte / 255 - bias) * scale.
 struct WebPlanes {
-  std::vector<cv::Mat> images;  ///< 8-bit BGR, plane 3j + c in channel c of image j
+  int width = 0, height = 0;
+  std::string type = "ptm";        ///< "ptm" or "hsh"
+  std::string colorspace = "rgb";  ///< "rgb" or "lrgb"
+  std::vector<cv::Mat> images;     ///< 8-bit BGR, plane 3j + c in channel c of image j
   std::vector<float> scales, biases;
   /// info.json's fields: width, height, type, colorspace, nplanes, materials.
-  nlohmann::json Info(const Ptm& ptm) const;
+  nlohmann::json Info() const;
 };
 WebPlanes QuantiseWebPlanes(const Ptm& ptm);
 /// Planes of width x height values (row-major) quantised and packed three to an image
-/// as QuantiseWebPlanes does; the last image's unused channels are 0.
+/// as QuantiseWebPlanes does; the last image's unused channels are 0. Type "ptm", RGB.
 WebPlanes QuantisePlanes(const std::vector<std::vector<float>>& planes, int width, int height);
-/// Writes `web.images` into `dir` as `plane_N.jpg`, each atomically.
-void WriteWebPlaneJpegs(const WebPlanes& web, const std::filesystem::path& dir, int jpeg_quality);
+/// Writes `web` into `dir` (created) as relight's web format: `plane_N.jpg` and
+/// `info.json` (Info, with format "jpg" and the quality), each atomically. Returns the
+/// number of files written.
+int WriteWebPlanes(const WebPlanes& web, const std::filesystem::path& dir, int jpeg_quality);
 
 /// Writes the relight / OpenLIME web format into `dir`: `info.json` (type "ptm",
 /// colorspace "rgb", nplanes, per-plane scale and bias) and the coefficient planes as

@@ -55,8 +55,10 @@ else
   echo "install_deps: web packages already installed"
 fi
 # The viewer's page loads one bundle: web/viewer/viewer.js with the parts of
-# three.js it uses, minified by esbuild (web/dist/viewer.js).
-if [ ! -f "$web/dist/viewer.js" ] || [ "$web/viewer/viewer.js" -nt "$web/dist/viewer.js" ] ||
+# three.js it uses (and web/viewer/colmap_camera.js), minified by esbuild
+# (web/dist/viewer.js), rebuilt when a file of web/viewer is newer.
+if [ ! -f "$web/dist/viewer.js" ] ||
+   [ -n "$(find "$web/viewer" -name '*.js' -newer "$web/dist/viewer.js")" ] ||
    [ "$web/package-lock.json" -nt "$web/dist/viewer.js" ]; then
   echo "install_deps: npm run build in $web"
   (cd "$web" && npm run build --silent)

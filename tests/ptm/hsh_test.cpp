@@ -100,7 +100,7 @@ TEST(HshFit, TooFewOrDegenerateLightsAndBadOrdersAreRefused) {
   const std::vector<Eigen::Vector3d> few_lights(k.lights.begin(), k.lights.begin() + 8);
   EXPECT_NE(testing::InputErrorMessage([&] {
               FitHshFromFiles(few, few_lights, 3, 8);
-            }).find("at least as many lights"),
+            }).find("8 usable lights; an order-3 HSH needs at least 9"),
             std::string::npos);
   std::vector<Eigen::Vector3d> ring(k.lights.size(), Eigen::Vector3d::Zero());
   for (std::size_t n = 0; n < ring.size(); ++n) {  // one elevation: theta-only terms are confounded

@@ -6,6 +6,7 @@
 // flipGreen reads the normal map's green the other way (DirectX's convention).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { colmapProjection, worldFromColmapCamera } from '../viewer/colmap_camera.js';
 
 const canvas = document.getElementById('view');
 const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true });
@@ -32,23 +33,13 @@ window.drawGlb = async (url, c, lightInModel, { normalMap = true, flipGreen = fa
   const light = new THREE.DirectionalLight(0xffffff, Math.PI);
   light.position.copy(new THREE.Vector3(...lightInModel).transformDirection(gltfFromModel));
   scene.add(light);
-  // COLMAP's camera (looking along +z, y down) in glTF's frame.
-  const camFromModel = new THREE.Quaternion(c.qvec[1], c.qvec[2], c.qvec[3], c.qvec[0]).normalize();
-  const modelFromCam = new THREE.Matrix4().makeRotationFromQuaternion(camFromModel.clone().invert());
-  const centre = new THREE.Vector3(...c.tvec).applyQuaternion(camFromModel.clone().invert()).multiplyScalar(-1);
-  modelFromCam.setPosition(centre);
-  const flip = new THREE.Matrix4().makeRotationX(Math.PI);
+  // COLMAP's camera in the model's frame, moved into glTF's frame.
   const camera = new THREE.PerspectiveCamera();
   camera.matrixAutoUpdate = false;
-  camera.matrix.copy(gltfFromModel).multiply(modelFromCam).multiply(flip);
+  camera.matrix.copy(gltfFromModel).multiply(worldFromColmapCamera(c));
   camera.matrixWorld.copy(camera.matrix);
   camera.matrixWorldInverse.copy(camera.matrix).invert();
-  const n = 0.01, f = 100;
-  camera.projectionMatrix.set(
-      2 * c.fx / c.width, 0, 1 - 2 * c.cx / c.width, 0,
-      0, 2 * c.fy / c.height, 2 * c.cy / c.height - 1, 0,
-      0, 0, -(f + n) / (f - n), -2 * f * n / (f - n),
-      0, 0, -1, 0);
+  camera.projectionMatrix.copy(colmapProjection(c, 0.01, 100));
   camera.projectionMatrixInverse.copy(camera.projectionMatrix).invert();
   renderer.setSize(c.width, c.height, false);
   renderer.render(scene, camera);

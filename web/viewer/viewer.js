@@ -3,6 +3,7 @@
 // /model/geometry.bin and the PTM of every atlas as 8-bit RGBA PNGs.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { colmapProjection, worldFromColmapCamera } from './colmap_camera.js';
 
 const statusEl = document.getElementById('status');
 let canvas = document.getElementById('view');  // replaced by makeRenderer on a GPU
@@ -347,17 +348,9 @@ async function main() {
   // unit light direction in the world. COLMAP's camera looks along +z with y down;
   // three.js's along -z with y up.
   const setView = (c, lightWorld) => {
-    const camFromWorld = new THREE.Quaternion(c.qvec[1], c.qvec[2], c.qvec[3], c.qvec[0]).normalize();
-    const worldFromCam = camFromWorld.clone().invert();
-    camera.position.set(...c.tvec).applyQuaternion(worldFromCam).multiplyScalar(-1);
-    camera.quaternion.copy(worldFromCam).multiply(new THREE.Quaternion(1, 0, 0, 0));  // turn about x by 180 degrees
+    worldFromColmapCamera(c).decompose(camera.position, camera.quaternion, camera.scale);
     camera.updateMatrixWorld();
-    const n = camera.near, f = camera.far;
-    const projection = new THREE.Matrix4().set(
-        2 * c.fx / c.width, 0, 1 - 2 * c.cx / c.width, 0,
-        0, 2 * c.fy / c.height, 2 * c.cy / c.height - 1, 0,
-        0, 0, -(f + n) / (f - n), -2 * f * n / (f - n),
-        0, 0, -1, 0);
+    const projection = colmapProjection(c, camera.near, camera.far);
     colmapView = { projection, lightWorld: new THREE.Vector3(...lightWorld).normalize() };
     render();
   };
