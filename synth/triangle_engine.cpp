@@ -92,6 +92,7 @@ TriangleEngine::TriangleEngine(const mesh::TriangleMesh& mesh,
       options_(options),
       correction_(correction) {
   for (std::size_t n = 0; n < photos.size(); ++n) photo_index_[photos[n].image_id] = n;
+  vertex_normals_ = mesh::VertexNormals(mesh);
 }
 
 TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
@@ -343,17 +344,49 @@ PhotometricObservation TriangleEngine::Observe(std::size_t face, const Rectified
   o.steep = rect.steep;
   o.photo_channels = PhotoLinearSums(rect, sample_.Domain());
   o.photo_linear = o.photo_channels[0] + o.photo_channels[1] + o.photo_channels[2];
-  const auto relit_under = [&](const Eigen::Vector3d& l, double intensity) {
-    return sample_.RelitLinearSum(FaceLighting{rect.lighting.view_in_frame, {{l, intensity}}, {}},
-                                  rect.count);
+  const auto relit_under = [&](const Eigen::Vector3d& view, const Eigen::Vector3d& l,
+                               double intensity) {
+    return sample_.RelitLinearSum(FaceLighting{view, {{l, intensity}}, {}}, rect.count);
   };
-  for (const auto& [l, intensity] : rect.lighting.lights)
-    if (l.z() > 0.0)
-      o.lights.emplace_back(std::asin(std::min(1.0, l.z())) * 180.0 / std::numbers::pi,
-                            relit_under(l, intensity));
-  o.zenith_linear = zenith_per_cell >= 0.0 ? zenith_per_cell * rect.count
-                                           : relit_under(Eigen::Vector3d::UnitZ(), 1.0);
+  // Each light as the renderer shades it: per pixel, in the frame turned onto the smooth
+  // normal, so that near the terminator part of a face is lit and part is not. Each of
+  // the shading points stands for an equal share of the face's cells.
+  for (const Eigen::Quaterniond& turn : ShadingTurns(face)) {
+    const Eigen::Vector3d view = turn * rect.lighting.view_in_frame;
+    for (const auto& [light, intensity] : rect.lighting.lights) {
+      const Eigen::Vector3d l = turn * light;
+      if (l.z() > 0.0)
+        o.lights.emplace_back(std::asin(std::min(1.0, l.z())) * 180.0 / std::numbers::pi,
+                              relit_under(view, l, intensity) / kShadingPoints);
+    }
+  }
+  o.zenith_linear = zenith_per_cell >= 0.0
+                        ? zenith_per_cell * rect.count
+                        : relit_under(rect.lighting.view_in_frame, Eigen::Vector3d::UnitZ(), 1.0);
   return o;
+}
+
+std::array<Eigen::Quaterniond, TriangleEngine::kShadingPoints> TriangleEngine::ShadingTurns(
+    std::size_t face) const {
+  // Points at barycentric (2/3, 1/6, 1/6) and its permutations.
+  const mesh::TriangleFrame& frame = result_.patches[face].frame;
+  std::array<Eigen::Quaterniond, kShadingPoints> turns;
+  for (int i = 0; i < kShadingPoints; ++i) {
+    Eigen::Vector3d normal_in_world = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const double weight = k == i ? 2.0 / 3.0 : 1.0 / 6.0;
+      normal_in_world +=
+          weight *
+          vertex_normals_[static_cast<std::size_t>(mesh_.faces[face][static_cast<std::size_t>(k)])];
+    }
+    const Eigen::Vector3d normal_in_frame = frame.DirectionInFrame(normal_in_world);
+    turns[static_cast<std::size_t>(i)] =
+        normal_in_frame.norm() > 1e-12
+            ? Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), normal_in_frame)
+                  .conjugate()
+            : Eigen::Quaterniond::Identity();
+  }
+  return turns;
 }
 
 double TriangleEngine::OverlapTargets::Error(const MaterialSample& sample, int width, int sx,

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <map>
@@ -179,6 +180,11 @@ class TriangleEngine {
   // view-independent sample's, computed once); < 0: computed for the view.
   PhotometricObservation Observe(std::size_t face, const RectifiedView& rect,
                                  double zenith_per_cell) const;
+  // The rotations from face `face`'s frame into the frames the renderer shades in at
+  // kShadingPoints points of the face: the frame turned by the smallest rotation onto
+  // the smooth normal there (render/model_render.h).
+  static constexpr int kShadingPoints = 3;
+  std::array<Eigen::Quaterniond, kShadingPoints> ShadingTurns(std::size_t face) const;
   // The sample relit under a rectified view's lighting, as luminance, over a
   // window of the view's grid size (the photo blur's comparison).
   cv::Mat SampleWindowLuminance(std::size_t face, const RectifiedView& rect) const;
@@ -211,6 +217,7 @@ class TriangleEngine {
   PhotoCorrection* correction_;
   std::map<sfm::ImageId, std::size_t> photo_index_;
   std::vector<char> done_;
+  std::vector<Eigen::Vector3d> vertex_normals_;  // mesh::VertexNormals, for ShadingTurns
   /// Cells the score reads beyond the triangle (world units): W_e / 2 for a
   /// blended sample (its blending zone, so that a blend mixes two
   /// photo-corrected patches), none for a sample that is cut.
