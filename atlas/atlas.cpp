@@ -6,6 +6,7 @@
 #include <cmath>
 #include <deque>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <unordered_map>
@@ -317,15 +318,19 @@ void AtlasLayouter::PackStrips() {
                               {StripSide::kTallest, 8.0 * band + 0.5, 0.5 * band}};
   RowPacking best;
   std::int64_t best_texels = 0;
-  // Every variant as it is and fitted to irregular faces (synth/charts.h).
+  // Every variant as it is and fitted to irregular faces (synth/charts.h), one
+  // progress bar over all of them.
+  const std::size_t passes = 2 * std::size(variants);
+  std::size_t pass = 0;
   for (const bool fit_irregular_faces : {false, true})
     for (const Variant& variant : variants) {
       so.side = variant.side;
       so.max_stack_texels = variant.max_stack_texels;
       so.max_stack_overhang_texels = variant.max_stack_overhang_texels;
       so.fit_irregular_faces = fit_irregular_faces;
-      RowPacking rows = PackStripsInRows(MakeStripCharts(mesh_, patches_, unfoldings_, so),
-                                         patches_, t_, gutter_, options_.atlas_size, progress_);
+      RowPacking rows =
+          PackStripsInRows(MakeStripCharts(mesh_, patches_, unfoldings_, so), patches_, t_, gutter_,
+                           options_.atlas_size, PartOfStage(progress_, pass++, passes));
       if (best.pieces.empty() || rows.texels < best_texels)
         best_texels = rows.texels, best = std::move(rows);
     }
@@ -352,7 +357,7 @@ void AtlasLayouter::PackByOutlines() {
   const auto count_placed = [&] {
     ++placed;
     if (progress_ && (placed % 8 == 0 || placed == to_place))
-      progress_("packing", placed, to_place);
+      progress_("packing outlines", placed, to_place);
   };
   for (const DropRule rule : {DropRule::kLowestBottom, DropRule::kLowestPosition}) {
     OutlinePacking packing = PackOutlines(outlines, order, options_.atlas_size, rule, count_placed);

@@ -264,7 +264,7 @@ RowPacking RowPacker::Run(const std::vector<std::vector<ChartFace>>& charts) {
     PackChart(order_[pick]);
     ++done_;
     if (progress_ && (done_ % 8 == 0 || done_ == order_.size()))
-      progress_("packing", done_, order_.size());
+      progress_("packing strips", done_, order_.size());
   }
   CountTexels();
   return std::move(out_);
