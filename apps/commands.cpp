@@ -8,7 +8,6 @@
 #include "apps/cli.h"
 #include "apps/progress_bar.h"
 #include "apps/view_command.h"
-#include "core/units.h"
 #include "pipeline/jobs.h"
 
 namespace texlume::apps {
@@ -225,10 +224,9 @@ void AddDemoCommand(CLI::App& app, CommandRunners& run) {
   sub->add_option("--height", o->image_height, "photo height in pixels")->capture_default_str();
   BindSensor(sub, o->sensor);
   auto world_unit = std::make_shared<std::string>();
-  sub->add_option("--world-unit", *world_unit,
-                  "how long one world unit is (1m, 10cm): the reports give millimetres");
+  BindWorldUnit(sub, *world_unit);
   run[sub] = [o, world_unit](std::ostream& out, std::ostream& err) {
-    if (!world_unit->empty()) o->mm_per_world_unit = ParseLengthMm(*world_unit, "--world-unit");
+    o->mm_per_world_unit = WorldUnitMm(*world_unit);
     ProgressBar bar;
     pipeline::RunDemoJob(*o, out, err, bar.Callback());
     return kExitOk;

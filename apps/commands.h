@@ -67,5 +67,10 @@ std::map<std::string, datasets::MaterialKind> MaterialWords();
 /// The scene photos' sensor options (--shot-noise, --read-noise, --vignetting,
 /// --white-balance-spread, --jpeg-quality), for `scene` and `demo`.
 void BindSensor(CLI::App* sub, datasets::SensorOptions& s);
+/// `--world-unit LENGTH` (synth, demo): its text, read by WorldUnitMm after parsing.
+void BindWorldUnit(CLI::App* sub, std::string& text);
+/// The length `--world-unit` gave, in millimetres (core/units.h ParseLengthMm); 0 when
+/// not given. Throws OptionError naming the option for anything but a length.
+double WorldUnitMm(const std::string& text);
 
 }  // namespace texlume::apps

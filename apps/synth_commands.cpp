@@ -36,9 +36,7 @@ void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords
       ->capture_default_str();
   sub->add_option("--sample-texel-size", j.synthesis.sample_texel_size,
                   "world units per sample texel (required with --sample; BTF: the capture's)");
-  sub->add_option("--world-unit", w.world_unit,
-                  "how long one world unit is (1m, 10cm, 25.4mm, 1in): the report gives "
-                  "millimetres");
+  BindWorldUnit(sub, w.world_unit);
   sub->add_option("--seam-band", o.seam_band,
                   "BTF graph-cut band half-width in texels [min(4, "
                   "strip)]");
@@ -153,7 +151,7 @@ void Resolve(const CLI::App* sub, const SynthWords& w, pipeline::SynthCommandOpt
   }
   o.job.atlas.blend_strip = s.strip;
   o.job.write_report = !w.no_report;
-  if (!w.world_unit.empty()) o.job.mm_per_world_unit = ParseLengthMm(w.world_unit, "--world-unit");
+  o.job.mm_per_world_unit = WorldUnitMm(w.world_unit);
 }
 
 }  // namespace
@@ -203,6 +201,16 @@ void AddRenderCommand(CLI::App& app, CommandRunners& run) {
     pipeline::RunRenderCommandJob(*o, baseline->count() > 0, out, err, bar.Callback());
     return 0;
   };
+}
+
+void BindWorldUnit(CLI::App* sub, std::string& text) {
+  sub->add_option("--world-unit", text,
+                  "how long one world unit is (1m, 10cm, 25.4mm, 1in): the reports give "
+                  "millimetres");
+}
+
+double WorldUnitMm(const std::string& text) {
+  return text.empty() ? 0.0 : ParseLengthMm(text, "--world-unit");
 }
 
 void BindSensor(CLI::App* sub, datasets::SensorOptions& s) {

@@ -1,7 +1,9 @@
 #include "core/units.h"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <utility>
@@ -9,33 +11,40 @@
 #include "core/errors.h"
 
 namespace texlume {
-namespace {
+namespace {}  // namespace
 
-std::string Significant3(double value) {
+std::string ThreeSignificantDigits(double value) {
+  if (!std::isfinite(value)) return "?";
+  if (value == 0.0) return "0";
+  const double scale = std::pow(10.0, 2.0 - std::floor(std::log10(std::abs(value))));
+  const double rounded = std::round(value * scale) / scale;
+  const int decimals = std::max(0, 2 - static_cast<int>(std::floor(std::log10(std::abs(rounded)))));
   char text[64];
-  std::snprintf(text, sizeof text, "%.3g", value);
-  return text;
+  std::snprintf(text, sizeof text, "%.*f", decimals, rounded);
+  std::string out = text;
+  if (out.find('.') != std::string::npos) {
+    while (out.back() == '0') out.pop_back();
+    if (out.back() == '.') out.pop_back();
+  }
+  return out;
 }
-
-}  // namespace
 
 double ParseLengthMm(const std::string& text, const std::string& option) {
   const auto refuse = [&] {
     throw OptionError(option + " '" + text +
                       "' is not a length (a number and a unit: um, mm, cm, m, in or ft, e.g. 1m)");
   };
-  std::size_t used = 0;
   double value = 1.0;
-  const bool starts_with_number =
-      !text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) || text[0] == '.');
-  if (starts_with_number) {
-    try {
-      value = std::stod(text, &used);
-    } catch (const std::exception&) {
-      refuse();
-    }
+  const char* first = text.data();
+  const char* last = text.data() + text.size();
+  const char* number_end = first;
+  if (!text.empty() && (std::isdigit(static_cast<unsigned char>(text[0])) || text[0] == '.')) {
+    const std::from_chars_result read = std::from_chars(
+        first, last, value, std::chars_format::fixed | std::chars_format::scientific);
+    if (read.ec != std::errc()) refuse();
+    number_end = read.ptr;
   }
-  std::string unit = text.substr(used);
+  std::string unit(number_end, last);
   while (!unit.empty() && unit.front() == ' ') unit.erase(0, 1);
   constexpr std::array<std::pair<const char*, double>, 7> kMmPerUnit = {{{"um", 1e-3},
                                                                          {"\u00b5m", 1e-3},
@@ -55,13 +64,14 @@ double ParseLengthMm(const std::string& text, const std::string& option) {
 }
 
 std::string MillimetreText(double mm) {
-  if (std::abs(mm) < 0.1) return Significant3(mm * 1e3) + " um";
-  if (std::abs(mm) >= 1000.0) return Significant3(mm / 1e3) + " m";
-  return Significant3(mm) + " mm";
+  // The unit by the length as it is printed (999.7 mm reads "1 m").
+  if (std::abs(mm) < 0.09995) return ThreeSignificantDigits(mm * 1e3) + " um";
+  if (std::abs(mm) >= 999.5) return ThreeSignificantDigits(mm / 1e3) + " m";
+  return ThreeSignificantDigits(mm) + " mm";
 }
 
 std::string WorldLengthText(double world_units, double mm_per_world_unit) {
-  std::string text = Significant3(world_units) + " world units";
+  std::string text = ThreeSignificantDigits(world_units) + " world units";
   if (mm_per_world_unit > 0.0) text += " (" + MillimetreText(world_units * mm_per_world_unit) + ")";
   return text;
 }

@@ -16,8 +16,12 @@ double ParseLengthMm(const std::string& text, const std::string& option);
 std::string WorldLengthText(double world_units, double mm_per_world_unit);
 
 /// A length in millimetres in um, mm or m whichever reads best, three significant digits:
-/// "391 um", "3.91 mm", "1.20 m".
+/// "391 um", "3.91 mm", "1.2 m".
 std::string MillimetreText(double mm);
+
+/// A number to three significant digits, without an exponent or trailing zeros: "0.00391",
+/// "1.2", "1000", "1230000"; "?" when not finite.
+std::string ThreeSignificantDigits(double value);
 
 /// The "nice" length (1, 2 or 5 times a power of ten) closest below `at_most`, > 0.
 double NiceLengthAtMost(double at_most);

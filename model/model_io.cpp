@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "core/check.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/partial_output.h"
@@ -247,7 +248,7 @@ class ModelFolderWriter {
   }
 
   const TexturedModel& model_;
-  const fs::path& tmp_;
+  const fs::path tmp_;
   nlohmann::json manifest_;
   std::ostringstream mtl_;
   std::vector<GlbAtlas> glb_atlases_;
@@ -315,6 +316,12 @@ Eigen::Matrix3d AtlasFaceFrame(const TexturedModel& model, std::size_t f) {
 
 void ForEachCornerByAtlas(const TexturedModel& model,
                           const std::function<void(const ModelCorner&)>& visit) {
+  TEXLUME_CHECK(model.corner_px.size() == model.mesh.faces.size() &&
+                    model.face_atlas.size() == model.mesh.faces.size(),
+                "texture coordinates and an atlas for every face");
+  for (const int a : model.face_atlas)
+    TEXLUME_CHECK(a >= 0 && static_cast<std::size_t>(a) < model.atlases.size(),
+                  "every face's atlas exists");
   std::vector<std::size_t> order(model.mesh.faces.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {

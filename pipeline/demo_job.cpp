@@ -287,8 +287,7 @@ void DemoJobOptions::Check() const {
     throw OptionError("--width and --height must be in [64, 8192] pixels, got " +
                       std::to_string(image_width) + " x " + std::to_string(image_height));
   sensor.Check();
-  if (!(mm_per_world_unit >= 0.0 && std::isfinite(mm_per_world_unit)))
-    throw OptionError("the world unit's length must be positive and finite");
+  CheckWorldUnit(mm_per_world_unit);
 }
 
 nlohmann::json DemoJobOptions::ToJson() const {

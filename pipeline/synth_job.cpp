@@ -177,6 +177,11 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
   return inputs;
 }
 
+void CheckWorldUnit(double mm_per_world_unit) {
+  if (!(mm_per_world_unit >= 0.0 && std::isfinite(mm_per_world_unit)))
+    throw OptionError("the world unit's length must be 0 (not stated) or positive and finite");
+}
+
 nlohmann::json WorldUnitJson(double mm_per_world_unit) {
   return mm_per_world_unit > 0.0 ? nlohmann::json(mm_per_world_unit) : nlohmann::json(nullptr);
 }
@@ -253,8 +258,7 @@ void SynthJobOptions::CheckInputsAndLayout() const {
   visibility.Check();
   if (max_subdivisions < 0 || max_subdivisions > 6)
     throw OptionError("max subdivisions must be in [0, 6]");
-  if (!(mm_per_world_unit >= 0.0 && std::isfinite(mm_per_world_unit)))
-    throw OptionError("the world unit's length must be positive and finite");
+  CheckWorldUnit(mm_per_world_unit);
 }
 
 nlohmann::json SynthJobOptions::InputsJson() const {

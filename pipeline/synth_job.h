@@ -146,5 +146,7 @@ SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallba
 nlohmann::json AtlasSettingsJson(const atlas::AtlasOptions& atlas);
 /// The world unit's length in millimetres as the manifests record it: null when not stated.
 nlohmann::json WorldUnitJson(double mm_per_world_unit);
+/// Throws OptionError unless the world unit's length is 0 (not stated) or positive and finite.
+void CheckWorldUnit(double mm_per_world_unit);
 
 }  // namespace texlume::pipeline

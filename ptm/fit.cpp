@@ -204,6 +204,7 @@ void FitOptions::Check() const {
 
 void CheckLightSet(const std::vector<Eigen::Vector3d>& lights, const FitOptions& options,
                    const std::string& label) {
+  options.Check();
   CheckLightsForBasis(lights, LightMatrix(lights), static_cast<std::size_t>(options.min_lights),
                       options.max_condition_number, "a PTM", label);
 }

@@ -47,8 +47,9 @@ struct HshFitResult {
 
 /// Least-squares HSH fit of an RTI capture, streamed by bands of `band_rows` rows (in
 /// parallel over the texels). The light set is refused (InputError) with fewer lights
-/// than terms, a light at or below the horizon, or a normal matrix of the basis with
-/// a condition number over 1e7 (PTMs: ptm::CheckLightSet, with at least 6 lights).
+/// than terms, a light that is not a unit vector or is at or below the horizon, or a
+/// normal matrix of the basis with a condition number over 1e7
+/// (ptm::CheckLightsForBasis, as for PTMs with at least 6 lights).
 HshFitResult FitHshFromFiles(const std::vector<std::filesystem::path>& files,
                              const std::vector<Eigen::Vector3d>& lights, int order, int band_rows,
                              const ProgressCallback& progress = {});

@@ -85,9 +85,7 @@ cv::Mat ErrorScale() {
 // A length for a scale bar: millimetre units when the world unit is known, else world units.
 std::string ScaleBarLabel(double world_units, double mm_per_world_unit) {
   if (mm_per_world_unit > 0.0) return MillimetreText(world_units * mm_per_world_unit);
-  char text[48];
-  std::snprintf(text, sizeof text, "%.3g units", world_units);
-  return text;
+  return ThreeSignificantDigits(world_units) + " units";
 }
 
 // `bgr8` with a scale bar at its lower left: the longest 1-2-5 length (in mm when
@@ -214,12 +212,13 @@ class ReportWriter {
     if (progress_) progress_("report", step_, steps_);
   }
 
-  // ", whose texel is 0.002 world units (2 mm) on the object; the bar..." for the sample
-  // and atlas sections (`whose`: "its", "an atlas"); empty when the texel size is unknown.
+  // "; its texel spans 0.002 world units (2 mm) on the object, ..." for the sample and atlas
+  // sections (`whose`: "its", "an atlas"); empty when the texel size is unknown.
   std::string ScaleText(const std::string& whose) const {
     if (!(in_.texel_size > 0.0)) return "";
     return "; " + whose + " texel spans " + WorldLengthText(in_.texel_size, in_.mm_per_world_unit) +
-           " on the object, the bar at the lower left gives the scale" +
+           " on the object, a bar at the lower left of a picture large enough for it (the "
+           "sample's head-on one, each atlas) gives the scale" +
            (in_.mm_per_world_unit > 0.0 ? "" : " (no --world-unit was given: world units)");
   }
 

@@ -22,9 +22,11 @@ struct PhotometricObservation {
   /// once the photo's white balance is taken out.
   std::array<double, 3> photo_channels{};
   double photo_linear = 0.0;
-  /// Per light above the face's horizon: its elevation in the face's frame
-  /// (degrees) and the sample's mean relit linear R + G + B under it alone
-  /// (intensity and horizon fade included) over as many cells.
+  /// Per light and shading point of the face (TriangleEngine::ShadingTurns: the
+  /// face frame turned onto the smooth normal there, as the renderer shades), when
+  /// the light is above the tangent plane there: its elevation (degrees) and the
+  /// sample's mean relit linear R + G + B under it alone (intensity and horizon fade
+  /// included) over the point's share (a third) of the cells.
   std::vector<std::pair<double, double>> lights;
   double zenith_linear = 0.0;  ///< the same under a unit light at the zenith
   /// Every light and the view steep (RectifiedView::steep): the gains trust it.

@@ -20,7 +20,8 @@ TEST(ParseLengthMm, ReadsEachUnit) {
 }
 
 TEST(ParseLengthMm, RefusesWhatIsNotALengthNamingTheOption) {
-  for (const char* bad : {"", "1", "1 parsec", "-1m", "0m", "1e30m", "nanm", "m1", "1M", "x"}) {
+  for (const char* bad :
+       {"", "1", "1 parsec", "-1m", "0m", "1e30m", "nanm", "m1", "1M", "x", "0x10mm", "infm"}) {
     try {
       ParseLengthMm(bad, "--world-unit");
       ADD_FAILURE() << "accepted '" << bad << "'";
@@ -36,6 +37,12 @@ TEST(LengthText, ChoosesTheUnitThatReadsBest) {
   EXPECT_EQ(MillimetreText(1200.0), "1.2 m");
   EXPECT_EQ(WorldLengthText(0.00391, 0.0), "0.00391 world units");
   EXPECT_EQ(WorldLengthText(0.00391, 1000.0), "0.00391 world units (3.91 mm)");
+  // Never an exponent: lengths that round up take the next unit, large ones all digits.
+  EXPECT_EQ(MillimetreText(999.7), "1 m");
+  EXPECT_EQ(MillimetreText(0.09996), "0.1 mm");
+  EXPECT_EQ(WorldLengthText(1234.0, 0.0), "1230 world units");
+  EXPECT_EQ(ThreeSignificantDigits(999.7), "1000");
+  EXPECT_EQ(ThreeSignificantDigits(-0.012345), "-0.0123");
 }
 
 TEST(NiceLengthAtMost, IsOneTwoOrFiveTimesAPowerOfTen) {
