@@ -542,6 +542,16 @@ MeshStats ComputeMeshStats(const TriangleMesh& mesh) {
   return s;
 }
 
+Eigen::Vector3d SmoothNormalAt(const TriangleMesh& mesh,
+                               const std::vector<Eigen::Vector3d>& vertex_normals, std::size_t f,
+                               const Eigen::Vector3d& barycentric) {
+  const auto& v = mesh.faces[f];
+  return (barycentric[0] * vertex_normals[static_cast<std::size_t>(v[0])] +
+          barycentric[1] * vertex_normals[static_cast<std::size_t>(v[1])] +
+          barycentric[2] * vertex_normals[static_cast<std::size_t>(v[2])])
+      .normalized();
+}
+
 std::vector<Eigen::Vector3d> VertexNormals(const TriangleMesh& mesh) {
   std::vector<Eigen::Vector3d> n(mesh.vertices.size(), Eigen::Vector3d::Zero());
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {

@@ -124,6 +124,12 @@ Eigen::Vector3d BoundingBoxCentre(const TriangleMesh& mesh);
 /// Smooth (area-weighted) vertex normals.
 std::vector<Eigen::Vector3d> VertexNormals(const TriangleMesh& mesh);
 
+/// The smooth normal at barycentric (b0, b1, b2) of face f: its vertex normals
+/// (VertexNormals) interpolated and normalised, as the renderer and the viewer shade.
+Eigen::Vector3d SmoothNormalAt(const TriangleMesh& mesh,
+                               const std::vector<Eigen::Vector3d>& vertex_normals, std::size_t f,
+                               const Eigen::Vector3d& barycentric);
+
 /// 1-to-4 midpoint subdivision (shared edge midpoints welded).
 TriangleMesh SubdivideMidpoint(const TriangleMesh& mesh);
 

@@ -111,11 +111,8 @@ RenderedView ModelRenderer::RenderWith(const sfm::Camera& camera,
           const double b1 = hit->b1, b2 = hit->b2, b0 = 1.0 - b1 - b2;
           s.point = origin + hit->distance * direction;
           s.to_viewer = (origin - s.point).normalized();
-          const auto& v = mesh.faces[s.face];
-          s.smooth_normal = (b0 * vertex_normals_[static_cast<std::size_t>(v[0])] +
-                             b1 * vertex_normals_[static_cast<std::size_t>(v[1])] +
-                             b2 * vertex_normals_[static_cast<std::size_t>(v[2])])
-                                .normalized();
+          s.smooth_normal =
+              mesh::SmoothNormalAt(mesh, vertex_normals_, s.face, Eigen::Vector3d(b0, b1, b2));
           if (!model_.corner_px.empty()) {
             const auto& c = model_.corner_px[s.face];
             s.atlas = model_.face_atlas[s.face];

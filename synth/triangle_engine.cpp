@@ -283,6 +283,7 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
                 FaceLighting{Eigen::Vector3d::UnitZ(), {{Eigen::Vector3d::UnitZ(), 1.0}}, {}}, 1);
   for (std::size_t f = 0; f < num_faces; ++f) {
     if (progress && f % 256 == 0) progress("photometry", f, num_faces);
+    const ShadingTurnSet turns = ShadingTurns(f);
     int steep = 0, other = 0;
     for (const sfm::TriangleView& view : visibility_.triangles[f].views) {
       if (!view.fully_visible || steep >= 8) continue;
@@ -291,7 +292,7 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
       if (!rect.steep && (other >= 8 || !options_.light_response)) continue;
       if (blur && rect.steep && blur->Wants(rect.photo) && SpreadForBlur(f))
         blur->Add(rect.photo, PhotoLuminance(rect), SampleWindowLuminance(f, rect), rect.mask);
-      PhotometricObservation o = Observe(f, rect, zenith_per_cell);
+      PhotometricObservation o = Observe(f, rect, zenith_per_cell, turns);
       // A steep view counts towards the 8 only when it is lit enough for the
       // gains (GainsUnder's test under the identity).
       const bool lit = o.Predicted({}) > 0.02 * 3 * o.cells && o.photo_linear > 1e-6;
@@ -336,7 +337,8 @@ cv::Mat TriangleEngine::SampleWindowLuminance(std::size_t face, const RectifiedV
 }
 
 PhotometricObservation TriangleEngine::Observe(std::size_t face, const RectifiedView& rect,
-                                               double zenith_per_cell) const {
+                                               double zenith_per_cell,
+                                               const ShadingTurnSet& turns) const {
   PhotometricObservation o;
   o.face = face;
   o.photo = rect.photo;
@@ -351,7 +353,7 @@ PhotometricObservation TriangleEngine::Observe(std::size_t face, const Rectified
   // Each light as the renderer shades it: per pixel, in the frame turned onto the smooth
   // normal, so that near the terminator part of a face is lit and part is not. Each of
   // the shading points stands for an equal share of the face's cells.
-  for (const Eigen::Quaterniond& turn : ShadingTurns(face)) {
+  for (const Eigen::Quaterniond& turn : turns) {
     const Eigen::Vector3d view = turn * rect.lighting.view_in_frame;
     for (const auto& [light, intensity] : rect.lighting.lights) {
       const Eigen::Vector3d l = turn * light;
@@ -366,20 +368,15 @@ PhotometricObservation TriangleEngine::Observe(std::size_t face, const Rectified
   return o;
 }
 
-std::array<Eigen::Quaterniond, TriangleEngine::kShadingPoints> TriangleEngine::ShadingTurns(
-    std::size_t face) const {
+TriangleEngine::ShadingTurnSet TriangleEngine::ShadingTurns(std::size_t face) const {
   // Points at barycentric (2/3, 1/6, 1/6) and its permutations.
   const mesh::TriangleFrame& frame = result_.patches[face].frame;
-  std::array<Eigen::Quaterniond, kShadingPoints> turns;
+  ShadingTurnSet turns;
   for (int i = 0; i < kShadingPoints; ++i) {
-    Eigen::Vector3d normal_in_world = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 3; ++k) {
-      const double weight = k == i ? 2.0 / 3.0 : 1.0 / 6.0;
-      normal_in_world +=
-          weight *
-          vertex_normals_[static_cast<std::size_t>(mesh_.faces[face][static_cast<std::size_t>(k)])];
-    }
-    const Eigen::Vector3d normal_in_frame = frame.DirectionInFrame(normal_in_world);
+    Eigen::Vector3d barycentric = Eigen::Vector3d::Constant(1.0 / 6.0);
+    barycentric[i] = 2.0 / 3.0;
+    const Eigen::Vector3d normal_in_frame =
+        frame.DirectionInFrame(mesh::SmoothNormalAt(mesh_, vertex_normals_, face, barycentric));
     turns[static_cast<std::size_t>(i)] =
         normal_in_frame.norm() > 1e-12
             ? Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), normal_in_frame)

@@ -178,13 +178,15 @@ class TriangleEngine {
   void EstimatePhotometry(const ProgressCallback& progress);
   // `zenith_per_cell` >= 0: the sample's mean under a unit zenith light (a
   // view-independent sample's, computed once); < 0: computed for the view.
-  PhotometricObservation Observe(std::size_t face, const RectifiedView& rect,
-                                 double zenith_per_cell) const;
   // The rotations from face `face`'s frame into the frames the renderer shades in at
   // kShadingPoints points of the face: the frame turned by the smallest rotation onto
-  // the smooth normal there (render/model_render.h).
+  // the smooth normal there (mesh::SmoothNormalAt, render/model_render.h).
   static constexpr int kShadingPoints = 3;
-  std::array<Eigen::Quaterniond, kShadingPoints> ShadingTurns(std::size_t face) const;
+  using ShadingTurnSet = std::array<Eigen::Quaterniond, kShadingPoints>;
+  ShadingTurnSet ShadingTurns(std::size_t face) const;
+  // `turns`: the face's ShadingTurns.
+  PhotometricObservation Observe(std::size_t face, const RectifiedView& rect,
+                                 double zenith_per_cell, const ShadingTurnSet& turns) const;
   // The sample relit under a rectified view's lighting, as luminance, over a
   // window of the view's grid size (the photo blur's comparison).
   cv::Mat SampleWindowLuminance(std::size_t face, const RectifiedView& rect) const;

@@ -4,6 +4,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/errors.h"
@@ -40,6 +41,16 @@ model::TexturedModel OneTriangle() {
   return m;
 }
 
+// A view whose reference and drawings are all `grey`, seen everywhere.
+render::ViewPictures GreyView(const cv::Mat& grey, std::vector<render::ViewPictures::Drawn> drawn) {
+  render::ViewPictures view;
+  view.name = "view_0.png";
+  view.reference = grey;
+  view.inside = cv::Mat(grey.rows, grey.cols, CV_8UC1, cv::Scalar(255));
+  view.drawn = std::move(drawn);
+  return view;
+}
+
 // The report lays out pictures and metrics it is given: every picture it links
 // exists, the metrics shown are the given ones (it measures nothing), and
 // text is escaped.
@@ -53,11 +64,8 @@ TEST(WriteReport, ShowsTheGivenPicturesAndMetricsAndLinksOnlyWhatItWrote) {
   in.sample_relit = {{Eigen::Vector3d::UnitZ(), grey}, {Eigen::Vector3d::UnitX(), grey}};
   in.sample_width = 32;
   in.sample_height = 24;
-  render::ViewPictures view;
-  view.name = "view_0.png";
-  view.reference = grey;
-  view.inside = cv::Mat(24, 32, CV_8UC1, cv::Scalar(255));
-  view.drawn = {{"texlume", grey, 31.25, 0.875}, {"flat", grey, 12.5, 0.25}};
+  const render::ViewPictures view =
+      GreyView(grey, {{"texlume", grey, 31.25, 0.875}, {"flat", grey, 12.5, 0.25}});
   in.views = {view, view};
   in.views_total = 5;
   in.views_heading = "Held-out views";
@@ -101,11 +109,7 @@ TEST(WriteReport, GivesThePhysicalScaleOfTheSampleTheAtlasesAndTheViews) {
   in.sample_relit = {{Eigen::Vector3d::UnitZ(), grey}};
   in.sample_width = 400;
   in.sample_height = 200;
-  render::ViewPictures view;
-  view.name = "view_0.png";
-  view.reference = grey;
-  view.inside = cv::Mat(100, 200, CV_8UC1, cv::Scalar(255));
-  view.drawn = {{"texlume", grey, 20.0, 0.5}};
+  render::ViewPictures view = GreyView(grey, {{"texlume", grey, 20.0, 0.5}});
   view.world_per_pixel = 0.25;
   in.views = {view};
   testing::TempDir out;
