@@ -6,16 +6,23 @@
 //   view_fidelity TRUTH_DIR MASKS_DIR REDUCED_FACTOR LABEL=DIR [LABEL=DIR ...]
 //
 // Every PNG of TRUTH_DIR is a view; each DIR must hold an image of that name.
+//
+// Then the display luma bias taken apart: what the truth's own display luma
+// becomes when only its linear light is scaled by a row's linear bias, and when
+// it is only made smoother (a Gaussian blur of the linear values): the sRGB
+// curve is concave, so a smoother image with the same light reads brighter.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
 #include "core/errors.h"
 #include "core/image_io.h"
 #include "pipeline/render_job.h"
+#include "render/fidelity.h"
 
 namespace fs = std::filesystem;
 using namespace texlume;
@@ -40,6 +47,56 @@ Row MeasureFolder(const std::string& label, const fs::path& dir, const std::vect
   return {label, render::MeanViewMetrics(metrics)};
 }
 
+// The truth views' display and linear luma inside their masks, after `change`
+// of their linear values.
+struct LumaMeans {
+  double display = 0, linear = 0;
+};
+
+template <typename Change>
+LumaMeans TruthLuma(const std::vector<fs::path>& views, const fs::path& masks_dir,
+                    const Change& change) {
+  LumaMeans sum;
+  for (const fs::path& view : views) {
+    cv::Mat linear = ReadPhotoRgb(view);
+    linear.forEach<cv::Vec3f>([](cv::Vec3f& p, const int*) {
+      for (int c = 0; c < 3; ++c) p[c] = SrgbToLinear(p[c]);
+    });
+    linear = change(linear);
+    linear.forEach<cv::Vec3f>([](cv::Vec3f& p, const int*) {
+      for (int c = 0; c < 3; ++c) p[c] = LinearToSrgb(p[c]);
+    });
+    const cv::Mat mask = ReadImageGrey(masks_dir / view.filename()) > 0.5f;
+    const render::AppearanceStats stats = render::MeasureAppearance(linear, mask);
+    sum.display += stats.mean_luma, sum.linear += stats.mean_linear_luma;
+  }
+  return sum;
+}
+
+void PrintLumaBiasApart(const std::vector<Row>& rows, const std::vector<fs::path>& views,
+                        const fs::path& masks_dir) {
+  const LumaMeans truth = TruthLuma(views, masks_dir, [](const cv::Mat& m) { return m; });
+  std::printf("\nThe display luma bias taken apart (the truth changed in its linear values):\n");
+  for (const Row& row : rows) {
+    const double scale = 1.0 + row.mean.fidelity.linear_luma_bias;
+    const LumaMeans scaled =
+        TruthLuma(views, masks_dir, [&](const cv::Mat& m) -> cv::Mat { return m * scale; });
+    std::printf("- %s: linear %+.2f %%, display %+.2f %%; its linear bias alone gives %+.2f %%\n",
+                row.label.c_str(), 100 * row.mean.fidelity.linear_luma_bias,
+                100 * row.mean.fidelity.luma_bias, 100 * (scaled.display / truth.display - 1));
+  }
+  for (const double sigma_px : {0.5, 1.0, 1.5}) {
+    const LumaMeans blurred = TruthLuma(views, masks_dir, [&](const cv::Mat& m) {
+      cv::Mat out;
+      cv::GaussianBlur(m, out, cv::Size(0, 0), sigma_px);
+      return out;
+    });
+    std::printf("- the truth blurred by %.1f px: linear %+.2f %%, display %+.2f %%\n", sigma_px,
+                100 * (blurred.linear / truth.linear - 1),
+                100 * (blurred.display / truth.display - 1));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -56,8 +113,9 @@ int main(int argc, char** argv) {
     std::sort(views.begin(), views.end());
     if (views.empty()) throw InputError(truth_dir.string(), "holds no PNG views");
     std::printf(
-        "| %-16s | PSNR dB | SSIM | PSNR/%d | SSIM/%d | luma bias %% | chroma %% | grad EMD | "
-        "grad p90 (truth) | spectrum dB |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        "| %-16s | PSNR dB | SSIM | PSNR/%d | SSIM/%d | luma bias %% | linear %% | chroma %% | "
+        "grad EMD | grad p90 (truth) | spectrum dB "
+        "|\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         "", reduced_factor, reduced_factor);
     std::vector<Row> rows;
     for (int i = 4; i < argc; ++i) {
@@ -68,10 +126,12 @@ int main(int argc, char** argv) {
                                     masks_dir, reduced_factor);
       const render::FidelityMetrics& f = row.mean.fidelity;
       std::printf(
-          "| %-16s | %.2f | %.3f | %.2f | %.3f | %+.1f | %+.1f | %.5f | %.4f (%.4f) | %.2f |\n",
+          "| %-16s | %.2f | %.3f | %.2f | %.3f | %+.1f | %+.1f | %+.1f | %.5f | %.4f (%.4f) | %.2f "
+          "|\n",
           row.label.c_str(), row.mean.psnr, row.mean.ssim, row.mean.psnr_reduced,
-          row.mean.ssim_reduced, 100 * f.luma_bias, 100 * f.chroma_spread_ratio,
-          f.gradient_histogram_distance, f.gradient_p90, f.gradient_p90_truth, f.power_spectrum_db);
+          row.mean.ssim_reduced, 100 * f.luma_bias, 100 * f.linear_luma_bias,
+          100 * f.chroma_spread_ratio, f.gradient_histogram_distance, f.gradient_p90,
+          f.gradient_p90_truth, f.power_spectrum_db);
       rows.push_back(row);
     }
     std::printf(
@@ -87,6 +147,7 @@ int main(int argc, char** argv) {
       for (double db : row.mean.fidelity.band_power_db) std::printf(" %+.1f |", db);
       std::printf("\n");
     }
+    PrintLumaBiasApart(rows, views, masks_dir);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "view_fidelity: %s\n", e.what());
     return 1;

@@ -48,6 +48,7 @@ namespace {
 // A view's appearance figures as render.json records them (render/fidelity.h).
 nlohmann::json FidelityJson(const render::FidelityMetrics& f) {
   return {{"luma_bias", f.luma_bias},
+          {"linear_luma_bias", f.linear_luma_bias},
           {"chroma_spread_ratio", f.chroma_spread_ratio},
           {"gradient_histogram_distance", f.gradient_histogram_distance},
           {"gradient_p90", f.gradient_p90},

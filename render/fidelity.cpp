@@ -5,6 +5,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "core/image_io.h"
+
 namespace texlume::render {
 namespace {
 
@@ -13,6 +15,14 @@ cv::Mat Luma(const cv::Mat& rgb) {
   cv::Mat luma;
   cv::transform(rgb, luma, cv::Matx13f(0.2126f, 0.7152f, 0.0722f));
   return luma;
+}
+
+cv::Mat DecodeSrgb(const cv::Mat& rgb) {
+  cv::Mat linear = rgb.clone();
+  linear.forEach<cv::Vec3f>([](cv::Vec3f& p, const int*) {
+    for (int c = 0; c < 3; ++c) p[c] = SrgbToLinear(p[c]);
+  });
+  return linear;
 }
 
 // Gradient magnitude by central differences, inside `inner` (the border pixels
@@ -93,6 +103,7 @@ AppearanceStats MeasureAppearance(const cv::Mat& rgb, const cv::Mat& mask) {
   const int inside = cv::countNonZero(mask);
   if (inside > 0) {
     stats.mean_luma = cv::mean(luma, mask)[0];
+    stats.mean_linear_luma = cv::mean(Luma(DecodeSrgb(rgb)), mask)[0];
     cv::Mat channels[3], high, low;
     cv::split(rgb, channels);
     high = cv::max(cv::max(channels[0], channels[1]), channels[2]);
@@ -110,6 +121,7 @@ FidelityMetrics CompareAppearance(const AppearanceStats& rendered, const Appeara
   FidelityMetrics m;
   auto relative = [](double a, double b) { return b > 0 ? a / b - 1.0 : 0.0; };
   m.luma_bias = relative(rendered.mean_luma, truth.mean_luma);
+  m.linear_luma_bias = relative(rendered.mean_linear_luma, truth.mean_linear_luma);
   m.chroma_spread_ratio = relative(rendered.mean_chroma_spread, truth.mean_chroma_spread);
   // 1-D earth mover's distance: the area between the two cumulative histograms.
   double cdf_rendered = 0, cdf_truth = 0;

@@ -10,6 +10,9 @@ namespace texlume::render {
 /// values in [0, 1]; luma is Rec. 709's Y' = 0.2126 R + 0.7152 G + 0.0722 B.
 struct AppearanceStats {
   double mean_luma = 0;
+  /// Mean luma of the linear values (sRGB decoded): the light the image carries,
+  /// which a display-luma mean weighs by the sRGB curve.
+  double mean_linear_luma = 0;
   /// Mean of max(R, G, B) - min(R, G, B): how coloured the image is.
   double mean_chroma_spread = 0;
   /// Normalised histogram of the luma gradient magnitude (central differences,
@@ -35,6 +38,10 @@ AppearanceStats MeasureAppearance(const cv::Mat& rgb, const cv::Mat& mask);
 struct FidelityMetrics {
   /// mean luma / truth's - 1 (0.01 = 1 % too bright).
   double luma_bias = 0;
+  /// The same of the linear luma: a rendering with the truth's light but less
+  /// fine contrast has a linear bias near 0 and a positive display bias (the
+  /// sRGB curve is concave, so it lifts the mean of a smoother image).
+  double linear_luma_bias = 0;
   /// mean chroma spread / truth's - 1 (0.1 = 10 % more colourful).
   double chroma_spread_ratio = 0;
   /// Earth mover's distance between the gradient histograms, luma per pixel:

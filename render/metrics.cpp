@@ -73,6 +73,7 @@ ViewMetrics MeanViewMetrics(const std::vector<ViewMetrics>& views) {
     mean.psnr_reduced += m.psnr_reduced / n;
     mean.ssim_reduced += m.ssim_reduced / n;
     f.luma_bias += m.fidelity.luma_bias / n;
+    f.linear_luma_bias += m.fidelity.linear_luma_bias / n;
     f.chroma_spread_ratio += m.fidelity.chroma_spread_ratio / n;
     f.gradient_histogram_distance += m.fidelity.gradient_histogram_distance / n;
     f.gradient_p90 += m.fidelity.gradient_p90 / n;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <opencv2/core.hpp>
 
+#include "core/image_io.h"
+
 namespace texlume::render {
 namespace {
 
@@ -44,6 +46,28 @@ TEST(Fidelity, LumaAndChromaHaveTheKnownAnswers) {
   // Twice as colourful: +100 %.
   const cv::Mat pale(64, 64, CV_32FC3, cv::Scalar(0.55, 0.45, 0.5));
   EXPECT_NEAR(CompareAppearance(t, MeasureAppearance(pale, kAll)).chroma_spread_ratio, 1.0, 1e-5);
+}
+
+// The sRGB curve is concave: an image with the same light but less contrast has
+// no linear bias and a positive display bias.
+TEST(Fidelity, LinearLumaBiasSeesTheLightAndNotTheContrast) {
+  cv::Mat checker(64, 64, CV_32FC3), even(64, 64, CV_32FC3);
+  const float dark = LinearToSrgb(0.1f), light = LinearToSrgb(0.3f), mid = LinearToSrgb(0.2f);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      checker.at<cv::Vec3f>(y, x) = cv::Vec3f::all((x + y) % 2 ? light : dark);
+      even.at<cv::Vec3f>(y, x) = cv::Vec3f::all(mid);
+    }
+  const AppearanceStats truth = MeasureAppearance(checker, kAll);
+  EXPECT_NEAR(truth.mean_linear_luma, 0.2, 1e-4);
+  const FidelityMetrics smooth = CompareAppearance(MeasureAppearance(even, kAll), truth);
+  EXPECT_NEAR(smooth.linear_luma_bias, 0.0, 1e-4);
+  EXPECT_NEAR(smooth.luma_bias, mid / (0.5 * (dark + light)) - 1, 1e-4);
+  EXPECT_GT(smooth.luma_bias, 0.03);
+  cv::Mat brighter = even.clone();
+  brighter.setTo(cv::Scalar::all(LinearToSrgb(0.22f)));
+  EXPECT_NEAR(CompareAppearance(MeasureAppearance(brighter, kAll), truth).linear_luma_bias, 0.1,
+              1e-4);
 }
 
 TEST(Fidelity, GradientHistogramDistanceIsTheShiftOfTheEdgeStrengths) {
