@@ -4,31 +4,11 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <opencv2/imgproc/detail/gcgraph.hpp>
+
+#include "synth/min_cut.h"
 
 namespace texlume::synth {
 namespace {
-
-// The minimum cut of a small graph (paper 004 Fig. 8), behind an interface of
-// our own: nodes, n-links, t-links, then which side each node ends on. OpenCV's
-// GCGraph (BSD/Apache) does the work.
-class MinCut {
- public:
-  MinCut(int nodes, int links) : graph_(static_cast<unsigned>(nodes), 2u * links) {
-    for (int i = 0; i < nodes; ++i) graph_.addVtx();
-  }
-  void Link(int a, int b, double weight) { graph_.addEdges(a, b, weight, weight); }
-  /// Costs of labelling node a with A (source) and with B (sink).
-  void Terminals(int a, double cost_a, double cost_b) {
-    // GCGraph's t-link to the source is cut when the node ends on the sink side.
-    graph_.addTermWeights(a, cost_b, cost_a);
-  }
-  void Solve() { graph_.maxFlow(); }
-  bool IsA(int a) { return graph_.inSourceSegment(a); }
-
- private:
-  cv::detail::GCGraph<double> graph_;
-};
 
 int NearestEdge(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p) {
   int best = 0;
