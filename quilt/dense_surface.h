@@ -1,0 +1,66 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
+#include <opencv2/core.hpp>
+#include <span>
+#include <vector>
+
+#include "atlas/atlas.h"
+#include "mesh/mesh.h"
+#include "mesh/triangle_frame.h"
+#include "synth/triangle_parts.h"
+
+// The dense surface of graph-cut quilting (paper 004 §III-A, "GIM-based
+// sampling"): one sample per atlas texel whose centre lies inside a triangle,
+// so that synthesising the samples is synthesising the atlas texels. Inside a
+// chart a sample's neighbours are its 4 atlas neighbours; across a chart's
+// border they are found on the mesh (the texel one step away, carried over the
+// shared edges into the neighbouring face and its chart), which zips the charts
+// together as the paper's multi-chart geometry image does.
+
+namespace texlume::quilt {
+
+struct DenseSample {
+  int atlas = 0, x = 0, y = 0;  ///< the atlas texel (x right, y down)
+  int face = 0, chart = 0;
+  Eigen::Vector2d p_in_frame = Eigen::Vector2d::Zero();  ///< texel centre, face frame, world units
+};
+
+class DenseSurface {
+ public:
+  /// Samples every texel inside a face of `layout` (atlas::VisitAtlasTexels,
+  /// the first face wins on a shared edge) and links them. `patches` and
+  /// `unfoldings` are those the layout was made from (synth::PatchGeometry).
+  static DenseSurface Build(const atlas::AtlasLayout& layout,
+                            const std::vector<synth::TrianglePatch>& patches,
+                            const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
+                            double texel_size);
+
+  const std::vector<DenseSample>& samples() const { return samples_; }
+  std::size_t size() const { return samples_.size(); }
+  /// The samples linked to sample s (undirected, each once, ascending).
+  std::span<const int> Neighbours(int s) const;
+  /// The sample at an atlas texel, or -1.
+  int At(int atlas, int x, int y) const;
+  /// The sample's position in the world (world units).
+  Eigen::Vector3d PointInWorld(int s) const;
+
+  std::size_t links() const { return adjacency_.size() / 2; }
+  std::size_t chart_seam_links() const { return chart_seam_links_; }
+  /// Sample directions with no neighbour (the mesh's border, or a step that
+  /// lands outside every sample).
+  std::size_t open_directions() const { return open_directions_; }
+
+ private:
+  friend class DenseSurfaceBuilder;
+
+  std::vector<mesh::TriangleFrame> frames_;  ///< per face
+  std::vector<DenseSample> samples_;
+  std::vector<cv::Mat> index_;  ///< per atlas, CV_32SC1: sample or -1
+  std::vector<int> offsets_, adjacency_;
+  std::size_t chart_seam_links_ = 0, open_directions_ = 0;
+};
+
+}  // namespace texlume::quilt

@@ -1,0 +1,152 @@
+#include "quilt/patch_matching.h"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "core/errors.h"
+#include "ptm/coefficient_space.h"
+#include "synth/template_match.h"
+
+namespace texlume::quilt {
+namespace {
+
+Placement BestOf(const cv::Mat& ssd, int rotation, double overlap) {
+  Placement best;
+  best.rotation = rotation;
+  best.cost = std::numeric_limits<double>::max();
+  for (int y = 0; y < ssd.rows; ++y) {
+    const float* row = ssd.ptr<float>(y);
+    for (int x = 0; x < ssd.cols; ++x)
+      if (row[x] < best.cost) best.cost = row[x], best.x = x, best.y = y;
+  }
+  best.cost /= std::max(overlap, 1.0);
+  return best;
+}
+
+cv::Mat Spectrum(const cv::Mat& plane, int dft_size) {
+  cv::Mat padded = cv::Mat::zeros(dft_size, dft_size, CV_32FC1), spectrum;
+  plane.copyTo(padded(cv::Rect(0, 0, plane.cols, plane.rows)));
+  cv::dft(padded, spectrum, 0, plane.rows);
+  return spectrum;
+}
+
+// sum_c sum M (T_c - I_c)^2 at every placement, expanded as in
+// synth::MaskedSsd: corr(E, M) - 2 sum_c corr(I_c, M T_c) + sum_c sum M T_c^2,
+// the correlations summed in the frequency domain (one inverse DFT). The copy
+// is padded to at least its side, so placements inside it never wrap.
+cv::Mat MaskedSsdBySpectra(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
+                           const cv::Mat& mask) {
+  cv::Mat sum, term, masked;
+  cv::mulSpectrums(copy.energy_spectrum, Spectrum(mask, copy.dft_size), sum, 0, true);
+  double constant = 0;
+  for (std::size_t c = 0; c < work_planes.size(); ++c) {
+    cv::multiply(work_planes[c], mask, masked);
+    constant += masked.dot(work_planes[c]);
+    cv::mulSpectrums(copy.plane_spectra[c], Spectrum(masked, copy.dft_size), term, 0, true);
+    cv::scaleAdd(term, -2.0, sum, sum);
+  }
+  cv::Mat full;
+  cv::dft(sum, full, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
+  cv::Mat ssd =
+      full(cv::Rect(0, 0, copy.side() - mask.cols + 1, copy.side() - mask.rows + 1)) + constant;
+  cv::max(ssd, 0.0, ssd);
+  return ssd;
+}
+
+void CheckWorkImage(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
+                    const cv::Mat& work_mask) {
+  if (work_planes.size() != copy.planes.size() || work_mask.type() != CV_32FC1)
+    throw std::invalid_argument("MatchEntirePatch: one work plane per feature, a CV_32FC1 mask");
+  if (work_mask.cols > copy.side() || work_mask.rows > copy.side())
+    throw std::invalid_argument("MatchEntirePatch: the work image is larger than the sample");
+}
+
+}  // namespace
+
+RotatedSample::RotatedSample(const synth::MaterialSample& sample, std::size_t cached_copies)
+    : sample_(sample),
+      budget_(std::max<std::size_t>(cached_copies, 1)),
+      side_(static_cast<int>(
+          std::floor(std::min(sample.Width(), sample.Height()) / std::numbers::sqrt2))) {
+  if (side_ < 8)
+    throw InputError("the " + sample.Name() + " sample",
+                     "is " + std::to_string(sample.Width()) + " x " +
+                         std::to_string(sample.Height()) +
+                         " texels; graph-cut quilting needs at least 12 x 12");
+}
+
+int RotatedSample::RotationNearest(double angle_rad) {
+  const double turns = angle_rad / (2 * std::numbers::pi);
+  const long r = std::lround((turns - std::floor(turns)) * kRotations);
+  return static_cast<int>(r % kRotations);
+}
+
+double RotatedSample::AngleOf(int rotation) { return 2 * std::numbers::pi * rotation / kRotations; }
+
+Eigen::Vector2d RotatedSample::SamplePosition(int rotation, const Eigen::Vector2d& copy_px) const {
+  // The copy shows the sample turned by +angle (y up): a copy offset v (rows
+  // down) comes from the sample offset turned by -angle, here in rows-down terms.
+  const double a = AngleOf(rotation), c = std::cos(a), s = std::sin(a);
+  const Eigen::Vector2d v = copy_px - Eigen::Vector2d(side_ / 2.0, side_ / 2.0);
+  return Eigen::Vector2d(sample_.Width() / 2.0, sample_.Height() / 2.0) +
+         Eigen::Vector2d(c * v.x() - s * v.y(), s * v.x() + c * v.y());
+}
+
+RotatedCopy RotatedSample::Make(int rotation) const {
+  RotatedCopy copy;
+  copy.rotation = rotation;
+  copy.angle_rad = AngleOf(rotation);
+  const int n = sample_.NumFeatures();
+  for (int c = 0; c < n; ++c) copy.planes.emplace_back(side_, side_, CV_32FC1);
+  // The copy's frame is the sample's turned by -angle: its features are the
+  // sample's carried into it (synth::Unfolding: p_sample = R(-angle) p_copy).
+  synth::Unfolding turn;
+  turn.rotation = Eigen::Rotation2Dd(-copy.angle_rad).toRotationMatrix();
+  turn.coefficients_to_this = ptm::OrthonormalFrameRotation(-copy.angle_rad);
+  std::vector<float> f(static_cast<std::size_t>(n));
+  for (int y = 0; y < side_; ++y)
+    for (int x = 0; x < side_; ++x) {
+      sample_.FeaturesAt(SamplePosition(rotation, Eigen::Vector2d(x + 0.5, y + 0.5)), f.data());
+      sample_.TurnFeatures(turn, f.data());
+      for (int c = 0; c < n; ++c)
+        copy.planes[static_cast<std::size_t>(c)].at<float>(y, x) = f[static_cast<std::size_t>(c)];
+    }
+  copy.energy = synth::PlaneEnergy(copy.planes);
+  copy.dft_size = cv::getOptimalDFTSize(side_);
+  for (const cv::Mat& plane : copy.planes)
+    copy.plane_spectra.push_back(Spectrum(plane, copy.dft_size));
+  copy.energy_spectrum = Spectrum(copy.energy, copy.dft_size);
+  return copy;
+}
+
+const RotatedCopy& RotatedSample::Copy(int rotation) {
+  if (rotation < 0 || rotation >= kRotations)
+    throw std::out_of_range("RotatedSample::Copy: rotation " + std::to_string(rotation));
+  for (auto it = cache_.begin(); it != cache_.end(); ++it)
+    if (it->rotation == rotation) {
+      cache_.splice(cache_.begin(), cache_, it);
+      return cache_.front();
+    }
+  cache_.push_front(Make(rotation));
+  if (cache_.size() > budget_) cache_.pop_back();
+  return cache_.front();
+}
+
+Placement MatchEntirePatch(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
+                           const cv::Mat& work_mask) {
+  CheckWorkImage(copy, work_planes, work_mask);
+  return BestOf(MaskedSsdBySpectra(copy, work_planes, work_mask), copy.rotation,
+                cv::sum(work_mask)[0]);
+}
+
+Placement MatchEntirePatchBruteForce(const RotatedCopy& copy,
+                                     const std::vector<cv::Mat>& work_planes,
+                                     const cv::Mat& work_mask) {
+  CheckWorkImage(copy, work_planes, work_mask);
+  return BestOf(synth::MaskedSsdBruteForce(copy.planes, work_planes, work_mask), copy.rotation,
+                cv::sum(work_mask)[0]);
+}
+
+}  // namespace texlume::quilt
