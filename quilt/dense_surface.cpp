@@ -28,6 +28,7 @@ class DenseSurfaceBuilder {
 
   void TakeSamples() {
     for (const synth::TrianglePatch& patch : patches_) out_.frames_.push_back(patch.frame);
+    out_.texel_size_ = texel_size_;
     for (const cv::Size& size : layout_.atlas_sizes) out_.index_.emplace_back(size, CV_32SC1, -1);
     atlas::VisitAtlasTexels(
         layout_, texel_size_, 0, [&](int atlas, int x, int y, int face, const Eigen::Vector2d& p) {

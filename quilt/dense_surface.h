@@ -46,6 +46,11 @@ class DenseSurface {
   int At(int atlas, int x, int y) const;
   /// The sample's position in the world (world units).
   Eigen::Vector3d PointInWorld(int s) const;
+  /// A face's triangle frame (synth::TrianglePatch::frame).
+  const mesh::TriangleFrame& FrameOf(int face) const {
+    return frames_[static_cast<std::size_t>(face)];
+  }
+  double texel_size() const { return texel_size_; }
 
   std::size_t links() const { return adjacency_.size() / 2; }
   std::size_t chart_seam_links() const { return chart_seam_links_; }
@@ -57,6 +62,7 @@ class DenseSurface {
   friend class DenseSurfaceBuilder;
 
   std::vector<mesh::TriangleFrame> frames_;  ///< per face
+  double texel_size_ = 0;
   std::vector<DenseSample> samples_;
   std::vector<cv::Mat> index_;  ///< per atlas, CV_32SC1: sample or -1
   std::vector<int> offsets_, adjacency_;

@@ -60,7 +60,10 @@ void CheckWorkImage(const RotatedCopy& copy, const std::vector<cv::Mat>& work_pl
   if (work_planes.size() != copy.planes.size() || work_mask.type() != CV_32FC1)
     throw std::invalid_argument("MatchEntirePatch: one work plane per feature, a CV_32FC1 mask");
   if (work_mask.cols > copy.side() || work_mask.rows > copy.side())
-    throw std::invalid_argument("MatchEntirePatch: the work image is larger than the sample");
+    throw std::invalid_argument("MatchEntirePatch: the work image (" +
+                                std::to_string(work_mask.cols) + " x " +
+                                std::to_string(work_mask.rows) + ") is larger than the copies (" +
+                                std::to_string(copy.side()) + ")");
 }
 
 }  // namespace

@@ -1,0 +1,458 @@
+#include "quilt/surface_quilting.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <queue>
+#include <string>
+#include <unordered_map>
+
+#include "core/check.h"
+#include "core/errors.h"
+#include "ptm/coefficient_space.h"
+#include "synth/min_cut.h"
+
+namespace texlume::quilt {
+
+void QuiltOptions::Check() const {
+  if (min_work_patch_levels < 1 || work_patch_levels < min_work_patch_levels)
+    throw OptionError("--work-patch must be at least the smallest work patch (" +
+                      std::to_string(min_work_patch_levels) + " levels)");
+  if (!(shrink > 0.0 && shrink < 1.0)) throw OptionError("the work patch shrink must be in (0, 1)");
+  if (!(max_area_distortion >= 1.0)) throw OptionError("T_d must be at least 1");
+  if (!(seam_threshold > 0.0)) throw OptionError("--seam-threshold must be positive");
+}
+
+namespace {
+
+constexpr double kForced = 1e30;  ///< a t-link that a cut never takes
+/// Longest link a work image keeps (pixels): links are about a texel long
+/// (DenseSurface), a chart's stretch makes them at most twice that.
+constexpr double kMostLinkPx = 3.0;
+
+// One sample of a work patch: where it lies in the work image (pixels, rows
+// down, continuous) and how its chart's atlas frame turns into the work frame
+// (radians, counter-clockwise with y up).
+struct PatchSample {
+  int sample = 0;
+  Eigen::Vector2d w = Eigen::Vector2d::Zero();
+  double chart_to_work_rad = 0;
+};
+
+struct WorkPatch {
+  bool fits = false;        ///< the work image fits in the sample's copies
+  double distortion = 0.0;  ///< its area distortion (T_d)
+  std::vector<PatchSample> samples;
+  std::unordered_map<int, int> local;  ///< dense sample -> index in samples
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();
+  int width = 0, height = 0;  ///< the work image, pixels
+};
+
+// A rotation of y-up angle `rad` acting on pixel vectors (rows down).
+Eigen::Matrix2d PixelRotation(double rad) {
+  const double c = std::cos(rad), s = std::sin(rad);
+  Eigen::Matrix2d m;
+  m << c, s, -s, c;
+  return m;
+}
+
+float Bilinear(const cv::Mat& plane, double x, double y) {
+  x = std::clamp(x - 0.5, 0.0, plane.cols - 1.0);
+  y = std::clamp(y - 0.5, 0.0, plane.rows - 1.0);
+  const int x0 = std::min(static_cast<int>(x), plane.cols - 2);
+  const int y0 = std::min(static_cast<int>(y), plane.rows - 2);
+  const double fx = x - x0, fy = y - y0;
+  const float* r0 = plane.ptr<float>(y0);
+  const float* r1 = plane.ptr<float>(y0 + 1);
+  return static_cast<float>((1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) +
+                            fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]));
+}
+
+class SurfaceQuilter {
+ public:
+  SurfaceQuilter(const DenseSurface& surface, const atlas::AtlasLayout& layout,
+                 const synth::MaterialSample& sample, const QuiltOptions& options)
+      : surface_(surface),
+        layout_(layout),
+        sample_(sample),
+        options_(options),
+        rotated_(sample),
+        features_(sample.NumFeatures()),
+        rng_(options.seed) {
+    if (2 * options.min_work_patch_levels + 1 > rotated_.side())
+      throw InputError("the " + sample.Name() + " sample",
+                       "is smaller than the smallest work patch (" +
+                           std::to_string(2 * options.min_work_patch_levels + 1) +
+                           " texels a side once turned)");
+    MakeFaceAxes();
+    result_.lookups.resize(surface.size());
+    result_.patch_of.assign(surface.size(), -1);
+    values_.assign(surface.size() * static_cast<std::size_t>(features_), 0.0f);
+    synthesised_neighbours_.assign(surface.size(), 0);
+    result_.stats.random_pair_cost = RandomPairCost();
+  }
+
+  QuiltResult Run(const ProgressCallback& progress) {
+    const auto start = std::chrono::steady_clock::now();
+    for (std::size_t s = 0; s < surface_.size(); ++s) queue_.emplace(0, -static_cast<int>(s));
+    std::size_t done = 0, reported = 0;
+    const std::size_t total = surface_.size();
+    while (done < total) {
+      const int v = MostConstrained();
+      done += PlacePatchAt(v);
+      if (progress && (done * 100 / total > reported * 100 / total || done == total)) {
+        progress("quilting", done, total);
+        reported = done;
+      }
+    }
+    result_.stats.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return std::move(result_);
+  }
+
+ private:
+  // Per face, its atlas frame's axes in the world (x right, y up) and normal.
+  void MakeFaceAxes() {
+    for (std::size_t f = 0; f < layout_.faces.size(); ++f) {
+      const mesh::TriangleFrame& frame = surface_.FrameOf(static_cast<int>(f));
+      const double a = layout_.faces[f].AtlasFrameAngle();
+      const Eigen::Vector3d x = std::cos(a) * frame.x_axis + std::sin(a) * frame.y_axis;
+      atlas_x_.push_back(x);
+      atlas_y_.push_back(frame.z_axis.cross(x));
+      normal_.push_back(frame.z_axis);
+      field_in_chart_rad_.push_back(-a);  // the face frame's x axis, in the atlas frame
+    }
+  }
+
+  // T_c's unit: the mean cost of a cut between two unrelated texels of the
+  // sample, |f(p) - g(p)| + |f(q) - g(q)| with f, g at random positions.
+  double RandomPairCost() {
+    const RotatedCopy& copy = rotated_.Copy(0);
+    std::uniform_int_distribution<int> at(0, copy.side() - 1);
+    double sum = 0;
+    const int pairs = 512;
+    for (int i = 0; i < pairs; ++i) {
+      const int x0 = at(rng_), y0 = at(rng_), x1 = at(rng_), y1 = at(rng_);
+      double d2 = 0;
+      for (const cv::Mat& plane : copy.planes) {
+        const double d = plane.at<float>(y0, x0) - plane.at<float>(y1, x1);
+        d2 += d * d;
+      }
+      sum += 2 * std::sqrt(d2);
+    }
+    return sum / pairs;
+  }
+
+  // The unsynthesised sample with the most synthesised neighbours (paper 004
+  // Fig. 4), the lowest index among equals.
+  int MostConstrained() {
+    while (true) {
+      const auto [count, minus_s] = queue_.top();
+      queue_.pop();
+      const int s = -minus_s;
+      if (!result_.lookups[static_cast<std::size_t>(s)].synthesised &&
+          count == synthesised_neighbours_[static_cast<std::size_t>(s)])
+        return s;
+    }
+  }
+
+  // The hierarchical search: shrink r_w until the work image is flat enough and
+  // the seam cheap enough. Returns the samples newly synthesised.
+  std::size_t PlacePatchAt(int v) {
+    int levels = options_.work_patch_levels;
+    while (true) {
+      const bool smallest = levels <= options_.min_work_patch_levels;
+      WorkPatch patch;
+      BuildWorkPatch(v, levels, patch);
+      TEXLUME_CHECK(patch.fits || !smallest, "the smallest work patch outgrew the sample");
+      if (patch.fits && (patch.distortion <= options_.max_area_distortion || smallest)) {
+        const std::size_t placed = TryPatch(patch, smallest, levels);
+        if (placed > 0) return placed;
+      }
+      levels = std::max(options_.min_work_patch_levels,
+                        static_cast<int>(std::floor(levels * options_.shrink)));
+    }
+  }
+
+  // The work patch P(v): breadth-first, `levels` deep; each sample placed in
+  // the work image through its chart's rigid map (charts met across a border
+  // are turned by the angle between their atlas frames), with whether the
+  // image fits the sample's copies and its area distortion.
+  void BuildWorkPatch(int v, int levels, WorkPatch& patch) {
+    std::unordered_map<int, std::pair<double, Eigen::Vector2d>> chart_maps;  // angle, translation
+    const auto place = [&](int s, const Eigen::Vector2d& w, double angle) {
+      patch.local.emplace(s, static_cast<int>(patch.samples.size()));
+      patch.samples.push_back({s, w, angle});
+    };
+    const DenseSample& seed = surface_.samples()[static_cast<std::size_t>(v)];
+    chart_maps[seed.chart] = {0.0, -Centre(seed)};
+    place(v, Eigen::Vector2d::Zero(), 0.0);
+    std::vector<int> frontier{v}, next;
+    for (int level = 0; level < levels && !frontier.empty(); ++level) {
+      next.clear();
+      for (const int a : frontier)
+        for (const int b : surface_.Neighbours(a)) {
+          if (patch.local.count(b)) continue;
+          const PatchSample& pa = patch.samples[static_cast<std::size_t>(patch.local.at(a))];
+          const DenseSample& db = surface_.samples()[static_cast<std::size_t>(b)];
+          auto it = chart_maps.find(db.chart);
+          if (it == chart_maps.end()) {
+            const double angle = pa.chart_to_work_rad + TurnBetween(b, a);
+            const Eigen::Vector2d w = pa.w + PixelRotation(pa.chart_to_work_rad) * StepPx(a, b);
+            it = chart_maps
+                     .emplace(db.chart,
+                              std::make_pair(
+                                  angle, Eigen::Vector2d(w - PixelRotation(angle) * Centre(db))))
+                     .first;
+          }
+          const auto& [angle, t] = it->second;
+          const Eigen::Vector2d w = PixelRotation(angle) * Centre(db) + t;
+          // A chart met again where it does not join on (a rigid chart's crack,
+          // or a chart that winds round): b stays out of this patch.
+          if ((w - pa.w).norm() > kMostLinkPx) continue;
+          place(b, w, angle);
+          next.push_back(b);
+        }
+      frontier.swap(next);
+    }
+    patch.fits = FrameWorkImage(patch);
+    patch.distortion = AreaDistortion(patch);
+  }
+
+  static Eigen::Vector2d Centre(const DenseSample& d) { return {d.x + 0.5, d.y + 0.5}; }
+
+  // The step from a to b on the surface in a's atlas pixels (rows down).
+  Eigen::Vector2d StepPx(int a, int b) const {
+    const Eigen::Vector3d d = surface_.PointInWorld(b) - surface_.PointInWorld(a);
+    const int f = surface_.samples()[static_cast<std::size_t>(a)].face;
+    const double t = surface_.texel_size();
+    return {d.dot(atlas_x_[static_cast<std::size_t>(f)]) / t,
+            -d.dot(atlas_y_[static_cast<std::size_t>(f)]) / t};
+  }
+
+  // The angle (y up) that takes directions of b's atlas frame into a's: b's
+  // atlas x axis laid onto a's tangent plane.
+  double TurnBetween(int b, int a) const {
+    const auto fa = static_cast<std::size_t>(surface_.samples()[static_cast<std::size_t>(a)].face);
+    const auto fb = static_cast<std::size_t>(surface_.samples()[static_cast<std::size_t>(b)].face);
+    const Eigen::Vector3d x = atlas_x_[fb] - atlas_x_[fb].dot(normal_[fa]) * normal_[fa];
+    return std::atan2(x.dot(atlas_y_[fa]), x.dot(atlas_x_[fa]));
+  }
+
+  bool FrameWorkImage(WorkPatch& patch) const {
+    Eigen::Vector2d lo = patch.samples[0].w, hi = lo;
+    for (const PatchSample& p : patch.samples) lo = lo.cwiseMin(p.w), hi = hi.cwiseMax(p.w);
+    patch.origin = Eigen::Vector2d(std::floor(lo.x()), std::floor(lo.y()));
+    patch.width = static_cast<int>(std::floor(hi.x() - patch.origin.x())) + 1;
+    patch.height = static_cast<int>(std::floor(hi.y() - patch.origin.y())) + 1;
+    return patch.width <= rotated_.side() && patch.height <= rotated_.side();
+  }
+
+  // The largest (length in the work image / on the surface)^2, either way,
+  // over the patch's links.
+  double AreaDistortion(const WorkPatch& patch) const {
+    double worst = 1.0;
+    for (const PatchSample& p : patch.samples)
+      for (const int n : surface_.Neighbours(p.sample)) {
+        const auto it = patch.local.find(n);
+        if (it == patch.local.end() || n < p.sample) continue;
+        const double image = (patch.samples[static_cast<std::size_t>(it->second)].w - p.w).norm();
+        const double surface = (surface_.PointInWorld(n) - surface_.PointInWorld(p.sample)).norm() /
+                               surface_.texel_size();
+        if (!(image > 0) || !(surface > 0)) return std::numeric_limits<double>::infinity();
+        const double r = image / surface;
+        worst = std::max({worst, r * r, 1.0 / (r * r)});
+      }
+    return worst;
+  }
+
+  // Features of sample s turned from its chart's frame into the work frame
+  // (or back, with the opposite angle).
+  void Turn(float* f, double chart_to_work_rad) const {
+    synth::Unfolding turn;
+    turn.rotation = Eigen::Rotation2Dd(chart_to_work_rad).toRotationMatrix();
+    turn.coefficients_to_this = ptm::OrthonormalFrameRotation(-chart_to_work_rad);
+    sample_.TurnFeatures(turn, f);
+  }
+  float* ValuesOf(int s) {
+    return values_.data() + static_cast<std::size_t>(s) * static_cast<std::size_t>(features_);
+  }
+  bool Synthesised(int s) const { return result_.lookups[static_cast<std::size_t>(s)].synthesised; }
+
+  // Patch matching, fitting and, below T_c (or at the smallest r_w), commit.
+  std::size_t TryPatch(const WorkPatch& patch, bool smallest, int levels) {
+    const int rotation = ChooseRotation(patch);
+    const RotatedCopy& copy = rotated_.Copy(rotation);
+    const Placement placement = MatchPlacement(patch, copy);
+    const Fit fit = FitPatch(patch, copy, placement);
+    const double mean_cost = fit.cut_links ? fit.seam_cost / fit.cut_links : 0.0;
+    const bool cheap = mean_cost <= options_.seam_threshold * result_.stats.random_pair_cost;
+    if (!cheap && !smallest) return 0;
+    result_.stats.forced += !cheap;
+    ++result_.stats.accepted_at_levels[levels];
+    result_.stats.cut_links += fit.cut_links;
+    result_.stats.seam_cost += fit.seam_cost;
+    return Commit(patch, copy, fit);
+  }
+
+  // The sample's x axis along the patch's mean field orientation, or random.
+  int ChooseRotation(const WorkPatch& patch) {
+    if (options_.random_orientation)
+      return std::uniform_int_distribution<int>(0, RotatedSample::kRotations - 1)(rng_);
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const PatchSample& p : patch.samples) {
+      const int f = surface_.samples()[static_cast<std::size_t>(p.sample)].face;
+      const double a = field_in_chart_rad_[static_cast<std::size_t>(f)] + p.chart_to_work_rad;
+      mean += Eigen::Vector2d(std::cos(a), std::sin(a));
+    }
+    return RotatedSample::RotationNearest(std::atan2(mean.y(), mean.x()));
+  }
+
+  // Entire-patch matching against the synthesised part of the work image; a
+  // random placement when nothing is synthesised yet.
+  Placement MatchPlacement(const WorkPatch& patch, const RotatedCopy& copy) {
+    std::vector<cv::Mat> planes(static_cast<std::size_t>(features_));
+    for (cv::Mat& plane : planes) plane = cv::Mat::zeros(patch.height, patch.width, CV_32FC1);
+    cv::Mat mask = cv::Mat::zeros(patch.height, patch.width, CV_32FC1);
+    std::vector<float> f(static_cast<std::size_t>(features_));
+    for (const PatchSample& p : patch.samples) {
+      if (!Synthesised(p.sample)) continue;
+      const auto [x, y] = Pixel(patch, p);
+      if (mask.at<float>(y, x) > 0) continue;  // two samples on one pixel: the nearer to v
+      std::copy_n(ValuesOf(p.sample), features_, f.data());
+      Turn(f.data(), p.chart_to_work_rad);
+      for (int c = 0; c < features_; ++c)
+        planes[static_cast<std::size_t>(c)].at<float>(y, x) = f[static_cast<std::size_t>(c)];
+      mask.at<float>(y, x) = 1.0f;
+    }
+    if (cv::countNonZero(mask) > 0) return MatchEntirePatch(copy, planes, mask);
+    Placement random;
+    random.rotation = copy.rotation;
+    random.x = std::uniform_int_distribution<int>(0, copy.side() - patch.width)(rng_);
+    random.y = std::uniform_int_distribution<int>(0, copy.side() - patch.height)(rng_);
+    return random;
+  }
+
+  static std::pair<int, int> Pixel(const WorkPatch& patch, const PatchSample& p) {
+    return {
+        std::clamp(static_cast<int>(std::floor(p.w.x() - patch.origin.x())), 0, patch.width - 1),
+        std::clamp(static_cast<int>(std::floor(p.w.y() - patch.origin.y())), 0, patch.height - 1)};
+  }
+
+  struct Fit {
+    std::vector<Eigen::Vector2d> copy_px;  ///< per patch sample
+    std::vector<float> fresh;              ///< per patch sample, features in its chart's frame
+    std::vector<bool> take_new;
+    std::size_t cut_links = 0;
+    double seam_cost = 0;
+  };
+
+  // Patch fitting (paper 004 §III-B after Kwatra et al. 2003): a minimum cut
+  // over the patch's samples between the old values (A) and the copy's (B);
+  // unsynthesised samples must take B, synthesised ones next to synthesised
+  // samples outside the patch keep A. Old seams are not yet kept as nodes.
+  Fit FitPatch(const WorkPatch& patch, const RotatedCopy& copy, const Placement& placement) {
+    const std::size_t n = patch.samples.size(), nf = static_cast<std::size_t>(features_);
+    Fit fit;
+    fit.fresh.resize(n * nf);
+    for (std::size_t i = 0; i < n; ++i) {
+      const PatchSample& p = patch.samples[i];
+      fit.copy_px.push_back(Eigen::Vector2d(placement.x, placement.y) + p.w - patch.origin +
+                            Eigen::Vector2d(0.5, 0.5));
+      float* f = fit.fresh.data() + i * nf;
+      for (std::size_t c = 0; c < nf; ++c)
+        f[c] = Bilinear(copy.planes[c], fit.copy_px[i].x(), fit.copy_px[i].y());
+      Turn(f, -p.chart_to_work_rad);
+    }
+    // |A(s) - B(s)| per sample (0 where A is not synthesised).
+    std::vector<double> change(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!Synthesised(patch.samples[i].sample)) continue;
+      const float* a = ValuesOf(patch.samples[i].sample);
+      double d2 = 0;
+      for (std::size_t c = 0; c < nf; ++c) d2 += std::pow(a[c] - fit.fresh[i * nf + c], 2);
+      change[i] = std::sqrt(d2);
+    }
+    synth::MinCut cut(static_cast<int>(n), static_cast<int>(4 * n));
+    std::vector<std::array<std::size_t, 2>> links;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int s = patch.samples[i].sample;
+      bool keep = false;
+      for (const int nb : surface_.Neighbours(s)) {
+        const auto it = patch.local.find(nb);
+        if (it == patch.local.end()) {
+          keep = keep || (Synthesised(s) && Synthesised(nb));
+        } else if (nb > s) {
+          const auto j = static_cast<std::size_t>(it->second);
+          cut.Link(static_cast<int>(i), static_cast<int>(j), change[i] + change[j]);
+          links.push_back({i, j});
+        }
+      }
+      if (!Synthesised(s))
+        cut.Terminals(static_cast<int>(i), kForced, 0.0);  // must take B
+      else if (keep)
+        cut.Terminals(static_cast<int>(i), 0.0, kForced);  // must keep A
+    }
+    cut.Solve();
+    fit.take_new.resize(n);
+    for (std::size_t i = 0; i < n; ++i) fit.take_new[i] = !cut.IsA(static_cast<int>(i));
+    for (const auto& [i, j] : links)
+      if (fit.take_new[i] != fit.take_new[j]) {
+        ++fit.cut_links;
+        fit.seam_cost += change[i] + change[j];
+      }
+    return fit;
+  }
+
+  std::size_t Commit(const WorkPatch& patch, const RotatedCopy& copy, const Fit& fit) {
+    const int id = static_cast<int>(result_.stats.patches++);
+    const std::size_t nf = static_cast<std::size_t>(features_);
+    std::size_t fresh = 0;
+    for (std::size_t i = 0; i < patch.samples.size(); ++i) {
+      if (!fit.take_new[i]) continue;
+      const PatchSample& p = patch.samples[i];
+      std::copy_n(fit.fresh.data() + i * nf, nf, ValuesOf(p.sample));
+      SampleLookup& lookup = result_.lookups[static_cast<std::size_t>(p.sample)];
+      const Eigen::Vector2d sample_px = rotated_.SamplePosition(copy.rotation, fit.copy_px[i]);
+      lookup.sample_px = sample_px.cast<float>();
+      lookup.angle_rad = static_cast<float>(copy.angle_rad - p.chart_to_work_rad);
+      result_.patch_of[static_cast<std::size_t>(p.sample)] = id;
+      if (lookup.synthesised) continue;
+      lookup.synthesised = true;
+      ++fresh;
+      for (const int nb : surface_.Neighbours(p.sample)) {
+        if (Synthesised(nb)) continue;
+        queue_.emplace(++synthesised_neighbours_[static_cast<std::size_t>(nb)], -nb);
+      }
+    }
+    return fresh;
+  }
+
+  const DenseSurface& surface_;
+  const atlas::AtlasLayout& layout_;
+  const synth::MaterialSample& sample_;
+  const QuiltOptions options_;
+  RotatedSample rotated_;
+  const int features_;
+  std::mt19937_64 rng_;
+  std::vector<Eigen::Vector3d> atlas_x_, atlas_y_, normal_;
+  std::vector<double> field_in_chart_rad_;
+  std::vector<float> values_;  ///< per sample, its features in its chart's frame
+  std::vector<int> synthesised_neighbours_;
+  std::priority_queue<std::pair<int, int>> queue_;  ///< (count, -sample), stale entries skipped
+  QuiltResult result_;
+};
+
+}  // namespace
+
+QuiltResult QuiltSurface(const DenseSurface& surface, const atlas::AtlasLayout& layout,
+                         const synth::MaterialSample& sample, const QuiltOptions& options,
+                         const ProgressCallback& progress) {
+  options.Check();
+  if (surface.size() == 0) return {};
+  return SurfaceQuilter(surface, layout, sample, options).Run(progress);
+}
+
+}  // namespace texlume::quilt

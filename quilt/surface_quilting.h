@@ -1,0 +1,72 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <random>
+#include <vector>
+
+#include "core/progress.h"
+#include "quilt/dense_surface.h"
+#include "quilt/patch_matching.h"
+#include "synth/material_sample.h"
+
+// The quilting loop of paper 004 §III-B (Fig. 4) on a dense surface: pick the
+// most constrained sample, build the work patch and its work image, match the
+// whole (rotated) sample against the work image, fit the patch by a graph cut,
+// and accept it when the seam is cheap enough, or shrink the patch and retry.
+
+namespace texlume::quilt {
+
+struct QuiltOptions {
+  /// r_w: levels of the breadth-first work patch (paper: 32 for a 512^2 image).
+  int work_patch_levels = 32;
+  int min_work_patch_levels = 4;  ///< the hierarchical search stops here (paper)
+  double shrink = 0.8;            ///< r_w factor per retry (paper)
+  /// T_d: largest area distortion of a work image (paper: 4): a link's length
+  /// in the work image over its length on the surface, squared, either way.
+  double max_area_distortion = 4.0;
+  /// T_c: largest mean seam cost per cut link, as a fraction of the cost of a
+  /// cut between two unrelated sample texels (the sample's own feature spread).
+  double seam_threshold = 0.6;
+  /// Orientation: true turns each patch to a random one of the 72 rotations
+  /// (isotropic samples); false aligns the sample's x axis with each face
+  /// frame's x axis (the tangent field the patch geometry was made with).
+  bool random_orientation = false;
+  std::uint64_t seed = 1;
+  void Check() const;
+};
+
+/// What one dense sample shows: the sample position (texels, x right, y down,
+/// centres at +0.5) and how the sample is turned there, counter-clockwise from
+/// the sample's atlas frame (x right, y up).
+struct SampleLookup {
+  Eigen::Vector2f sample_px = Eigen::Vector2f::Zero();
+  float angle_rad = 0;
+  bool synthesised = false;
+};
+
+struct QuiltStats {
+  std::size_t patches = 0;
+  std::map<int, std::size_t> accepted_at_levels;  ///< r_w -> patches accepted there
+  std::size_t forced = 0;                         ///< accepted at the smallest r_w above T_c
+  std::size_t cut_links = 0;    ///< links whose two samples came from different patches
+  double seam_cost = 0;         ///< summed over the cut links (feature units)
+  double random_pair_cost = 0;  ///< T_c's unit: a cut between unrelated texels
+  double seconds = 0;
+};
+
+struct QuiltResult {
+  std::vector<SampleLookup> lookups;  ///< per dense sample
+  std::vector<int> patch_of;          ///< per dense sample: the patch that wrote it
+  QuiltStats stats;
+};
+
+/// Quilts `sample` over `surface`. `layout` is the layout the surface was built
+/// from (chart frames). Deterministic for a seed.
+QuiltResult QuiltSurface(const DenseSurface& surface, const atlas::AtlasLayout& layout,
+                         const synth::MaterialSample& sample, const QuiltOptions& options,
+                         const ProgressCallback& progress = {});
+
+}  // namespace texlume::quilt

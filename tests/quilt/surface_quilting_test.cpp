@@ -1,0 +1,136 @@
+#include "quilt/surface_quilting.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/errors.h"
+#include "datasets_synthetic/shapes.h"
+
+namespace texlume::quilt {
+namespace {
+
+// An LRGB PTM of smooth random coefficients (seeded): structure a seam shows.
+ptm::Ptm SmoothPtm(int side, unsigned seed) {
+  ptm::Ptm p;
+  p.Resize(ptm::PtmFormat::kLrgb, side, side);
+  cv::RNG rng(seed);
+  for (int m = 0; m < 6; ++m) {
+    cv::Mat coarse(side / 8, side / 8, CV_32FC1), plane;
+    rng.fill(coarse, cv::RNG::UNIFORM, -0.3, 0.3);
+    cv::resize(coarse, plane, cv::Size(side, side), 0, 0, cv::INTER_CUBIC);
+    for (int t = 0; t < side * side; ++t)
+      p.Coefficients(static_cast<std::size_t>(t))[m] =
+          plane.at<float>(t / side, t % side) + (m == 5 ? 0.5f : 0.0f);
+  }
+  std::fill(p.colour.begin(), p.colour.end(), 1.0f);
+  return p;
+}
+
+struct Surface {
+  synth::PatchGeometry geometry;
+  atlas::AtlasLayout layout;
+  DenseSurface dense;
+};
+
+Surface MakeSurface(const mesh::TriangleMesh& mesh, double texel, atlas::AtlasMode mode) {
+  Surface s;
+  s.geometry = synth::MakePatchGeometry(mesh, texel, 4, synth::TangentFrame::kFirstEdge,
+                                        Eigen::Vector3d::UnitZ());
+  atlas::AtlasOptions o;
+  o.mode = mode;
+  o.flattening = atlas::ChartFlattening::kRigid;
+  o.atlas_size = 512;
+  s.layout = atlas::LayoutAtlases(mesh, s.geometry.patches, s.geometry.unfoldings, texel, o);
+  s.dense = DenseSurface::Build(s.layout, s.geometry.patches, s.geometry.unfoldings, texel);
+  return s;
+}
+
+// Over the links, how much the two samples' distance in the sample differs
+// from their distance on the surface (texels): 0 where the texture runs on
+// without a seam or a stretch.
+double MeanLookupGap(const Surface& s, const QuiltResult& r, bool across_charts) {
+  double sum = 0;
+  int count = 0;
+  for (std::size_t a = 0; a < s.dense.size(); ++a)
+    for (const int b : s.dense.Neighbours(static_cast<int>(a))) {
+      const auto bi = static_cast<std::size_t>(b);
+      const bool crosses = s.dense.samples()[a].chart != s.dense.samples()[bi].chart;
+      if (crosses != across_charts || bi < a) continue;
+      const double in_sample =
+          (r.lookups[a].sample_px - r.lookups[bi].sample_px).cast<double>().norm();
+      const double on_surface =
+          (s.dense.PointInWorld(static_cast<int>(a)) - s.dense.PointInWorld(b)).norm() /
+          s.dense.texel_size();
+      sum += std::abs(in_sample - on_surface);
+      ++count;
+    }
+  return count ? sum / count : 0.0;
+}
+
+// One work patch large enough for the whole plane copies the sample onto it in
+// one piece: every sample synthesised, neighbours one texel apart in the sample.
+TEST(QuiltSurface, OnePatchCopiesTheSampleInOnePiece) {
+  const ptm::Ptm ptm = SmoothPtm(64, 1);
+  const synth::PtmSample sample(ptm);
+  const Surface s = MakeSurface(datasets::MakeGridPlane(2, 0.3), 0.01, atlas::AtlasMode::kCharts);
+  QuiltOptions o;
+  o.work_patch_levels = 64;
+  const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o);
+  EXPECT_EQ(r.stats.patches, 1u);
+  for (const SampleLookup& l : r.lookups) {
+    ASSERT_TRUE(l.synthesised);
+    EXPECT_GE(l.sample_px.x(), 0.0f);
+    EXPECT_LE(l.sample_px.x(), 64.0f);
+  }
+  EXPECT_LT(MeanLookupGap(s, r, false), 1e-4);
+}
+
+// Per-triangle boxes make every face a chart: one patch still runs across
+// their borders as across texels inside them (the charts' rigid maps).
+TEST(QuiltSurface, OnePatchRunsOnAcrossChartBorders) {
+  const ptm::Ptm ptm = SmoothPtm(64, 2);
+  const synth::PtmSample sample(ptm);
+  const Surface s =
+      MakeSurface(datasets::MakeGridPlane(2, 0.3), 0.01, atlas::AtlasMode::kPerTriangle);
+  ASSERT_GT(s.dense.chart_seam_links(), 0u);
+  QuiltOptions o;
+  o.work_patch_levels = 64;
+  const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o);
+  EXPECT_EQ(r.stats.patches, 1u);
+  EXPECT_LT(MeanLookupGap(s, r, false), 1e-4);
+  EXPECT_LT(MeanLookupGap(s, r, true), 1e-4);
+}
+
+// Small patches on a closed surface: everything synthesised, by many patches
+// whose seams cost less than cuts between unrelated texels; the same seed
+// gives the same result.
+TEST(QuiltSurface, SmallPatchesCoverAClosedSurfaceDeterministically) {
+  const ptm::Ptm ptm = SmoothPtm(64, 3);
+  const synth::PtmSample sample(ptm);
+  const Surface s = MakeSurface(datasets::MakeIcosphere(1, 0.25), 0.01, atlas::AtlasMode::kCharts);
+  QuiltOptions o;
+  o.work_patch_levels = 8;
+  const QuiltResult a = QuiltSurface(s.dense, s.layout, sample, o);
+  const QuiltResult b = QuiltSurface(s.dense, s.layout, sample, o);
+  EXPECT_GT(a.stats.patches, 5u);
+  for (std::size_t i = 0; i < a.lookups.size(); ++i) {
+    ASSERT_TRUE(a.lookups[i].synthesised);
+    ASSERT_EQ(a.lookups[i].sample_px, b.lookups[i].sample_px);
+  }
+  ASSERT_GT(a.stats.cut_links, 0u);
+  EXPECT_LT(a.stats.seam_cost / a.stats.cut_links, a.stats.random_pair_cost);
+}
+
+TEST(QuiltSurface, RefusesASampleSmallerThanTheSmallestPatch) {
+  const ptm::Ptm ptm = SmoothPtm(16, 4);  // copies of 11 texels
+  const synth::PtmSample sample(ptm);
+  const Surface s = MakeSurface(datasets::MakeGridPlane(1, 0.1), 0.01, atlas::AtlasMode::kCharts);
+  QuiltOptions o;
+  o.min_work_patch_levels = 6;
+  o.work_patch_levels = 8;
+  EXPECT_THROW(QuiltSurface(s.dense, s.layout, sample, o), InputError);
+}
+
+}  // namespace
+}  // namespace texlume::quilt
