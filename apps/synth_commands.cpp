@@ -13,7 +13,8 @@ namespace {
 
 // What the synth command reads besides the Options it binds directly.
 struct SynthWords {
-  std::string tangent_frame, prior_shrink, world_unit;
+  std::string tangent_frame, prior_shrink, world_unit, engine = "triangle",
+                                                       orientation = "face-frames";
   std::vector<double> tangent_field;
   bool best_view_only = false, no_additive = false, no_channel = false, no_detail = false,
        no_report = false, no_light_response = false, no_white_balance = false,
@@ -22,9 +23,10 @@ struct SynthWords {
 
 void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords& w) {
   pipeline::SynthJobOptions& j = o.job;
-  sub->add_option("--model", j.model_dir, "COLMAP model folder")->required();
-  sub->add_option("--images", j.images_dir, "the object photos")->required();
-  sub->add_option("--lights", j.lights_file, "object-lights JSON (docs/lights.md)")->required();
+  sub->add_option("--model", j.model_dir, "COLMAP model folder (required by --engine triangle)");
+  sub->add_option("--images", j.images_dir, "the object photos (required by --engine triangle)");
+  sub->add_option("--lights", j.lights_file,
+                  "object-lights JSON (docs/lights.md; required by --engine triangle)");
   sub->add_option("--mesh", j.mesh_file, "coarse mesh in the model's frame")->required();
   sub->add_option("--out", j.out_dir, "the model folder to write")->required();
   auto* sample =
@@ -66,6 +68,26 @@ void BindEngine(CLI::App* sub, synth::MeshSynthesisOptions& s, SynthWords& w) {
       ->delimiter(',')
       ->expected(3)
       ->excludes(frame);
+}
+
+// Graph-cut surface quilting (paper 004 §III, docs/quilting.md).
+void BindQuilting(CLI::App* sub, pipeline::QuiltJobOptions& q, SynthWords& w) {
+  sub->add_option("--engine", w.engine,
+                  "triangle (paper 003, from the photos) or graphcut (paper 004, no photos)")
+      ->check(OneOf({"triangle", "graphcut"}, "give triangle or graphcut"))
+      ->capture_default_str();
+  sub->add_option("--work-patch", q.quilt.work_patch_levels,
+                  "graphcut: r_w, breadth-first levels of the work patch")
+      ->capture_default_str();
+  sub->add_option("--seam-threshold", q.quilt.seam_threshold,
+                  "graphcut: T_c, the largest mean seam cost per cut link, as a share of a cut "
+                  "between unrelated texels")
+      ->capture_default_str();
+  sub->add_option("--orientation", w.orientation,
+                  "graphcut: the sample's x axis along each face frame's (face-frames) or "
+                  "turned at random per patch (random)")
+      ->check(OneOf({"face-frames", "random"}, "give face-frames or random"))
+      ->capture_default_str();
 }
 
 void BindCorrection(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords& w) {
@@ -127,6 +149,31 @@ void BindAtlas(CLI::App* sub, atlas::AtlasOptions& a, SynthWords& w) {
   sub->add_flag("--no-report", w.no_report, "do not write report.html");
 }
 
+// `--engine graphcut`: the quilting job's Options from the command's. What it
+// does not take yet is refused, not ignored.
+pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
+                                       const pipeline::SynthCommandOptions& o,
+                                       pipeline::QuiltJobOptions q) {
+  for (const char* name : {"--model", "--images", "--lights", "--btf"})
+    if (sub->count(name) > 0)
+      throw UsageError(std::string(name) +
+                       ": --engine graphcut takes a mesh and a PTM or colour sample only so far "
+                       "(docs/quilting.md)");
+  if (sub->count("--sample-texel-size") == 0)
+    throw UsageError(
+        "--sample-texel-size: give the sample's texel size in world units of the mesh");
+  q.mesh_file = o.job.mesh_file;
+  q.sample_file = o.job.sample_file;
+  q.out_dir = o.job.out_dir;
+  q.sample_texel_size = o.job.synthesis.sample_texel_size;
+  q.quilt.seed = o.job.synthesis.seed;
+  q.quilt.random_orientation = w.orientation == "random";
+  const atlas::ChartFlattening flattening = q.atlas.flattening;
+  q.atlas = o.job.atlas;
+  if (sub->count("--chart-flattening") == 0) q.atlas.flattening = flattening;
+  return q;
+}
+
 // The words and flags into the job's Options.
 void Resolve(const CLI::App* sub, const SynthWords& w, pipeline::SynthCommandOptions& o) {
   synth::MeshSynthesisOptions& s = o.job.synthesis;
@@ -152,6 +199,8 @@ void Resolve(const CLI::App* sub, const SynthWords& w, pipeline::SynthCommandOpt
   o.job.atlas.blend_strip = s.strip;
   o.job.write_report = !w.no_report;
   o.job.mm_per_world_unit = WorldUnitMm(w.world_unit);
+  for (const char* name : {"--model", "--images", "--lights"})
+    if (sub->count(name) == 0) throw UsageError(std::string(name) + " is required");
 }
 
 }  // namespace
@@ -168,9 +217,15 @@ void AddSynthCommand(CLI::App& app, CommandRunners& run) {
   BindEngine(sub, o->job.synthesis, *w);
   BindCorrection(sub, *o, *w);
   BindAtlas(sub, o->job.atlas, *w);
-  run[sub] = [sub, o, w](std::ostream& out, std::ostream& err) {
-    Resolve(sub, *w, *o);
+  auto q = std::make_shared<pipeline::QuiltJobOptions>();
+  BindQuilting(sub, *q, *w);
+  run[sub] = [sub, o, w, q](std::ostream& out, std::ostream& err) {
     ProgressBar bar;
+    if (w->engine == "graphcut") {
+      pipeline::RunQuiltCommandJob(QuiltJobFrom(sub, *w, *o, *q), out, err, bar.Callback());
+      return 0;
+    }
+    Resolve(sub, *w, *o);
     pipeline::RunSynthCommandJob(*o, out, err, bar.Callback());
     return 0;
   };

@@ -518,6 +518,19 @@ void RunSynthCommandJob(const SynthCommandOptions& options, std::ostream& out, s
       << (job.write_report ? " and report.html" : "") << ")\n";
 }
 
+void RunQuiltCommandJob(const QuiltJobOptions& options, std::ostream& out, std::ostream& err,
+                        const ProgressCallback& progress) {
+  const QuiltJobSummary s = RunQuiltJob(options, progress);
+  for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
+  const quilt::QuiltStats& q = s.stats;
+  out << "Quilted " << s.samples << " surface samples of " << s.faces << " triangles with "
+      << q.patches << " graph-cut patches (" << q.forced << " above the seam threshold; seam cost "
+      << (q.cut_links ? q.seam_cost / static_cast<double>(q.cut_links) / q.random_pair_cost : 0.0)
+      << " of an unrelated cut) into " << s.atlases << " atlas(es), " << s.charts
+      << " charts, occupancy " << s.occupancy << ", in " << s.seconds_total
+      << " s: " << options.out_dir.string() << " (see manifest.json)\n";
+}
+
 void RunRenderCommandJob(pipeline::RenderJobOptions o, bool baseline_asked, std::ostream& out,
                          std::ostream& err, const ProgressCallback& progress) {
   o.Check();

@@ -10,6 +10,7 @@
 
 #include "core/progress.h"
 #include "datasets_synthetic/scene.h"
+#include "pipeline/quilt_job.h"
 #include "pipeline/render_job.h"
 #include "pipeline/synth_job.h"
 #include "ptm/fit.h"
@@ -103,6 +104,10 @@ struct SynthCommandOptions {
   void Check() const;
 };
 void RunSynthCommandJob(const SynthCommandOptions& options, std::ostream& out, std::ostream& err,
+                        const ProgressCallback& progress = {});
+
+/// `texlume synth --engine graphcut`: RunQuiltJob, and a line of what it did.
+void RunQuiltCommandJob(const QuiltJobOptions& options, std::ostream& out, std::ostream& err,
                         const ProgressCallback& progress = {});
 
 /// `texlume render`: pipeline::RunRenderJob, drawing a BTF model folder as a BTF

@@ -32,6 +32,10 @@ namespace texlume::pipeline {
 namespace fs = std::filesystem;
 namespace {
 
+// The fewest sample texels across the mesh's bounding box for a texture to mean
+// anything: a larger texel size is a texel size in other units than the mesh's.
+constexpr double kMinTexelsAcrossMesh = 4.0;
+
 // Mean prior shrink over the photo-corrected patches (null when none was).
 nlohmann::json MeanPriorShrink(const synth::MeshSynthesis& synthesis) {
   double sum = 0.0;
@@ -52,9 +56,20 @@ synth::ColourSynthesisOptions ColourOptions(const synth::MeshSynthesisOptions& p
   return colour;
 }
 
-// The fewest sample texels across the mesh's bounding box for a texture to mean
-// anything: a larger texel size is a texel size in other units than the mesh's.
-constexpr double kMinTexelsAcrossMesh = 4.0;
+// The photos the job holds at once (float RGB and a luminance plane: 16 bytes a
+// pixel), against the memory limit.
+void RequirePhotoMemory(const sfm::Reconstruction& reconstruction, const sfm::ObjectLights& lights,
+                        const fs::path& images_dir) {
+  double pixels = 0.0;
+  for (const auto& [id, image] : reconstruction.images) {
+    if (!lights.contains(image.name)) continue;
+    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
+    pixels += static_cast<double>(camera.width) * static_cast<double>(camera.height);
+  }
+  RequireMemory(16.0 * pixels, "holding the photos", images_dir.string());
+}
+
+}  // namespace
 
 void RefuseSampleLargerThanMesh(const mesh::TriangleMesh& mesh, double sample_texel_size,
                                 const fs::path& mesh_path) {
@@ -73,21 +88,6 @@ void RefuseSampleLargerThanMesh(const mesh::TriangleMesh& mesh, double sample_te
                       " texels across it); give --sample-texel-size in the mesh's units");
   }
 }
-
-// The photos the job holds at once (float RGB and a luminance plane: 16 bytes a
-// pixel), against the memory limit.
-void RequirePhotoMemory(const sfm::Reconstruction& reconstruction, const sfm::ObjectLights& lights,
-                        const fs::path& images_dir) {
-  double pixels = 0.0;
-  for (const auto& [id, image] : reconstruction.images) {
-    if (!lights.contains(image.name)) continue;
-    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
-    pixels += static_cast<double>(camera.width) * static_cast<double>(camera.height);
-  }
-  RequireMemory(16.0 * pixels, "holding the photos", images_dir.string());
-}
-
-}  // namespace
 
 bool IsColourImage(const fs::path& path) {
   const std::string ext = LowerCaseExtension(path);

@@ -123,6 +123,12 @@ nlohmann::json EngineSummaryJson(const synth::TriangleSynthesis& synthesis);
 std::vector<std::pair<std::string, std::filesystem::path>> InputFiles(
     const SynthJobOptions& options, const std::filesystem::path& model_folder);
 
+/// Refuses a sample texel size that is not small against the mesh (fewer than 4
+/// texels across its bounding box: a texel size in other units than the mesh's),
+/// with an OptionError naming the mesh.
+void RefuseSampleLargerThanMesh(const mesh::TriangleMesh& mesh, double sample_texel_size,
+                                const std::filesystem::path& mesh_path);
+
 /// Refuses an output folder that exists and is not a texlume model folder
 /// (InputError naming it): a job never replaces anything else.
 void RefuseForeignModelFolder(const std::filesystem::path& out_dir);

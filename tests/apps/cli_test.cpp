@@ -5,6 +5,7 @@
 #include <chrono>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "datasets_synthetic/object_scene.h"
 #include "datasets_synthetic/scene.h"
@@ -541,6 +542,59 @@ TEST(Cli, SynthWithAColourSampleWritesAModelThatRenders) {
                     &out),
             1);
   EXPECT_NE(out.find("not_an_image.png"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
+}
+
+// Graph-cut quilting (issue 32, docs/quilting.md): a mesh and a sample, no photos.
+TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
+  TempDir tmp;
+  datasets::SceneOptions options = SmallBtfScene(8, 96, 40);
+  options.write_btf = false;
+  options.capture_size = 64;
+  options.focal_px = 90;
+  options.num_held_out_views = 1;
+  options.held_out_lights_per_view = 1;
+  options.material.texel_size = 0.01;
+  datasets::GenerateScene(options, tmp.path() / "scene");
+  const std::string scene = (tmp / "scene").string();
+  const std::string inputs =
+      " --engine graphcut --mesh " + scene +
+      "/object/mesh.ply --atlas-size 512 --sample-texel-size 0.01 --sample " + scene +
+      "/material/capture/rti_005.png --work-patch 16";
+  std::string out;
+  ASSERT_EQ(Texlume("synth" + inputs + " --out " + (tmp / "model").string(), &out), 0) << out;
+  EXPECT_NE(out.find("graph-cut patches"), std::string::npos) << out;
+  const nlohmann::json manifest =
+      nlohmann::json::parse(testing::ReadText(tmp / "model/manifest.json"));
+  EXPECT_EQ(manifest["settings"]["engine"], "graphcut");
+  EXPECT_EQ(manifest["settings"]["work_patch_levels"], 16);
+  EXPECT_GT(manifest["summary"]["dense_samples"].get<int>(), 1000);
+  EXPECT_GT(manifest["summary"]["patches"].get<int>(), 1);
+  EXPECT_LT(manifest["summary"]["seam_cost_per_cut_link"].get<double>(),
+            manifest["summary"]["unrelated_cut_cost"].get<double>());
+  const std::string held = scene + "/object/held_out";
+  ASSERT_EQ(Texlume("render --model " + (tmp / "model").string() + " --cameras " + held +
+                        "/sparse --lights " + held + "/lights.json --truth " + held +
+                        "/images --truth-masks " + held + "/masks --out " + (tmp / "r").string(),
+                    &out),
+            0)
+      << out;
+  const nlohmann::json render = nlohmann::json::parse(testing::ReadText(tmp / "r/render.json"));
+  EXPECT_GT(render["metrics"]["mean_psnr_db"].get<double>(), 10.0);
+  // Photos are not taken by this engine yet: refused, not ignored (2).
+  EXPECT_EQ(Texlume("synth" + inputs + " --model a --out " + (tmp / "bad").string(), &out), 2);
+  EXPECT_NE(out.find("--model"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth --engine graphcut --mesh m --sample s --out o", &out), 2);
+  EXPECT_NE(out.find("sample-texel-size"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth" + inputs + " --engine quilting --out o", &out), 2);
+  // A sample smaller than the smallest work patch: an input error naming it (1).
+  cv::imwrite((tmp / "tiny.png").string(), cv::Mat(12, 12, CV_8UC3, cv::Scalar(90, 120, 150)));
+  EXPECT_EQ(Texlume("synth --engine graphcut --mesh " + scene +
+                        "/object/mesh.ply --sample-texel-size 0.01 --sample " +
+                        (tmp / "tiny.png").string() + " --out " + (tmp / "bad").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("tiny.png"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
 }
 

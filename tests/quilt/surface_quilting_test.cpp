@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
+#include <set>
 
 #include "core/errors.h"
 #include "datasets_synthetic/shapes.h"
+#include "quilt/quilt_atlases.h"
 
 namespace texlume::quilt {
 namespace {
@@ -130,6 +132,45 @@ TEST(QuiltSurface, RefusesASampleSmallerThanTheSmallestPatch) {
   o.min_work_patch_levels = 6;
   o.work_patch_levels = 8;
   EXPECT_THROW(QuiltSurface(s.dense, s.layout, sample, o), InputError);
+}
+
+}  // namespace
+}  // namespace texlume::quilt
+
+namespace texlume::quilt {
+namespace {
+
+// The baked atlas turns each texel's light response with its lookup: a sample
+// lit most from its +x is, in the atlas, lit most from the direction the
+// sample's x axis takes there.
+TEST(BakeQuiltedAtlases, TurnsTheLightResponseWithTheLookup) {
+  ptm::Ptm lit;
+  lit.Resize(ptm::PtmFormat::kLrgb, 64, 64);
+  for (std::size_t t = 0; t < lit.NumTexels(); ++t) {
+    lit.Coefficients(t)[3] = 0.4f;
+    lit.Coefficients(t)[5] = 0.5f;
+  }
+  std::fill(lit.colour.begin(), lit.colour.end(), 1.0f);
+  const synth::PtmSample sample(lit);
+  const Surface s = MakeSurface(datasets::MakeGridPlane(2, 0.3), 0.01, atlas::AtlasMode::kCharts);
+  QuiltOptions o;
+  o.work_patch_levels = 8;
+  o.random_orientation = true;
+  const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o);
+  const atlas::Atlases atlases =
+      BakeQuiltedAtlases(s.dense, r, s.layout, s.geometry.patches, sample, 2);
+  ASSERT_EQ(atlases.ptms.size(), 1u);
+  std::set<int> angles;
+  for (std::size_t i = 0; i < s.dense.size(); ++i) {
+    const DenseSample& d = s.dense.samples()[i];
+    const ptm::Ptm& atlas = atlases.ptms[static_cast<std::size_t>(d.atlas)];
+    const float* a = atlas.Coefficients(static_cast<std::size_t>(d.y) * atlas.width + d.x);
+    const double angle = r.lookups[i].angle_rad;
+    EXPECT_NEAR(a[3], 0.4 * std::cos(angle), 1e-4);
+    EXPECT_NEAR(a[4], 0.4 * std::sin(angle), 1e-4);
+    angles.insert(static_cast<int>(std::lround(angle * 100)));
+  }
+  EXPECT_GT(angles.size(), 2u);  // several patches, turned differently
 }
 
 }  // namespace

@@ -1,0 +1,211 @@
+#include "pipeline/quilt_job.h"
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+#include "core/errors.h"
+#include "core/memory_budget.h"
+#include "core/timing.h"
+#include "mesh/mesh.h"
+#include "model/model_io.h"
+#include "pipeline/synth_job.h"
+#include "quilt/quilt_atlases.h"
+#include "synth/colour_sample.h"
+
+namespace texlume::pipeline {
+namespace fs = std::filesystem;
+
+void QuiltJobOptions::Check() const {
+  for (const auto& [path, what] :
+       {std::pair{&mesh_file, "--mesh"}, std::pair{&sample_file, "--sample"},
+        std::pair{&out_dir, "--out"}})
+    if (path->empty()) throw OptionError(std::string("synth --engine graphcut needs ") + what);
+  if (!(sample_texel_size > 0.0) || !std::isfinite(sample_texel_size))
+    throw OptionError("synth --engine graphcut needs --sample-texel-size > 0");
+  quilt.Check();
+  atlas.Check();
+}
+
+nlohmann::json QuiltJobOptions::ToJson() const {
+  return {{"engine", "graphcut"},
+          {"sample_texel_size", sample_texel_size},
+          {"work_patch_levels", quilt.work_patch_levels},
+          {"min_work_patch_levels", quilt.min_work_patch_levels},
+          {"work_patch_shrink", quilt.shrink},
+          {"max_area_distortion", quilt.max_area_distortion},
+          {"seam_threshold", quilt.seam_threshold},
+          {"orientation", quilt.random_orientation ? "random" : "face-frames"},
+          {"seed", quilt.seed},
+          {"atlas_size", atlas.atlas_size},
+          {"gutter", atlas.gutter},
+          {"chart_flattening", atlas::ChartFlatteningName(atlas.flattening)},
+          {"max_chart_stretch", atlas.max_chart_stretch}};
+}
+
+namespace {
+
+double SurfaceArea(const mesh::TriangleMesh& mesh) {
+  double area = 0;
+  for (const auto& f : mesh.faces) {
+    const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(f[0])];
+    area += 0.5 * (mesh.vertices[static_cast<std::size_t>(f[1])] - a)
+                      .cross(mesh.vertices[static_cast<std::size_t>(f[2])] - a)
+                      .norm();
+  }
+  return area;
+}
+
+// The job's steps, each a method (RunQuiltJob).
+class QuiltJob {
+ public:
+  QuiltJob(const QuiltJobOptions& options, const ProgressCallback& progress)
+      : options_(options), progress_(progress) {}
+
+  QuiltJobSummary Run() {
+    const auto start = std::chrono::steady_clock::now();
+    RefuseForeignModelFolder(options_.out_dir);
+    AnnounceStep(progress_, "reading the inputs");
+    Load();
+    LayOut();
+    Quilt();
+    Bake();
+    AnnounceStep(progress_, "writing the model folder");
+    Write();
+    summary_.seconds_total = SecondsSince(start);
+    return summary_;
+  }
+
+ private:
+  void Load() {
+    mesh::LoadedMesh loaded = mesh::LoadMesh(options_.mesh_file);
+    for (const std::string& problem : loaded.report.Problems())
+      summary_.warnings.push_back(options_.mesh_file.string() + ": " + problem);
+    mesh_ = std::move(loaded.mesh);
+    if (mesh_.faces.empty()) throw InputError(options_.mesh_file.string(), "has no triangles");
+    RefuseSampleLargerThanMesh(mesh_, options_.sample_texel_size, options_.mesh_file);
+    // Per dense sample: lookup, patch, features, links, index: about 64 bytes
+    // plus 4 per feature; the stretch of the charts adds up to 1.25^2.
+    const double samples = 1.6 * SurfaceArea(mesh_) / std::pow(options_.sample_texel_size, 2);
+    RequireMemory(samples * (64 + 4 * 18), "the dense surface",
+                  options_.mesh_file.string() + " at a texel size of " +
+                      std::to_string(options_.sample_texel_size));
+    sample_ = ReadSample(options_.sample_file);
+    RefuseSampleSmallerThanWorkPatch();
+    ptm_sample_ = std::make_unique<synth::PtmSample>(sample_.ptm);
+    if (!sample_.colour.empty())
+      colour_sample_ = std::make_unique<synth::ColourSample>(sample_.colour);
+    summary_.faces = mesh_.faces.size();
+  }
+
+  // The sample's rotated copies (quilt::RotatedSample) must hold the smallest
+  // work patch.
+  void RefuseSampleSmallerThanWorkPatch() const {
+    const int side = static_cast<int>(
+        std::floor(std::min(sample_.ptm.width, sample_.ptm.height) / std::numbers::sqrt2));
+    const int smallest = 2 * options_.quilt.min_work_patch_levels + 1;
+    if (side < std::max(smallest, 8))
+      throw InputError(options_.sample_file.string(),
+                       "is " + std::to_string(sample_.ptm.width) + " x " +
+                           std::to_string(sample_.ptm.height) +
+                           " texels; turned, it leaves squares of " + std::to_string(side) +
+                           ", smaller than the smallest work patch (" + std::to_string(smallest) +
+                           " texels a side)");
+  }
+
+  void LayOut() {
+    const auto start = std::chrono::steady_clock::now();
+    geometry_ = synth::MakePatchGeometry(mesh_, options_.sample_texel_size, 2,
+                                         synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
+    layout_ = atlas::LayoutAtlases(mesh_, geometry_.patches, geometry_.unfoldings,
+                                   options_.sample_texel_size, options_.atlas, progress_);
+    surface_ = quilt::DenseSurface::Build(layout_, geometry_.patches, geometry_.unfoldings,
+                                          options_.sample_texel_size);
+    summary_.samples = surface_.size();
+    summary_.links = surface_.links();
+    summary_.chart_seam_links = surface_.chart_seam_links();
+    summary_.seconds_layout = SecondsSince(start);
+  }
+
+  void Quilt() {
+    const synth::MaterialSample& matched =
+        colour_sample_ ? static_cast<const synth::MaterialSample&>(*colour_sample_) : *ptm_sample_;
+    result_ = quilt::QuiltSurface(surface_, layout_, matched, options_.quilt, progress_);
+    summary_.stats = result_.stats;
+    summary_.seconds_quilting = result_.stats.seconds;
+  }
+
+  void Bake() {
+    atlases_ = quilt::BakeQuiltedAtlases(surface_, result_, layout_, geometry_.patches,
+                                         *ptm_sample_, options_.atlas.gutter, progress_);
+    summary_.atlases = atlases_.ptms.size();
+    summary_.charts = static_cast<std::size_t>(atlases_.num_charts);
+    summary_.occupancy = atlases_.occupancy;
+    summary_.seconds_atlas = atlases_.seconds;
+  }
+
+  void Write() {
+    model::TexturedModel model;
+    model.mesh = mesh_;
+    model.atlases = atlases_.ptms;
+    for (const atlas::FacePlacement& fp : atlases_.faces) {
+      model.face_atlas.push_back(fp.atlas);
+      model.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
+                                 fp.corners_px[2].cast<float>()});
+    }
+    model::WriteModelFolder(options_.out_dir, model, Record());
+  }
+
+  nlohmann::json Record() const {
+    const quilt::QuiltStats& q = summary_.stats;
+    nlohmann::json accepted = nlohmann::json::object();
+    for (const auto& [levels, n] : q.accepted_at_levels) accepted[std::to_string(levels)] = n;
+    const double per_link = q.cut_links ? q.seam_cost / static_cast<double>(q.cut_links) : 0.0;
+    return {{"command", "synth"},
+            {"inputs",
+             {{"mesh", options_.mesh_file.string()}, {"sample", options_.sample_file.string()}}},
+            {"settings", options_.ToJson()},
+            {"summary",
+             {{"faces", summary_.faces},
+              {"dense_samples", summary_.samples},
+              {"links", summary_.links},
+              {"links_across_charts", summary_.chart_seam_links},
+              {"patches", q.patches},
+              {"accepted_at_work_patch_levels", accepted},
+              {"forced_patches", q.forced},
+              {"seam_cost_per_cut_link", per_link},
+              {"unrelated_cut_cost", q.random_pair_cost},
+              {"atlases", summary_.atlases},
+              {"charts", summary_.charts},
+              {"occupancy", summary_.occupancy}}},
+            {"warnings", summary_.warnings},
+            {"timings_s",
+             {{"layout", summary_.seconds_layout},
+              {"quilting", summary_.seconds_quilting},
+              {"quilting_per_patch",
+               summary_.seconds_quilting / std::max<double>(1.0, static_cast<double>(q.patches))},
+              {"atlas", summary_.seconds_atlas}}}};
+  }
+
+  const QuiltJobOptions& options_;
+  const ProgressCallback& progress_;
+  mesh::TriangleMesh mesh_;
+  Sample sample_;
+  std::unique_ptr<synth::PtmSample> ptm_sample_;
+  std::unique_ptr<synth::ColourSample> colour_sample_;
+  synth::PatchGeometry geometry_;
+  atlas::AtlasLayout layout_;
+  quilt::DenseSurface surface_;
+  quilt::QuiltResult result_;
+  atlas::Atlases atlases_;
+  QuiltJobSummary summary_;
+};
+
+}  // namespace
+
+QuiltJobSummary RunQuiltJob(const QuiltJobOptions& options, const ProgressCallback& progress) {
+  options.Check();
+  return QuiltJob(options, progress).Run();
+}
+
+}  // namespace texlume::pipeline

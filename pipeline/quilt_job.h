@@ -1,0 +1,52 @@
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "atlas/atlas.h"
+#include "core/progress.h"
+#include "quilt/surface_quilting.h"
+
+// `texlume synth --engine graphcut` (issue 32, docs/quilting.md): graph-cut
+// quilting of a sample over a mesh without photos (paper 004 §III), baked into
+// PTM atlases and written as a model folder.
+
+namespace texlume::pipeline {
+
+struct QuiltJobOptions {
+  std::filesystem::path mesh_file;
+  std::filesystem::path sample_file;  ///< PTM (.ptm, .exr) or colour image (ReadSample)
+  std::filesystem::path out_dir;      ///< the model folder written
+  double sample_texel_size = 0.0;     ///< world units per sample texel, > 0
+  quilt::QuiltOptions quilt;
+  /// The charts are the dense surface's geometry image: conformal by default.
+  atlas::AtlasOptions atlas = ConformalAtlas();
+  void Check() const;
+  nlohmann::json ToJson() const;
+
+  static atlas::AtlasOptions ConformalAtlas() {
+    atlas::AtlasOptions o;
+    o.flattening = atlas::ChartFlattening::kConformal;
+    return o;
+  }
+};
+
+struct QuiltJobSummary {
+  std::size_t faces = 0, samples = 0, links = 0, chart_seam_links = 0;
+  quilt::QuiltStats stats;
+  std::size_t atlases = 0, charts = 0;
+  double occupancy = 0.0;
+  std::vector<std::string> warnings;
+  double seconds_layout = 0, seconds_quilting = 0, seconds_atlas = 0, seconds_total = 0;
+};
+
+/// Reads the mesh and the sample, lays the faces out in charts, quilts the
+/// dense surface and writes the model folder (atomically). Throws InputError
+/// naming a bad file, OptionError for bad settings (a texel size the memory
+/// limit cannot hold is refused before anything is allocated, with the estimate).
+QuiltJobSummary RunQuiltJob(const QuiltJobOptions& options, const ProgressCallback& progress = {});
+
+}  // namespace texlume::pipeline

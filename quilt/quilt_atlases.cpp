@@ -1,0 +1,106 @@
+#include "quilt/quilt_atlases.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "ptm/coefficient_space.h"
+#include "synth/planar_synthesis.h"
+
+namespace texlume::quilt {
+namespace {
+
+// A face's atlas pixel coordinates of a point of its frame (atlas::FacePlacement).
+Eigen::Vector2d AtlasPx(const atlas::FacePlacement& fp, const Eigen::Vector2d& p_in_frame,
+                        double texel_size) {
+  const Eigen::Vector2d r = fp.linear * p_in_frame / texel_size;
+  return {fp.offset.x() + r.x(), fp.offset.y() - r.y()};
+}
+
+// The sample of the face's chart whose texel centre is nearest to px, within
+// `reach` texels; -1 when none is.
+int NearestSample(const DenseSurface& surface, const atlas::FacePlacement& fp,
+                  const Eigen::Vector2d& px, int reach) {
+  const int x0 = static_cast<int>(std::floor(px.x())), y0 = static_cast<int>(std::floor(px.y()));
+  const int own = surface.At(fp.atlas, x0, y0);
+  if (own >= 0 && surface.samples()[static_cast<std::size_t>(own)].chart == fp.chart) return own;
+  int best = -1;
+  double best_d2 = std::numeric_limits<double>::max();
+  for (int y = y0 - reach; y <= y0 + reach; ++y)
+    for (int x = x0 - reach; x <= x0 + reach; ++x) {
+      const int s = surface.At(fp.atlas, x, y);
+      if (s < 0 || surface.samples()[static_cast<std::size_t>(s)].chart != fp.chart) continue;
+      const double d2 = (Eigen::Vector2d(x + 0.5, y + 0.5) - px).squaredNorm();
+      if (d2 < best_d2) best_d2 = d2, best = s;
+    }
+  return best;
+}
+
+float BilinearClamped(const cv::Mat& plane, double x, double y) {
+  x = std::clamp(x - 0.5, 0.0, plane.cols - 1.0);
+  y = std::clamp(y - 0.5, 0.0, plane.rows - 1.0);
+  const int x0 = std::min(static_cast<int>(x), std::max(plane.cols - 2, 0));
+  const int y0 = std::min(static_cast<int>(y), std::max(plane.rows - 2, 0));
+  const int x1 = std::min(x0 + 1, plane.cols - 1), y1 = std::min(y0 + 1, plane.rows - 1);
+  const double fx = x - x0, fy = y - y0;
+  return static_cast<float>(
+      (1 - fy) * ((1 - fx) * plane.at<float>(y0, x0) + fx * plane.at<float>(y0, x1)) +
+      fy * ((1 - fx) * plane.at<float>(y1, x0) + fx * plane.at<float>(y1, x1)));
+}
+
+}  // namespace
+
+atlas::Atlases BakeQuiltedAtlases(const DenseSurface& surface, const QuiltResult& quilt,
+                                  const atlas::AtlasLayout& layout,
+                                  const std::vector<synth::TrianglePatch>& patches,
+                                  const synth::PtmSample& sample, int gutter,
+                                  const ProgressCallback& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  const double t = surface.texel_size();
+  const std::vector<cv::Mat>& values = sample.Values();
+  const int num_planes = static_cast<int>(values.size());
+  const int polynomials = sample.CoefficientPlanes() / 6;
+  atlas::BakedPlanes baked = atlas::BakeAtlasPlanes(
+      layout, t, gutter, num_planes,
+      [&](int face, const Eigen::Vector2d& p_in_frame, float* out) {
+        const atlas::FacePlacement& fp = layout.faces[static_cast<std::size_t>(face)];
+        const Eigen::Vector2d px = AtlasPx(fp, p_in_frame, t);
+        const int s = NearestSample(surface, fp, px, gutter + 2);
+        if (s < 0) {
+          std::fill_n(out, num_planes, 0.0f);
+          return;
+        }
+        const DenseSample& d = surface.samples()[static_cast<std::size_t>(s)];
+        const SampleLookup& lookup = quilt.lookups[static_cast<std::size_t>(s)];
+        // The sample is turned by `angle` against the atlas frame: an atlas
+        // offset (rows down) is the sample offset turned back by it.
+        const double a = lookup.angle_rad, c = std::cos(a), sn = std::sin(a);
+        const Eigen::Vector2d v = px - Eigen::Vector2d(d.x + 0.5, d.y + 0.5);
+        const Eigen::Vector2d at = lookup.sample_px.cast<double>() +
+                                   Eigen::Vector2d(c * v.x() - sn * v.y(), sn * v.x() + c * v.y());
+        for (int k = 0; k < num_planes; ++k)
+          out[k] = BilinearClamped(values[static_cast<std::size_t>(k)], at.x(), at.y());
+        const Eigen::Matrix<double, 6, 6> to_atlas = ptm::OrthonormalFrameRotation(-a);
+        for (int poly = 0; poly < polynomials; ++poly) {
+          Eigen::Matrix<double, 6, 1> o;
+          for (int i = 0; i < 6; ++i) o[i] = out[poly * 6 + i];
+          o = to_atlas * o;
+          for (int i = 0; i < 6; ++i) out[poly * 6 + i] = static_cast<float>(o[i]);
+        }
+      },
+      progress);
+  atlas::Atlases atlases;
+  atlases.num_charts = layout.num_charts;
+  atlases.flattening = layout.flattening;
+  atlases.faces = layout.faces;
+  atlases.stretch = atlas::MeasureStretch(patches, layout);
+  for (const std::vector<cv::Mat>& planes : baked.planes)
+    atlases.ptms.push_back(synth::FromOrthonormalPlanes(planes, sample.format()));
+  atlases.coverage = std::move(baked.coverage);
+  atlases.occupancy = baked.occupancy;
+  atlases.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return atlases;
+}
+
+}  // namespace texlume::quilt
