@@ -1,5 +1,6 @@
 // Graph-cut quilting benchmarks (issue 32).
 // Run: build/bench/quilt_bench [--sample S] [--ptm FILE] [--levels R] [--texel T]
+//                               [--compare MODEL_DIR]
 // Entire-patch matching (paper 004 §III-B) by FFT against brute force: a random
 // LRGB PTM sample of S x S texels (default 256) is turned to several of the 72
 // rotations; work images of 16, 32 and 64 texels a side, half synthesised (a
@@ -9,19 +10,30 @@
 // Then the quilting loop (paper 004 Fig. 4) over an icosphere of radius 0.5 (1280
 // faces) in conformal charts at texel T (default 0.004 world units), with the
 // PTM FILE (default: a smooth random 256^2 LRGB PTM) and work patches of R
-// levels (default 32): samples, patches accepted at each r_w, forced patches,
-// the mean seam cost per cut link against a cut between unrelated texels, time.
+// levels (default 32), against random placement (the same loop, patches placed at
+// random and always accepted): patches, time, forced patches, the mean seam cost
+// per cut link against a cut between unrelated texels, the share of the sample
+// reused, and the nearest-patch energy of the baked atlas (quilt/patch_energy.h;
+// also of the model folder MODEL_DIR's atlases, e.g. the per-triangle engine's
+// with the same sample); then the time from about 12k to 800k samples.
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <string>
 
 #include "datasets_synthetic/shapes.h"
+#include "model/model_io.h"
 #include "ptm/ptm_io.h"
+#include "quilt/patch_energy.h"
 #include "quilt/patch_matching.h"
+#include "quilt/quilt_atlases.h"
 #include "quilt/surface_quilting.h"
+#include "synth/planar_synthesis.h"
 
 using namespace texlume;
 
@@ -57,34 +69,124 @@ ptm::Ptm SmoothPtm(int side, unsigned seed) {
   return p;
 }
 
-void QuiltSphere(const ptm::Ptm& sample_ptm, int levels, double texel) {
-  const synth::PtmSample sample(sample_ptm);
-  const mesh::TriangleMesh mesh = datasets::MakeIcosphere(3, 0.5);
+// The share of the sample's texels that some surface sample shows.
+double SampleReused(const quilt::QuiltResult& r, int width, int height) {
+  std::vector<bool> used(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  for (const quilt::SampleLookup& l : r.lookups) {
+    const int x = std::clamp(static_cast<int>(l.sample_px.x()), 0, width - 1);
+    const int y = std::clamp(static_cast<int>(l.sample_px.y()), 0, height - 1);
+    used[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+         static_cast<std::size_t>(x)] = true;
+  }
+  return static_cast<double>(std::count(used.begin(), used.end(), true)) /
+         static_cast<double>(used.size());
+}
+
+// The nearest-patch energy of a model's PTM atlases against the sample.
+double AtlasEnergy(const std::vector<ptm::Ptm>& ptms, const std::vector<cv::Mat>& inside,
+                   quilt::RotatedSample& rotated) {
+  double sum = 0;
+  int windows = 0;
+  for (std::size_t a = 0; a < ptms.size(); ++a) {
+    std::vector<cv::Mat> planes = synth::ToOrthonormalPlanes(ptms[a]);
+    planes.resize(rotated.Copy(0).planes.size());  // the coefficients: the sample's features
+    const quilt::PatchEnergy e = quilt::NearestPatchEnergy(planes, inside[a], rotated);
+    sum += e.per_texel * e.windows;
+    windows += e.windows;
+  }
+  return windows ? sum / windows : 0.0;
+}
+
+// Texels inside the faces of a model read back (its texture coordinates).
+std::vector<cv::Mat> InsideMasks(const model::TexturedModel& m) {
+  std::vector<cv::Mat> inside;
+  for (const ptm::Ptm& p : m.atlases) inside.push_back(cv::Mat::zeros(p.height, p.width, CV_8UC1));
+  for (std::size_t f = 0; f < m.corner_px.size(); ++f) {
+    std::array<Eigen::Vector2d, 3> c;
+    for (int k = 0; k < 3; ++k)
+      c[static_cast<std::size_t>(k)] = m.corner_px[f][static_cast<std::size_t>(k)].cast<double>();
+    cv::Mat& mask = inside[static_cast<std::size_t>(m.face_atlas[f])];
+    for (int y = 0; y < mask.rows; ++y)
+      for (int x = 0; x < mask.cols; ++x)
+        if (mesh::SignedDistanceToTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5)) <= 0)
+          mask.at<std::uint8_t>(y, x) = 255;
+  }
+  return inside;
+}
+
+struct Quilted {
+  quilt::QuiltResult result;
+  atlas::Atlases atlases;
+  std::size_t samples = 0;
+};
+
+Quilted QuiltIcosphere(const synth::PtmSample& sample, int subdivisions, double texel,
+                       const quilt::QuiltOptions& q) {
+  const mesh::TriangleMesh mesh = datasets::MakeIcosphere(subdivisions, 0.5);
   const synth::PatchGeometry g = synth::MakePatchGeometry(
-      mesh, texel, 4, synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
+      mesh, texel, 2, synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
   atlas::AtlasOptions o;
   o.flattening = atlas::ChartFlattening::kConformal;
   const atlas::AtlasLayout layout = atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, texel, o);
-  auto t0 = std::chrono::steady_clock::now();
   const quilt::DenseSurface surface =
       quilt::DenseSurface::Build(layout, g.patches, g.unfoldings, texel);
-  const double build_s = Seconds(t0);
-  quilt::QuiltOptions q;
-  q.work_patch_levels = levels;
-  const quilt::QuiltResult r = quilt::QuiltSurface(surface, layout, sample, q);
-  std::printf("\nQuilting an icosphere (1280 faces, %d charts), sample %d x %d, texel %g:\n",
-              layout.num_charts, sample_ptm.width, sample_ptm.height, texel);
-  std::printf("- %zu samples, %zu links (%zu across charts); dense surface %.2f s\n",
-              surface.size(), surface.links(), surface.chart_seam_links(), build_s);
-  std::printf("- %zu patches, %.1f ms each, %.2f s in all; forced %zu\n", r.stats.patches,
-              1000 * r.stats.seconds / std::max<std::size_t>(r.stats.patches, 1), r.stats.seconds,
-              r.stats.forced);
-  std::printf("- accepted at r_w:");
-  for (const auto& [l, n] : r.stats.accepted_at_levels) std::printf(" %d: %zu;", l, n);
+  Quilted out;
+  out.samples = surface.size();
+  out.result = quilt::QuiltSurface(surface, layout, sample, q);
+  out.atlases = quilt::BakeQuiltedAtlases(surface, out.result, layout, g.patches, sample, 2);
+  return out;
+}
+
+void QuiltSphere(const ptm::Ptm& sample_ptm, int levels, double texel, const char* compare) {
+  const synth::PtmSample sample(sample_ptm);
+  quilt::RotatedSample rotated(sample);
   std::printf(
-      "\n- seam cost per cut link %.4f, a cut between unrelated texels %.4f (ratio %.2f)\n",
-      r.stats.seam_cost / std::max<std::size_t>(r.stats.cut_links, 1), r.stats.random_pair_cost,
-      r.stats.seam_cost / std::max<std::size_t>(r.stats.cut_links, 1) / r.stats.random_pair_cost);
+      "\nQuilting an icosphere of radius 0.5 (1280 faces, conformal charts), sample %d x %d, "
+      "texel %g, r_w %d:\n",
+      sample_ptm.width, sample_ptm.height, texel, levels);
+  std::printf(
+      "| | patches | ms per patch | s | forced | seam cost / unrelated cut | sample reused "
+      "| nearest-patch energy |\n|---|---|---|---|---|---|---|---|\n");
+  std::string accepted;
+  for (const bool random : {false, true}) {
+    quilt::QuiltOptions q;
+    q.work_patch_levels = levels;
+    q.random_placement = random;
+    const Quilted run = QuiltIcosphere(sample, 3, texel, q);
+    const quilt::QuiltStats& s = run.result.stats;
+    std::printf("| %s | %zu | %.1f | %.2f | %zu | %.2f | %.2f | %.4f |\n",
+                random ? "random placement" : "graph-cut quilting", s.patches,
+                1000 * s.seconds / std::max<std::size_t>(s.patches, 1), s.seconds, s.forced,
+                s.seam_cost / std::max<std::size_t>(s.cut_links, 1) / s.random_pair_cost,
+                SampleReused(run.result, sample_ptm.width, sample_ptm.height),
+                AtlasEnergy(run.atlases.ptms, run.atlases.coverage, rotated));
+    if (!random) {
+      accepted = "accepted at r_w:";
+      for (const auto& [l, n] : s.accepted_at_levels) {
+        char item[48];
+        std::snprintf(item, sizeof item, " %d: %zu;", l, n);
+        accepted += item;
+      }
+    }
+  }
+  std::printf("(graph-cut quilting %s)\n", accepted.c_str());
+  if (compare) {
+    const model::TexturedModel m = model::ReadModelFolder(compare);
+    std::printf("| the model folder %s | | | | | | | %.4f |\n", compare,
+                AtlasEnergy(m.atlases, InsideMasks(m), rotated));
+  }
+  std::printf("\nTime against the dense samples (graph-cut quilting, same sample and r_w):\n");
+  std::printf(
+      "| icosphere faces | samples | patches | s | us per sample |\n|---|---|---|---|---|\n");
+  for (const auto& [subdivisions, t] : {std::pair{3, 4 * texel}, std::pair{3, 2 * texel},
+                                        std::pair{3, texel}, std::pair{4, texel / 2}}) {
+    quilt::QuiltOptions q;
+    q.work_patch_levels = levels;
+    const Quilted run = QuiltIcosphere(sample, subdivisions, t, q);
+    std::printf("| %d | %zu | %zu | %.2f | %.1f |\n", 20 << (2 * subdivisions), run.samples,
+                run.result.stats.patches, run.result.stats.seconds,
+                1e6 * run.result.stats.seconds / static_cast<double>(run.samples));
+  }
 }
 
 }  // namespace
@@ -93,11 +195,13 @@ int main(int argc, char** argv) {
   int side = 256, levels = 32;
   double texel = 0.004;
   const char* ptm_file = nullptr;
+  const char* compare = nullptr;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--sample")) side = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--ptm")) ptm_file = argv[i + 1];
     if (!std::strcmp(argv[i], "--levels")) levels = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--texel")) texel = std::atof(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--compare")) compare = argv[i + 1];
   }
   const ptm::Ptm sample_ptm = RandomPtm(side, 1), work_ptm = RandomPtm(96, 2);
   const synth::PtmSample sample(sample_ptm), work_sample(work_ptm);
@@ -132,6 +236,6 @@ int main(int argc, char** argv) {
     std::printf("| %d x %d | %d | %d of %d | %.4f | %.4f | %.0fx |\n", w, w, positions, same,
                 trials, fft / trials, brute / trials, brute / fft);
   }
-  QuiltSphere(ptm_file ? ptm::ReadPtmFile(ptm_file) : SmoothPtm(256, 7), levels, texel);
+  QuiltSphere(ptm_file ? ptm::ReadPtmFile(ptm_file) : SmoothPtm(256, 7), levels, texel, compare);
   return 0;
 }

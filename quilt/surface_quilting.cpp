@@ -31,6 +31,7 @@ constexpr double kForced = 1e30;  ///< a t-link that a cut never takes
 /// Longest link a work image keeps (pixels): links are about a texel long
 /// (DenseSurface), a chart's stretch makes them at most twice that.
 constexpr double kMostLinkPx = 3.0;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // One sample of a work patch: where it lies in the work image (pixels, rows
 // down, continuous) and how its chart's atlas frame turns into the work frame
@@ -250,22 +251,23 @@ class SurfaceQuilter {
     return patch.width <= rotated_.side() && patch.height <= rotated_.side();
   }
 
-  // The largest (length in the work image / on the surface)^2, either way,
-  // over the patch's links.
+  // How much the work image stretches the patch's area: the summed squared
+  // link lengths in the image over those on the surface, either way round (1:
+  // none). Links shorter than a quarter texel on the surface are left out.
   double AreaDistortion(const WorkPatch& patch) const {
-    double worst = 1.0;
+    double image2 = 0, surface2 = 0;
     for (const PatchSample& p : patch.samples)
       for (const int n : surface_.Neighbours(p.sample)) {
         const auto it = patch.local.find(n);
         if (it == patch.local.end() || n < p.sample) continue;
-        const double image = (patch.samples[static_cast<std::size_t>(it->second)].w - p.w).norm();
         const double surface = (surface_.PointInWorld(n) - surface_.PointInWorld(p.sample)).norm() /
                                surface_.texel_size();
-        if (!(image > 0) || !(surface > 0)) return std::numeric_limits<double>::infinity();
-        const double r = image / surface;
-        worst = std::max({worst, r * r, 1.0 / (r * r)});
+        if (surface < 0.25) continue;
+        image2 += (patch.samples[static_cast<std::size_t>(it->second)].w - p.w).squaredNorm();
+        surface2 += surface * surface;
       }
-    return worst;
+    if (!(image2 > 0) || !(surface2 > 0)) return surface2 > 0 ? kInfinity : 1.0;
+    return std::max(image2 / surface2, surface2 / image2);
   }
 
   // Features of sample s turned from its chart's frame into the work frame
@@ -289,8 +291,8 @@ class SurfaceQuilter {
     const Fit fit = FitPatch(patch, copy, placement);
     const double mean_cost = fit.cut_links ? fit.seam_cost / fit.cut_links : 0.0;
     const bool cheap = mean_cost <= options_.seam_threshold * result_.stats.random_pair_cost;
-    if (!cheap && !smallest) return 0;
-    result_.stats.forced += !cheap;
+    if (!cheap && !smallest && !options_.random_placement) return 0;
+    result_.stats.forced += !cheap && !options_.random_placement;
     ++result_.stats.accepted_at_levels[levels];
     result_.stats.cut_links += fit.cut_links;
     result_.stats.seam_cost += fit.seam_cost;
@@ -327,7 +329,8 @@ class SurfaceQuilter {
         planes[static_cast<std::size_t>(c)].at<float>(y, x) = f[static_cast<std::size_t>(c)];
       mask.at<float>(y, x) = 1.0f;
     }
-    if (cv::countNonZero(mask) > 0) return MatchEntirePatch(copy, planes, mask);
+    if (cv::countNonZero(mask) > 0 && !options_.random_placement)
+      return MatchEntirePatch(copy, planes, mask);
     Placement random;
     random.rotation = copy.rotation;
     random.x = std::uniform_int_distribution<int>(0, copy.side() - patch.width)(rng_);

@@ -34,6 +34,9 @@ struct QuiltOptions {
   /// (isotropic samples); false aligns the sample's x axis with each face
   /// frame's x axis (the tangent field the patch geometry was made with).
   bool random_orientation = false;
+  /// A baseline, not the paper: each patch placed at random in the sample (no
+  /// matching) and accepted whatever its seam costs.
+  bool random_placement = false;
   std::uint64_t seed = 1;
   void Check() const;
 };

@@ -8,6 +8,7 @@
 
 #include "core/errors.h"
 #include "ptm/coefficient_space.h"
+#include "quilt/patch_energy.h"
 
 namespace texlume::quilt {
 namespace {
@@ -122,6 +123,35 @@ TEST(RotatedSample, RefusesASampleTooSmallToTurn) {
   const ptm::Ptm sample_ptm = RandomPtm(10, 40, 6);
   const synth::PtmSample sample(sample_ptm);
   EXPECT_THROW(RotatedSample{sample}, InputError);
+}
+
+}  // namespace
+}  // namespace texlume::quilt
+
+namespace texlume::quilt {
+namespace {
+
+// A window cut out of a turned copy is the sample itself: no energy. Noise of
+// the sample's spread is far from every window of the sample.
+TEST(NearestPatchEnergy, IsZeroForTheSampleAndLargeForNoise) {
+  const ptm::Ptm sample_ptm = RandomPtm(48, 48, 8);
+  const synth::PtmSample sample(sample_ptm);
+  RotatedSample rotated(sample);
+  const RotatedCopy& copy = rotated.Copy(12);
+  const std::vector<cv::Mat> texture = Crop(copy, cv::Rect(3, 4, 24, 24));
+  const cv::Mat inside(24, 24, CV_8UC1, cv::Scalar(255));
+  PatchEnergyOptions o;
+  o.windows = 6;
+  const PatchEnergy own = NearestPatchEnergy(texture, inside, rotated, o);
+  EXPECT_EQ(own.windows, 6);
+  EXPECT_LT(own.per_texel, 1e-6);
+  std::vector<cv::Mat> noise;
+  cv::RNG rng(9);
+  for (std::size_t c = 0; c < texture.size(); ++c) {
+    noise.emplace_back(24, 24, CV_32FC1);
+    rng.fill(noise.back(), cv::RNG::UNIFORM, -0.5, 0.5);
+  }
+  EXPECT_GT(NearestPatchEnergy(noise, inside, rotated, o).per_texel, 0.05);
 }
 
 }  // namespace
