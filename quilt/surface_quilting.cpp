@@ -348,17 +348,40 @@ class SurfaceQuilter {
     std::vector<Eigen::Vector2d> copy_px;  ///< per patch sample
     std::vector<float> fresh;              ///< per patch sample, features in its chart's frame
     std::vector<bool> take_new;
+    std::vector<std::array<std::size_t, 2>> links;  ///< patch-local (lo, hi), lo's sample < hi's
     std::size_t cut_links = 0;
     double seam_cost = 0;
   };
 
-  // Patch fitting (paper 004 §III-B after Kwatra et al. 2003): a minimum cut
-  // over the patch's samples between the old values (A) and the copy's (B);
-  // unsynthesised samples must take B, synthesised ones next to synthesised
-  // samples outside the patch keep A. Old seams are not yet kept as nodes.
-  Fit FitPatch(const WorkPatch& patch, const RotatedCopy& copy, const Placement& placement) {
+  // An old seam between two linked samples (Kwatra et al. 2003, §3.3): the
+  // patches on either side when it was cut, and what each patch shows on the
+  // other side (in that sample's chart frame).
+  struct OldSeam {
+    int patch_lo = -1, patch_hi = -1;
+    std::vector<float> hi_patch_at_lo, lo_patch_at_hi;
+  };
+  static std::uint64_t LinkKey(int lo, int hi) {
+    return (static_cast<std::uint64_t>(lo) << 32) | static_cast<std::uint32_t>(hi);
+  }
+  // The old seam on a link, when it is still there (both sides unchanged).
+  const OldSeam* SeamOn(int lo, int hi) const {
+    const auto it = old_seams_.find(LinkKey(lo, hi));
+    if (it == old_seams_.end()) return nullptr;
+    const OldSeam& seam = it->second;
+    const bool current = result_.patch_of[static_cast<std::size_t>(lo)] == seam.patch_lo &&
+                         result_.patch_of[static_cast<std::size_t>(hi)] == seam.patch_hi;
+    return current ? &seam : nullptr;
+  }
+  double Distance(const float* a, const float* b) const {
+    double d2 = 0;
+    for (int c = 0; c < features_; ++c) d2 += std::pow(static_cast<double>(a[c]) - b[c], 2);
+    return std::sqrt(d2);
+  }
+
+  // The copy's values at every sample of the patch, in the samples' chart frames.
+  void FreshValues(const WorkPatch& patch, const RotatedCopy& copy, const Placement& placement,
+                   Fit& fit) const {
     const std::size_t n = patch.samples.size(), nf = static_cast<std::size_t>(features_);
-    Fit fit;
     fit.fresh.resize(n * nf);
     for (std::size_t i = 0; i < n; ++i) {
       const PatchSample& p = patch.samples[i];
@@ -369,30 +392,60 @@ class SurfaceQuilter {
         f[c] = Bilinear(copy.planes[c], fit.copy_px[i].x(), fit.copy_px[i].y());
       Turn(f, -p.chart_to_work_rad);
     }
-    // |A(s) - B(s)| per sample (0 where A is not synthesised).
-    std::vector<double> change(n, 0.0);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!Synthesised(patch.samples[i].sample)) continue;
-      const float* a = ValuesOf(patch.samples[i].sample);
-      double d2 = 0;
-      for (std::size_t c = 0; c < nf; ++c) d2 += std::pow(a[c] - fit.fresh[i * nf + c], 2);
-      change[i] = std::sqrt(d2);
+  }
+
+  // Patch fitting (paper 004 §III-B after Kwatra et al. 2003): a minimum cut
+  // over the patch's samples between the old values (A) and the copy's (B),
+  // M(s, t, A, B) = |A(s) - B(s)| + |A(t) - B(t)|. Unsynthesised samples must
+  // take B; synthesised ones next to synthesised samples outside the patch keep
+  // A; an old seam on a link becomes a node between its two samples, tied to B
+  // by the old seam's cost, so a new cut pays for what it keeps of it.
+  Fit FitPatch(const WorkPatch& patch, const RotatedCopy& copy, const Placement& placement) {
+    const std::size_t n = patch.samples.size(), nf = static_cast<std::size_t>(features_);
+    Fit fit;
+    FreshValues(patch, copy, placement, fit);
+    const auto fresh = [&](std::size_t i) { return fit.fresh.data() + i * nf; };
+    const auto old = [&](std::size_t i) { return ValuesOf(patch.samples[i].sample); };
+    std::vector<double> change(n, 0.0);  // |A(s) - B(s)|, 0 where A is not synthesised
+    for (std::size_t i = 0; i < n; ++i)
+      if (Synthesised(patch.samples[i].sample)) change[i] = Distance(old(i), fresh(i));
+    std::vector<std::pair<std::size_t, const OldSeam*>> seams;  // link index, seam
+    for (std::size_t i = 0; i < n; ++i)
+      for (const int nb : surface_.Neighbours(patch.samples[i].sample)) {
+        const auto it = patch.local.find(nb);
+        if (it == patch.local.end() || nb < patch.samples[i].sample) continue;
+        fit.links.push_back({i, static_cast<std::size_t>(it->second)});
+        if (const OldSeam* seam = SeamOn(patch.samples[i].sample, nb))
+          seams.emplace_back(fit.links.size() - 1, seam);
+      }
+    synth::MinCut cut(static_cast<int>(n + seams.size()),
+                      static_cast<int>(fit.links.size() + 2 * seams.size()));
+    std::vector<std::array<double, 2>> seam_costs(fit.links.size(),
+                                                  {0.0, 0.0});  // M(A_lo,B), M(A_hi,B)
+    std::size_t next_seam = 0;
+    for (std::size_t k = 0; k < fit.links.size(); ++k) {
+      const auto [i, j] = fit.links[k];
+      if (next_seam < seams.size() && seams[next_seam].first == k) {
+        const OldSeam& seam = *seams[next_seam].second;
+        const int node = static_cast<int>(n + next_seam++);
+        const double lo_b = change[i] + Distance(seam.lo_patch_at_hi.data(), fresh(j));
+        const double hi_b = Distance(seam.hi_patch_at_lo.data(), fresh(i)) + change[j];
+        const double lo_hi = Distance(old(i), seam.hi_patch_at_lo.data()) +
+                             Distance(seam.lo_patch_at_hi.data(), old(j));
+        cut.Link(static_cast<int>(i), node, lo_b);
+        cut.Link(node, static_cast<int>(j), hi_b);
+        cut.Terminals(node, lo_hi, 0.0);
+        seam_costs[k] = {lo_b, hi_b};
+      } else {
+        cut.Link(static_cast<int>(i), static_cast<int>(j), change[i] + change[j]);
+        seam_costs[k] = {change[i] + change[j], change[i] + change[j]};
+      }
     }
-    synth::MinCut cut(static_cast<int>(n), static_cast<int>(4 * n));
-    std::vector<std::array<std::size_t, 2>> links;
     for (std::size_t i = 0; i < n; ++i) {
       const int s = patch.samples[i].sample;
       bool keep = false;
-      for (const int nb : surface_.Neighbours(s)) {
-        const auto it = patch.local.find(nb);
-        if (it == patch.local.end()) {
-          keep = keep || (Synthesised(s) && Synthesised(nb));
-        } else if (nb > s) {
-          const auto j = static_cast<std::size_t>(it->second);
-          cut.Link(static_cast<int>(i), static_cast<int>(j), change[i] + change[j]);
-          links.push_back({i, j});
-        }
-      }
+      for (const int nb : surface_.Neighbours(s))
+        keep = keep || (!patch.local.count(nb) && Synthesised(s) && Synthesised(nb));
       if (!Synthesised(s))
         cut.Terminals(static_cast<int>(i), kForced, 0.0);  // must take B
       else if (keep)
@@ -401,16 +454,51 @@ class SurfaceQuilter {
     cut.Solve();
     fit.take_new.resize(n);
     for (std::size_t i = 0; i < n; ++i) fit.take_new[i] = !cut.IsA(static_cast<int>(i));
-    for (const auto& [i, j] : links)
-      if (fit.take_new[i] != fit.take_new[j]) {
-        ++fit.cut_links;
-        fit.seam_cost += change[i] + change[j];
-      }
+    for (std::size_t k = 0; k < fit.links.size(); ++k) {
+      const auto [i, j] = fit.links[k];
+      if (fit.take_new[i] == fit.take_new[j]) continue;
+      ++fit.cut_links;  // the new seam lies between B and the kept side's patch
+      fit.seam_cost += fit.take_new[i] ? seam_costs[k][1] : seam_costs[k][0];
+    }
     return fit;
+  }
+
+  // The seams the accepted cut leaves, remembered with what each side's patch
+  // shows across them (only where both values are known).
+  void RememberSeams(const WorkPatch& patch, const Fit& fit, int id) {
+    const std::size_t nf = static_cast<std::size_t>(features_);
+    for (const auto& [i, j] : fit.links) {
+      if (fit.take_new[i] == fit.take_new[j]) continue;
+      const std::size_t fresh_side = fit.take_new[i] ? i : j, kept = fit.take_new[i] ? j : i;
+      const int s_new = patch.samples[fresh_side].sample, s_kept = patch.samples[kept].sample;
+      // The kept side's patch at the new sample: its old value when that patch
+      // was there, or what an old seam on this link remembers of it.
+      if (!Synthesised(s_new)) continue;
+      const float* kept_at_new = nullptr;
+      if (result_.patch_of[static_cast<std::size_t>(s_new)] ==
+          result_.patch_of[static_cast<std::size_t>(s_kept)]) {
+        kept_at_new = ValuesOf(s_new);
+      } else if (const OldSeam* old = SeamOn(std::min(s_new, s_kept), std::max(s_new, s_kept))) {
+        kept_at_new = (s_new < s_kept ? old->hi_patch_at_lo : old->lo_patch_at_hi).data();
+      } else {
+        continue;
+      }
+      const float* new_at_kept = fit.fresh.data() + kept * nf;
+      OldSeam seam;
+      const bool new_is_lo = s_new < s_kept;
+      seam.patch_lo = new_is_lo ? id : result_.patch_of[static_cast<std::size_t>(s_kept)];
+      seam.patch_hi = new_is_lo ? result_.patch_of[static_cast<std::size_t>(s_kept)] : id;
+      seam.hi_patch_at_lo.assign(new_is_lo ? kept_at_new : new_at_kept,
+                                 (new_is_lo ? kept_at_new : new_at_kept) + nf);
+      seam.lo_patch_at_hi.assign(new_is_lo ? new_at_kept : kept_at_new,
+                                 (new_is_lo ? new_at_kept : kept_at_new) + nf);
+      old_seams_[LinkKey(std::min(s_new, s_kept), std::max(s_new, s_kept))] = std::move(seam);
+    }
   }
 
   std::size_t Commit(const WorkPatch& patch, const RotatedCopy& copy, const Fit& fit) {
     const int id = static_cast<int>(result_.stats.patches++);
+    RememberSeams(patch, fit, id);
     const std::size_t nf = static_cast<std::size_t>(features_);
     std::size_t fresh = 0;
     for (std::size_t i = 0; i < patch.samples.size(); ++i) {
@@ -445,6 +533,7 @@ class SurfaceQuilter {
   std::vector<float> values_;  ///< per sample, its features in its chart's frame
   std::vector<int> synthesised_neighbours_;
   std::priority_queue<std::pair<int, int>> queue_;  ///< (count, -sample), stale entries skipped
+  std::unordered_map<std::uint64_t, OldSeam> old_seams_;  ///< by LinkKey(lo, hi)
   QuiltResult result_;
 };
 
