@@ -13,8 +13,7 @@ namespace {
 
 // What the synth command reads besides the Options it binds directly.
 struct SynthWords {
-  std::string tangent_frame, prior_shrink, world_unit, engine = "triangle",
-                                                       orientation = "face-frames";
+  std::string tangent_frame, prior_shrink, world_unit, engine = "triangle", orientation = "field";
   std::vector<double> tangent_field;
   bool best_view_only = false, no_additive = false, no_channel = false, no_detail = false,
        no_report = false, no_light_response = false, no_white_balance = false,
@@ -84,10 +83,13 @@ void BindQuilting(CLI::App* sub, pipeline::QuiltJobOptions& q, SynthWords& w) {
                   "between unrelated texels")
       ->capture_default_str();
   sub->add_option("--orientation", w.orientation,
-                  "graphcut: the sample's x axis along each face frame's (face-frames) or "
-                  "turned at random per patch (random)")
-      ->check(OneOf({"face-frames", "random"}, "give face-frames or random"))
+                  "graphcut: the sample's x axis along the field (--field, or --tangent-field "
+                  "laid on every face, default 0,0,1) or turned at random per patch")
+      ->check(OneOf({"field", "random"}, "give field or random"))
       ->capture_default_str();
+  sub->add_option("--field", q.field_file,
+                  "graphcut: key vectors orienting the sample (docs/quilting.md, \"The field "
+                  "file\")");
 }
 
 void BindCorrection(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords& w) {
@@ -154,11 +156,34 @@ void BindAtlas(CLI::App* sub, atlas::AtlasOptions& a, SynthWords& w) {
 pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
                                        const pipeline::SynthCommandOptions& o,
                                        pipeline::QuiltJobOptions q) {
-  for (const char* name : {"--model", "--images", "--lights", "--btf"})
+  for (const char* name : {"--model",
+                           "--images",
+                           "--lights",
+                           "--btf",
+                           "--components",
+                           "--seam-band",
+                           "--strip",
+                           "--top-k",
+                           "--best-view-only",
+                           "--max-views",
+                           "--tangent-frame",
+                           "--max-subdivisions",
+                           "--max-buffer-size",
+                           "--correction-iterations",
+                           "--correction-noise",
+                           "--correction-sigma",
+                           "--correction-prior-shrink",
+                           "--no-additive-correction",
+                           "--no-channel-correction",
+                           "--no-detail-transfer",
+                           "--no-light-response",
+                           "--no-white-balance",
+                           "--no-photo-blur",
+                           "--no-report",
+                           "--world-unit"})
     if (sub->count(name) > 0)
       throw UsageError(std::string(name) +
-                       ": --engine graphcut takes a mesh and a PTM or colour sample only so far "
-                       "(docs/quilting.md)");
+                       " is not taken by --engine graphcut so far (docs/quilting.md)");
   if (sub->count("--sample-texel-size") == 0)
     throw UsageError(
         "--sample-texel-size: give the sample's texel size in world units of the mesh");
@@ -168,6 +193,9 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
   q.sample_texel_size = o.job.synthesis.sample_texel_size;
   q.quilt.seed = o.job.synthesis.seed;
   q.quilt.random_orientation = w.orientation == "random";
+  if (!w.tangent_field.empty())
+    q.field_direction_in_world =
+        Eigen::Vector3d(w.tangent_field[0], w.tangent_field[1], w.tangent_field[2]);
   const atlas::ChartFlattening flattening = q.atlas.flattening;
   q.atlas = o.job.atlas;
   if (sub->count("--chart-flattening") == 0) q.atlas.flattening = flattening;
@@ -176,6 +204,10 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
 
 // The words and flags into the job's Options.
 void Resolve(const CLI::App* sub, const SynthWords& w, pipeline::SynthCommandOptions& o) {
+  for (const char* name : {"--model", "--images", "--lights"})
+    if (sub->count(name) == 0) throw UsageError(std::string(name) + " is required");
+  for (const char* name : {"--work-patch", "--seam-threshold", "--orientation", "--field"})
+    if (sub->count(name) > 0) throw UsageError(std::string(name) + " is for --engine graphcut");
   synth::MeshSynthesisOptions& s = o.job.synthesis;
   if (o.btf.empty() && sub->count("--sample-texel-size") == 0)
     throw UsageError(
@@ -199,8 +231,6 @@ void Resolve(const CLI::App* sub, const SynthWords& w, pipeline::SynthCommandOpt
   o.job.atlas.blend_strip = s.strip;
   o.job.write_report = !w.no_report;
   o.job.mm_per_world_unit = WorldUnitMm(w.world_unit);
-  for (const char* name : {"--model", "--images", "--lights"})
-    if (sub->count(name) == 0) throw UsageError(std::string(name) + " is required");
 }
 
 }  // namespace

@@ -90,7 +90,9 @@ double AtlasEnergy(const std::vector<ptm::Ptm>& ptms, const std::vector<cv::Mat>
   for (std::size_t a = 0; a < ptms.size(); ++a) {
     std::vector<cv::Mat> planes = synth::ToOrthonormalPlanes(ptms[a]);
     planes.resize(rotated.Copy(0).planes.size());  // the coefficients: the sample's features
-    const quilt::PatchEnergy e = quilt::NearestPatchEnergy(planes, inside[a], rotated);
+    quilt::PatchEnergyOptions o;
+    o.windows = 192;
+    const quilt::PatchEnergy e = quilt::NearestPatchEnergy(planes, inside[a], rotated, o);
     sum += e.per_texel * e.windows;
     windows += e.windows;
   }
@@ -148,19 +150,23 @@ void QuiltSphere(const ptm::Ptm& sample_ptm, int levels, double texel, const cha
       "| | patches | ms per patch | s | forced | seam cost / unrelated cut | sample reused "
       "| nearest-patch energy |\n|---|---|---|---|---|---|---|---|\n");
   std::string accepted;
-  for (const bool random : {false, true}) {
+  for (const int run_kind : {0, 1, 2}) {
+    const bool random = run_kind == 2;
     quilt::QuiltOptions q;
     q.work_patch_levels = levels;
     q.random_placement = random;
+    q.keep_old_seams = run_kind != 1;
     const Quilted run = QuiltIcosphere(sample, 3, texel, q);
     const quilt::QuiltStats& s = run.result.stats;
     std::printf("| %s | %zu | %.1f | %.2f | %zu | %.2f | %.2f | %.4f |\n",
-                random ? "random placement" : "graph-cut quilting", s.patches,
-                1000 * s.seconds / std::max<std::size_t>(s.patches, 1), s.seconds, s.forced,
-                s.seam_cost / std::max<std::size_t>(s.cut_links, 1) / s.random_pair_cost,
+                run_kind == 0   ? "graph-cut quilting"
+                : run_kind == 1 ? "graph-cut, old seams not kept"
+                                : "random placement",
+                s.patches, 1000 * s.seconds / std::max<std::size_t>(s.patches, 1), s.seconds,
+                s.forced, s.seam_cost / std::max<std::size_t>(s.cut_links, 1) / s.random_pair_cost,
                 SampleReused(run.result, sample_ptm.width, sample_ptm.height),
                 AtlasEnergy(run.atlases.ptms, run.atlases.coverage, rotated));
-    if (!random) {
+    if (run_kind == 0) {
       accepted = "accepted at r_w:";
       for (const auto& [l, n] : s.accepted_at_levels) {
         char item[48];
@@ -220,9 +226,8 @@ int main(int argc, char** argv) {
       std::vector<cv::Mat> work;
       for (const cv::Mat& plane : work_copy.planes) work.push_back(plane(cv::Rect(0, 0, w, w)));
       cv::Mat mask(w, w, CV_32FC1);
-      rng.fill(mask, cv::RNG::UNIFORM, 0, 2);
-      mask.convertTo(mask, CV_32S);
-      mask.convertTo(mask, CV_32F);
+      rng.fill(mask, cv::RNG::UNIFORM, 0, 1);
+      cv::threshold(mask, mask, 0.5, 1.0, cv::THRESH_BINARY);  // half synthesised
       auto t0 = std::chrono::steady_clock::now();
       const quilt::Placement a = quilt::MatchEntirePatch(copy, work, mask);
       fft += Seconds(t0);

@@ -11,6 +11,7 @@
 #include "model/model_io.h"
 #include "pipeline/synth_job.h"
 #include "quilt/quilt_atlases.h"
+#include "quilt/vector_field.h"
 #include "synth/colour_sample.h"
 
 namespace texlume::pipeline {
@@ -24,23 +25,33 @@ void QuiltJobOptions::Check() const {
   if (!(sample_texel_size > 0.0) || !std::isfinite(sample_texel_size))
     throw OptionError("synth --engine graphcut needs --sample-texel-size > 0");
   quilt.Check();
+  if (quilt.random_orientation && !field_file.empty())
+    throw OptionError("give --field or --orientation random, not both");
+  if (!field_direction_in_world.allFinite() || !(field_direction_in_world.norm() > 0))
+    throw OptionError("--tangent-field must be a non-zero direction");
   atlas.Check();
 }
 
 nlohmann::json QuiltJobOptions::ToJson() const {
-  return {{"engine", "graphcut"},
-          {"sample_texel_size", sample_texel_size},
-          {"work_patch_levels", quilt.work_patch_levels},
-          {"min_work_patch_levels", quilt.min_work_patch_levels},
-          {"work_patch_shrink", quilt.shrink},
-          {"max_area_distortion", quilt.max_area_distortion},
-          {"seam_threshold", quilt.seam_threshold},
-          {"orientation", quilt.random_orientation ? "random" : "face-frames"},
-          {"seed", quilt.seed},
-          {"atlas_size", atlas.atlas_size},
-          {"gutter", atlas.gutter},
-          {"chart_flattening", atlas::ChartFlatteningName(atlas.flattening)},
-          {"max_chart_stretch", atlas.max_chart_stretch}};
+  return {
+      {"engine", "graphcut"},
+      {"sample_texel_size", sample_texel_size},
+      {"work_patch_levels", quilt.work_patch_levels},
+      {"min_work_patch_levels", quilt.min_work_patch_levels},
+      {"work_patch_shrink", quilt.shrink},
+      {"max_area_distortion", quilt.max_area_distortion},
+      {"seam_threshold", quilt.seam_threshold},
+      {"orientation", quilt.random_orientation ? "random"
+                      : field_file.empty()     ? "world-direction"
+                                               : "field"},
+      {"field_direction_in_world",
+       {field_direction_in_world.x(), field_direction_in_world.y(), field_direction_in_world.z()}},
+      {"field", field_file.empty() ? nlohmann::json(nullptr) : nlohmann::json(field_file.string())},
+      {"seed", quilt.seed},
+      {"atlas_size", atlas.atlas_size},
+      {"gutter", atlas.gutter},
+      {"chart_flattening", atlas::ChartFlatteningName(atlas.flattening)},
+      {"max_chart_stretch", atlas.max_chart_stretch}};
 }
 
 namespace {
@@ -60,7 +71,7 @@ double SurfaceArea(const mesh::TriangleMesh& mesh) {
 class QuiltJob {
  public:
   QuiltJob(const QuiltJobOptions& options, const ProgressCallback& progress)
-      : options_(options), progress_(progress) {}
+      : options_(options), progress_(progress), quilt_options_(options.quilt) {}
 
   QuiltJobSummary Run() {
     const auto start = std::chrono::steady_clock::now();
@@ -85,13 +96,19 @@ class QuiltJob {
     if (mesh_.faces.empty()) throw InputError(options_.mesh_file.string(), "has no triangles");
     RefuseSampleLargerThanMesh(mesh_, options_.sample_texel_size, options_.mesh_file);
     // Per dense sample: lookup, patch, features, links, index: about 64 bytes
-    // plus 4 per feature; the stretch of the charts adds up to 1.25^2.
+    // plus 4 per feature; remembered seams (Kwatra's old seams: two feature
+    // vectors and a hash node, on at most about one link in two); the stretch
+    // of the charts adds up to 1.25^2.
     const double samples = 1.6 * SurfaceArea(mesh_) / std::pow(options_.sample_texel_size, 2);
-    RequireMemory(samples * (64 + 4 * 18), "the dense surface",
+    RequireMemory(samples * (64 + 4 * 18 + 0.5 * (2 * 4 * 18 + 96)), "the dense surface",
                   options_.mesh_file.string() + " at a texel size of " +
                       std::to_string(options_.sample_texel_size));
+    if (!options_.field_file.empty())
+      quilt_options_.field_in_world =
+          quilt::InterpolateField(mesh_, quilt::ReadFieldFile(options_.field_file, mesh_));
     sample_ = ReadSample(options_.sample_file);
     RefuseSampleSmallerThanWorkPatch();
+    RequireCopyMemory();
     ptm_sample_ = std::make_unique<synth::PtmSample>(sample_.ptm);
     if (!sample_.colour.empty())
       colour_sample_ = std::make_unique<synth::ColourSample>(sample_.colour);
@@ -113,10 +130,23 @@ class QuiltJob {
                            " texels a side)");
   }
 
+  // The sample's rotated copies the quilting keeps (8, each with its planes and
+  // their spectra: quilt::RotatedSample).
+  void RequireCopyMemory() const {
+    const double side =
+        std::floor(std::min(sample_.ptm.width, sample_.ptm.height) / std::numbers::sqrt2);
+    const double features = sample_.colour.empty() ? 18.0 : 3.0;
+    RequireMemory(8 * side * side * (2 * features + 2) * 4 * 1.2, "the sample's rotated copies",
+                  options_.sample_file.string());
+  }
+
   void LayOut() {
     const auto start = std::chrono::steady_clock::now();
+    // The face frames' x axes: the world direction laid onto each face, the
+    // field the sample follows when no field file is given.
     geometry_ = synth::MakePatchGeometry(mesh_, options_.sample_texel_size, 2,
-                                         synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
+                                         synth::TangentFrame::kSmoothField,
+                                         options_.field_direction_in_world);
     layout_ = atlas::LayoutAtlases(mesh_, geometry_.patches, geometry_.unfoldings,
                                    options_.sample_texel_size, options_.atlas, progress_);
     surface_ = quilt::DenseSurface::Build(layout_, geometry_.patches, geometry_.unfoldings,
@@ -130,7 +160,7 @@ class QuiltJob {
   void Quilt() {
     const synth::MaterialSample& matched =
         colour_sample_ ? static_cast<const synth::MaterialSample&>(*colour_sample_) : *ptm_sample_;
-    result_ = quilt::QuiltSurface(surface_, layout_, matched, options_.quilt, progress_);
+    result_ = quilt::QuiltSurface(surface_, layout_, matched, quilt_options_, progress_);
     summary_.stats = result_.stats;
     summary_.seconds_quilting = result_.stats.seconds;
   }
@@ -189,6 +219,7 @@ class QuiltJob {
 
   const QuiltJobOptions& options_;
   const ProgressCallback& progress_;
+  quilt::QuiltOptions quilt_options_;  ///< the options', with the interpolated field
   mesh::TriangleMesh mesh_;
   Sample sample_;
   std::unique_ptr<synth::PtmSample> ptm_sample_;

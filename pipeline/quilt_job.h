@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -20,7 +21,11 @@ struct QuiltJobOptions {
   std::filesystem::path mesh_file;
   std::filesystem::path sample_file;  ///< PTM (.ptm, .exr) or colour image (ReadSample)
   std::filesystem::path out_dir;      ///< the model folder written
-  double sample_texel_size = 0.0;     ///< world units per sample texel, > 0
+  /// Key vectors orienting the sample (quilt/vector_field.h); empty: the world
+  /// direction below laid onto every face (synth::TangentFrame::kSmoothField).
+  std::filesystem::path field_file;
+  Eigen::Vector3d field_direction_in_world = Eigen::Vector3d::UnitZ();
+  double sample_texel_size = 0.0;  ///< world units per sample texel, > 0
   quilt::QuiltOptions quilt;
   /// The charts are the dense surface's geometry image: conformal by default.
   atlas::AtlasOptions atlas = ConformalAtlas();

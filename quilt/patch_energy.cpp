@@ -26,17 +26,23 @@ PatchEnergy NearestPatchEnergy(const std::vector<cv::Mat>& planes, const cv::Mat
   corners.resize(std::min<std::size_t>(corners.size(), static_cast<std::size_t>(options.windows)));
   const cv::Mat mask(w, w, CV_32FC1, cv::Scalar(1));
   const int step = std::max(1, RotatedSample::kRotations / std::max(1, options.rotations));
+  // Rotations outside, windows inside: each rotated copy is made once.
+  std::vector<std::vector<cv::Mat>> windows;
+  for (const cv::Point& corner : corners) {
+    windows.emplace_back();
+    for (const cv::Mat& plane : planes)
+      windows.back().push_back(plane(cv::Rect(corner, cv::Size(w, w))));
+  }
+  std::vector<double> best(windows.size(), std::numeric_limits<double>::max());
+  for (int r = 0; r < RotatedSample::kRotations; r += step) {
+    const RotatedCopy& copy = sample.Copy(r);
+    for (std::size_t i = 0; i < windows.size(); ++i)
+      best[i] = std::min(best[i], MatchEntirePatch(copy, windows[i], mask).cost);
+  }
   PatchEnergy energy;
   double sum = 0;
-  for (const cv::Point& corner : corners) {
-    std::vector<cv::Mat> window;
-    for (const cv::Mat& plane : planes) window.push_back(plane(cv::Rect(corner, cv::Size(w, w))));
-    double best = std::numeric_limits<double>::max();
-    for (int r = 0; r < RotatedSample::kRotations; r += step)
-      best = std::min(best, MatchEntirePatch(sample.Copy(r), window, mask).cost);
-    sum += best;
-    ++energy.windows;
-  }
+  for (const double b : best) sum += b;
+  energy.windows = static_cast<int>(best.size());
   energy.per_texel = energy.windows ? sum / energy.windows : 0.0;
   return energy;
 }

@@ -23,6 +23,8 @@ void QuiltOptions::Check() const {
   if (!(shrink > 0.0 && shrink < 1.0)) throw OptionError("the work patch shrink must be in (0, 1)");
   if (!(max_area_distortion >= 1.0)) throw OptionError("T_d must be at least 1");
   if (!(seam_threshold > 0.0)) throw OptionError("--seam-threshold must be positive");
+  if (random_orientation && !field_in_world.empty())
+    throw OptionError("give a field or a random orientation, not both");
 }
 
 namespace {
@@ -123,7 +125,12 @@ class SurfaceQuilter {
       atlas_x_.push_back(x);
       atlas_y_.push_back(frame.z_axis.cross(x));
       normal_.push_back(frame.z_axis);
-      field_in_chart_rad_.push_back(-a);  // the face frame's x axis, in the atlas frame
+      if (options_.field_in_world.empty()) {
+        field_in_chart_rad_.push_back(-a);  // the face frame's x axis, in the atlas frame
+      } else {
+        const Eigen::Vector3d& v = options_.field_in_world[f];
+        field_in_chart_rad_.push_back(std::atan2(v.dot(atlas_y_.back()), v.dot(x)));
+      }
     }
   }
 
@@ -167,6 +174,7 @@ class SurfaceQuilter {
       const bool smallest = levels <= options_.min_work_patch_levels;
       WorkPatch patch;
       BuildWorkPatch(v, levels, patch);
+      if (smallest && !patch.fits) TrimToCopySide(patch);
       TEXLUME_CHECK(patch.fits || !smallest, "the smallest work patch outgrew the sample");
       if (patch.fits && (patch.distortion <= options_.max_area_distortion || smallest)) {
         const std::size_t placed = TryPatch(patch, smallest, levels);
@@ -191,7 +199,10 @@ class SurfaceQuilter {
     chart_maps[seed.chart] = {0.0, -Centre(seed)};
     place(v, Eigen::Vector2d::Zero(), 0.0);
     std::vector<int> frontier{v}, next;
+    Eigen::Vector2d lo = Eigen::Vector2d::Zero(), hi = lo;  // the image so far
+    const double widest = rotated_.side();
     for (int level = 0; level < levels && !frontier.empty(); ++level) {
+      if ((hi - lo).maxCoeff() >= widest) break;  // it outgrew the copies: no use growing on
       next.clear();
       for (const int a : frontier)
         for (const int b : surface_.Neighbours(a)) {
@@ -214,6 +225,7 @@ class SurfaceQuilter {
           // or a chart that winds round): b stays out of this patch.
           if ((w - pa.w).norm() > kMostLinkPx) continue;
           place(b, w, angle);
+          lo = lo.cwiseMin(w), hi = hi.cwiseMax(w);
           next.push_back(b);
         }
       frontier.swap(next);
@@ -242,13 +254,29 @@ class SurfaceQuilter {
     return std::atan2(x.dot(atlas_y_[fa]), x.dot(atlas_x_[fa]));
   }
 
+  // The work image's frame: each sample on the pixel nearest to it.
   bool FrameWorkImage(WorkPatch& patch) const {
     Eigen::Vector2d lo = patch.samples[0].w, hi = lo;
     for (const PatchSample& p : patch.samples) lo = lo.cwiseMin(p.w), hi = hi.cwiseMax(p.w);
     patch.origin = Eigen::Vector2d(std::floor(lo.x()), std::floor(lo.y()));
-    patch.width = static_cast<int>(std::floor(hi.x() - patch.origin.x())) + 1;
-    patch.height = static_cast<int>(std::floor(hi.y() - patch.origin.y())) + 1;
+    patch.width = static_cast<int>(std::lround(hi.x() - patch.origin.x())) + 1;
+    patch.height = static_cast<int>(std::lround(hi.y() - patch.origin.y())) + 1;
     return patch.width <= rotated_.side() && patch.height <= rotated_.side();
+  }
+
+  // Keeps the samples of the patch within the copies' reach of the seed (the
+  // smallest patch, when a chart's turn makes it wider than its levels).
+  void TrimToCopySide(WorkPatch& patch) const {
+    const double reach = std::floor((rotated_.side() - 3) / 2.0);
+    WorkPatch trimmed;
+    for (const PatchSample& p : patch.samples)
+      if (std::abs(p.w.x()) <= reach && std::abs(p.w.y()) <= reach) {
+        trimmed.local.emplace(p.sample, static_cast<int>(trimmed.samples.size()));
+        trimmed.samples.push_back(p);
+      }
+    trimmed.fits = FrameWorkImage(trimmed);
+    trimmed.distortion = AreaDistortion(trimmed);
+    patch = std::move(trimmed);
   }
 
   // How much the work image stretches the patch's area: the summed squared
@@ -340,8 +368,8 @@ class SurfaceQuilter {
 
   static std::pair<int, int> Pixel(const WorkPatch& patch, const PatchSample& p) {
     return {
-        std::clamp(static_cast<int>(std::floor(p.w.x() - patch.origin.x())), 0, patch.width - 1),
-        std::clamp(static_cast<int>(std::floor(p.w.y() - patch.origin.y())), 0, patch.height - 1)};
+        std::clamp(static_cast<int>(std::lround(p.w.x() - patch.origin.x())), 0, patch.width - 1),
+        std::clamp(static_cast<int>(std::lround(p.w.y() - patch.origin.y())), 0, patch.height - 1)};
   }
 
   struct Fit {
@@ -365,6 +393,7 @@ class SurfaceQuilter {
   }
   // The old seam on a link, when it is still there (both sides unchanged).
   const OldSeam* SeamOn(int lo, int hi) const {
+    if (!options_.keep_old_seams) return nullptr;
     const auto it = old_seams_.find(LinkKey(lo, hi));
     if (it == old_seams_.end()) return nullptr;
     const OldSeam& seam = it->second;
@@ -543,6 +572,8 @@ QuiltResult QuiltSurface(const DenseSurface& surface, const atlas::AtlasLayout& 
                          const synth::MaterialSample& sample, const QuiltOptions& options,
                          const ProgressCallback& progress) {
   options.Check();
+  if (!options.field_in_world.empty() && options.field_in_world.size() != layout.faces.size())
+    throw std::invalid_argument("QuiltSurface: one field vector per face");
   if (surface.size() == 0) return {};
   return SurfaceQuilter(surface, layout, sample, options).Run(progress);
 }

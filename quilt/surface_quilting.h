@@ -24,26 +24,33 @@ struct QuiltOptions {
   int work_patch_levels = 32;
   int min_work_patch_levels = 4;  ///< the hierarchical search stops here (paper)
   double shrink = 0.8;            ///< r_w factor per retry (paper)
-  /// T_d: largest area distortion of a work image (paper: 4): a link's length
-  /// in the work image over its length on the surface, squared, either way.
+  /// T_d: largest area distortion of a work image (paper: 4): the patch's
+  /// summed squared link lengths in the work image over those on the surface,
+  /// either way round.
   double max_area_distortion = 4.0;
   /// T_c: largest mean seam cost per cut link, as a fraction of the cost of a
   /// cut between two unrelated sample texels (the sample's own feature spread).
   double seam_threshold = 0.6;
   /// Orientation: true turns each patch to a random one of the 72 rotations
-  /// (isotropic samples); false aligns the sample's x axis with each face
-  /// frame's x axis (the tangent field the patch geometry was made with).
+  /// (isotropic samples); false aligns the sample's x axis with the field:
+  /// `field_in_world` (per face, in its plane; InterpolateField), or when that
+  /// is empty each face frame's x axis (the tangent field the patch geometry
+  /// was made with: synth::TangentFrame::kSmoothField gives a coherent one).
   bool random_orientation = false;
+  std::vector<Eigen::Vector3d> field_in_world;
   /// A baseline, not the paper: each patch placed at random in the sample (no
   /// matching) and accepted whatever its seam costs.
   bool random_placement = false;
+  /// Old seams kept as nodes of later cuts (Kwatra et al. 2003); false: a cut
+  /// sees only the values there now (an ablation).
+  bool keep_old_seams = true;
   std::uint64_t seed = 1;
   void Check() const;
 };
 
 /// What one dense sample shows: the sample position (texels, x right, y down,
 /// centres at +0.5) and how the sample is turned there, counter-clockwise from
-/// the sample's atlas frame (x right, y up).
+/// the atlas frame of the sample's chart (x right, y up).
 struct SampleLookup {
   Eigen::Vector2f sample_px = Eigen::Vector2f::Zero();
   float angle_rad = 0;

@@ -587,6 +587,23 @@ TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
   EXPECT_EQ(Texlume("synth --engine graphcut --mesh m --sample s --out o", &out), 2);
   EXPECT_NE(out.find("sample-texel-size"), std::string::npos) << out;
   EXPECT_EQ(Texlume("synth" + inputs + " --engine quilting --out o", &out), 2);
+  // A field file naming a face the mesh does not have: an input error naming it (1).
+  testing::WriteText(
+      tmp / "field.json",
+      R"({"format": "texlume-field", "vectors": [{"face": 99999999, "direction": [1, 0, 0]}]})");
+  EXPECT_EQ(Texlume("synth" + inputs + " --field " + (tmp / "field.json").string() + " --out " +
+                        (tmp / "bad").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("field.json"), std::string::npos) << out;
+  // Options of one engine are refused by the other (2).
+  EXPECT_EQ(
+      Texlume("synth" + inputs + " --no-detail-transfer --out " + (tmp / "bad").string(), &out), 2);
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --work-patch 8",
+                    &out),
+            2);
+  EXPECT_NE(out.find("--work-patch is for --engine graphcut"), std::string::npos) << out;
   // A sample smaller than the smallest work patch: an input error naming it (1).
   cv::imwrite((tmp / "tiny.png").string(), cv::Mat(12, 12, CV_8UC3, cv::Scalar(90, 120, 150)));
   EXPECT_EQ(Texlume("synth --engine graphcut --mesh " + scene +

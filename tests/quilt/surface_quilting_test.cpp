@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <numbers>
 #include <opencv2/imgproc.hpp>
 #include <set>
 
@@ -70,6 +71,26 @@ double MeanLookupGap(const Surface& s, const QuiltResult& r, bool across_charts)
   return count ? sum / count : 0.0;
 }
 
+// Over the links inside charts, how far the step in the sample differs from
+// the atlas step turned back by the lookup's angle (texels): 0 where the
+// lookups map the atlas onto the sample rigidly, the right way round.
+double MeanStepError(const Surface& s, const QuiltResult& r) {
+  double sum = 0;
+  int count = 0;
+  for (std::size_t a = 0; a < s.dense.size(); ++a)
+    for (const int b : s.dense.Neighbours(static_cast<int>(a))) {
+      const auto bi = static_cast<std::size_t>(b);
+      const DenseSample &da = s.dense.samples()[a], &db = s.dense.samples()[bi];
+      if (da.chart != db.chart) continue;
+      const double angle = r.lookups[a].angle_rad, c = std::cos(angle), sn = std::sin(angle);
+      const Eigen::Vector2d step(db.x - da.x, db.y - da.y);  // atlas pixels, rows down
+      const Eigen::Vector2d expected(c * step.x() - sn * step.y(), sn * step.x() + c * step.y());
+      sum += ((r.lookups[bi].sample_px - r.lookups[a].sample_px).cast<double>() - expected).norm();
+      ++count;
+    }
+  return count ? sum / count : 0.0;
+}
+
 // One work patch large enough for the whole plane copies the sample onto it in
 // one piece: every sample synthesised, neighbours one texel apart in the sample.
 TEST(QuiltSurface, OnePatchCopiesTheSampleInOnePiece) {
@@ -80,6 +101,7 @@ TEST(QuiltSurface, OnePatchCopiesTheSampleInOnePiece) {
   o.work_patch_levels = 64;
   const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o);
   EXPECT_EQ(r.stats.patches, 1u);
+  EXPECT_LT(MeanStepError(s, r), 1e-4);
   for (const SampleLookup& l : r.lookups) {
     ASSERT_TRUE(l.synthesised);
     EXPECT_GE(l.sample_px.x(), 0.0f);
@@ -102,6 +124,7 @@ TEST(QuiltSurface, OnePatchRunsOnAcrossChartBorders) {
   EXPECT_EQ(r.stats.patches, 1u);
   EXPECT_LT(MeanLookupGap(s, r, false), 1e-4);
   EXPECT_LT(MeanLookupGap(s, r, true), 1e-4);
+  EXPECT_LT(MeanStepError(s, r), 1e-4);
 }
 
 // Small patches on a closed surface: everything synthesised, by many patches
@@ -122,6 +145,31 @@ TEST(QuiltSurface, SmallPatchesCoverAClosedSurfaceDeterministically) {
   }
   ASSERT_GT(a.stats.cut_links, 0u);
   EXPECT_LT(a.stats.seam_cost / a.stats.cut_links, a.stats.random_pair_cost);
+}
+
+// With a field, each patch turns the sample's x axis along it (to the nearest
+// of the 72 rotations, 5 degrees apart).
+TEST(QuiltSurface, TurnsTheSampleAlongTheField) {
+  const ptm::Ptm ptm = SmoothPtm(64, 5);
+  const synth::PtmSample sample(ptm);
+  const mesh::TriangleMesh plane = datasets::MakeGridPlane(2, 0.3);
+  const Surface s = MakeSurface(plane, 0.01, atlas::AtlasMode::kCharts);
+  QuiltOptions o;
+  o.work_patch_levels = 8;
+  const Eigen::Vector3d along(std::cos(1.0), std::sin(1.0), 0.0);  // 57.3 degrees
+  o.field_in_world.assign(plane.faces.size(), along);
+  const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o);
+  ASSERT_GT(r.stats.patches, 3u);
+  for (std::size_t i = 0; i < s.dense.size(); ++i) {
+    const DenseSample& d = s.dense.samples()[i];
+    // The field's angle in the sample's atlas frame.
+    const mesh::TriangleFrame& frame = s.dense.FrameOf(d.face);
+    const double a = s.layout.faces[static_cast<std::size_t>(d.face)].AtlasFrameAngle();
+    const Eigen::Vector3d x = std::cos(a) * frame.x_axis + std::sin(a) * frame.y_axis;
+    const double field = std::atan2(along.dot(frame.z_axis.cross(x)), along.dot(x));
+    const double off = std::remainder(r.lookups[i].angle_rad - field, 2 * std::numbers::pi);
+    EXPECT_LT(std::abs(off), 2.5 * std::numbers::pi / 180 + 1e-6) << "sample " << i;
+  }
 }
 
 TEST(QuiltSurface, RefusesASampleSmallerThanTheSmallestPatch) {
