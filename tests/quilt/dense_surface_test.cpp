@@ -108,7 +108,7 @@ TEST(DenseSurface, LinksCrossChartsAtTheTexelSpacing) {
 // A closed surface in conformal charts: one connected piece, no border.
 TEST(DenseSurface, AClosedSurfaceIsOnePieceWithoutBorder) {
   const mesh::TriangleMesh sphere = datasets::MakeIcosphere(2, 1.0);  // 320 faces
-  const double texel = 0.02;
+  const double texel = 0.04;
   const Dense d =
       MakeDense(sphere, texel, atlas::AtlasMode::kCharts, atlas::ChartFlattening::kConformal);
   ASSERT_GT(d.layout.num_charts, 1);

@@ -133,9 +133,9 @@ TEST(QuiltSurface, OnePatchRunsOnAcrossChartBorders) {
 TEST(QuiltSurface, SmallPatchesCoverAClosedSurfaceDeterministically) {
   const ptm::Ptm ptm = SmoothPtm(64, 3);
   const synth::PtmSample sample(ptm);
-  const Surface s = MakeSurface(datasets::MakeIcosphere(1, 0.25), 0.01, atlas::AtlasMode::kCharts);
+  const Surface s = MakeSurface(datasets::MakeIcosphere(1, 0.25), 0.02, atlas::AtlasMode::kCharts);
   QuiltOptions o;
-  o.work_patch_levels = 8;
+  o.work_patch_levels = 5;
   const QuiltResult a = QuiltSurface(s.dense, s.layout, sample, o);
   const QuiltResult b = QuiltSurface(s.dense, s.layout, sample, o);
   EXPECT_GT(a.stats.patches, 5u);
