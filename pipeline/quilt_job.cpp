@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 
 #include "core/errors.h"
 #include "core/memory_budget.h"
@@ -56,17 +57,6 @@ nlohmann::json QuiltJobOptions::ToJson() const {
 
 namespace {
 
-double SurfaceArea(const mesh::TriangleMesh& mesh) {
-  double area = 0;
-  for (const auto& f : mesh.faces) {
-    const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(f[0])];
-    area += 0.5 * (mesh.vertices[static_cast<std::size_t>(f[1])] - a)
-                      .cross(mesh.vertices[static_cast<std::size_t>(f[2])] - a)
-                      .norm();
-  }
-  return area;
-}
-
 // The job's steps, each a method (RunQuiltJob).
 class QuiltJob {
  public:
@@ -99,7 +89,9 @@ class QuiltJob {
     // plus 4 per feature; remembered seams (Kwatra's old seams: two feature
     // vectors and a hash node, on at most about one link in two); the stretch
     // of the charts adds up to 1.25^2.
-    const double samples = 1.6 * SurfaceArea(mesh_) / std::pow(options_.sample_texel_size, 2);
+    const std::vector<double> areas = mesh::FaceAreas(mesh_);
+    const double area = std::accumulate(areas.begin(), areas.end(), 0.0);
+    const double samples = 1.6 * area / std::pow(options_.sample_texel_size, 2);
     RequireMemory(samples * (64 + 4 * 18 + 0.5 * (2 * 4 * 18 + 96)), "the dense surface",
                   options_.mesh_file.string() + " at a texel size of " +
                       std::to_string(options_.sample_texel_size));

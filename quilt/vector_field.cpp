@@ -22,18 +22,10 @@ Eigen::Vector3d Centroid(const mesh::TriangleMesh& mesh, std::size_t f) {
   return c / 3.0;
 }
 
-Eigen::Vector3d Normal(const mesh::TriangleMesh& mesh, std::size_t f) {
-  const auto& v = mesh.faces[f];
-  const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(v[0])];
-  return (mesh.vertices[static_cast<std::size_t>(v[1])] - a)
-      .cross(mesh.vertices[static_cast<std::size_t>(v[2])] - a)
-      .normalized();
-}
-
 // The direction laid onto face f's plane, unit; the first edge when it lies
 // along the normal.
-Eigen::Vector3d InPlane(const mesh::TriangleMesh& mesh, std::size_t f, const Eigen::Vector3d& d) {
-  const Eigen::Vector3d n = Normal(mesh, f);
+Eigen::Vector3d InPlane(const mesh::TriangleMesh& mesh, std::size_t f, const Eigen::Vector3d& n,
+                        const Eigen::Vector3d& d) {
   const Eigen::Vector3d t = d - d.dot(n) * n;
   if (t.norm() > 1e-6 * std::max(d.norm(), 1e-300)) return t.normalized();
   const auto& v = mesh.faces[f];
@@ -59,7 +51,7 @@ double RbfWidth(const std::vector<Eigen::Vector3d>& centres, const mesh::Triangl
 }
 
 KeyVector ReadKey(const nlohmann::json& item, const std::string& file, std::size_t index,
-                  const mesh::TriangleMesh& mesh) {
+                  const mesh::TriangleMesh& mesh, const std::vector<Eigen::Vector3d>& normals) {
   const std::string where = "vectors[" + std::to_string(index) + "]";
   if (!item.is_object() || !item.contains("face") || !item["face"].is_number_integer() ||
       !item.contains("direction") || !item["direction"].is_array() || item["direction"].size() != 3)
@@ -75,7 +67,7 @@ KeyVector ReadKey(const nlohmann::json& item, const std::string& file, std::size
     if (!x.is_number()) throw InputError(file, where + ": direction is not three numbers");
     key.direction_in_world[c] = x.get<double>();
   }
-  const Eigen::Vector3d n = Normal(mesh, static_cast<std::size_t>(face));
+  const Eigen::Vector3d& n = normals[static_cast<std::size_t>(face)];
   const Eigen::Vector3d& d = key.direction_in_world;
   if (!d.allFinite() || !(d.norm() > 0))
     throw InputError(file, where + ": the direction is zero or not finite");
@@ -101,9 +93,10 @@ std::vector<KeyVector> ReadFieldFile(const std::filesystem::path& path,
   if (vectors.size() > kMostKeys)
     throw InputError(file, "gives " + std::to_string(vectors.size()) + " vectors; at most " +
                                std::to_string(kMostKeys) + " key faces are interpolated");
+  const std::vector<Eigen::Vector3d> normals = mesh::FaceNormals(mesh);
   std::vector<KeyVector> keys;
   for (std::size_t i = 0; i < vectors.size(); ++i)
-    keys.push_back(ReadKey(vectors[i], file, i, mesh));
+    keys.push_back(ReadKey(vectors[i], file, i, mesh, normals));
   return keys;
 }
 
@@ -113,6 +106,7 @@ std::vector<Eigen::Vector3d> InterpolateField(const mesh::TriangleMesh& mesh,
   for (const KeyVector& k : keys)
     centres.push_back(Centroid(mesh, static_cast<std::size_t>(k.face)));
   const double width = RbfWidth(centres, mesh);
+  const std::vector<Eigen::Vector3d> normals = mesh::FaceNormals(mesh);
   const auto phi = [width](double r) { return std::exp(-(r * r) / (width * width)); };
   // Phi W = V: each key face gets its own (in-plane, unit) vector.
   const auto m = static_cast<Eigen::Index>(keys.size());
@@ -120,7 +114,8 @@ std::vector<Eigen::Vector3d> InterpolateField(const mesh::TriangleMesh& mesh,
   for (Eigen::Index i = 0; i < m; ++i) {
     const auto ki = static_cast<std::size_t>(i);
     values.row(i) =
-        InPlane(mesh, static_cast<std::size_t>(keys[ki].face), keys[ki].direction_in_world)
+        InPlane(mesh, static_cast<std::size_t>(keys[ki].face),
+                normals[static_cast<std::size_t>(keys[ki].face)], keys[ki].direction_in_world)
             .transpose();
     for (Eigen::Index j = 0; j < m; ++j)
       rbf(i, j) = phi((centres[ki] - centres[static_cast<std::size_t>(j)]).norm());
@@ -133,7 +128,7 @@ std::vector<Eigen::Vector3d> InterpolateField(const mesh::TriangleMesh& mesh,
     Eigen::Vector3d v = Eigen::Vector3d::Zero();
     for (Eigen::Index k = 0; k < m; ++k)
       v += phi((c - centres[static_cast<std::size_t>(k)]).norm()) * weights.row(k).transpose();
-    field[f] = InPlane(mesh, f, v);
+    field[f] = InPlane(mesh, f, normals[f], v);
   }
   return field;
 }

@@ -500,11 +500,8 @@ TEST(Cli, SynthWithABtfSampleRendersAsABtfAndRefusesBadInput) {
   EXPECT_FALSE(std::filesystem::exists(tmp / "x"));
 }
 
-// The main job with a colour sample (an ordinary photo of the material): a
-// model folder of PTM atlases that `texlume render` draws; a sample that is no
-// image is an input error naming it.
-TEST(Cli, SynthWithAColourSampleWritesAModelThatRenders) {
-  TempDir tmp;
+// A small scene without a BTF, for colour samples (material texel 0.01): its folder.
+std::string WriteColourSampleScene(const TempDir& tmp) {
   datasets::SceneOptions options = SmallBtfScene(8, 96, 40);
   options.write_btf = false;
   options.capture_size = 64;
@@ -513,7 +510,15 @@ TEST(Cli, SynthWithAColourSampleWritesAModelThatRenders) {
   options.held_out_lights_per_view = 1;
   options.material.texel_size = 0.01;
   datasets::GenerateScene(options, tmp.path() / "scene");
-  const std::string scene = (tmp / "scene").string();
+  return (tmp / "scene").string();
+}
+
+// The main job with a colour sample (an ordinary photo of the material): a
+// model folder of PTM atlases that `texlume render` draws; a sample that is no
+// image is an input error naming it.
+TEST(Cli, SynthWithAColourSampleWritesAModelThatRenders) {
+  TempDir tmp;
+  const std::string scene = WriteColourSampleScene(tmp);
   const std::string inputs = " --model " + scene + "/object/sparse --images " + scene +
                              "/object/images --lights " + scene + "/object/lights.json --mesh " +
                              scene + "/object/mesh.ply --atlas-size 512 --no-report" +
@@ -548,15 +553,7 @@ TEST(Cli, SynthWithAColourSampleWritesAModelThatRenders) {
 // Graph-cut quilting (issue 32, docs/quilting.md): a mesh and a sample, no photos.
 TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
   TempDir tmp;
-  datasets::SceneOptions options = SmallBtfScene(8, 96, 40);
-  options.write_btf = false;
-  options.capture_size = 64;
-  options.focal_px = 90;
-  options.num_held_out_views = 1;
-  options.held_out_lights_per_view = 1;
-  options.material.texel_size = 0.01;
-  datasets::GenerateScene(options, tmp.path() / "scene");
-  const std::string scene = (tmp / "scene").string();
+  const std::string scene = WriteColourSampleScene(tmp);
   const std::string inputs =
       " --engine graphcut --mesh " + scene +
       "/object/mesh.ply --atlas-size 512 --sample-texel-size 0.01 --sample " + scene +
