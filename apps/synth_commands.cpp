@@ -30,7 +30,8 @@ void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords
   sub->add_option("--out", j.out_dir, "the model folder to write")->required();
   auto* sample =
       sub->add_option("--sample", j.sample_file,
-                      "sample: a PTM (.ptm, .exr) or a colour photo (.png, .jpg, .tif, RGB .exr)");
+                      "sample: a PTM (.ptm, .exr) or a colour photo (.png, .jpg, .tif, RGB .exr); "
+                      "graphcut also a BTF capture or factorisation folder");
   sub->add_option("--btf", o.btf, "BTF capture or factorisation folder (instead of --sample)")
       ->excludes(sample);
   sub->add_option("--components", o.components, "BTF components kept when factorising a capture")
@@ -159,8 +160,6 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
   for (const char* name : {"--model",
                            "--images",
                            "--lights",
-                           "--btf",
-                           "--components",
                            "--seam-band",
                            "--strip",
                            "--top-k",
@@ -184,11 +183,15 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
     if (sub->count(name) > 0)
       throw UsageError(std::string(name) +
                        " is not taken by --engine graphcut so far (docs/quilting.md)");
-  if (sub->count("--sample-texel-size") == 0)
+  q.mesh_file = o.job.mesh_file;
+  q.sample_file = o.btf.empty() ? o.job.sample_file : o.btf;
+  if (q.sample_file.empty()) throw UsageError("--sample or --btf is required");
+  q.btf_components = o.components;
+  if (sub->count("--components") > 0 && !q.BtfSample())
+    throw UsageError("--components is for a BTF sample (a capture folder)");
+  if (sub->count("--sample-texel-size") == 0 && !q.BtfSample())
     throw UsageError(
         "--sample-texel-size: give the sample's texel size in world units of the mesh");
-  q.mesh_file = o.job.mesh_file;
-  q.sample_file = o.job.sample_file;
   q.out_dir = o.job.out_dir;
   q.sample_texel_size = o.job.synthesis.sample_texel_size;
   q.quilt.seed = o.job.synthesis.seed;

@@ -28,26 +28,20 @@ std::vector<Eigen::Vector3d> PreviewLights() {
 
 }  // namespace
 
-BtfAtlases BuildBtfAtlases(const mesh::TriangleMesh& mesh, const synth::BtfMeshSynthesis& synthesis,
-                           const btf::BtfFactorisation& sample, const atlas::AtlasOptions& options,
-                           const ProgressCallback& progress) {
+BtfAtlases BakeBtfAtlases(AtlasLayout layout, double texel_size, int gutter,
+                          const btf::BtfFactorisation& sample, const BtfTexelLookup& lookup,
+                          const ProgressCallback& progress) {
   BtfAtlases out;
-  out.layout = atlas::LayoutAtlases(mesh, synthesis.patches, synthesis.unfoldings,
-                                    synthesis.texel_size, options, progress);
+  out.layout = std::move(layout);
   const int n = sample.Components();
   // Planes: sample x, sample y, angle, the factors r, g, b, then g_0 .. g_{n-1}.
-  std::vector<double> face_angle;
-  for (const atlas::FacePlacement& fp : out.layout.faces)
-    face_angle.push_back(-fp.AtlasFrameAngle());  // the atlas frame's turn from the face frame
   BakedPlanes baked = BakeAtlasPlanes(
-      out.layout, synthesis.texel_size, options.gutter, 6 + n,
+      out.layout, texel_size, gutter, 6 + n,
       [&](int face, const Eigen::Vector2d& p_in_frame, float* value) {
-        const synth::BtfSampleLookup look = synthesis.Lookup(face, p_in_frame);
+        const BtfAtlasLookup look = lookup(face, p_in_frame);
         value[0] = static_cast<float>(look.sample_px.x());
         value[1] = static_cast<float>(look.sample_px.y());
-        // d_sample = R(look) d_face and d_face = R(-face) d_atlas.
-        value[2] = static_cast<float>(
-            WrapAngle(look.angle_rad - face_angle[static_cast<std::size_t>(face)]));
+        value[2] = static_cast<float>(WrapAngle(look.atlas_to_sample_rad));
         for (int c = 0; c < 3; ++c) value[3 + c] = look.colour_gain[c];
         btf::SampleGeometry(sample, look.sample_px, value + 6);
       },
@@ -64,6 +58,26 @@ BtfAtlases BuildBtfAtlases(const mesh::TriangleMesh& mesh, const synth::BtfMeshS
   out.coverage = std::move(baked.coverage);
   out.occupancy = baked.occupancy;
   return out;
+}
+
+BtfAtlases BuildBtfAtlases(const mesh::TriangleMesh& mesh, const synth::BtfMeshSynthesis& synthesis,
+                           const btf::BtfFactorisation& sample, const atlas::AtlasOptions& options,
+                           const ProgressCallback& progress) {
+  AtlasLayout layout = atlas::LayoutAtlases(mesh, synthesis.patches, synthesis.unfoldings,
+                                            synthesis.texel_size, options, progress);
+  std::vector<double> face_angle;
+  for (const atlas::FacePlacement& fp : layout.faces)
+    face_angle.push_back(-fp.AtlasFrameAngle());  // the atlas frame's turn from the face frame
+  return BakeBtfAtlases(
+      std::move(layout), synthesis.texel_size, options.gutter, sample,
+      [&](int face, const Eigen::Vector2d& p_in_frame) {
+        const synth::BtfSampleLookup look = synthesis.Lookup(face, p_in_frame);
+        // d_sample = R(look) d_face and d_face = R(-face) d_atlas.
+        return BtfAtlasLookup{look.sample_px,
+                              look.angle_rad - face_angle[static_cast<std::size_t>(face)],
+                              look.colour_gain};
+      },
+      progress);
 }
 
 std::vector<ptm::Ptm> PreviewPtms(const BtfAtlases& atlases, const btf::BtfFactorisation& sample,

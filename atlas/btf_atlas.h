@@ -1,5 +1,7 @@
 #pragma once
 
+#include <Eigen/Core>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -31,8 +33,24 @@ struct BtfAtlases {
   double occupancy = 0.0;
 };
 
-/// Lays out and bakes the atlases. The graph-cut labels decide which patch a
-/// texel shows; nothing is blended.
+/// What one surface point of a BTF model shows (BtfAtlases' channels).
+struct BtfAtlasLookup {
+  Eigen::Vector2d sample_px = Eigen::Vector2d::Zero();  ///< x right, y down, centres at +0.5
+  /// A tangent direction d in the atlas frame is R(angle) d in the sample's frame.
+  double atlas_to_sample_rad = 0.0;
+  Eigen::Vector3f colour_gain = Eigen::Vector3f::Ones();
+};
+using BtfTexelLookup = std::function<BtfAtlasLookup(int face, const Eigen::Vector2d& p_in_frame)>;
+
+/// Bakes the atlases of `layout` (BakeAtlasPlanes) from per-surface-point
+/// lookups: the sample coordinates, the factors and the geometry maps there.
+/// Every engine's BTF model goes through it.
+BtfAtlases BakeBtfAtlases(AtlasLayout layout, double texel_size, int gutter,
+                          const btf::BtfFactorisation& sample, const BtfTexelLookup& lookup,
+                          const ProgressCallback& progress = {});
+
+/// Lays out and bakes the atlases of the per-triangle engine (BakeBtfAtlases).
+/// The graph-cut labels decide which patch a texel shows; nothing is blended.
 BtfAtlases BuildBtfAtlases(const mesh::TriangleMesh& mesh, const synth::BtfMeshSynthesis& synthesis,
                            const btf::BtfFactorisation& sample, const AtlasOptions& options,
                            const ProgressCallback& progress = {});

@@ -237,6 +237,23 @@ std::vector<SvdError> SvdErrorTable(const BtfFactorisation& factorisation,
   return table;
 }
 
+std::vector<SvdError> SvdErrorTable(const BtfFactorisation& factorisation) {
+  std::vector<int> ns;
+  for (int k = 1; k < factorisation.Components(); k *= 2) ns.push_back(k);
+  ns.push_back(factorisation.Components());
+  return SvdErrorTable(factorisation, ns);
+}
+
+BtfFactorisation ReadOrFactoriseBtf(const fs::path& dir, int components,
+                                    const ProgressCallback& progress) {
+  if (fs::exists(dir / "btf_svd.json")) return ReadBtfFactorisation(dir);
+  if (!fs::exists(dir / "btf.json"))
+    throw InputError(dir.string(),
+                     "is not a BTF sample folder (it has neither btf.json, a capture, nor "
+                     "btf_svd.json, a factorisation)");
+  return FactoriseBtf(ReadBtfCapture(dir), components, progress);
+}
+
 std::vector<std::pair<std::size_t, double>> DirectionWeights(
     const std::vector<Eigen::Vector3d>& grid, const Eigen::Vector3d& query) {
   const Eigen::Vector3d q = query.normalized();

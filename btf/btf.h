@@ -72,6 +72,12 @@ struct BtfFactorisation {
 BtfFactorisation FactoriseBtf(const BtfCapture& capture, int components,
                               const ProgressCallback& progress = {});
 
+/// A BTF sample folder as a factorisation: a factorisation (btf_svd.json) read
+/// as it is, or a capture (btf.json) factorised keeping `components` terms.
+/// Throws InputError naming the folder when it holds neither.
+BtfFactorisation ReadOrFactoriseBtf(const std::filesystem::path& dir, int components,
+                                    const ProgressCallback& progress = {});
+
 /// Reconstruction error with the first n components, from the singular values:
 /// RMS over every texel, view, light and channel (linear RGB units), and
 /// relative to the RMS of the data.
@@ -81,6 +87,8 @@ struct SvdError {
 };
 std::vector<SvdError> SvdErrorTable(const BtfFactorisation& factorisation,
                                     const std::vector<int>& components);
+/// The table at 1, 2, 4, ... components and at all of them (what a model folder records).
+std::vector<SvdError> SvdErrorTable(const BtfFactorisation& factorisation);
 
 /// Weights of the grid directions for a query direction (unit, towards the
 /// viewer or light): the 3 nearest grid directions by angle, weighted by the

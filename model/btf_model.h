@@ -1,8 +1,10 @@
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "btf/btf.h"
@@ -18,7 +20,34 @@ std::string BtfAtlasFileName(std::size_t k);
 void WriteBtfAtlas(const std::filesystem::path& file, const cv::Mat& sample_coords,
                    const cv::Mat& colour_gain);
 
-/// The BTF parts of a model folder written by RunBtfSynthJob.
+/// The BTF files of a model folder (docs/btf.md), encoded before the folder is
+/// written: the factorisation (`btf/`), per atlas the sample coordinates and
+/// factors (`btf_atlas_K.exr`) and the geometry maps baked per texel
+/// (`btf_geometry_K_P.png`: 8 bits with a scale and bias per component, four
+/// components per RGBA PNG). Every BTF engine's job writes its folder with it.
+class BtfModelFiles {
+ public:
+  /// `sample_coords`, `colour_gain` (CV_32FC3) and `geometry` (n CV_32FC1
+  /// planes) per atlas, as atlas::BtfAtlases holds them.
+  BtfModelFiles(const btf::BtfFactorisation& sample, const std::vector<cv::Mat>& sample_coords,
+                const std::vector<cv::Mat>& colour_gain,
+                const std::vector<std::vector<cv::Mat>>& geometry);
+  /// The manifest's "btf" section.
+  const nlohmann::json& Manifest() const { return manifest_; }
+  /// Writes the files into the folder being written (WriteModelFolder's callback).
+  void Write(const std::filesystem::path& folder) const;
+
+ private:
+  nlohmann::json EncodeGeometry(const std::vector<std::vector<cv::Mat>>& geometry);
+
+  const btf::BtfFactorisation& sample_;
+  const std::vector<cv::Mat>& sample_coords_;
+  const std::vector<cv::Mat>& colour_gain_;
+  std::vector<std::pair<std::string, std::vector<unsigned char>>> geometry_png_;
+  nlohmann::json manifest_;
+};
+
+/// The BTF parts of a model folder written by BtfModelFiles.
 struct BtfModel {
   btf::BtfFactorisation sample;
   std::vector<cv::Mat> sample_coords;  ///< as atlas::BtfAtlases

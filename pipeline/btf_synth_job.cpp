@@ -12,21 +12,12 @@
 #include "model/baselines.h"
 #include "model/btf_model.h"
 #include "model/model_io.h"
-#include "model/web_model.h"
 #include "ptm/coefficient_space.h"
 #include "ptm/exr_io.h"
 #include "render/model_render.h"
 
 namespace texlume::pipeline {
 namespace fs = std::filesystem;
-namespace {
-
-std::string GeometryFileName(std::size_t atlas, std::size_t part) {
-  return "btf_geometry_" + std::to_string(atlas) + "_" + std::to_string(part) + ".png";
-}
-
-}  // namespace
-
 void BtfSynthJobOptions::Check() const {
   job.CheckInputsAndLayout();
   if (btf.empty()) throw OptionError("synth --btf needs a BTF capture or factorisation folder");
@@ -59,11 +50,13 @@ class BtfSynthJob {
     nlohmann::json record = Record();
     // The geometry maps baked per atlas texel, for export (docs/btf.md).
     const auto t = std::chrono::steady_clock::now();
-    record["btf"]["geometry_atlases"] = EncodeGeometryAtlases();
+    const model::BtfModelFiles btf_files(sample_, atlases_.sample_coords, atlases_.colour_gain,
+                                         atlases_.geometry);
+    record["btf"] = btf_files.Manifest();
     summary_.seconds_export = SecondsSince(t);
     record["timings_s"]["export_geometry"] = summary_.seconds_export;
     model::WriteModelFolder(job_.out_dir, model_, record, extra_images_,
-                            [this](const fs::path& folder) { WriteBtfFiles(folder); });
+                            [&](const fs::path& folder) { btf_files.Write(folder); });
     summary_.seconds_total = SecondsSince(start);
     return summary_;
   }
@@ -73,16 +66,7 @@ class BtfSynthJob {
   // error table; the synthesis settings with its texel size; the mesh.
   void LoadSample() {
     const auto t = std::chrono::steady_clock::now();
-    if (fs::exists(options_.btf / "btf_svd.json")) {
-      sample_ = btf::ReadBtfFactorisation(options_.btf);
-    } else {
-      const btf::BtfCapture capture = btf::ReadBtfCapture(options_.btf);
-      sample_ = btf::FactoriseBtf(capture, options_.components, progress_);
-    }
-    std::vector<int> ns;
-    for (int k = 1; k < sample_.Components(); k *= 2) ns.push_back(k);
-    ns.push_back(sample_.Components());
-    errors_ = btf::SvdErrorTable(sample_, ns);
+    sample_ = btf::ReadOrFactoriseBtf(options_.btf, options_.components, progress_);
     summary_.seconds_factorise = SecondsSince(t);
     so_ = options_.synthesis;
     if (so_.sample_texel_size == 0.0) so_.sample_texel_size = sample_.texel_size;
@@ -173,15 +157,6 @@ class BtfSynthJob {
     record["summary"] = Summary();
     record["warnings"] = summary_.warnings;
     extra_images_ = model::RecordBaselines(flat_albedo_, baked_, record);
-    nlohmann::json btf_files = nlohmann::json::array();
-    for (std::size_t a = 0; a < atlases_.geometry.size(); ++a)
-      btf_files.push_back(model::BtfAtlasFileName(a));
-    record["btf"] = {
-        {"format", "texlume-btf-model-1"},
-        {"factorisation", "btf/btf_svd.json"},
-        {"atlases", btf_files},
-        {"atlas_channels", "sample_x, sample_y, angle, gain_r, gain_g, gain_b (docs/btf.md)"},
-        {"ptm_atlases", "a preview: the BTF seen head-on, fitted per texel"}};
     const BtfSynthJobSummary& s = summary_;
     record["timings_s"] = {
         {"load", inputs_.seconds_load},
@@ -196,61 +171,12 @@ class BtfSynthJob {
     return record;
   }
 
-  // 8 bits per component with a scale and bias each, four components per RGBA
-  // PNG (docs/btf.md); the PNGs go into geometry_png_, the manifest's entries
-  // are returned.
-  nlohmann::json EncodeGeometryAtlases() {
-    nlohmann::json geometry_json = nlohmann::json::array();
-    for (std::size_t a = 0; a < atlases_.geometry.size(); ++a) {
-      const auto& planes = atlases_.geometry[a];
-      const int w = planes[0].cols, h = planes[0].rows;
-      std::vector<model::QuantisedPlane> quantised(planes.size());
-#pragma omp parallel for schedule(dynamic, 1)
-      for (std::size_t i = 0; i < planes.size(); ++i) {
-        const cv::Mat flat = planes[i].reshape(1, 1);
-        quantised[i] =
-            model::QuantisePlane(std::vector<float>(flat.begin<float>(), flat.end<float>()));
-      }
-      const std::size_t parts = (planes.size() + 3) / 4;
-      geometry_png_.resize(geometry_png_.size() + parts);
-      const std::size_t first = geometry_png_.size() - parts;
-#pragma omp parallel for schedule(dynamic, 1)
-      for (std::size_t part = 0; part < parts; ++part) {
-        std::vector<const model::QuantisedPlane*> group;
-        for (std::size_t i = part * 4; i < std::min(planes.size(), part * 4 + 4); ++i)
-          group.push_back(&quantised[i]);
-        const std::string name = GeometryFileName(a, part);
-        geometry_png_[first + part] = {name, model::PlanesPng(group, w, h, name)};
-      }
-      nlohmann::json files = nlohmann::json::array();
-      for (std::size_t part = 0; part < parts; ++part) {
-        nlohmann::json scale = nlohmann::json::array(), bias = nlohmann::json::array();
-        for (std::size_t i = part * 4; i < std::min(planes.size(), part * 4 + 4); ++i)
-          scale.push_back(quantised[i].scale), bias.push_back(quantised[i].bias);
-        files.push_back({{"file", GeometryFileName(a, part)}, {"scale", scale}, {"bias", bias}});
-      }
-      geometry_json.push_back(files);
-    }
-    return geometry_json;
-  }
-
-  // The factorisation, the per-texel sample coordinates and factors, and the
-  // geometry-map PNGs, into the model folder being written.
-  void WriteBtfFiles(const fs::path& folder) const {
-    btf::WriteBtfFactorisation(sample_, errors_, folder / "btf");
-    for (std::size_t a = 0; a < atlases_.sample_coords.size(); ++a)
-      model::WriteBtfAtlas(folder / model::BtfAtlasFileName(a), atlases_.sample_coords[a],
-                           atlases_.colour_gain[a]);
-    for (const auto& [name, bytes] : geometry_png_) WriteBytesAtomically(folder / name, bytes);
-  }
-
   const BtfSynthJobOptions& options_;
   const pipeline::SynthJobOptions& job_;
   const ProgressCallback& progress_;
   BtfSynthJobSummary summary_;
   pipeline::SynthInputs inputs_;
   btf::BtfFactorisation sample_;
-  std::vector<btf::SvdError> errors_;
   synth::BtfMeshSynthesisOptions so_;
   synth::BtfMeshSynthesis synthesis_;
   atlas::BtfAtlases atlases_;
@@ -258,7 +184,6 @@ class BtfSynthJob {
   std::vector<cv::Mat> baked_;
   Eigen::Vector3f flat_albedo_ = Eigen::Vector3f::Constant(0.5f);
   std::vector<std::pair<std::string, cv::Mat>> extra_images_;
-  std::vector<std::pair<std::string, std::vector<unsigned char>>> geometry_png_;
 };
 
 }  // namespace

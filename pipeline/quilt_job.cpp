@@ -5,14 +5,18 @@
 #include <numbers>
 #include <numeric>
 
+#include "atlas/btf_atlas.h"
+#include "btf/btf.h"
 #include "core/errors.h"
 #include "core/memory_budget.h"
 #include "core/timing.h"
 #include "mesh/mesh.h"
+#include "model/btf_model.h"
 #include "model/model_io.h"
 #include "pipeline/synth_job.h"
 #include "quilt/quilt_atlases.h"
 #include "quilt/vector_field.h"
+#include "synth/btf_sample.h"
 #include "synth/colour_sample.h"
 
 namespace texlume::pipeline {
@@ -23,8 +27,10 @@ void QuiltJobOptions::Check() const {
        {std::pair{&mesh_file, "--mesh"}, std::pair{&sample_file, "--sample"},
         std::pair{&out_dir, "--out"}})
     if (path->empty()) throw OptionError(std::string("synth --engine graphcut needs ") + what);
-  if (!(sample_texel_size > 0.0) || !std::isfinite(sample_texel_size))
+  if (!(sample_texel_size > 0.0 || (sample_texel_size == 0.0 && BtfSample())) ||
+      !std::isfinite(sample_texel_size))
     throw OptionError("synth --engine graphcut needs --sample-texel-size > 0");
+  if (BtfSample() && btf_components < 1) throw OptionError("--components must be >= 1");
   quilt.Check();
   if (quilt.random_orientation && !field_file.empty())
     throw OptionError("give --field or --orientation random, not both");
@@ -33,10 +39,13 @@ void QuiltJobOptions::Check() const {
   atlas.Check();
 }
 
+bool QuiltJobOptions::BtfSample() const { return fs::is_directory(sample_file); }
+
 nlohmann::json QuiltJobOptions::ToJson() const {
   return {
       {"engine", "graphcut"},
       {"sample_texel_size", sample_texel_size},
+      {"btf_components", btf_components},
       {"work_patch_levels", quilt.work_patch_levels},
       {"min_work_patch_levels", quilt.min_work_patch_levels},
       {"work_patch_shrink", quilt.shrink},
@@ -84,39 +93,65 @@ class QuiltJob {
       summary_.warnings.push_back(options_.mesh_file.string() + ": " + problem);
     mesh_ = std::move(loaded.mesh);
     if (mesh_.faces.empty()) throw InputError(options_.mesh_file.string(), "has no triangles");
-    RefuseSampleLargerThanMesh(mesh_, options_.sample_texel_size, options_.mesh_file);
-    // Per dense sample: lookup, patch, features, links, index: about 64 bytes
-    // plus 4 per feature; remembered seams (Kwatra's old seams: two feature
-    // vectors and a hash node, on at most about one link in two); the stretch
-    // of the charts adds up to 1.25^2.
-    const std::vector<double> areas = mesh::FaceAreas(mesh_);
-    const double area = std::accumulate(areas.begin(), areas.end(), 0.0);
-    const double samples = 1.6 * area / std::pow(options_.sample_texel_size, 2);
-    RequireMemory(samples * (64 + 4 * 18 + 0.5 * (2 * 4 * 18 + 96)), "the dense surface",
-                  options_.mesh_file.string() + " at a texel size of " +
-                      std::to_string(options_.sample_texel_size));
+    summary_.faces = mesh_.faces.size();
+    texel_size_ = options_.sample_texel_size;
+    if (texel_size_ > 0) RequireSurfaceMemory(3);  // before the sample is read, at least
+    LoadSample();
+    RefuseSampleLargerThanMesh(mesh_, texel_size_, options_.mesh_file);
+    RequireSurfaceMemory(matched_->NumFeatures());
+    RefuseSampleSmallerThanWorkPatch();
+    RequireCopyMemory();
     if (!options_.field_file.empty())
       quilt_options_.field_in_world =
           quilt::InterpolateField(mesh_, quilt::ReadFieldFile(options_.field_file, mesh_));
-    sample_ = ReadSample(options_.sample_file);
-    RefuseSampleSmallerThanWorkPatch();
-    RequireCopyMemory();
-    ptm_sample_ = std::make_unique<synth::PtmSample>(sample_.ptm);
-    if (!sample_.colour.empty())
-      colour_sample_ = std::make_unique<synth::ColourSample>(sample_.colour);
-    summary_.faces = mesh_.faces.size();
+  }
+
+  // The sample, and the one the quilting matches: a BTF (its geometry maps), a
+  // colour image, or a PTM.
+  void LoadSample() {
+    const auto start = std::chrono::steady_clock::now();
+    AnnounceStep(progress_, "reading the sample");
+    if (options_.BtfSample()) {
+      btf_ = btf::ReadOrFactoriseBtf(options_.sample_file, options_.btf_components, progress_);
+      if (texel_size_ == 0) texel_size_ = btf_.texel_size;
+      btf_sample_ = std::make_unique<synth::BtfSample>(btf_);
+      matched_ = btf_sample_.get();
+    } else {
+      sample_ = ReadSample(options_.sample_file);
+      ptm_sample_ = std::make_unique<synth::PtmSample>(sample_.ptm);
+      matched_ = ptm_sample_.get();
+      if (!sample_.colour.empty()) {
+        colour_sample_ = std::make_unique<synth::ColourSample>(sample_.colour);
+        matched_ = colour_sample_.get();
+      }
+    }
+    summary_.sample_kind = matched_->Name();
+    summary_.sample_texel_size = texel_size_;
+    summary_.seconds_sample = SecondsSince(start);
+  }
+
+  // Per dense sample: lookup, patch, features, links, index: about 64 bytes
+  // plus 4 per feature; remembered seams (Kwatra's old seams: two feature
+  // vectors and a hash node, on at most about one link in two); the stretch
+  // of the charts adds up to 1.25^2. Refused before anything is allocated.
+  void RequireSurfaceMemory(int features) const {
+    const std::vector<double> areas = mesh::FaceAreas(mesh_);
+    const double area = std::accumulate(areas.begin(), areas.end(), 0.0);
+    const double samples = 1.6 * area / std::pow(texel_size_, 2);
+    RequireMemory(
+        samples * (64 + 4.0 * features + 0.5 * (2 * 4.0 * features + 96)), "the dense surface",
+        options_.mesh_file.string() + " at a texel size of " + std::to_string(texel_size_));
   }
 
   // The sample's rotated copies (quilt::RotatedSample) must hold the smallest
   // work patch.
   void RefuseSampleSmallerThanWorkPatch() const {
-    const int side = static_cast<int>(
-        std::floor(std::min(sample_.ptm.width, sample_.ptm.height) / std::numbers::sqrt2));
+    const int w = matched_->Width(), h = matched_->Height();
+    const int side = static_cast<int>(std::floor(std::min(w, h) / std::numbers::sqrt2));
     const int smallest = 2 * options_.quilt.min_work_patch_levels + 1;
     if (side < std::max(smallest, 8))
       throw InputError(options_.sample_file.string(),
-                       "is " + std::to_string(sample_.ptm.width) + " x " +
-                           std::to_string(sample_.ptm.height) +
+                       "is " + std::to_string(w) + " x " + std::to_string(h) +
                            " texels; turned, it leaves squares of " + std::to_string(side) +
                            ", smaller than the smallest work patch (" + std::to_string(smallest) +
                            " texels a side)");
@@ -126,23 +161,21 @@ class QuiltJob {
   // their spectra: quilt::RotatedSample).
   void RequireCopyMemory() const {
     const double side =
-        std::floor(std::min(sample_.ptm.width, sample_.ptm.height) / std::numbers::sqrt2);
-    const double features = sample_.colour.empty() ? 18.0 : 3.0;
-    RequireMemory(8 * side * side * (2 * features + 2) * 4 * 1.2, "the sample's rotated copies",
-                  options_.sample_file.string());
+        std::floor(std::min(matched_->Width(), matched_->Height()) / std::numbers::sqrt2);
+    RequireMemory(8 * side * side * (2.0 * matched_->NumFeatures() + 2) * 4 * 1.2,
+                  "the sample's rotated copies", options_.sample_file.string());
   }
 
   void LayOut() {
     const auto start = std::chrono::steady_clock::now();
     // The face frames' x axes: the world direction laid onto each face, the
     // field the sample follows when no field file is given.
-    geometry_ = synth::MakePatchGeometry(mesh_, options_.sample_texel_size, 2,
-                                         synth::TangentFrame::kSmoothField,
+    geometry_ = synth::MakePatchGeometry(mesh_, texel_size_, 2, synth::TangentFrame::kSmoothField,
                                          options_.field_direction_in_world);
-    layout_ = atlas::LayoutAtlases(mesh_, geometry_.patches, geometry_.unfoldings,
-                                   options_.sample_texel_size, options_.atlas, progress_);
-    surface_ = quilt::DenseSurface::Build(layout_, geometry_.patches, geometry_.unfoldings,
-                                          options_.sample_texel_size);
+    layout_ = atlas::LayoutAtlases(mesh_, geometry_.patches, geometry_.unfoldings, texel_size_,
+                                   options_.atlas, progress_);
+    surface_ =
+        quilt::DenseSurface::Build(layout_, geometry_.patches, geometry_.unfoldings, texel_size_);
     summary_.samples = surface_.size();
     summary_.links = surface_.links();
     summary_.chart_seam_links = surface_.chart_seam_links();
@@ -150,32 +183,53 @@ class QuiltJob {
   }
 
   void Quilt() {
-    const synth::MaterialSample& matched =
-        colour_sample_ ? static_cast<const synth::MaterialSample&>(*colour_sample_) : *ptm_sample_;
-    result_ = quilt::QuiltSurface(surface_, layout_, matched, quilt_options_, progress_);
+    result_ = quilt::QuiltSurface(surface_, layout_, *matched_, quilt_options_, progress_);
     summary_.stats = result_.stats;
     summary_.seconds_quilting = result_.stats.seconds;
   }
 
+  // PTM atlases, or BTF atlases and their PTM preview as the model's atlases.
   void Bake() {
-    atlases_ = quilt::BakeQuiltedAtlases(surface_, result_, layout_, geometry_.patches,
-                                         *ptm_sample_, options_.atlas.gutter, progress_);
-    summary_.atlases = atlases_.ptms.size();
-    summary_.charts = static_cast<std::size_t>(atlases_.num_charts);
-    summary_.occupancy = atlases_.occupancy;
-    summary_.seconds_atlas = atlases_.seconds;
+    const auto start = std::chrono::steady_clock::now();
+    if (btf_sample_) {
+      btf_atlases_ = quilt::BakeQuiltedBtfAtlases(surface_, result_, layout_, btf_,
+                                                  options_.atlas.gutter, progress_);
+      summary_.seconds_atlas = SecondsSince(start);
+      const auto preview = std::chrono::steady_clock::now();
+      ptms_ = atlas::PreviewPtms(btf_atlases_, btf_, progress_);
+      summary_.seconds_preview = SecondsSince(preview);
+      summary_.occupancy = btf_atlases_.occupancy;
+    } else {
+      atlas::Atlases atlases =
+          quilt::BakeQuiltedAtlases(surface_, result_, layout_, geometry_.patches, *ptm_sample_,
+                                    options_.atlas.gutter, progress_);
+      ptms_ = std::move(atlases.ptms);
+      summary_.occupancy = atlases.occupancy;
+      summary_.seconds_atlas = SecondsSince(start);
+    }
+    summary_.atlases = ptms_.size();
+    summary_.charts = static_cast<std::size_t>(layout_.num_charts);
   }
 
   void Write() {
     model::TexturedModel model;
     model.mesh = mesh_;
-    model.atlases = atlases_.ptms;
-    for (const atlas::FacePlacement& fp : atlases_.faces) {
+    model.atlases = ptms_;
+    for (const atlas::FacePlacement& fp : layout_.faces) {
       model.face_atlas.push_back(fp.atlas);
       model.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
                                  fp.corners_px[2].cast<float>()});
     }
-    model::WriteModelFolder(options_.out_dir, model, Record());
+    nlohmann::json record = Record();
+    if (!btf_sample_) {
+      model::WriteModelFolder(options_.out_dir, model, record);
+      return;
+    }
+    const model::BtfModelFiles files(btf_, btf_atlases_.sample_coords, btf_atlases_.colour_gain,
+                                     btf_atlases_.geometry);
+    record["btf"] = files.Manifest();
+    model::WriteModelFolder(options_.out_dir, model, record, {},
+                            [&](const fs::path& folder) { files.Write(folder); });
   }
 
   nlohmann::json Record() const {
@@ -183,12 +237,15 @@ class QuiltJob {
     nlohmann::json accepted = nlohmann::json::object();
     for (const auto& [levels, n] : q.accepted_at_levels) accepted[std::to_string(levels)] = n;
     const double per_link = q.cut_links ? q.seam_cost / static_cast<double>(q.cut_links) : 0.0;
+    nlohmann::json settings = options_.ToJson();
+    settings["sample_texel_size"] = texel_size_;
     return {{"command", "synth"},
             {"inputs",
              {{"mesh", options_.mesh_file.string()}, {"sample", options_.sample_file.string()}}},
-            {"settings", options_.ToJson()},
+            {"settings", settings},
             {"summary",
-             {{"faces", summary_.faces},
+             {{"sample_kind", summary_.sample_kind},
+              {"faces", summary_.faces},
               {"dense_samples", summary_.samples},
               {"links", summary_.links},
               {"links_across_charts", summary_.chart_seam_links},
@@ -202,25 +259,32 @@ class QuiltJob {
               {"occupancy", summary_.occupancy}}},
             {"warnings", summary_.warnings},
             {"timings_s",
-             {{"layout", summary_.seconds_layout},
+             {{"sample", summary_.seconds_sample},
+              {"layout", summary_.seconds_layout},
               {"quilting", summary_.seconds_quilting},
               {"quilting_per_patch",
                summary_.seconds_quilting / std::max<double>(1.0, static_cast<double>(q.patches))},
-              {"atlas", summary_.seconds_atlas}}}};
+              {"atlas", summary_.seconds_atlas},
+              {"ptm_preview", summary_.seconds_preview}}}};
   }
 
   const QuiltJobOptions& options_;
   const ProgressCallback& progress_;
   quilt::QuiltOptions quilt_options_;  ///< the options', with the interpolated field
   mesh::TriangleMesh mesh_;
+  double texel_size_ = 0;  ///< world units per sample texel (the BTF's own when not given)
   Sample sample_;
+  btf::BtfFactorisation btf_;
   std::unique_ptr<synth::PtmSample> ptm_sample_;
   std::unique_ptr<synth::ColourSample> colour_sample_;
+  std::unique_ptr<synth::BtfSample> btf_sample_;
+  const synth::MaterialSample* matched_ = nullptr;  ///< the sample the quilting matches
   synth::PatchGeometry geometry_;
   atlas::AtlasLayout layout_;
   quilt::DenseSurface surface_;
   quilt::QuiltResult result_;
-  atlas::Atlases atlases_;
+  atlas::BtfAtlases btf_atlases_;
+  std::vector<ptm::Ptm> ptms_;  ///< the model's atlases (a BTF's preview)
   QuiltJobSummary summary_;
 };
 

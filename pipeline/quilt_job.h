@@ -19,18 +19,24 @@ namespace texlume::pipeline {
 
 struct QuiltJobOptions {
   std::filesystem::path mesh_file;
-  std::filesystem::path sample_file;  ///< PTM (.ptm, .exr) or colour image (ReadSample)
-  std::filesystem::path out_dir;      ///< the model folder written
+  /// A PTM (.ptm, .exr) or colour image (ReadSample), or a BTF capture or
+  /// factorisation folder (btf::ReadOrFactoriseBtf).
+  std::filesystem::path sample_file;
+  int btf_components = 40;        ///< kept when factorising a BTF capture (paper 004: 40)
+  std::filesystem::path out_dir;  ///< the model folder written
   /// Key vectors orienting the sample (quilt/vector_field.h); empty: the world
   /// direction below laid onto every face (synth::TangentFrame::kSmoothField).
   std::filesystem::path field_file;
   Eigen::Vector3d field_direction_in_world = Eigen::Vector3d::UnitZ();
-  double sample_texel_size = 0.0;  ///< world units per sample texel, > 0
+  /// World units per sample texel, > 0; a BTF sample's own when 0.
+  double sample_texel_size = 0.0;
   quilt::QuiltOptions quilt;
   /// The charts are the dense surface's geometry image: conformal by default.
   atlas::AtlasOptions atlas = ConformalAtlas();
   void Check() const;
   nlohmann::json ToJson() const;
+  /// Whether `sample_file` is a BTF folder (a directory).
+  bool BtfSample() const;
 
   static atlas::AtlasOptions ConformalAtlas() {
     atlas::AtlasOptions o;
@@ -40,16 +46,21 @@ struct QuiltJobOptions {
 };
 
 struct QuiltJobSummary {
+  std::string sample_kind;  ///< "PTM", "colour" or "BTF"
+  double sample_texel_size = 0;
   std::size_t faces = 0, samples = 0, links = 0, chart_seam_links = 0;
   quilt::QuiltStats stats;
   std::size_t atlases = 0, charts = 0;
   double occupancy = 0.0;
   std::vector<std::string> warnings;
-  double seconds_layout = 0, seconds_quilting = 0, seconds_atlas = 0, seconds_total = 0;
+  double seconds_sample = 0, seconds_layout = 0, seconds_quilting = 0, seconds_atlas = 0,
+         seconds_preview = 0, seconds_total = 0;
 };
 
 /// Reads the mesh and the sample, lays the faces out in charts, quilts the
-/// dense surface and writes the model folder (atomically). Throws InputError
+/// dense surface and writes the model folder (atomically): PTM atlases for a
+/// PTM or colour sample; for a BTF, the BTF files of a BTF model folder
+/// (model::BtfModelFiles) with a PTM preview as its atlases. Throws InputError
 /// naming a bad file, OptionError for bad settings (a texel size the memory
 /// limit cannot hold is refused before anything is allocated, with the estimate).
 QuiltJobSummary RunQuiltJob(const QuiltJobOptions& options, const ProgressCallback& progress = {});

@@ -51,34 +51,47 @@ float BilinearClamped(const cv::Mat& plane, double x, double y) {
 
 }  // namespace
 
+QuiltedSurfaceLookup::QuiltedSurfaceLookup(const DenseSurface& surface, const QuiltResult& quilt,
+                                           const atlas::AtlasLayout& layout, int gutter)
+    : surface_(surface), quilt_(quilt), layout_(layout), reach_(gutter + 2) {}
+
+bool QuiltedSurfaceLookup::At(int face, const Eigen::Vector2d& p_in_frame,
+                              Eigen::Vector2d* sample_px, double* angle_rad) const {
+  const atlas::FacePlacement& fp = layout_.faces[static_cast<std::size_t>(face)];
+  const Eigen::Vector2d px = AtlasPx(fp, p_in_frame, surface_.texel_size());
+  const int s = NearestSample(surface_, fp, px, reach_);
+  if (s < 0) return false;
+  const DenseSample& d = surface_.samples()[static_cast<std::size_t>(s)];
+  const SampleLookup& lookup = quilt_.lookups[static_cast<std::size_t>(s)];
+  // The sample is turned by `angle` against the atlas frame: an atlas offset
+  // (rows down) is the sample offset turned back by it.
+  const double a = lookup.angle_rad, c = std::cos(a), sn = std::sin(a);
+  const Eigen::Vector2d v = px - Eigen::Vector2d(d.x + 0.5, d.y + 0.5);
+  *sample_px = lookup.sample_px.cast<double>() +
+               Eigen::Vector2d(c * v.x() - sn * v.y(), sn * v.x() + c * v.y());
+  *angle_rad = a;
+  return true;
+}
+
 atlas::Atlases BakeQuiltedAtlases(const DenseSurface& surface, const QuiltResult& quilt,
                                   const atlas::AtlasLayout& layout,
                                   const std::vector<synth::TrianglePatch>& patches,
                                   const synth::PtmSample& sample, int gutter,
                                   const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
-  const double t = surface.texel_size();
+  const QuiltedSurfaceLookup lookup(surface, quilt, layout, gutter);
   const std::vector<cv::Mat>& values = sample.Values();
   const int num_planes = static_cast<int>(values.size());
   const int polynomials = sample.CoefficientPlanes() / 6;
   atlas::BakedPlanes baked = atlas::BakeAtlasPlanes(
-      layout, t, gutter, num_planes,
+      layout, surface.texel_size(), gutter, num_planes,
       [&](int face, const Eigen::Vector2d& p_in_frame, float* out) {
-        const atlas::FacePlacement& fp = layout.faces[static_cast<std::size_t>(face)];
-        const Eigen::Vector2d px = AtlasPx(fp, p_in_frame, t);
-        const int s = NearestSample(surface, fp, px, gutter + 2);
-        if (s < 0) {
+        Eigen::Vector2d at;
+        double a = 0;
+        if (!lookup.At(face, p_in_frame, &at, &a)) {
           std::fill_n(out, num_planes, 0.0f);
           return;
         }
-        const DenseSample& d = surface.samples()[static_cast<std::size_t>(s)];
-        const SampleLookup& lookup = quilt.lookups[static_cast<std::size_t>(s)];
-        // The sample is turned by `angle` against the atlas frame: an atlas
-        // offset (rows down) is the sample offset turned back by it.
-        const double a = lookup.angle_rad, c = std::cos(a), sn = std::sin(a);
-        const Eigen::Vector2d v = px - Eigen::Vector2d(d.x + 0.5, d.y + 0.5);
-        const Eigen::Vector2d at = lookup.sample_px.cast<double>() +
-                                   Eigen::Vector2d(c * v.x() - sn * v.y(), sn * v.x() + c * v.y());
         for (int k = 0; k < num_planes; ++k)
           out[k] = BilinearClamped(values[static_cast<std::size_t>(k)], at.x(), at.y());
         const Eigen::Matrix<double, 6, 6> to_atlas = ptm::OrthonormalFrameRotation(-a);
@@ -101,6 +114,24 @@ atlas::Atlases BakeQuiltedAtlases(const DenseSurface& surface, const QuiltResult
   atlases.occupancy = baked.occupancy;
   atlases.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return atlases;
+}
+
+atlas::BtfAtlases BakeQuiltedBtfAtlases(const DenseSurface& surface, const QuiltResult& quilt,
+                                        const atlas::AtlasLayout& layout,
+                                        const btf::BtfFactorisation& sample, int gutter,
+                                        const ProgressCallback& progress) {
+  const QuiltedSurfaceLookup lookup(surface, quilt, layout, gutter);
+  return atlas::BakeBtfAtlases(
+      layout, surface.texel_size(), gutter, sample,
+      [&](int face, const Eigen::Vector2d& p_in_frame) {
+        atlas::BtfAtlasLookup out;
+        double a = 0;
+        // The sample turned by a in the atlas frame: an atlas direction is
+        // turned by -a in the sample's.
+        if (lookup.At(face, p_in_frame, &out.sample_px, &a)) out.atlas_to_sample_rad = -a;
+        return out;
+      },
+      progress);
 }
 
 }  // namespace texlume::quilt

@@ -501,9 +501,9 @@ TEST(Cli, SynthWithABtfSampleRendersAsABtfAndRefusesBadInput) {
 }
 
 // A small scene without a BTF, for colour samples (material texel 0.01): its folder.
-std::string WriteColourSampleScene(const TempDir& tmp) {
-  datasets::SceneOptions options = SmallBtfScene(8, 96, 40);
-  options.write_btf = false;
+std::string WriteColourSampleScene(const TempDir& tmp, int btf_size = 0) {
+  datasets::SceneOptions options = SmallBtfScene(8, 96, std::max(btf_size, 16));
+  options.write_btf = btf_size > 0;
   options.capture_size = 64;
   options.focal_px = 90;
   options.num_held_out_views = 1;
@@ -610,6 +610,53 @@ TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
             1);
   EXPECT_NE(out.find("tiny.png"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
+}
+
+// Graph-cut quilting with a BTF sample (issue 32): the capture factorised, its
+// geometry maps matched, a BTF model folder that `texlume render` draws as a
+// BTF; a capture missing an image is an input error naming it.
+TEST(Cli, SynthGraphcutQuiltsABtfIntoABtfModelFolder) {
+  TempDir tmp;
+  const std::string scene = WriteColourSampleScene(tmp, 40);
+  const std::string inputs = " --engine graphcut --mesh " + scene +
+                             "/object/mesh.ply --atlas-size 512 --work-patch 8 --components 8";
+  std::string out;
+  ASSERT_EQ(Texlume("synth" + inputs + " --btf " + scene + "/material/btf --out " +
+                        (tmp / "model").string(),
+                    &out),
+            0)
+      << out;
+  const nlohmann::json manifest =
+      nlohmann::json::parse(testing::ReadText(tmp / "model/manifest.json"));
+  EXPECT_EQ(manifest["summary"]["sample_kind"], "BTF");
+  EXPECT_EQ(manifest["settings"]["sample_texel_size"], 0.01);  // the capture's own
+  EXPECT_EQ(manifest["btf"]["format"], "texlume-btf-model-1");
+  EXPECT_GT(manifest["summary"]["patches"].get<int>(), 1);
+  EXPECT_TRUE(std::filesystem::exists(tmp / "model/btf/btf_svd.json"));
+  EXPECT_TRUE(std::filesystem::exists(tmp / "model/btf_atlas_0.exr"));
+  const std::string held = scene + "/object/held_out";
+  ASSERT_EQ(Texlume("render --model " + (tmp / "model").string() + " --cameras " + held +
+                        "/sparse --lights " + held + "/lights.json --truth " + held +
+                        "/images --truth-masks " + held + "/masks --out " + (tmp / "r").string(),
+                    &out),
+            0)
+      << out;
+  const nlohmann::json render = nlohmann::json::parse(testing::ReadText(tmp / "r/render.json"));
+  EXPECT_EQ(render["settings"]["mode"], "btf");
+  EXPECT_GT(render["metrics"]["mean_psnr_db"].get<double>(), 10.0);
+  // The same folder given as --sample; a capture missing an image: refused, naming it.
+  std::filesystem::remove(scene + "/material/btf/view_00_light_03.png");
+  EXPECT_EQ(Texlume("synth" + inputs + " --sample " + scene + "/material/btf --out " +
+                        (tmp / "bad").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("view_00_light_03.png"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
+  // --components with a sample that is no BTF: refused (2).
+  EXPECT_EQ(Texlume("synth" + inputs + " --sample-texel-size 0.01 --sample " + scene +
+                        "/material/capture/rti_005.png --out " + (tmp / "bad").string(),
+                    &out),
+            2);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "datasets_synthetic/shapes.h"
 #include "quilt/quilt_atlases.h"
+#include "synth/btf_sample.h"
 
 namespace texlume::quilt {
 namespace {
@@ -182,12 +183,6 @@ TEST(QuiltSurface, RefusesASampleSmallerThanTheSmallestPatch) {
   EXPECT_THROW(QuiltSurface(s.dense, s.layout, sample, o), InputError);
 }
 
-}  // namespace
-}  // namespace texlume::quilt
-
-namespace texlume::quilt {
-namespace {
-
 // The baked atlas turns each texel's light response with its lookup: a sample
 // lit most from its +x is, in the atlas, lit most from the direction the
 // sample's x axis takes there.
@@ -216,6 +211,51 @@ TEST(BakeQuiltedAtlases, TurnsTheLightResponseWithTheLookup) {
     const double angle = r.lookups[i].angle_rad;
     EXPECT_NEAR(a[3], 0.4 * std::cos(angle), 1e-4);
     EXPECT_NEAR(a[4], 0.4 * std::sin(angle), 1e-4);
+    angles.insert(static_cast<int>(std::lround(angle * 100)));
+  }
+  EXPECT_GT(angles.size(), 2u);  // several patches, turned differently
+}
+
+// A BTF of one component lit most from its +x: the quilted BTF atlases hold
+// each dense sample's lookup (position, and the atlas frame's turn into the
+// sample's, the reverse of the sample's turn), and their PTM preview is lit
+// most from the direction the sample's x axis takes in the atlas, as the PTM
+// bake above.
+TEST(BakeQuiltedBtfAtlases, HoldsTheLookupAndTurnsTheLightWithIt) {
+  btf::BtfFactorisation lit;
+  lit.width = lit.height = 64;
+  lit.texel_size = 0.01;
+  lit.views = {Eigen::Vector3d::UnitZ()};
+  for (int k = 0; k < 8; ++k) {
+    const double a = k * std::numbers::pi / 4, e = std::numbers::pi / 4;
+    lit.lights.emplace_back(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+  }
+  lit.geometry = Eigen::MatrixXf::Ones(64 * 64, 1);
+  lit.appearance.resize(8 * 3, 1);
+  for (int k = 0; k < 8; ++k)
+    lit.appearance.middleRows(k * 3, 3).setConstant(
+        static_cast<float>(0.1 + 0.3 * std::max(0.0, lit.lights[static_cast<std::size_t>(k)].x())));
+  lit.singular_values = {1.0};
+  const synth::BtfSample sample(lit);
+  const Surface s = MakeSurface(datasets::MakeGridPlane(2, 0.3), 0.01, atlas::AtlasMode::kCharts);
+  QuiltOptions o;
+  o.work_patch_levels = 8;
+  o.random_orientation = true;
+  const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o);
+  const atlas::BtfAtlases atlases = BakeQuiltedBtfAtlases(s.dense, r, s.layout, lit, 2);
+  ASSERT_EQ(atlases.sample_coords.size(), 1u);
+  const std::vector<ptm::Ptm> preview = atlas::PreviewPtms(atlases, lit);
+  std::set<int> angles;
+  for (std::size_t i = 0; i < s.dense.size(); ++i) {
+    const DenseSample& d = s.dense.samples()[i];
+    const cv::Vec3f c = atlases.sample_coords[0].at<cv::Vec3f>(d.y, d.x);
+    EXPECT_NEAR(c[0], r.lookups[i].sample_px.x(), 1e-4);
+    EXPECT_NEAR(c[1], r.lookups[i].sample_px.y(), 1e-4);
+    const double angle = r.lookups[i].angle_rad;
+    EXPECT_NEAR(std::remainder(c[2] + angle, 2 * std::numbers::pi), 0.0, 1e-4);
+    const float* a =
+        preview[0].Coefficients(static_cast<std::size_t>(d.y) * preview[0].width + d.x);
+    EXPECT_NEAR(std::remainder(std::atan2(a[4], a[3]) - angle, 2 * std::numbers::pi), 0.0, 0.02);
     angles.insert(static_cast<int>(std::lround(angle * 100)));
   }
   EXPECT_GT(angles.size(), 2u);  // several patches, turned differently
