@@ -4,6 +4,8 @@
 #   - the BTF model from the scene's BTF capture (texlume synth --btf),
 #   - the PTM model from the RTI capture of the same material, with and without
 #     the PTM pipeline's photo-consistency pass,
+#   - the BTF model of graph-cut quilting (texlume synth --engine graphcut --btf,
+#     issue 32: the same capture over the mesh without photos),
 # renders the held-out views (views and lights no photo has) of each, the BTF
 # model's PTM preview and the two baselines, and prints PSNR / SSIM against the
 # ground truth, the SVD error table and the time per triangle.
@@ -25,8 +27,10 @@ inputs=(--model "$object/sparse" --images "$object/images" --lights "$object/lig
         --mesh "$object/mesh.ply" --no-report)
 capture="$scene/material/capture"
 "$texlume" fit --images "$capture" --lights "$capture/lights.lp" --out "$work/sample.ptm" > /dev/null
-rm -rf "$work/btf" "$work/ptm" "$work/ptm_plain"
+rm -rf "$work/btf" "$work/ptm" "$work/ptm_plain" "$work/btf_graphcut"
 "$texlume" synth "${inputs[@]}" --btf "$scene/material/btf" --out "$work/btf" > /dev/null
+"$texlume" synth --engine graphcut --mesh "$object/mesh.ply" --btf "$work/btf/btf" \
+  --out "$work/btf_graphcut" > /dev/null
 "$texlume" synth "${inputs[@]}" --sample "$work/sample.ptm" --sample-texel-size 0.002 \
   --out "$work/ptm" > /dev/null
 "$texlume" synth "${inputs[@]}" --sample "$work/sample.ptm" --sample-texel-size 0.002 \
@@ -41,6 +45,7 @@ render() {  # name model [extra arguments]
 }
 render btf "$work/btf"
 render btf_ptm_preview "$work/btf" --baseline ptm
+render btf_graphcut "$work/btf_graphcut"
 render ptm "$work/ptm"
 render ptm_no_correction "$work/ptm_plain"
 render flat "$work/btf" --baseline flat
@@ -51,7 +56,7 @@ work = sys.argv[1]
 print("Held-out views x lights, inside the object masks (12 images):")
 print("| model | PSNR (dB) | SSIM | render time (s) |")
 print("| --- | --- | --- | --- |")
-for name in ["btf", "btf_ptm_preview", "ptm", "ptm_no_correction", "flat", "baked"]:
+for name in ["btf", "btf_ptm_preview", "btf_graphcut", "ptm", "ptm_no_correction", "flat", "baked"]:
     r = json.load(open(f"{work}/render_{name}/render.json"))
     m = r["metrics"]
     print(f"| {name} | {m['mean_psnr_db']:.2f} | {m['mean_ssim']:.3f} | {r['timings_s']['total']:.1f} |")
@@ -64,6 +69,9 @@ t = b["timings_s"]
 s = b["summary"]
 print(f"| BTF | {t['synthesis_per_triangle']:.4f} | {t['seams']:.2f} | "
       f"{s['seam_cost_per_link']:.3f} | {s['straight_edge_cost_per_link']:.3f} |")
+g = json.load(open(f"{work}/btf_graphcut/manifest.json"))
+print(f"| BTF, graph-cut quilting (no photos) | "
+      f"{g['timings_s']['quilting'] / g['summary']['faces']:.4f} | | | |")
 print(f"| PTM (no correction) | {p['timings_s']['synthesis_per_triangle']:.4f} | | | |")
 svd = json.load(open(f"{work}/btf/btf/btf_svd.json"))
 print()

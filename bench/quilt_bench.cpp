@@ -15,7 +15,10 @@
 // per cut link against a cut between unrelated texels, the share of the sample
 // reused, and the nearest-patch energy of the baked atlas (quilt/patch_energy.h;
 // also of the model folder MODEL_DIR's atlases, e.g. the per-triangle engine's
-// with the same sample); then the time from about 12k to 800k samples.
+// with the same sample); then the time from about 12k to 800k samples. Last,
+// meshes of several kinds quilted alike (a handle, creases, two components, a
+// non-manifold line, an irregular lumpy 81920-face scan-like mesh): coverage,
+// charts, seams, energy and time.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -119,12 +122,12 @@ std::vector<cv::Mat> InsideMasks(const model::TexturedModel& m) {
 struct Quilted {
   quilt::QuiltResult result;
   atlas::Atlases atlases;
-  std::size_t samples = 0;
+  std::size_t samples = 0, links_across_charts = 0, texels_inside = 0, synthesised = 0;
+  int charts = 0;
 };
 
-Quilted QuiltIcosphere(const synth::PtmSample& sample, int subdivisions, double texel,
-                       const quilt::QuiltOptions& q) {
-  const mesh::TriangleMesh mesh = datasets::MakeIcosphere(subdivisions, 0.5);
+Quilted QuiltMesh(const mesh::TriangleMesh& mesh, const synth::PtmSample& sample, double texel,
+                  const quilt::QuiltOptions& q) {
   const synth::PatchGeometry g = synth::MakePatchGeometry(
       mesh, texel, 2, synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
   atlas::AtlasOptions o;
@@ -134,9 +137,51 @@ Quilted QuiltIcosphere(const synth::PtmSample& sample, int subdivisions, double 
       quilt::DenseSurface::Build(layout, g.patches, g.unfoldings, texel);
   Quilted out;
   out.samples = surface.size();
+  out.charts = layout.num_charts;
+  out.links_across_charts = surface.chart_seam_links();
   out.result = quilt::QuiltSurface(surface, layout, sample, q);
   out.atlases = quilt::BakeQuiltedAtlases(surface, out.result, layout, g.patches, sample, 2);
+  for (const cv::Mat& c : out.atlases.coverage) out.texels_inside += cv::countNonZero(c == 255);
+  for (const quilt::SampleLookup& l : out.result.lookups) out.synthesised += l.synthesised;
   return out;
+}
+
+Quilted QuiltIcosphere(const synth::PtmSample& sample, int subdivisions, double texel,
+                       const quilt::QuiltOptions& q) {
+  return QuiltMesh(datasets::MakeIcosphere(subdivisions, 0.5), sample, texel, q);
+}
+
+// Meshes of several kinds, quilted alike: coverage, seams, energy and time.
+void QuiltMeshes(const synth::PtmSample& sample, int levels, double texel) {
+  quilt::RotatedSample rotated(sample);
+  std::printf(
+      "\nMeshes of several kinds (conformal charts, texel %g, r_w %d, the sample above):\n"
+      "| mesh | faces | samples | texels inside faces | synthesised | charts | links across "
+      "charts | patches | forced | seam cost / unrelated cut | nearest-patch energy | s |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+      texel, levels);
+  const mesh::TriangleMesh sphere = datasets::MakeIcosphere(3, 0.3);
+  mesh::TriangleMesh apart = sphere;
+  for (Eigen::Vector3d& v : apart.vertices) v.x() += 0.8;
+  const std::pair<const char*, mesh::TriangleMesh> meshes[] = {
+      {"icosphere", datasets::MakeIcosphere(3, 0.5)},
+      {"torus (a handle)", datasets::MakeTorus(48, 20, 0.35, 0.15)},
+      {"capped cylinder (creases)", datasets::MakeCylinder(32, 8, 0.3, 0.8)},
+      {"two spheres (disconnected)", datasets::JoinMeshes(sphere, apart)},
+      {"crossed planes (non-manifold)", datasets::MakeCrossedPlanes(16, 0.8)},
+      {"scan-like (irregular, lumpy)", datasets::MakeScanLikeMesh(6, 0.5, 0.1, 1)}};
+  for (const auto& [name, mesh] : meshes) {
+    quilt::QuiltOptions q;
+    q.work_patch_levels = levels;
+    const auto t0 = std::chrono::steady_clock::now();
+    const Quilted run = QuiltMesh(mesh, sample, texel, q);
+    const quilt::QuiltStats& st = run.result.stats;
+    std::printf("| %s | %zu | %zu | %zu | %zu | %d | %zu | %zu | %zu | %.2f | %.4f | %.1f |\n",
+                name, mesh.faces.size(), run.samples, run.texels_inside, run.synthesised,
+                run.charts, run.links_across_charts, st.patches, st.forced,
+                st.seam_cost / std::max<std::size_t>(st.cut_links, 1) / st.random_pair_cost,
+                AtlasEnergy(run.atlases.ptms, run.atlases.coverage, rotated), Seconds(t0));
+  }
 }
 
 void QuiltSphere(const ptm::Ptm& sample_ptm, int levels, double texel, const char* compare) {
@@ -241,6 +286,8 @@ int main(int argc, char** argv) {
     std::printf("| %d x %d | %d | %d of %d | %.4f | %.4f | %.0fx |\n", w, w, positions, same,
                 trials, fft / trials, brute / trials, brute / fft);
   }
-  QuiltSphere(ptm_file ? ptm::ReadPtmFile(ptm_file) : SmoothPtm(256, 7), levels, texel, compare);
+  const ptm::Ptm quilted = ptm_file ? ptm::ReadPtmFile(ptm_file) : SmoothPtm(256, 7);
+  QuiltSphere(quilted, levels, texel, compare);
+  QuiltMeshes(synth::PtmSample(quilted), levels, texel);
   return 0;
 }

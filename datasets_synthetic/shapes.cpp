@@ -4,6 +4,9 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <random>
+#include <utility>
+#include <vector>
 
 namespace texlume::datasets {
 namespace {
@@ -175,6 +178,53 @@ mesh::TriangleMesh MakeTorus(int around, int tube, double major, double minor) {
       mesh.faces.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
       mesh.faces.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
     }
+  }
+  return mesh;
+}
+
+mesh::TriangleMesh MakeCrossedPlanes(int segments, double size) {
+  const mesh::TriangleMesh a = MakeGridPlane(segments, size);
+  mesh::TriangleMesh out = a;
+  const int n = static_cast<int>(a.vertices.size());
+  for (const Eigen::Vector3d& v : a.vertices) out.vertices.emplace_back(v.x(), 0.0, v.y());
+  // The second plane's vertices on the line are the first's.
+  auto second = [&](int k) {
+    return std::abs(a.vertices[static_cast<std::size_t>(k)].y()) < 1e-12 ? k : k + n;
+  };
+  for (const auto& f : a.faces) out.faces.push_back({second(f[0]), second(f[1]), second(f[2])});
+  return out;
+}
+
+mesh::TriangleMesh JoinMeshes(const mesh::TriangleMesh& a, const mesh::TriangleMesh& b) {
+  mesh::TriangleMesh out = a;
+  const int offset = static_cast<int>(a.vertices.size());
+  out.vertices.insert(out.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (const auto& f : b.faces) out.faces.push_back({f[0] + offset, f[1] + offset, f[2] + offset});
+  return out;
+}
+
+mesh::TriangleMesh MakeScanLikeMesh(int subdivisions, double radius, double relief, unsigned seed) {
+  mesh::TriangleMesh mesh = MakeIcosphere(subdivisions, 1.0);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double edge = (mesh.Corner(0, 1) - mesh.Corner(0, 0)).norm();
+  for (Eigen::Vector3d& v : mesh.vertices) {
+    const Eigen::Vector3d n = v.normalized();
+    // Drawn one at a time: a call's arguments are evaluated in an unspecified order.
+    const double dz = u(rng), dy = u(rng), dx = u(rng);
+    const Eigen::Vector3d d(dx, dy, dz);
+    v = (v + (edge / 3.0) * (d - d.dot(n) * n)).normalized();
+  }
+  std::vector<std::pair<Eigen::Vector3d, double>> bumps;  // centre on the sphere, height
+  for (int k = 0; relief > 0 && k < 8; ++k) {
+    const double z = u(rng), y = u(rng), x = u(rng), h = u(rng);
+    bumps.emplace_back(Eigen::Vector3d(x, y, z).normalized(), h);
+  }
+  for (Eigen::Vector3d& v : mesh.vertices) {
+    double r = 1.0;
+    for (const auto& [centre, height] : bumps)
+      r += relief * height * std::exp(-(v - centre).squaredNorm() / 0.5);
+    v *= radius * r;
   }
   return mesh;
 }

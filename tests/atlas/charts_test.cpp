@@ -39,19 +39,7 @@ void ExpectEachFaceInOneChart(const std::vector<std::vector<atlas::ChartFace>>& 
 /// The 1280-face icosphere with every vertex moved along the sphere by up to a
 /// third of an edge (seeded): an irregular mesh.
 mesh::TriangleMesh JitteredIcosphere(unsigned seed) {
-  mesh::TriangleMesh mesh = datasets::MakeIcosphere(3, 1.0);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const double edge = (mesh.Corner(0, 1) - mesh.Corner(0, 0)).norm();
-  for (Eigen::Vector3d& v : mesh.vertices) {
-    const Eigen::Vector3d n = v.normalized();
-    // Drawn one at a time, last first: a call's arguments are evaluated in an
-    // unspecified order (GCC right to left, clang left to right).
-    const double dz = u(rng), dy = u(rng), dx = u(rng);
-    const Eigen::Vector3d d(dx, dy, dz);
-    v = (v + (edge / 3.0) * (d - d.dot(n) * n)).normalized();
-  }
-  return mesh;
+  return datasets::MakeScanLikeMesh(3, 1.0, 0.0, seed);
 }
 
 // Strip charts of the mesh, every face in exactly one of them.

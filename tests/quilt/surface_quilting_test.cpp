@@ -173,6 +173,26 @@ TEST(QuiltSurface, TurnsTheSampleAlongTheField) {
   }
 }
 
+// A mesh of two components, one of them non-manifold (two planes crossing, four
+// faces on each edge of the line): every sample is synthesised, by several
+// patches linked across chart borders.
+TEST(QuiltSurface, CoversDisconnectedAndNonManifoldMeshes) {
+  const ptm::Ptm smooth = SmoothPtm(96, 5);
+  const synth::PtmSample sample(smooth);
+  mesh::TriangleMesh crossed = datasets::MakeCrossedPlanes(4, 0.3);
+  mesh::TriangleMesh sphere = datasets::MakeIcosphere(2, 0.15);
+  for (Eigen::Vector3d& v : sphere.vertices) v.x() += 0.5;
+  const Surface s =
+      MakeSurface(datasets::JoinMeshes(crossed, sphere), 0.01, atlas::AtlasMode::kCharts);
+  QuiltOptions o;
+  o.work_patch_levels = 8;
+  const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o);
+  ASSERT_EQ(r.lookups.size(), s.dense.size());
+  for (const SampleLookup& l : r.lookups) EXPECT_TRUE(l.synthesised);
+  EXPECT_GT(s.dense.chart_seam_links(), 0u);
+  EXPECT_GT(r.stats.patches, 2u);
+}
+
 TEST(QuiltSurface, RefusesASampleSmallerThanTheSmallestPatch) {
   const ptm::Ptm ptm = SmoothPtm(16, 4);  // copies of 11 texels
   const synth::PtmSample sample(ptm);
