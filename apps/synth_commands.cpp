@@ -5,6 +5,7 @@
 #include "apps/cli.h"
 #include "apps/commands.h"
 #include "apps/progress_bar.h"
+#include "core/errors.h"
 #include "core/units.h"
 #include "pipeline/jobs.h"
 
@@ -37,7 +38,8 @@ void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords
   sub->add_option("--components", o.components, "BTF components kept when factorising a capture")
       ->capture_default_str();
   sub->add_option("--sample-texel-size", j.synthesis.sample_texel_size,
-                  "world units per sample texel (required with --sample; BTF: the capture's)");
+                  "world units per sample texel (required with --sample but a BTF folder; BTF: the "
+                  "capture's)");
   BindWorldUnit(sub, w.world_unit);
   sub->add_option("--seam-band", o.seam_band,
                   "BTF graph-cut band half-width in texels [min(4, "
@@ -186,6 +188,8 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
   q.mesh_file = o.job.mesh_file;
   q.sample_file = o.btf.empty() ? o.job.sample_file : o.btf;
   if (q.sample_file.empty()) throw UsageError("--sample or --btf is required");
+  if (!o.btf.empty() && !q.BtfSample())
+    throw InputError(o.btf.string(), "is not a folder (a BTF capture or factorisation)");
   q.btf_components = o.components;
   if (sub->count("--components") > 0 && !q.BtfSample())
     throw UsageError("--components is for a BTF sample (a capture folder)");

@@ -5,6 +5,7 @@
 #include <map>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -183,15 +184,24 @@ mesh::TriangleMesh MakeTorus(int around, int tube, double major, double minor) {
 }
 
 mesh::TriangleMesh MakeCrossedPlanes(int segments, double size) {
+  if (segments % 2 != 0) throw std::invalid_argument("crossed planes need an even segment count");
   const mesh::TriangleMesh a = MakeGridPlane(segments, size);
   mesh::TriangleMesh out = a;
-  const int n = static_cast<int>(a.vertices.size());
-  for (const Eigen::Vector3d& v : a.vertices) out.vertices.emplace_back(v.x(), 0.0, v.y());
-  // The second plane's vertices on the line are the first's.
-  auto second = [&](int k) {
-    return std::abs(a.vertices[static_cast<std::size_t>(k)].y()) < 1e-12 ? k : k + n;
-  };
-  for (const auto& f : a.faces) out.faces.push_back({second(f[0]), second(f[1]), second(f[2])});
+  // The second plane's vertices: those on the line are the first's.
+  std::vector<int> second(a.vertices.size());
+  for (std::size_t k = 0; k < a.vertices.size(); ++k) {
+    const Eigen::Vector3d& v = a.vertices[k];
+    if (std::abs(v.y()) < 1e-12) {
+      second[k] = static_cast<int>(k);
+      continue;
+    }
+    second[k] = static_cast<int>(out.vertices.size());
+    out.vertices.emplace_back(v.x(), 0.0, v.y());
+  }
+  for (const auto& f : a.faces)
+    out.faces.push_back({second[static_cast<std::size_t>(f[0])],
+                         second[static_cast<std::size_t>(f[1])],
+                         second[static_cast<std::size_t>(f[2])]});
   return out;
 }
 

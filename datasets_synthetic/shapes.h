@@ -53,16 +53,17 @@ mesh::TriangleMesh MakeCylinder(int segments_around, int segments_along, double 
 mesh::TriangleMesh MakeGridPlane(int segments, double size);
 mesh::TriangleMesh MakeTorus(int segments_around, int segments_tube, double major_radius,
                              double minor_radius);
+/// Two grid planes (z = 0 and y = 0) crossing along the x axis (`segments` even):
+/// every edge on the line is shared by four faces, a non-manifold mesh. Throws
+/// std::invalid_argument when `segments` is odd (no line of vertices on the axis).
+mesh::TriangleMesh MakeCrossedPlanes(int segments, double size);
+/// Both meshes in one (b's vertices after a's): a mesh of two components.
+mesh::TriangleMesh JoinMeshes(const mesh::TriangleMesh& a, const mesh::TriangleMesh& b);
 /// An irregular, scan-like closed mesh (20 * 4^subdivisions faces, seeded): an
 /// icosphere whose vertices are moved along the sphere by up to a third of an
 /// edge (triangles of uneven size and shape, as a mesher of a scan gives), then
 /// pushed out or in by `relief` (a share of the radius) with 8 random smooth
 /// bumps, a lumpy stone rather than a sphere (0: on the sphere).
-/// Two grid planes (z = 0 and y = 0) crossing along the x axis (`segments` even):
-/// every edge on the line is shared by four faces, a non-manifold mesh.
-mesh::TriangleMesh MakeCrossedPlanes(int segments, double size);
-/// Both meshes in one (b's vertices after a's): a mesh of two components.
-mesh::TriangleMesh JoinMeshes(const mesh::TriangleMesh& a, const mesh::TriangleMesh& b);
 mesh::TriangleMesh MakeScanLikeMesh(int subdivisions, double radius, double relief, unsigned seed);
 
 }  // namespace texlume::datasets

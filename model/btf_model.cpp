@@ -22,12 +22,14 @@ std::string GeometryFileName(std::size_t atlas, std::size_t part) {
 }  // namespace
 
 BtfModelFiles::BtfModelFiles(const btf::BtfFactorisation& sample,
-                             const std::vector<cv::Mat>& sample_coords,
-                             const std::vector<cv::Mat>& colour_gain,
+                             std::vector<cv::Mat> sample_coords, std::vector<cv::Mat> colour_gain,
                              const std::vector<std::vector<cv::Mat>>& geometry)
-    : sample_(sample), sample_coords_(sample_coords), colour_gain_(colour_gain) {
+    : sample_(sample),
+      sample_coords_(std::move(sample_coords)),
+      colour_gain_(std::move(colour_gain)) {
   nlohmann::json atlas_files = nlohmann::json::array();
-  for (std::size_t a = 0; a < sample_coords.size(); ++a) atlas_files.push_back(BtfAtlasFileName(a));
+  for (std::size_t a = 0; a < sample_coords_.size(); ++a)
+    atlas_files.push_back(BtfAtlasFileName(a));
   manifest_ = {
       {"format", "texlume-btf-model-1"},
       {"factorisation", "btf/btf_svd.json"},

@@ -29,9 +29,11 @@ class BtfModelFiles {
  public:
   /// `sample_coords`, `colour_gain` (CV_32FC3) and `geometry` (n CV_32FC1
   /// planes) per atlas, as atlas::BtfAtlases holds them.
-  BtfModelFiles(const btf::BtfFactorisation& sample, const std::vector<cv::Mat>& sample_coords,
-                const std::vector<cv::Mat>& colour_gain,
+  BtfModelFiles(const btf::BtfFactorisation& sample, std::vector<cv::Mat> sample_coords,
+                std::vector<cv::Mat> colour_gain,
                 const std::vector<std::vector<cv::Mat>>& geometry);
+  BtfModelFiles(btf::BtfFactorisation&&, std::vector<cv::Mat>, std::vector<cv::Mat>,
+                const std::vector<std::vector<cv::Mat>>&) = delete;  // it keeps the sample
   /// The manifest's "btf" section.
   const nlohmann::json& Manifest() const { return manifest_; }
   /// Writes the files into the folder being written (WriteModelFolder's callback).
@@ -41,8 +43,7 @@ class BtfModelFiles {
   nlohmann::json EncodeGeometry(const std::vector<std::vector<cv::Mat>>& geometry);
 
   const btf::BtfFactorisation& sample_;
-  const std::vector<cv::Mat>& sample_coords_;
-  const std::vector<cv::Mat>& colour_gain_;
+  std::vector<cv::Mat> sample_coords_, colour_gain_;  ///< shared with the caller's (cv::Mat)
   std::vector<std::pair<std::string, std::vector<unsigned char>>> geometry_png_;
   nlohmann::json manifest_;
 };

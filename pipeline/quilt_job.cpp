@@ -39,13 +39,15 @@ void QuiltJobOptions::Check() const {
   atlas.Check();
 }
 
-bool QuiltJobOptions::BtfSample() const { return fs::is_directory(sample_file); }
+bool QuiltJobOptions::BtfSample() const {
+  std::error_code error;
+  return fs::is_directory(sample_file, error);
+}
 
 nlohmann::json QuiltJobOptions::ToJson() const {
   return {
       {"engine", "graphcut"},
       {"sample_texel_size", sample_texel_size},
-      {"btf_components", btf_components},
       {"work_patch_levels", quilt.work_patch_levels},
       {"min_work_patch_levels", quilt.min_work_patch_levels},
       {"work_patch_shrink", quilt.shrink},
@@ -114,6 +116,9 @@ class QuiltJob {
     if (options_.BtfSample()) {
       btf_ = btf::ReadOrFactoriseBtf(options_.sample_file, options_.btf_components, progress_);
       if (texel_size_ == 0) texel_size_ = btf_.texel_size;
+      if (!(texel_size_ > 0) || !std::isfinite(texel_size_))
+        throw InputError(options_.sample_file.string(),
+                         "has no positive texel size; give --sample-texel-size");
       btf_sample_ = std::make_unique<synth::BtfSample>(btf_);
       matched_ = btf_sample_.get();
     } else {
@@ -126,7 +131,6 @@ class QuiltJob {
       }
     }
     summary_.sample_kind = matched_->Name();
-    summary_.sample_texel_size = texel_size_;
     summary_.seconds_sample = SecondsSince(start);
   }
 
@@ -238,7 +242,8 @@ class QuiltJob {
     for (const auto& [levels, n] : q.accepted_at_levels) accepted[std::to_string(levels)] = n;
     const double per_link = q.cut_links ? q.seam_cost / static_cast<double>(q.cut_links) : 0.0;
     nlohmann::json settings = options_.ToJson();
-    settings["sample_texel_size"] = texel_size_;
+    settings["sample_texel_size"] = texel_size_;  // a BTF's own when not given
+    if (btf_sample_) settings["btf_components"] = btf_.Components();
     return {{"command", "synth"},
             {"inputs",
              {{"mesh", options_.mesh_file.string()}, {"sample", options_.sample_file.string()}}},
@@ -265,7 +270,8 @@ class QuiltJob {
               {"quilting_per_patch",
                summary_.seconds_quilting / std::max<double>(1.0, static_cast<double>(q.patches))},
               {"atlas", summary_.seconds_atlas},
-              {"ptm_preview", summary_.seconds_preview}}}};
+              {"ptm_preview",
+               btf_sample_ ? nlohmann::json(summary_.seconds_preview) : nlohmann::json(nullptr)}}}};
   }
 
   const QuiltJobOptions& options_;

@@ -47,7 +47,6 @@ struct QuiltJobOptions {
 
 struct QuiltJobSummary {
   std::string sample_kind;  ///< "PTM", "colour" or "BTF"
-  double sample_texel_size = 0;
   std::size_t faces = 0, samples = 0, links = 0, chart_seam_links = 0;
   quilt::QuiltStats stats;
   std::size_t atlases = 0, charts = 0;
@@ -60,7 +59,9 @@ struct QuiltJobSummary {
 /// Reads the mesh and the sample, lays the faces out in charts, quilts the
 /// dense surface and writes the model folder (atomically): PTM atlases for a
 /// PTM or colour sample; for a BTF, the BTF files of a BTF model folder
-/// (model::BtfModelFiles) with a PTM preview as its atlases. Throws InputError
+/// (model::BtfModelFiles) with a PTM preview as its atlases. With a texel size
+/// given, a dense surface the memory limit cannot hold is refused before the
+/// sample is read; with a BTF's own, right after. Throws InputError
 /// naming a bad file, OptionError for bad settings (a texel size the memory
 /// limit cannot hold is refused before anything is allocated, with the estimate).
 QuiltJobSummary RunQuiltJob(const QuiltJobOptions& options, const ProgressCallback& progress = {});

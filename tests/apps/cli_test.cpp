@@ -500,7 +500,8 @@ TEST(Cli, SynthWithABtfSampleRendersAsABtfAndRefusesBadInput) {
   EXPECT_FALSE(std::filesystem::exists(tmp / "x"));
 }
 
-// A small scene without a BTF, for colour samples (material texel 0.01): its folder.
+// A small scene for colour samples (material texel 0.01), with a BTF capture of
+// btf_size texels a side when that is not 0: its folder.
 std::string WriteColourSampleScene(const TempDir& tmp, int btf_size = 0) {
   datasets::SceneOptions options = SmallBtfScene(8, 96, std::max(btf_size, 16));
   options.write_btf = btf_size > 0;
@@ -652,6 +653,12 @@ TEST(Cli, SynthGraphcutQuiltsABtfIntoABtfModelFolder) {
             1);
   EXPECT_NE(out.find("view_00_light_03.png"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
+  // --btf naming a file: an input error naming it (1).
+  EXPECT_EQ(Texlume("synth" + inputs + " --btf " + scene + "/object/mesh.ply --out " +
+                        (tmp / "bad").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("is not a folder"), std::string::npos) << out;
   // --components with a sample that is no BTF: refused (2).
   EXPECT_EQ(Texlume("synth" + inputs + " --sample-texel-size 0.01 --sample " + scene +
                         "/material/capture/rti_005.png --out " + (tmp / "bad").string(),

@@ -183,7 +183,7 @@ TEST(QuiltSurface, CoversDisconnectedAndNonManifoldMeshes) {
   mesh::TriangleMesh sphere = datasets::MakeIcosphere(2, 0.15);
   for (Eigen::Vector3d& v : sphere.vertices) v.x() += 0.5;
   const Surface s =
-      MakeSurface(datasets::JoinMeshes(crossed, sphere), 0.01, atlas::AtlasMode::kCharts);
+      MakeSurface(datasets::JoinMeshes(crossed, sphere), 0.02, atlas::AtlasMode::kCharts);
   QuiltOptions o;
   o.work_patch_levels = 8;
   const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o);
