@@ -514,6 +514,20 @@ std::string WriteColourSampleScene(const TempDir& tmp, int btf_size = 0) {
   return (tmp / "scene").string();
 }
 
+// Renders tmp/model at the scene's held-out views against their truth into
+// tmp/r: the exit code, and render.json when it is 0.
+int RenderHeldOut(const TempDir& tmp, const std::string& scene, std::string* out,
+                  nlohmann::json* render) {
+  const std::string held = scene + "/object/held_out";
+  const int code =
+      Texlume("render --model " + (tmp / "model").string() + " --cameras " + held +
+                  "/sparse --lights " + held + "/lights.json --truth " + held +
+                  "/images --truth-masks " + held + "/masks --out " + (tmp / "r").string(),
+              out);
+  if (code == 0) *render = nlohmann::json::parse(testing::ReadText(tmp / "r/render.json"));
+  return code;
+}
+
 // The main job with a colour sample (an ordinary photo of the material): a
 // model folder of PTM atlases that `texlume render` draws; a sample that is no
 // image is an input error naming it.
@@ -533,14 +547,8 @@ TEST(Cli, SynthWithAColourSampleWritesAModelThatRenders) {
   const nlohmann::json manifest =
       nlohmann::json::parse(testing::ReadText(tmp / "model/manifest.json"));
   EXPECT_EQ(manifest["settings"]["sample_kind"], "colour");
-  const std::string held = scene + "/object/held_out";
-  ASSERT_EQ(Texlume("render --model " + (tmp / "model").string() + " --cameras " + held +
-                        "/sparse --lights " + held + "/lights.json --truth " + held +
-                        "/images --truth-masks " + held + "/masks --out " + (tmp / "r").string(),
-                    &out),
-            0)
-      << out;
-  const nlohmann::json render = nlohmann::json::parse(testing::ReadText(tmp / "r/render.json"));
+  nlohmann::json render;
+  ASSERT_EQ(RenderHeldOut(tmp, scene, &out, &render), 0) << out;
   EXPECT_GT(render["metrics"]["mean_psnr_db"].get<double>(), 10.0);
   testing::WriteText(tmp / "not_an_image.png", "plain text");
   EXPECT_EQ(Texlume("synth" + inputs + " --sample " + (tmp / "not_an_image.png").string() +
@@ -570,14 +578,8 @@ TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
   EXPECT_GT(manifest["summary"]["patches"].get<int>(), 1);
   EXPECT_LT(manifest["summary"]["seam_cost_per_cut_link"].get<double>(),
             manifest["summary"]["unrelated_cut_cost"].get<double>());
-  const std::string held = scene + "/object/held_out";
-  ASSERT_EQ(Texlume("render --model " + (tmp / "model").string() + " --cameras " + held +
-                        "/sparse --lights " + held + "/lights.json --truth " + held +
-                        "/images --truth-masks " + held + "/masks --out " + (tmp / "r").string(),
-                    &out),
-            0)
-      << out;
-  const nlohmann::json render = nlohmann::json::parse(testing::ReadText(tmp / "r/render.json"));
+  nlohmann::json render;
+  ASSERT_EQ(RenderHeldOut(tmp, scene, &out, &render), 0) << out;
   EXPECT_GT(render["metrics"]["mean_psnr_db"].get<double>(), 10.0);
   // Photos are not taken by this engine yet: refused, not ignored (2).
   EXPECT_EQ(Texlume("synth" + inputs + " --model a --out " + (tmp / "bad").string(), &out), 2);
@@ -635,14 +637,8 @@ TEST(Cli, SynthGraphcutQuiltsABtfIntoABtfModelFolder) {
   EXPECT_GT(manifest["summary"]["patches"].get<int>(), 1);
   EXPECT_TRUE(std::filesystem::exists(tmp / "model/btf/btf_svd.json"));
   EXPECT_TRUE(std::filesystem::exists(tmp / "model/btf_atlas_0.exr"));
-  const std::string held = scene + "/object/held_out";
-  ASSERT_EQ(Texlume("render --model " + (tmp / "model").string() + " --cameras " + held +
-                        "/sparse --lights " + held + "/lights.json --truth " + held +
-                        "/images --truth-masks " + held + "/masks --out " + (tmp / "r").string(),
-                    &out),
-            0)
-      << out;
-  const nlohmann::json render = nlohmann::json::parse(testing::ReadText(tmp / "r/render.json"));
+  nlohmann::json render;
+  ASSERT_EQ(RenderHeldOut(tmp, scene, &out, &render), 0) << out;
   EXPECT_EQ(render["settings"]["mode"], "btf");
   EXPECT_GT(render["metrics"]["mean_psnr_db"].get<double>(), 10.0);
   // The same folder given as --sample; a capture missing an image: refused, naming it.
