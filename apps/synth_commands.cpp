@@ -14,7 +14,8 @@ namespace {
 
 // What the synth command reads besides the Options it binds directly.
 struct SynthWords {
-  std::string tangent_frame, prior_shrink, world_unit, engine = "triangle", orientation = "field";
+  std::string tangent_frame, prior_shrink, world_unit, engine = "triangle", orientation = "field",
+                                                       fill_unseen = "overlap";
   std::vector<double> tangent_field;
   bool best_view_only = false, no_additive = false, no_channel = false, no_detail = false,
        no_report = false, no_light_response = false, no_white_balance = false,
@@ -77,6 +78,12 @@ void BindQuilting(CLI::App* sub, pipeline::QuiltJobOptions& q, SynthWords& w) {
   sub->add_option("--engine", w.engine,
                   "triangle (paper 003, from the photos) or graphcut (paper 004, no photos)")
       ->check(OneOf({"triangle", "graphcut"}, "give triangle or graphcut"))
+      ->capture_default_str();
+  sub->add_option("--fill-unseen", w.fill_unseen,
+                  "triangle: the faces no photo sees placed by their overlap with their "
+                  "neighbours (overlap) or quilted by the graph-cut engine from the faces the "
+                  "photos placed (graphcut; --work-patch and --seam-threshold apply)")
+      ->check(OneOf({"overlap", "graphcut"}, "give overlap or graphcut"))
       ->capture_default_str();
   sub->add_option("--work-patch", q.quilt.work_patch_levels,
                   "graphcut: r_w, breadth-first levels of the work patch")
@@ -160,6 +167,7 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
                                        const pipeline::SynthCommandOptions& o,
                                        pipeline::QuiltJobOptions q) {
   for (const char* name : {"--model",
+                           "--fill-unseen",
                            "--images",
                            "--lights",
                            "--seam-band",
@@ -209,12 +217,26 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
   return q;
 }
 
+// The graph-cut settings of `--fill-unseen graphcut`; refused without it.
+void ResolveFillUnseen(const CLI::App* sub, const SynthWords& w, const quilt::QuiltOptions& quilt,
+                       pipeline::SynthJobOptions& job) {
+  const bool graphcut = w.fill_unseen == "graphcut";
+  for (const char* name : {"--orientation", "--field"})
+    if (sub->count(name) > 0) throw UsageError(std::string(name) + " is for --engine graphcut");
+  for (const char* name : {"--work-patch", "--seam-threshold"})
+    if (sub->count(name) > 0 && !graphcut)
+      throw UsageError(std::string(name) + " is for --engine graphcut or --fill-unseen graphcut");
+  job.fill_unseen = graphcut ? pipeline::FillUnseen::kGraphcut : pipeline::FillUnseen::kOverlap;
+  job.fill_quilt.work_patch_levels = quilt.work_patch_levels;
+  job.fill_quilt.seam_threshold = quilt.seam_threshold;
+}
+
 // The words and flags into the job's Options.
-void Resolve(const CLI::App* sub, const SynthWords& w, pipeline::SynthCommandOptions& o) {
+void Resolve(const CLI::App* sub, const SynthWords& w, const quilt::QuiltOptions& quilt,
+             pipeline::SynthCommandOptions& o) {
   for (const char* name : {"--model", "--images", "--lights"})
     if (sub->count(name) == 0) throw UsageError(std::string(name) + " is required");
-  for (const char* name : {"--work-patch", "--seam-threshold", "--orientation", "--field"})
-    if (sub->count(name) > 0) throw UsageError(std::string(name) + " is for --engine graphcut");
+  ResolveFillUnseen(sub, w, quilt, o.job);
   synth::MeshSynthesisOptions& s = o.job.synthesis;
   if (o.btf.empty() && sub->count("--sample-texel-size") == 0)
     throw UsageError(
@@ -262,7 +284,7 @@ void AddSynthCommand(CLI::App& app, CommandRunners& run) {
       pipeline::RunQuiltCommandJob(QuiltJobFrom(sub, *w, *o, *q), out, err, bar.Callback());
       return 0;
     }
-    Resolve(sub, *w, *o);
+    Resolve(sub, *w, q->quilt, *o);
     pipeline::RunSynthCommandJob(*o, out, err, bar.Callback());
     return 0;
   };

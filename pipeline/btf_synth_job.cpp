@@ -22,6 +22,8 @@ void BtfSynthJobOptions::Check() const {
   job.CheckInputsAndLayout();
   if (btf.empty()) throw OptionError("synth --btf needs a BTF capture or factorisation folder");
   if (components < 1) throw OptionError("components must be >= 1");
+  if (job.fill_unseen != FillUnseen::kOverlap)
+    throw OptionError("--fill-unseen graphcut takes a PTM or colour sample (not yet --btf)");
   if (!(synthesis.sample_texel_size >= 0.0))
     throw OptionError("sample texel size must be >= 0 (0: the capture's)");
   synth::BtfMeshSynthesisOptions resolved = synthesis;

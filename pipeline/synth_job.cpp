@@ -268,10 +268,15 @@ nlohmann::json SynthJobOptions::InputsJson() const {
           {"mesh", mesh_file.string()}};
 }
 
+const char* FillUnseenName(FillUnseen fill) {
+  return fill == FillUnseen::kGraphcut ? "graphcut" : "overlap";
+}
+
 void SynthJobOptions::Check() const {
   CheckInputsAndLayout();
   if (sample_file.empty()) throw OptionError("synth needs a sample");
   synthesis.Check();
+  if (fill_unseen == FillUnseen::kGraphcut) fill_quilt.Check();
 }
 
 nlohmann::json SynthCounts::ToJson() const {
@@ -382,6 +387,18 @@ class SynthJob {
     summary_.from_photos = synthesis_.num_from_photos;
     summary_.from_neighbours = synthesis_.num_from_neighbours;
     summary_.random = synthesis_.num_random;
+    if (options_.fill_unseen == FillUnseen::kGraphcut) FillUnseenFaces();
+  }
+
+  // The faces no photo placed, quilted by the graph-cut engine from the
+  // synthesis's sample (quilt/unseen_fill.h).
+  void FillUnseenFaces() {
+    AnnounceStep(progress_, "quilting the faces no photo sees (graph cut)");
+    quilt::UnseenFillOptions fill;
+    fill.quilt = options_.fill_quilt;
+    fill.quilt.seed = options_.synthesis.seed;
+    fill.atlas = options_.atlas;
+    summary_.unseen_fill = quilt::FillUnseenFaces(inputs_.mesh, synthesis_, fill, progress_);
   }
 
   // Blending and atlases: the textured model.
@@ -438,7 +455,11 @@ class SynthJob {
         {"white_balance", so.white_balance},
         {"photo_blur", so.photo_blur},
         {"seed", so.seed},
-        {"sample_kind", sample_.colour.empty() ? "PTM" : "colour"}};
+        {"sample_kind", sample_.colour.empty() ? "PTM" : "colour"},
+        {"fill_unseen", FillUnseenName(options_.fill_unseen)}};
+    if (options_.fill_unseen == FillUnseen::kGraphcut)
+      settings.update({{"fill_work_patch", options_.fill_quilt.work_patch_levels},
+                       {"fill_seam_threshold", options_.fill_quilt.seam_threshold}});
     settings.update(AtlasSettingsJson(options_.atlas));
     return settings;
   }
@@ -450,7 +471,22 @@ class SynthJob {
                      {{"mean", s.stretch.mean}, {"min", s.stretch.min}, {"max", s.stretch.max}}},
                     {"mean_prior_shrink", MeanPriorShrink(synthesis_)}});
     summary.update(EngineSummaryJson(synthesis_));
+    if (options_.fill_unseen == FillUnseen::kGraphcut) summary["unseen_fill"] = UnseenFillJson();
     return summary;
+  }
+
+  nlohmann::json UnseenFillJson() const {
+    const quilt::UnseenFillSummary& f = summary_.unseen_fill;
+    const double seam = f.stats.cut_links && f.stats.random_pair_cost > 0
+                            ? f.stats.seam_cost / f.stats.cut_links / f.stats.random_pair_cost
+                            : 0.0;
+    return {{"engine", "graphcut"},
+            {"faces", f.faces},
+            {"samples", f.samples},
+            {"given_samples", f.given_samples},
+            {"patches", f.stats.patches},
+            {"forced", f.stats.forced},
+            {"seam_cost_per_cut_link_over_unrelated", seam}};
   }
 
   // The manifest's record: inputs, settings, summary, warnings, baselines, timings.
@@ -468,6 +504,7 @@ class SynthJob {
         {"load", s.seconds_load},
         {"visibility", s.seconds_visibility},
         {"synthesis", s.seconds_synthesis},
+        {"unseen_fill", s.unseen_fill.seconds},
         {"atlas", s.seconds_atlas},
         {"baselines", s.seconds_baselines},
         {"synthesis_per_triangle", s.seconds_synthesis / std::max<std::size_t>(1, s.faces)}};
@@ -520,7 +557,7 @@ class SynthJob {
     report.facts = {
         {"triangles", std::to_string(s.faces) + " (" + std::to_string(s.from_photos) +
                           " constrained by photos, " + std::to_string(s.from_neighbours) +
-                          " by neighbours only)"},
+                          " by neighbours only" + FilledText() + ")"},
         {"photos used", std::to_string(s.photos_used)},
         {"sample and atlas texel size",
          WorldLengthText(options_.synthesis.sample_texel_size, options_.mm_per_world_unit)},
@@ -531,14 +568,18 @@ class SynthJob {
     report.view_folder = options_.out_dir.string();
     report.texel_size = options_.synthesis.sample_texel_size;
     report.mm_per_world_unit = options_.mm_per_world_unit;
-    report.timings_s = {{"load", s.seconds_load},
-                        {"visibility", s.seconds_visibility},
-                        {"synthesis", s.seconds_synthesis},
-                        {"atlas", s.seconds_atlas},
-                        {"baselines", s.seconds_baselines}};
+    report.timings_s = {{"load", s.seconds_load},           {"visibility", s.seconds_visibility},
+                        {"synthesis", s.seconds_synthesis}, {"unseen fill", s.unseen_fill.seconds},
+                        {"atlas", s.seconds_atlas},         {"baselines", s.seconds_baselines}};
     report.links = {
         {"model.glb", "model.glb"}, {"model.obj", "model.obj"}, {"manifest.json", "manifest.json"}};
     summary_.seconds_report = report::WriteReport(folder, report, progress_).seconds;
+  }
+
+  std::string FilledText() const {
+    if (options_.fill_unseen != FillUnseen::kGraphcut) return "";
+    return "; " + std::to_string(summary_.unseen_fill.faces) +
+           " seen by no photo, filled by graph-cut quilting";
   }
 
   const SynthJobOptions& options_;

@@ -12,11 +12,21 @@
 #include "core/progress.h"
 #include "model/baselines.h"
 #include "model/model_io.h"
+#include "quilt/surface_quilting.h"
+#include "quilt/unseen_fill.h"
 #include "render/model_render.h"
 #include "sfm/visibility.h"
 #include "synth/mesh_synthesis.h"
 
 namespace texlume::pipeline {
+
+/// What the faces no photo sees get (`--fill-unseen`).
+enum class FillUnseen {
+  kOverlap,   ///< the per-triangle engine's placement by the overlap alone (paper 003)
+  kGraphcut,  ///< graph-cut quilting grown out from the faces the photos placed (paper 004 §III)
+};
+/// "overlap" or "graphcut" (the CLI's and the manifest's names).
+const char* FillUnseenName(FillUnseen fill);
 
 /// Inputs and settings of the main job (`texlume synth`).
 struct SynthJobOptions {
@@ -32,6 +42,10 @@ struct SynthJobOptions {
   synth::MeshSynthesisOptions synthesis;  ///< sample_texel_size required
   atlas::AtlasOptions atlas;
   sfm::VisibilityOptions visibility;
+  /// The faces no photo sees (quilt/unseen_fill.h), and the graph-cut engine's
+  /// settings when it fills them (its seed is the synthesis's).
+  FillUnseen fill_unseen = FillUnseen::kOverlap;
+  quilt::QuiltOptions fill_quilt;
   /// Split every triangle in four (midpoints) up to this many times while the
   /// largest patch does not fit the sample. [0, 6].
   int max_subdivisions = 4;
@@ -70,6 +84,8 @@ struct SynthCounts {
 
 struct SynthJobSummary : SynthCounts {
   atlas::AtlasStretch stretch;
+  /// The graph-cut fill of the faces no photo sees (FillUnseen::kGraphcut).
+  quilt::UnseenFillSummary unseen_fill;
   /// The model and its baselines as written into the model folder.
   std::shared_ptr<const model::TexturedModel> model;
   model::ModelBaselines baselines;

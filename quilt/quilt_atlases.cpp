@@ -18,19 +18,23 @@ Eigen::Vector2d AtlasPx(const atlas::FacePlacement& fp, const Eigen::Vector2d& p
   return {fp.offset.x() + r.x(), fp.offset.y() - r.y()};
 }
 
-// The sample of the face's chart whose texel centre is nearest to px, within
-// `reach` texels; -1 when none is.
-int NearestSample(const DenseSurface& surface, const atlas::FacePlacement& fp,
-                  const Eigen::Vector2d& px, int reach) {
+// The quilted sample of the face's chart whose texel centre is nearest to px,
+// within `reach` texels; -1 when none is.
+int NearestSample(const DenseSurface& surface, const QuiltResult& quilt,
+                  const atlas::FacePlacement& fp, const Eigen::Vector2d& px, int reach) {
+  const auto usable = [&](int s) {
+    return s >= 0 && surface.samples()[static_cast<std::size_t>(s)].chart == fp.chart &&
+           quilt.lookups[static_cast<std::size_t>(s)].synthesised;
+  };
   const int x0 = static_cast<int>(std::floor(px.x())), y0 = static_cast<int>(std::floor(px.y()));
   const int own = surface.At(fp.atlas, x0, y0);
-  if (own >= 0 && surface.samples()[static_cast<std::size_t>(own)].chart == fp.chart) return own;
+  if (usable(own)) return own;
   int best = -1;
   double best_d2 = std::numeric_limits<double>::max();
   for (int y = y0 - reach; y <= y0 + reach; ++y)
     for (int x = x0 - reach; x <= x0 + reach; ++x) {
       const int s = surface.At(fp.atlas, x, y);
-      if (s < 0 || surface.samples()[static_cast<std::size_t>(s)].chart != fp.chart) continue;
+      if (!usable(s)) continue;
       const double d2 = (Eigen::Vector2d(x + 0.5, y + 0.5) - px).squaredNorm();
       if (d2 < best_d2) best_d2 = d2, best = s;
     }
@@ -59,7 +63,7 @@ bool QuiltedSurfaceLookup::At(int face, const Eigen::Vector2d& p_in_frame,
                               Eigen::Vector2d* sample_px, double* angle_rad) const {
   const atlas::FacePlacement& fp = layout_.faces[static_cast<std::size_t>(face)];
   const Eigen::Vector2d px = AtlasPx(fp, p_in_frame, surface_.texel_size());
-  const int s = NearestSample(surface_, fp, px, reach_);
+  const int s = NearestSample(surface_, quilt_, fp, px, reach_);
   if (s < 0) return false;
   const DenseSample& d = surface_.samples()[static_cast<std::size_t>(s)];
   const SampleLookup& lookup = quilt_.lookups[static_cast<std::size_t>(s)];

@@ -14,9 +14,9 @@
 namespace texlume::quilt {
 
 /// Where a point of a quilted surface's atlases reads the sample: the lookup of
-/// the nearest dense sample of the face's chart, continued to the point (so a
-/// gutter texel carries on the patch, and bilinear reads across a chart's edge
-/// see the texture that lies there).
+/// the nearest quilted dense sample of the face's chart, continued to the point
+/// (so a gutter texel carries on the patch, and bilinear reads across a chart's
+/// edge see the texture that lies there).
 class QuiltedSurfaceLookup {
  public:
   QuiltedSurfaceLookup(const DenseSurface& surface, const QuiltResult& quilt,

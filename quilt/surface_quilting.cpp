@@ -76,7 +76,8 @@ float Bilinear(const cv::Mat& plane, double x, double y) {
 class SurfaceQuilter {
  public:
   SurfaceQuilter(const DenseSurface& surface, const atlas::AtlasLayout& layout,
-                 const synth::MaterialSample& sample, const QuiltOptions& options)
+                 const synth::MaterialSample& sample, const QuiltOptions& options,
+                 const GivenSamples* given)
       : surface_(surface),
         layout_(layout),
         sample_(sample),
@@ -94,14 +95,17 @@ class SurfaceQuilter {
     result_.patch_of.assign(surface.size(), -1);
     values_.assign(surface.size() * static_cast<std::size_t>(features_), 0.0f);
     synthesised_neighbours_.assign(surface.size(), 0);
+    given_.assign(surface.size(), false);
+    if (given) TakeGiven(*given);
     result_.stats.random_pair_cost = RandomPairCost();
   }
 
   QuiltResult Run(const ProgressCallback& progress) {
     const auto start = std::chrono::steady_clock::now();
-    for (std::size_t s = 0; s < surface_.size(); ++s) queue_.emplace(0, -static_cast<int>(s));
+    for (std::size_t s = 0; s < surface_.size(); ++s)
+      if (!given_[s]) queue_.emplace(synthesised_neighbours_[s], -static_cast<int>(s));
     std::size_t done = 0, reported = 0;
-    const std::size_t total = surface_.size();
+    const std::size_t total = surface_.size() - result_.stats.given;
     while (done < total) {
       const int v = MostConstrained();
       done += PlacePatchAt(v);
@@ -116,6 +120,21 @@ class SurfaceQuilter {
   }
 
  private:
+  // The given samples' features, and their counts as synthesised neighbours.
+  void TakeGiven(const GivenSamples& given) {
+    const std::size_t nf = static_cast<std::size_t>(features_);
+    if (given.given.size() != surface_.size() || given.features.size() != surface_.size() * nf)
+      throw std::invalid_argument("QuiltSurface: given samples of another surface");
+    for (std::size_t s = 0; s < surface_.size(); ++s) {
+      if (!given.given[s]) continue;
+      given_[s] = true;
+      ++result_.stats.given;
+      std::copy_n(given.features.data() + s * nf, nf, ValuesOf(static_cast<int>(s)));
+      for (const int nb : surface_.Neighbours(static_cast<int>(s)))
+        ++synthesised_neighbours_[static_cast<std::size_t>(nb)];
+    }
+  }
+
   // Per face, its atlas frame's axes in the world (x right, y up) and normal.
   void MakeFaceAxes() {
     for (std::size_t f = 0; f < layout_.faces.size(); ++f) {
@@ -309,7 +328,10 @@ class SurfaceQuilter {
   float* ValuesOf(int s) {
     return values_.data() + static_cast<std::size_t>(s) * static_cast<std::size_t>(features_);
   }
-  bool Synthesised(int s) const { return result_.lookups[static_cast<std::size_t>(s)].synthesised; }
+  bool Synthesised(int s) const {
+    return given_[static_cast<std::size_t>(s)] ||
+           result_.lookups[static_cast<std::size_t>(s)].synthesised;
+  }
 
   // Patch matching, fitting and, below T_c (or at the smallest r_w), commit.
   std::size_t TryPatch(const WorkPatch& patch, bool smallest, int levels) {
@@ -477,7 +499,7 @@ class SurfaceQuilter {
         keep = keep || (!patch.local.count(nb) && Synthesised(s) && Synthesised(nb));
       if (!Synthesised(s))
         cut.Terminals(static_cast<int>(i), kForced, 0.0);  // must take B
-      else if (keep)
+      else if (keep || given_[static_cast<std::size_t>(s)])
         cut.Terminals(static_cast<int>(i), 0.0, kForced);  // must keep A
     }
     cut.Solve();
@@ -561,6 +583,7 @@ class SurfaceQuilter {
   std::vector<double> field_in_chart_rad_;
   std::vector<float> values_;  ///< per sample, its features in its chart's frame
   std::vector<int> synthesised_neighbours_;
+  std::vector<bool> given_;  ///< per sample: given before quilting (GivenSamples)
   std::priority_queue<std::pair<int, int>> queue_;  ///< (count, -sample), stale entries skipped
   std::unordered_map<std::uint64_t, OldSeam> old_seams_;  ///< by LinkKey(lo, hi)
   QuiltResult result_;
@@ -570,12 +593,12 @@ class SurfaceQuilter {
 
 QuiltResult QuiltSurface(const DenseSurface& surface, const atlas::AtlasLayout& layout,
                          const synth::MaterialSample& sample, const QuiltOptions& options,
-                         const ProgressCallback& progress) {
+                         const ProgressCallback& progress, const GivenSamples* given) {
   options.Check();
   if (!options.field_in_world.empty() && options.field_in_world.size() != layout.faces.size())
     throw std::invalid_argument("QuiltSurface: one field vector per face");
   if (surface.size() == 0) return {};
-  return SurfaceQuilter(surface, layout, sample, options).Run(progress);
+  return SurfaceQuilter(surface, layout, sample, options, given).Run(progress);
 }
 
 }  // namespace texlume::quilt

@@ -58,6 +58,7 @@ struct SampleLookup {
 };
 
 struct QuiltStats {
+  std::size_t given = 0;  ///< samples given before quilting (GivenSamples)
   std::size_t patches = 0;
   std::map<int, std::size_t> accepted_at_levels;  ///< r_w -> patches accepted there
   std::size_t forced = 0;                         ///< accepted at the smallest r_w above T_c
@@ -73,10 +74,21 @@ struct QuiltResult {
   QuiltStats stats;
 };
 
+/// Samples whose texture is given before quilting (the faces the photos placed,
+/// when the quilt fills those no photo sees): they count as synthesised from
+/// the start, so the quilt grows out from them and matches against them, and
+/// every cut keeps them. Their lookups stay unsynthesised (not the quilt's).
+struct GivenSamples {
+  std::vector<bool> given;      ///< per dense sample
+  std::vector<float> features;  ///< per dense sample, NumFeatures() values, chart's atlas frame
+};
+
 /// Quilts `sample` over `surface`. `layout` is the layout the surface was built
-/// from (chart frames). Deterministic for a seed.
+/// from (chart frames). `given`: samples that keep their texture (may be null).
+/// Deterministic for a seed.
 QuiltResult QuiltSurface(const DenseSurface& surface, const atlas::AtlasLayout& layout,
                          const synth::MaterialSample& sample, const QuiltOptions& options,
-                         const ProgressCallback& progress = {});
+                         const ProgressCallback& progress = {},
+                         const GivenSamples* given = nullptr);
 
 }  // namespace texlume::quilt

@@ -22,6 +22,7 @@ void MeshSynthesisOptions::Check() const {
 }
 
 bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) const {
+  if (!filled.empty() && filled[static_cast<std::size_t>(face)] && fill(face, p, out)) return true;
   return SamplePtmPatch(sample_planes, format, detail_bands,
                         patches[static_cast<std::size_t>(face)], texel_size, p, out);
 }

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -64,12 +65,20 @@ struct MeshSynthesis : TriangleSynthesis {
   /// Per photo-density level: the sample's detail band, its planes minus their
   /// reduction to that density brought back to full size (all planes, texels).
   std::map<int, std::vector<cv::Mat>> detail_bands;
+  /// Faces whose values another engine supplies in place of their patch (the
+  /// main job's graph-cut fill of the faces no photo sees, quilt/unseen_fill.h):
+  /// per face whether it does (empty: none), and its values at a point of the
+  /// face frame (all planes, orthonormal, face frame; false where it has none,
+  /// and the patch is read).
+  std::vector<bool> filled;
+  std::function<bool(int face, const Eigen::Vector2d& p_in_frame, float* planes_out)> fill;
 
   /// Most planes a texel has (RGB: 18 coefficients; LRGB: 6 + 3 colour).
   static constexpr std::size_t kMaxPlanes = 18;
   /// Number of coefficient planes (6 LRGB, 18 RGB); colour planes follow for LRGB.
   int CoefficientPlanes() const { return format == ptm::PtmFormat::kLrgb ? 6 : 18; }
-  /// The face's own patch at frame point p (world units), bilinear; false outside it.
+  /// The face's own patch at frame point p (world units), bilinear, or its fill;
+  /// false outside it.
   bool SamplePatch(int face, const Eigen::Vector2d& p_in_frame, float* planes_out) const;
   /// Blended value (paper 003 Fig. 4) at a point of the face: near an edge, the
   /// neighbour's patch unfolded across it and moved into this frame, weighted

@@ -352,6 +352,61 @@ TEST_F(MeshPipelineTest, RendersHeldOutViewsAndComparesWithTheBaselines) {
   EXPECT_TRUE(fs::exists(tmp_->path() / "render_ptm/render.json"));
 }
 
+// Texels (inside faces or gutters) whose values differ between two models of
+// one layout, and texels in all.
+std::pair<std::size_t, std::size_t> ChangedTexels(const model::TexturedModel& a,
+                                                  const model::TexturedModel& b) {
+  std::size_t changed = 0, texels = 0;
+  EXPECT_EQ(a.atlases.size(), b.atlases.size());
+  for (std::size_t k = 0; k < std::min(a.atlases.size(), b.atlases.size()); ++k) {
+    const ptm::Ptm &pa = a.atlases[k], &pb = b.atlases[k];
+    EXPECT_EQ(pa.NumTexels(), pb.NumTexels());
+    for (std::size_t t = 0; t < std::min(pa.NumTexels(), pb.NumTexels()); ++t) {
+      const float* ca = pa.Coefficients(t);
+      const float* cb = pb.Coefficients(t);
+      bool differs = false, zero = true;
+      for (int m = 0; m < 6; ++m) {
+        differs = differs || std::abs(ca[m] - cb[m]) > 1e-6f;
+        zero = zero && ca[m] == 0.0f && cb[m] == 0.0f;
+      }
+      texels += !zero;
+      changed += differs;
+    }
+  }
+  return {changed, texels};
+}
+
+// `--fill-unseen graphcut`: the faces no photo placed are quilted by the
+// graph-cut engine from the faces the photos placed, which keep their texture
+// (only their blend band next to a filled face changes), so the held-out views,
+// which see little of the unseen faces, score as before.
+TEST_F(MeshPipelineTest, GraphCutFillQuiltsOnlyTheFacesNoPhotoPlaced) {
+  pipeline::SynthJobOptions job = Job(tmp_->path() / "model_fill");
+  job.fill_unseen = pipeline::FillUnseen::kGraphcut;
+  job.write_report = false;
+  const pipeline::SynthJobSummary fill = pipeline::RunSynthJob(job);
+  EXPECT_EQ(fill.from_photos, summary_->from_photos);
+  EXPECT_EQ(fill.unseen_fill.faces, summary_->from_neighbours + summary_->random);
+  ASSERT_GT(fill.unseen_fill.faces, 0u);
+  EXPECT_GT(fill.unseen_fill.stats.patches, 1u);
+  const auto [changed, texels] = ChangedTexels(*summary_->model, *fill.model);
+  std::printf(
+      "graph-cut fill: %zu faces, %zu samples quilted (%zu patches); %zu of %zu texels "
+      "changed\n",
+      fill.unseen_fill.faces, fill.unseen_fill.samples, fill.unseen_fill.stats.patches, changed,
+      texels);
+  EXPECT_GT(changed, fill.unseen_fill.samples / 2);
+  EXPECT_LT(changed, 2 * fill.unseen_fill.samples);
+  const nlohmann::json manifest =
+      nlohmann::json::parse(testing::ReadText(tmp_->path() / "model_fill/manifest.json"));
+  EXPECT_EQ(manifest["settings"]["fill_unseen"], "graphcut");
+  EXPECT_EQ(manifest["summary"]["unseen_fill"]["faces"].get<std::size_t>(), fill.unseen_fill.faces);
+  const pipeline::RenderJobSummary filled =
+      Render(render::RenderMode::kPtm, "render_fill", "model_fill");
+  const pipeline::RenderJobSummary before = Render(render::RenderMode::kPtm, "render_no_fill");
+  EXPECT_NEAR(filled.mean_psnr, before.mean_psnr, 0.1);
+}
+
 // What each pass (detail transfer, the photo-consistency prior's shrink) adds under
 // held-out lights is a single-seed comparison: ABLATIONS=1 bench/fidelity_bench.sh
 // measures it (docs/synth.md, "Ablations").
