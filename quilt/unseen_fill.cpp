@@ -118,6 +118,7 @@ UnseenFillSummary FillUnseenFaces(const mesh::TriangleMesh& mesh, synth::MeshSyn
   const int reach = std::max(options.atlas.gutter, options.atlas.blend_strip);
   auto fill = std::make_shared<const QuiltedFill>(std::move(layout), std::move(surface),
                                                   std::move(quilt), synthesis, reach);
+  summary.filled = filled;
   synthesis.filled = std::move(filled);
   synthesis.fill = [fill](int face, const Eigen::Vector2d& p_in_frame, float* out) {
     return fill->At(face, p_in_frame, out);
