@@ -187,9 +187,7 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
                            "--no-detail-transfer",
                            "--no-light-response",
                            "--no-white-balance",
-                           "--no-photo-blur",
-                           "--no-report",
-                           "--world-unit"})
+                           "--no-photo-blur"})
     if (sub->count(name) > 0)
       throw UsageError(std::string(name) +
                        " is not taken by --engine graphcut so far (docs/quilting.md)");
@@ -205,6 +203,8 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
     throw UsageError(
         "--sample-texel-size: give the sample's texel size in world units of the mesh");
   q.out_dir = o.job.out_dir;
+  q.write_report = !w.no_report;
+  q.mm_per_world_unit = WorldUnitMm(w.world_unit);
   q.sample_texel_size = o.job.synthesis.sample_texel_size;
   q.quilt.seed = o.job.synthesis.seed;
   q.quilt.random_orientation = w.orientation == "random";

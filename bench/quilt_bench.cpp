@@ -18,19 +18,23 @@
 // with the same sample); then the time from about 12k to 800k samples. Last,
 // meshes of several kinds quilted alike (a handle, creases, two components, a
 // non-manifold line, an irregular lumpy 81920-face scan-like mesh): coverage,
-// charts, seams, energy and time.
+// charts, seams, energy and time; and samples of several kinds (the scene
+// generator's stone, brick and grooves captures) against random placement.
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 
+#include "datasets_synthetic/scene.h"
 #include "datasets_synthetic/shapes.h"
 #include "model/model_io.h"
+#include "ptm/fit.h"
 #include "ptm/ptm_io.h"
 #include "quilt/patch_energy.h"
 #include "quilt/patch_matching.h"
@@ -184,6 +188,63 @@ void QuiltMeshes(const synth::PtmSample& sample, int levels, double texel) {
   }
 }
 
+// Per face of the icosphere, the world's z axis laid onto it (x near the poles):
+// the field a directional sample follows.
+std::vector<Eigen::Vector3d> UpField(const mesh::TriangleMesh& mesh) {
+  std::vector<Eigen::Vector3d> field;
+  for (const auto& f : mesh.faces) {
+    const Eigen::Vector3d n = (mesh.vertices[f[1]] - mesh.vertices[f[0]])
+                                  .cross(mesh.vertices[f[2]] - mesh.vertices[f[0]])
+                                  .normalized();
+    const Eigen::Vector3d up =
+        std::abs(n.z()) > 0.95 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitZ();
+    field.push_back((up - up.dot(n) * n).normalized());
+  }
+  return field;
+}
+
+// Samples of several kinds (issue 32): the scene generator's stone (stochastic),
+// brick (structured) and grooves (directional) captures, 256^2 under 40 lights,
+// fitted into LRGB PTMs and quilted over the icosphere along the up field,
+// against random placement.
+void QuiltMaterials(int levels, double texel) {
+  std::printf(
+      "\nSamples of several kinds (icosphere of 1280 faces, texel %g, r_w %d, the sample's x "
+      "axis along the world's z laid on each face):\n| sample | run | patches | forced | seam "
+      "cost / unrelated cut | sample reused | nearest-patch energy | s |\n"
+      "|---|---|---|---|---|---|---|---|\n",
+      texel, levels);
+  const mesh::TriangleMesh sphere = datasets::MakeIcosphere(3, 0.5);
+  for (const datasets::MaterialKind kind :
+       {datasets::MaterialKind::kStone, datasets::MaterialKind::kBrick,
+        datasets::MaterialKind::kGrooves}) {
+    const std::string name(datasets::MaterialKindName(kind));
+    const std::filesystem::path work =
+        std::filesystem::temp_directory_path() / ("texlume_quilt_bench_" + name);
+    if (!std::filesystem::exists(work / "material/capture/lights.lp"))
+      datasets::GenerateScene(datasets::MaterialOnlySceneOptions(kind, 256, 40), work);
+    const ptm::RtiCapture capture =
+        ptm::ReadRtiCapture(work / "material/capture/lights.lp", work / "material/capture");
+    const ptm::Ptm fitted = ptm::FitPtmFromFiles(capture.files, capture.lights, {}).ptm;
+    const synth::PtmSample sample(fitted);
+    quilt::RotatedSample rotated(sample);
+    for (const bool random : {false, true}) {
+      quilt::QuiltOptions q;
+      q.work_patch_levels = levels;
+      q.random_placement = random;
+      q.field_in_world = UpField(sphere);
+      const Quilted run = QuiltMesh(sphere, sample, texel, q);
+      const quilt::QuiltStats& st = run.result.stats;
+      std::printf("| %s | %s | %zu | %zu | %.2f | %.2f | %.4f | %.2f |\n", name.c_str(),
+                  random ? "random placement" : "graph-cut quilting", st.patches, st.forced,
+                  st.seam_cost / std::max<std::size_t>(st.cut_links, 1) / st.random_pair_cost,
+                  SampleReused(run.result, fitted.width, fitted.height),
+                  AtlasEnergy(run.atlases.ptms, run.atlases.coverage, rotated), st.seconds);
+      std::fflush(stdout);
+    }
+  }
+}
+
 void QuiltSphere(const ptm::Ptm& sample_ptm, int levels, double texel, const char* compare) {
   const synth::PtmSample sample(sample_ptm);
   quilt::RotatedSample rotated(sample);
@@ -289,5 +350,6 @@ int main(int argc, char** argv) {
   const ptm::Ptm quilted = ptm_file ? ptm::ReadPtmFile(ptm_file) : SmoothPtm(256, 7);
   QuiltSphere(quilted, levels, texel, compare);
   QuiltMeshes(synth::PtmSample(quilted), levels, texel);
+  QuiltMaterials(levels, texel);
   return 0;
 }

@@ -4,18 +4,22 @@
 #include <cmath>
 #include <numbers>
 #include <numeric>
+#include <optional>
 
 #include "atlas/btf_atlas.h"
 #include "btf/btf.h"
 #include "core/errors.h"
 #include "core/memory_budget.h"
 #include "core/timing.h"
+#include "core/units.h"
 #include "mesh/mesh.h"
 #include "model/btf_model.h"
 #include "model/model_io.h"
+#include "pipeline/report_pictures.h"
 #include "pipeline/synth_job.h"
 #include "quilt/quilt_atlases.h"
 #include "quilt/vector_field.h"
+#include "report/report.h"
 #include "synth/btf_sample.h"
 #include "synth/colour_sample.h"
 
@@ -63,7 +67,9 @@ nlohmann::json QuiltJobOptions::ToJson() const {
       {"atlas_size", atlas.atlas_size},
       {"gutter", atlas.gutter},
       {"chart_flattening", atlas::ChartFlatteningName(atlas.flattening)},
-      {"max_chart_stretch", atlas.max_chart_stretch}};
+      {"max_chart_stretch", atlas.max_chart_stretch},
+      {"write_report", write_report},
+      {"world_unit_mm", WorldUnitJson(mm_per_world_unit)}};
 }
 
 namespace {
@@ -225,15 +231,91 @@ class QuiltJob {
                                  fp.corners_px[2].cast<float>()});
     }
     nlohmann::json record = Record();
-    if (!btf_sample_) {
-      model::WriteModelFolder(options_.out_dir, model, record);
-      return;
+    std::optional<model::BtfModelFiles> files;
+    if (btf_sample_) {
+      files.emplace(btf_, btf_atlases_.sample_coords, btf_atlases_.colour_gain,
+                    btf_atlases_.geometry);
+      record["btf"] = files->Manifest();
     }
-    const model::BtfModelFiles files(btf_, btf_atlases_.sample_coords, btf_atlases_.colour_gain,
-                                     btf_atlases_.geometry);
-    record["btf"] = files.Manifest();
-    model::WriteModelFolder(options_.out_dir, model, record, {},
-                            [&](const fs::path& folder) { files.Write(folder); });
+    model::WriteModelFolder(options_.out_dir, model, record, {}, [&](const fs::path& folder) {
+      if (files) files->Write(folder);
+      if (options_.write_report) WriteReport(model, folder);
+    });
+  }
+
+  // report.html: the sample, the model from views around it beside flat
+  // shading (no photos to compare with), a light sweep, the atlases, figures.
+  void WriteReport(const model::TexturedModel& model, const fs::path& folder) {
+    const auto start = std::chrono::steady_clock::now();
+    report::ReportInputs report;
+    report.title = "texlume synth --engine graphcut: " + options_.mesh_file.filename().string();
+    report.intro =
+        "The mesh covered with the material sample by graph-cut quilting on a dense resampling "
+        "of its surface (paper 004 \u00a7III), without photos: nothing ties the texture to the "
+        "object's own. Below, the model from four views around it, each under a light from "
+        "above the camera's left, beside flat shading with the model's mean colour.";
+    report.model = &model;
+    ReportScene scene;
+    scene.model = &model;
+    scene.flat_albedo = MeanHeadOnColour(model);
+    scene.sample = btf_sample_ ? nullptr : &sample_.ptm;
+    scene.views = ViewsAroundMesh(mesh_, 4, 400, 300);
+    report.views_heading = "Views around the model (no photos to compare with)";
+    DrawReportPictures(scene, report, progress_);
+    const quilt::QuiltStats& q = summary_.stats;
+    report.facts = {
+        {"sample", summary_.sample_kind + ", " + options_.sample_file.filename().string()},
+        {"triangles", std::to_string(summary_.faces)},
+        {"dense samples", std::to_string(summary_.samples) + " (" +
+                              std::to_string(summary_.chart_seam_links) + " links across charts)"},
+        {"patches", std::to_string(q.patches) + " (" + std::to_string(q.forced) +
+                        " forced at the smallest work patch)"},
+        {"seam cost per cut link", SeamText(q)},
+        {"sample and atlas texel size", WorldLengthText(texel_size_, options_.mm_per_world_unit)},
+        {"atlases", std::to_string(summary_.atlases) + " of " +
+                        std::to_string(options_.atlas.atlas_size) + " texels, " +
+                        std::to_string(summary_.charts) + " charts"}};
+    for (const std::string& w : summary_.warnings) report.facts.emplace_back("warning", w);
+    report.inputs = {{"mesh", options_.mesh_file}};
+    if (!options_.BtfSample()) report.inputs.emplace_back("sample", options_.sample_file);
+    report.view_folder = options_.out_dir.string();
+    report.texel_size = texel_size_;
+    report.mm_per_world_unit = options_.mm_per_world_unit;
+    report.occupancy = summary_.occupancy;
+    report.timings_s = {{"sample", summary_.seconds_sample},
+                        {"layout", summary_.seconds_layout},
+                        {"quilting", summary_.seconds_quilting},
+                        {"atlas", summary_.seconds_atlas}};
+    report.links = {
+        {"model.glb", "model.glb"}, {"model.obj", "model.obj"}, {"manifest.json", "manifest.json"}};
+    report::WriteReport(folder, report, progress_);
+    summary_.seconds_report = SecondsSince(start);
+  }
+
+  std::string SeamText(const quilt::QuiltStats& q) const {
+    const double share = q.cut_links && q.random_pair_cost > 0
+                             ? q.seam_cost / static_cast<double>(q.cut_links) / q.random_pair_cost
+                             : 0.0;
+    char text[96];
+    std::snprintf(text, sizeof text, "%.2f of a cut between unrelated texels (T_c %.2f)", share,
+                  options_.quilt.seam_threshold);
+    return text;
+  }
+
+  // The flat baseline's colour: the model's atlases lit head-on, averaged over
+  // the texels that hold a value.
+  static Eigen::Vector3f MeanHeadOnColour(const model::TexturedModel& model) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double count = 0;
+    for (const ptm::Ptm& p : model.atlases)
+      for (std::size_t t = 0; t < p.NumTexels(); ++t) {
+        const Eigen::Vector3f c = p.Evaluate(t, 0.0, 0.0);
+        if (c.isZero()) continue;
+        sum += c.cast<double>();
+        ++count;
+      }
+    return count > 0 ? Eigen::Vector3f((sum / count).cast<float>())
+                     : Eigen::Vector3f::Constant(0.5f);
   }
 
   nlohmann::json Record() const {

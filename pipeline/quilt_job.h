@@ -31,6 +31,12 @@ struct QuiltJobOptions {
   /// World units per sample texel, > 0; a BTF sample's own when 0.
   double sample_texel_size = 0.0;
   quilt::QuiltOptions quilt;
+  /// Also write report.html (and report/) into the model folder: the sample,
+  /// the model from four views around it beside flat shading, a light sweep,
+  /// the atlases, the quilting's figures and timings.
+  bool write_report = true;
+  /// How long one world unit is, in millimetres (`--world-unit`); 0 = not stated.
+  double mm_per_world_unit = 0.0;
   /// The charts are the dense surface's geometry image: conformal by default.
   atlas::AtlasOptions atlas = ConformalAtlas();
   void Check() const;
@@ -53,7 +59,7 @@ struct QuiltJobSummary {
   double occupancy = 0.0;
   std::vector<std::string> warnings;
   double seconds_sample = 0, seconds_layout = 0, seconds_quilting = 0, seconds_atlas = 0,
-         seconds_preview = 0, seconds_total = 0;
+         seconds_preview = 0, seconds_report = 0, seconds_total = 0;
 };
 
 /// Reads the mesh and the sample, lays the faces out in charts, quilts the

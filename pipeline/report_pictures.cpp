@@ -1,10 +1,14 @@
 #include "pipeline/report_pictures.h"
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <string>
 #include <utility>
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "datasets_synthetic/object_scene.h"
 
 namespace texlume::pipeline {
 
@@ -49,6 +53,41 @@ void DrawReportPictures(const ReportScene& scene, report::ReportInputs& report,
   report.sweep_view = first.name;
   report.sweep_elevation_deg = scene.light_elevation_deg;
   if (progress) progress("report pictures", steps, steps);
+}
+
+std::vector<render::PictureView> ViewsAroundMesh(const mesh::TriangleMesh& mesh, int count,
+                                                 int width, int height) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const Eigen::Vector3d& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  const double radius = std::max(0.5 * (hi - lo).norm(), 1e-9), distance = 3 * radius;
+  sfm::Camera camera;
+  camera.camera_id = sfm::CameraId(1);
+  camera.model = sfm::CameraModelId::kPinhole;
+  camera.width = static_cast<std::uint64_t>(width);
+  camera.height = static_cast<std::uint64_t>(height);
+  const double focal_px = 0.8 * 0.5 * height * distance / radius;
+  camera.params = {focal_px, focal_px, width / 2.0, height / 2.0};
+  const double elevation = 25 * std::numbers::pi / 180;
+  std::vector<render::PictureView> views;
+  for (int k = 0; k < count; ++k) {
+    const double azimuth = 2 * std::numbers::pi * k / count;
+    const Eigen::Vector3d toward_camera(std::cos(elevation) * std::cos(azimuth),
+                                        std::cos(elevation) * std::sin(azimuth),
+                                        std::sin(elevation));
+    render::PictureView view;
+    view.name = "view_" + std::to_string(k) + ".png";
+    view.camera = camera;
+    view.cam_from_world = datasets::LookAt(centre + distance * toward_camera, centre);
+    const Eigen::Vector3d right =
+        Eigen::Vector3d::UnitZ().cross(toward_camera).normalized();  // the camera's right
+    sfm::ObjectLight light;
+    light.direction_in_world =
+        (toward_camera + 0.6 * Eigen::Vector3d::UnitZ() - 0.5 * right).normalized();
+    view.lights = {light};
+    views.push_back(std::move(view));
+  }
+  return views;
 }
 
 report::LightPlot LightPlotOfModel(const std::string& title,

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/progress.h"
+#include "mesh/mesh.h"
 #include "model/model_io.h"
 #include "ptm/ptm.h"
 #include "render/view_pictures.h"
@@ -32,6 +33,13 @@ struct ReportScene {
   /// Throws OptionError when a count or size is out of range.
   void Check() const;
 };
+
+/// `count` views around a mesh for a report without photos: cameras on a ring
+/// 25 degrees above the bounding box centre's horizon (world +z up), at three
+/// times its half diagonal, the box filling about 80 % of the picture's height,
+/// each lit by one directional light from above the camera's left shoulder.
+std::vector<render::PictureView> ViewsAroundMesh(const mesh::TriangleMesh& mesh, int count,
+                                                 int width, int height);
 
 /// Lights seen by the model (directional as they are, point lights from the mesh's
 /// bounding box centre) on the hemisphere of the model's orientation: up as the photos

@@ -8,6 +8,7 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/errors.h"
 
@@ -71,6 +72,19 @@ inline std::string InputErrorMessage(const std::function<void()>& f) {
     return e.what();
   }
   return "";
+}
+
+// Every file a report page links to or shows, relative to its folder.
+inline std::vector<std::string> ReportLinks(const std::string& html) {
+  std::vector<std::string> links;
+  for (const std::string attribute : {"src=\"", "href=\""}) {
+    for (std::size_t at = html.find(attribute); at != std::string::npos;
+         at = html.find(attribute, at + 1)) {
+      const std::size_t begin = at + attribute.size();
+      links.push_back(html.substr(begin, html.find('"', begin) - begin));
+    }
+  }
+  return links;
 }
 
 }  // namespace texlume::testing

@@ -578,6 +578,15 @@ TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
   EXPECT_GT(manifest["summary"]["patches"].get<int>(), 1);
   EXPECT_LT(manifest["summary"]["seam_cost_per_cut_link"].get<double>(),
             manifest["summary"]["unrelated_cut_cost"].get<double>());
+  // Its report: the quilting's figures, the model from views around it; every
+  // picture it shows exists.
+  const std::string html = testing::ReadText(tmp / "model/report.html");
+  for (const char* part : {"dense samples", "graph-cut quilting", "Light sweep", "Atlases"})
+    EXPECT_NE(html.find(part), std::string::npos) << part;
+  const std::vector<std::string> links = testing::ReportLinks(html);
+  EXPECT_GE(links.size(), 5u + 4u * 2u + 1u + 1u);
+  for (const std::string& link : links)
+    EXPECT_TRUE(std::filesystem::exists(tmp / "model" / link)) << link;
   nlohmann::json render;
   ASSERT_EQ(RenderHeldOut(tmp, scene, &out, &render), 0) << out;
   EXPECT_GT(render["metrics"]["mean_psnr_db"].get<double>(), 10.0);
@@ -610,9 +619,9 @@ TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
                     &out),
             2);
   EXPECT_NE(out.find("give overlap or graphcut"), std::string::npos) << out;
-  EXPECT_EQ(Texlume("synth" + inputs + " --fill-unseen graphcut --out " + (tmp / "bad").string(),
-                    &out),
-            2);
+  EXPECT_EQ(
+      Texlume("synth" + inputs + " --fill-unseen graphcut --out " + (tmp / "bad").string(), &out),
+      2);
   EXPECT_NE(out.find("--fill-unseen is not taken by --engine graphcut"), std::string::npos) << out;
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --btf e --out f "
                     "--fill-unseen graphcut",

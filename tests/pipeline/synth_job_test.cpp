@@ -617,19 +617,6 @@ TEST_F(MeshPipelineTest, WebModelKeepsChartsAndThePtmWithinQuantisation) {
   EXPECT_TRUE(web.files.count("scene.json"));
 }
 
-// Every file a report page links to or shows, relative to its folder.
-std::vector<std::string> ReportLinks(const std::string& html) {
-  std::vector<std::string> links;
-  for (const std::string attribute : {"src=\"", "href=\""}) {
-    for (std::size_t at = html.find(attribute); at != std::string::npos;
-         at = html.find(attribute, at + 1)) {
-      const std::size_t begin = at + attribute.size();
-      links.push_back(html.substr(begin, html.find('"', begin) - begin));
-    }
-  }
-  return links;
-}
-
 // The model folder's report: every picture it shows exists and is listed in
 // the manifest; the model agrees with the photos better than the flat baseline.
 TEST_F(MeshPipelineTest, SynthReportShowsEveryPictureItLinks) {
@@ -641,7 +628,7 @@ TEST_F(MeshPipelineTest, SynthReportShowsEveryPictureItLinks) {
   // The physical scale: 0.004 world units of 1 m per texel.
   EXPECT_NE(html.find("texel spans 0.004 world units (4 mm) on the object"), std::string::npos);
   EXPECT_NE(html.find(" mm) at the model's centre"), std::string::npos);
-  const std::vector<std::string> links = ReportLinks(html);
+  const std::vector<std::string> links = testing::ReportLinks(html);
   EXPECT_GE(links.size(), 5u + 12u + 4u * 6u + 1u + 1u + 3u);
   for (const std::string& link : links) {
     EXPECT_EQ(link.find(".."), std::string::npos) << link;
@@ -689,7 +676,7 @@ TEST_F(MeshPipelineTest, ReportOnHeldOutViewsMeasuresAndSweepsTheLight) {
   const report::ReportSummary s = report::WriteReport(out.path(), in);
   const std::string html = testing::ReadText(out.path() / "report.html");
   EXPECT_NE(html.find("held-out &lt;views&gt; &amp; &quot;truth&quot;"), std::string::npos);
-  for (const std::string& link : ReportLinks(html))
+  for (const std::string& link : testing::ReportLinks(html))
     EXPECT_TRUE(fs::exists(out.path() / link)) << link;
   ASSERT_EQ(s.rows.size(), 4u * 3u);  // 4 views x texlume, flat, baked
   double ssim_texlume = 0, ssim_flat = 0;

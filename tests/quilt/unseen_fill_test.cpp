@@ -68,10 +68,12 @@ synth::MeshSynthesis HalfFromPhotos(const mesh::TriangleMesh& mesh, const ptm::P
   return s;
 }
 
+// Rigid charts: the quickest to lay out.
 atlas::AtlasOptions Charts() {
   atlas::AtlasOptions o;
   o.atlas_size = 512;
   o.blend_strip = 2;
+  o.flattening = atlas::ChartFlattening::kRigid;
   return o;
 }
 
