@@ -31,6 +31,7 @@
 #include <random>
 #include <string>
 
+#include "datasets_synthetic/material.h"
 #include "datasets_synthetic/scene.h"
 #include "datasets_synthetic/shapes.h"
 #include "model/model_io.h"
@@ -56,22 +57,6 @@ ptm::Ptm RandomPtm(int side, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(-0.3f, 0.3f);
   for (float& c : p.coefficients) c = u(rng);
-  std::fill(p.colour.begin(), p.colour.end(), 1.0f);
-  return p;
-}
-
-ptm::Ptm SmoothPtm(int side, unsigned seed) {
-  ptm::Ptm p;
-  p.Resize(ptm::PtmFormat::kLrgb, side, side);
-  cv::RNG rng(seed);
-  for (int m = 0; m < 6; ++m) {
-    cv::Mat coarse(side / 8, side / 8, CV_32FC1), plane;
-    rng.fill(coarse, cv::RNG::UNIFORM, -0.3, 0.3);
-    cv::resize(coarse, plane, cv::Size(side, side), 0, 0, cv::INTER_CUBIC);
-    for (int t = 0; t < side * side; ++t)
-      p.Coefficients(static_cast<std::size_t>(t))[m] =
-          plane.at<float>(t / side, t % side) + (m == 5 ? 0.5f : 0.0f);
-  }
   std::fill(p.colour.begin(), p.colour.end(), 1.0f);
   return p;
 }
@@ -347,7 +332,8 @@ int main(int argc, char** argv) {
     std::printf("| %d x %d | %d | %d of %d | %.4f | %.4f | %.0fx |\n", w, w, positions, same,
                 trials, fft / trials, brute / trials, brute / fft);
   }
-  const ptm::Ptm quilted = ptm_file ? ptm::ReadPtmFile(ptm_file) : SmoothPtm(256, 7);
+  const ptm::Ptm quilted =
+      ptm_file ? ptm::ReadPtmFile(ptm_file) : datasets::SmoothRandomPtm(256, 7);
   QuiltSphere(quilted, levels, texel, compare);
   QuiltMeshes(synth::PtmSample(quilted), levels, texel);
   QuiltMaterials(levels, texel);

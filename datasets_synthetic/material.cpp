@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <opencv2/imgproc.hpp>
 
 #include "core/errors.h"
 
@@ -286,6 +287,22 @@ Eigen::Vector3d BakedMaterial::Albedo(double u, double v) const {
   const Eigen::Vector3f b = albedo_[Index(i, j + 1)] * static_cast<float>(1 - fu) +
                             albedo_[Index(i + 1, j + 1)] * static_cast<float>(fu);
   return (a * static_cast<float>(1 - fv) + b * static_cast<float>(fv)).cast<double>();
+}
+
+ptm::Ptm SmoothRandomPtm(int side, unsigned seed) {
+  ptm::Ptm p;
+  p.Resize(ptm::PtmFormat::kLrgb, side, side);
+  cv::RNG rng(seed);
+  for (int m = 0; m < 6; ++m) {
+    cv::Mat coarse(side / 8, side / 8, CV_32FC1), plane;
+    rng.fill(coarse, cv::RNG::UNIFORM, -0.3, 0.3);
+    cv::resize(coarse, plane, cv::Size(side, side), 0, 0, cv::INTER_CUBIC);
+    for (int t = 0; t < side * side; ++t)
+      p.Coefficients(static_cast<std::size_t>(t))[m] =
+          plane.at<float>(t / side, t % side) + (m == 5 ? 0.5f : 0.0f);
+  }
+  std::fill(p.colour.begin(), p.colour.end(), 1.0f);
+  return p;
 }
 
 }  // namespace texlume::datasets

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "datasets_synthetic/noise.h"
+#include "ptm/ptm.h"
 
 namespace texlume::datasets {
 
@@ -117,5 +118,11 @@ class BakedMaterial {
   std::vector<float> height_;
   std::vector<Eigen::Vector3f> albedo_;
 };
+
+/// An LRGB PTM of smooth random coefficients (seeded; each plane uniform in
+/// [-0.3, 0.3] on a grid of side / 8, resized bicubically, plus 0.5 on the
+/// constant term; white colour): a sample with structure a seam shows, for
+/// tests and benchmarks of the quilting.
+ptm::Ptm SmoothRandomPtm(int side, unsigned seed);
 
 }  // namespace texlume::datasets

@@ -22,8 +22,6 @@ void BtfSynthJobOptions::Check() const {
   job.CheckInputsAndLayout();
   if (btf.empty()) throw OptionError("synth --btf needs a BTF capture or factorisation folder");
   if (components < 1) throw OptionError("components must be >= 1");
-  if (job.fill_unseen != FillUnseen::kOverlap)
-    throw OptionError("--fill-unseen graphcut takes a PTM or colour sample (not yet --btf)");
   if (!(synthesis.sample_texel_size >= 0.0))
     throw OptionError("sample texel size must be >= 0 (0: the capture's)");
   synth::BtfMeshSynthesisOptions resolved = synthesis;
@@ -89,6 +87,16 @@ class BtfSynthJob {
     summary_.seam_edges = synthesis_.seam_edges;
     summary_.seam_cost_per_link = synthesis_.seam_cost_per_link;
     summary_.edge_cost_per_link = synthesis_.edge_cost_per_link;
+    if (job_.fill_unseen == pipeline::FillUnseen::kGraphcut) FillUnseenFaces();
+  }
+
+  // The faces no photo placed, quilted by the graph-cut engine on the sample's
+  // geometry maps (quilt/unseen_fill.h).
+  void FillUnseenFaces() {
+    AnnounceStep(progress_, "quilting the faces no photo sees (graph cut)");
+    summary_.unseen_fill =
+        quilt::FillUnseenFaces(inputs_.mesh, synthesis_, synth::BtfSample(sample_),
+                               pipeline::UnseenFillOptionsOf(job_, so_.seed), progress_);
   }
 
   // The atlases, the PTM preview as the model's atlases, and the baselines
@@ -134,6 +142,7 @@ class BtfSynthJob {
                                {"photo_blur", so_.photo_blur},
                                {"seed", so_.seed},
                                {"horizon_elevation_deg", ptm::kHorizonElevationDeg}};
+    settings.update(pipeline::FillUnseenSettingsJson(job_));
     settings.update(pipeline::AtlasSettingsJson(job_.atlas));
     return settings;
   }
@@ -147,6 +156,8 @@ class BtfSynthJob {
                     {"photo_rms_quilted", synthesis_.photo_rms_quilted},
                     {"photo_rms_corrected", synthesis_.photo_rms_corrected}});
     summary.update(pipeline::EngineSummaryJson(synthesis_));
+    if (job_.fill_unseen == pipeline::FillUnseen::kGraphcut)
+      summary["unseen_fill"] = pipeline::UnseenFillJson(s.unseen_fill);
     return summary;
   }
 
@@ -166,6 +177,7 @@ class BtfSynthJob {
         {"factorise", s.seconds_factorise},
         {"synthesis", s.seconds_synthesis},
         {"seams", s.seconds_seams},
+        {"unseen_fill", s.unseen_fill.seconds},
         {"atlas", s.seconds_atlas},
         {"ptm_preview", s.seconds_preview},
         {"synthesis_per_triangle", (s.seconds_synthesis + s.seconds_seams) /

@@ -33,6 +33,7 @@ struct BtfSynthJobOptions {
 };
 
 struct BtfSynthJobSummary : pipeline::SynthCounts {
+  quilt::UnseenFillSummary unseen_fill;  ///< the graph-cut fill (FillUnseen::kGraphcut)
   std::size_t seam_edges = 0;
   double seam_cost_per_link = 0, edge_cost_per_link = 0;
   double seconds_factorise = 0, seconds_synthesis = 0, seconds_seams = 0, seconds_atlas = 0,

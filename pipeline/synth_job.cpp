@@ -272,6 +272,35 @@ const char* FillUnseenName(FillUnseen fill) {
   return fill == FillUnseen::kGraphcut ? "graphcut" : "overlap";
 }
 
+quilt::UnseenFillOptions UnseenFillOptionsOf(const SynthJobOptions& job, std::uint64_t seed) {
+  quilt::UnseenFillOptions fill;
+  fill.quilt = job.fill_quilt;
+  fill.quilt.seed = seed;
+  fill.atlas = job.atlas;
+  return fill;
+}
+
+nlohmann::json FillUnseenSettingsJson(const SynthJobOptions& job) {
+  nlohmann::json settings = {{"fill_unseen", FillUnseenName(job.fill_unseen)}};
+  if (job.fill_unseen == FillUnseen::kGraphcut)
+    settings.update({{"fill_work_patch", job.fill_quilt.work_patch_levels},
+                     {"fill_seam_threshold", job.fill_quilt.seam_threshold}});
+  return settings;
+}
+
+nlohmann::json UnseenFillJson(const quilt::UnseenFillSummary& fill) {
+  const quilt::QuiltStats& q = fill.stats;
+  const double seam =
+      q.cut_links && q.random_pair_cost > 0 ? q.seam_cost / q.cut_links / q.random_pair_cost : 0.0;
+  return {{"engine", "graphcut"},
+          {"faces", fill.faces},
+          {"samples", fill.samples},
+          {"given_samples", fill.given_samples},
+          {"patches", q.patches},
+          {"forced", q.forced},
+          {"seam_cost_per_cut_link_over_unrelated", seam}};
+}
+
 void SynthJobOptions::Check() const {
   CheckInputsAndLayout();
   if (sample_file.empty()) throw OptionError("synth needs a sample");
@@ -394,11 +423,9 @@ class SynthJob {
   // synthesis's sample (quilt/unseen_fill.h).
   void FillUnseenFaces() {
     AnnounceStep(progress_, "quilting the faces no photo sees (graph cut)");
-    quilt::UnseenFillOptions fill;
-    fill.quilt = options_.fill_quilt;
-    fill.quilt.seed = options_.synthesis.seed;
-    fill.atlas = options_.atlas;
-    summary_.unseen_fill = quilt::FillUnseenFaces(inputs_.mesh, synthesis_, fill, progress_);
+    summary_.unseen_fill =
+        quilt::FillUnseenFaces(inputs_.mesh, synthesis_,
+                               UnseenFillOptionsOf(options_, options_.synthesis.seed), progress_);
   }
 
   // Blending and atlases: the textured model.
@@ -455,11 +482,8 @@ class SynthJob {
         {"white_balance", so.white_balance},
         {"photo_blur", so.photo_blur},
         {"seed", so.seed},
-        {"sample_kind", sample_.colour.empty() ? "PTM" : "colour"},
-        {"fill_unseen", FillUnseenName(options_.fill_unseen)}};
-    if (options_.fill_unseen == FillUnseen::kGraphcut)
-      settings.update({{"fill_work_patch", options_.fill_quilt.work_patch_levels},
-                       {"fill_seam_threshold", options_.fill_quilt.seam_threshold}});
+        {"sample_kind", sample_.colour.empty() ? "PTM" : "colour"}};
+    settings.update(FillUnseenSettingsJson(options_));
     settings.update(AtlasSettingsJson(options_.atlas));
     return settings;
   }
@@ -471,22 +495,9 @@ class SynthJob {
                      {{"mean", s.stretch.mean}, {"min", s.stretch.min}, {"max", s.stretch.max}}},
                     {"mean_prior_shrink", MeanPriorShrink(synthesis_)}});
     summary.update(EngineSummaryJson(synthesis_));
-    if (options_.fill_unseen == FillUnseen::kGraphcut) summary["unseen_fill"] = UnseenFillJson();
+    if (options_.fill_unseen == FillUnseen::kGraphcut)
+      summary["unseen_fill"] = UnseenFillJson(s.unseen_fill);
     return summary;
-  }
-
-  nlohmann::json UnseenFillJson() const {
-    const quilt::UnseenFillSummary& f = summary_.unseen_fill;
-    const double seam = f.stats.cut_links && f.stats.random_pair_cost > 0
-                            ? f.stats.seam_cost / f.stats.cut_links / f.stats.random_pair_cost
-                            : 0.0;
-    return {{"engine", "graphcut"},
-            {"faces", f.faces},
-            {"samples", f.samples},
-            {"given_samples", f.given_samples},
-            {"patches", f.stats.patches},
-            {"forced", f.stats.forced},
-            {"seam_cost_per_cut_link_over_unrelated", seam}};
   }
 
   // The manifest's record: inputs, settings, summary, warnings, baselines, timings.

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -27,6 +28,13 @@ enum class FillUnseen {
 };
 /// "overlap" or "graphcut" (the CLI's and the manifest's names).
 const char* FillUnseenName(FillUnseen fill);
+struct SynthJobOptions;
+/// The graph-cut fill's options for a job (its charts; `seed` the synthesis's).
+quilt::UnseenFillOptions UnseenFillOptionsOf(const SynthJobOptions& job, std::uint64_t seed);
+/// The manifest's settings of the fill ("fill_unseen", and r_w and T_c when graph cut).
+nlohmann::json FillUnseenSettingsJson(const SynthJobOptions& job);
+/// The manifest's summary of a graph-cut fill ("unseen_fill").
+nlohmann::json UnseenFillJson(const quilt::UnseenFillSummary& fill);
 
 /// Inputs and settings of the main job (`texlume synth`).
 struct SynthJobOptions {

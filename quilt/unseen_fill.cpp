@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -13,40 +14,24 @@
 namespace texlume::quilt {
 namespace {
 
-// The quilt of the unseen faces, kept alive by MeshSynthesis::fill: what a
-// point of a filled face shows, read from the sample at its quilted lookup.
-class QuiltedFill {
+// The quilt of the unseen faces over the job's layout, kept alive by the
+// synthesis's fill: where a point of a filled face reads the sample.
+class UnseenQuilt {
  public:
-  QuiltedFill(atlas::AtlasLayout layout, DenseSurface surface, QuiltResult quilt,
-              const synth::MeshSynthesis& synthesis, int reach)
-      : layout_(std::move(layout)),
-        surface_(std::move(surface)),
-        quilt_(std::move(quilt)),
-        planes_(synthesis.sample_planes),
-        polynomials_(synthesis.CoefficientPlanes() / 6) {
+  UnseenQuilt(atlas::AtlasLayout layout, DenseSurface surface, QuiltResult quilt, int reach)
+      : layout_(std::move(layout)), surface_(std::move(surface)), quilt_(std::move(quilt)) {
     lookup_.emplace(surface_, quilt_, layout_, reach);
-    for (const atlas::FacePlacement& fp : layout_.faces)
-      atlas_to_face_.push_back(ptm::OrthonormalFrameRotation(-fp.AtlasFrameAngle()));
   }
 
-  // All planes at a point of the face's frame, in that frame: the sample's
-  // values at the lookup, turned by the lookup's angle into the atlas frame
-  // (as BakeQuiltedAtlases) and from there into the face frame (the inverse of
-  // atlas::BuildAtlases' turn).
-  bool At(int face, const Eigen::Vector2d& p_in_frame, float* out) const {
-    Eigen::Vector2d at;
-    double angle_rad = 0;
-    if (!lookup_->At(face, p_in_frame, &at, &angle_rad)) return false;
-    for (std::size_t k = 0; k < planes_.size(); ++k)
-      out[k] = static_cast<float>(synth::BilinearClamped(planes_[k], at.x() - 0.5, at.y() - 0.5));
-    const Eigen::Matrix<double, 6, 6> to_face =
-        atlas_to_face_[static_cast<std::size_t>(face)] * ptm::OrthonormalFrameRotation(-angle_rad);
-    for (int poly = 0; poly < polynomials_; ++poly) {
-      Eigen::Matrix<double, 6, 1> c;
-      for (int i = 0; i < 6; ++i) c[i] = out[poly * 6 + i];
-      c = to_face * c;
-      for (int i = 0; i < 6; ++i) out[poly * 6 + i] = static_cast<float>(c[i]);
-    }
+  // The sample position at a point of a face's frame, and the turn from the
+  // face frame into the sample's (d_sample = R(angle) d_face): the sample lies
+  // turned by the lookup's angle a in the atlas frame, which is the face frame
+  // turned by the atlas frame angle, so the turn is -a - that angle.
+  bool At(int face, const Eigen::Vector2d& p_in_frame, Eigen::Vector2d* sample_px,
+          double* face_to_sample_rad) const {
+    double a = 0;
+    if (!lookup_->At(face, p_in_frame, sample_px, &a)) return false;
+    *face_to_sample_rad = -a - layout_.faces[static_cast<std::size_t>(face)].AtlasFrameAngle();
     return true;
   }
 
@@ -54,76 +39,144 @@ class QuiltedFill {
   atlas::AtlasLayout layout_;
   DenseSurface surface_;
   QuiltResult quilt_;
-  std::vector<cv::Mat> planes_;
-  int polynomials_;
   std::optional<QuiltedSurfaceLookup> lookup_;  ///< over the members above
-  std::vector<Eigen::Matrix<double, 6, 6>> atlas_to_face_;
 };
 
-}  // namespace
+// What a face the photos placed shows at a point of its frame: the sample's
+// features there, in the face frame; false where it shows none.
+using FaceFeatures = std::function<bool(int face, const Eigen::Vector2d& p_in_frame, float* out)>;
 
-GivenSamples SamplesOfPhotoFaces(const DenseSurface& surface, const atlas::AtlasLayout& layout,
-                                 const synth::MeshSynthesis& synthesis) {
-  const int nf = synthesis.CoefficientPlanes();
+GivenSamples GivenFromPhotoFaces(const DenseSurface& surface, const atlas::AtlasLayout& layout,
+                                 const synth::TriangleSynthesis& synthesis,
+                                 const synth::MaterialSample& sample,
+                                 const FaceFeatures& features_of) {
+  const std::size_t nf = static_cast<std::size_t>(sample.NumFeatures());
   GivenSamples given;
   given.given.assign(surface.size(), false);
-  given.features.assign(surface.size() * static_cast<std::size_t>(nf), 0.0f);
-  std::array<float, synth::MeshSynthesis::kMaxPlanes> values{};
+  given.features.assign(surface.size() * nf, 0.0f);
   for (std::size_t s = 0; s < surface.size(); ++s) {
     const DenseSample& d = surface.samples()[s];
+    float* f = given.features.data() + s * nf;
     if (synthesis.patches[static_cast<std::size_t>(d.face)].source != synth::PatchSource::kPhotos ||
-        !synthesis.SamplePatch(d.face, d.p_in_frame, values.data()))
+        !features_of(d.face, d.p_in_frame, f))
       continue;
-    // The atlas frame is the face frame turned by the atlas frame angle
-    // (atlas::BuildAtlases turns the coefficients so).
-    const Eigen::Matrix<double, 6, 6> to_atlas = ptm::OrthonormalFrameRotation(
-        layout.faces[static_cast<std::size_t>(d.face)].AtlasFrameAngle());
-    float* f = given.features.data() + s * static_cast<std::size_t>(nf);
-    for (int poly = 0; poly < nf / 6; ++poly) {
-      Eigen::Matrix<double, 6, 1> c;
-      for (int i = 0; i < 6; ++i) c[i] = values[static_cast<std::size_t>(poly * 6 + i)];
-      c = to_atlas * c;
-      for (int i = 0; i < 6; ++i) f[poly * 6 + i] = static_cast<float>(c[i]);
-    }
+    // The atlas frame is the face frame turned by the atlas frame angle (the
+    // atlas bakers turn the values so).
+    const double a = layout.faces[static_cast<std::size_t>(d.face)].AtlasFrameAngle();
+    synth::Unfolding face_to_atlas;
+    face_to_atlas.rotation = Eigen::Rotation2Dd(a).toRotationMatrix();
+    face_to_atlas.coefficients_to_this = ptm::OrthonormalFrameRotation(a);
+    sample.TurnFeatures(face_to_atlas, f);
     given.given[s] = true;
   }
   return given;
 }
 
-UnseenFillSummary FillUnseenFaces(const mesh::TriangleMesh& mesh, synth::MeshSynthesis& synthesis,
-                                  const UnseenFillOptions& options,
-                                  const ProgressCallback& progress) {
+// The faces no photo placed, quilted from the others (their features given by
+// `features_of`) over the layout of `options.atlas`; null when there are none.
+std::shared_ptr<const UnseenQuilt> QuiltUnseenFaces(const mesh::TriangleMesh& mesh,
+                                                    const synth::TriangleSynthesis& synthesis,
+                                                    const synth::MaterialSample& sample,
+                                                    const FaceFeatures& features_of,
+                                                    const UnseenFillOptions& options,
+                                                    const ProgressCallback& progress,
+                                                    UnseenFillSummary& summary) {
   const auto start = std::chrono::steady_clock::now();
-  UnseenFillSummary summary;
-  std::vector<bool> filled(synthesis.patches.size(), false);
+  summary.filled.assign(synthesis.patches.size(), false);
   for (std::size_t f = 0; f < synthesis.patches.size(); ++f)
     if (synthesis.patches[f].source != synth::PatchSource::kPhotos)
-      filled[f] = true, ++summary.faces;
-  if (summary.faces == 0) return summary;
+      summary.filled[f] = true, ++summary.faces;
+  if (summary.faces == 0) return nullptr;
   atlas::AtlasLayout layout = atlas::LayoutAtlases(mesh, synthesis.patches, synthesis.unfoldings,
                                                    synthesis.texel_size, options.atlas, progress);
   DenseSurface surface =
       DenseSurface::Build(layout, synthesis.patches, synthesis.unfoldings, synthesis.texel_size);
-  const GivenSamples given = SamplesOfPhotoFaces(surface, layout, synthesis);
-  // The synthesis's own sample, whose features are its orthonormal coefficients.
-  const ptm::Ptm sample_ptm =
-      synth::FromOrthonormalPlanes(synthesis.sample_planes, synthesis.format);
-  const synth::PtmSample sample(sample_ptm);
+  const GivenSamples given = GivenFromPhotoFaces(surface, layout, synthesis, sample, features_of);
   QuiltResult quilt = QuiltSurface(surface, layout, sample, options.quilt, progress, &given);
   summary.stats = quilt.stats;
   summary.given_samples = quilt.stats.given;
   summary.samples = surface.size() - quilt.stats.given;
-  // A filled face's blend strip reads its neighbours' values W_e / 2 texels past
+  // A face's blend strip or seam band reads its neighbours W_e / 2 texels past
   // their edges: the lookup reaches that far, and over the gutter.
   const int reach = std::max(options.atlas.gutter, options.atlas.blend_strip);
-  auto fill = std::make_shared<const QuiltedFill>(std::move(layout), std::move(surface),
-                                                  std::move(quilt), synthesis, reach);
-  summary.filled = filled;
-  synthesis.filled = std::move(filled);
-  synthesis.fill = [fill](int face, const Eigen::Vector2d& p_in_frame, float* out) {
-    return fill->At(face, p_in_frame, out);
-  };
+  auto unseen = std::make_shared<const UnseenQuilt>(std::move(layout), std::move(surface),
+                                                    std::move(quilt), reach);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return unseen;
+}
+
+// The features of a PTM synthesis's patch (MeshSynthesis::SamplePatch: its
+// orthonormal coefficients, corrections and detail transfer included).
+FaceFeatures PtmPatchFeatures(const synth::MeshSynthesis& synthesis) {
+  return [&synthesis](int face, const Eigen::Vector2d& p, float* out) {
+    std::array<float, synth::MeshSynthesis::kMaxPlanes> values{};
+    if (!synthesis.SamplePatch(face, p, values.data())) return false;
+    std::copy_n(values.begin(), synthesis.CoefficientPlanes(), out);
+    return true;
+  };
+}
+
+}  // namespace
+
+GivenSamples SamplesOfPhotoFaces(const DenseSurface& surface, const atlas::AtlasLayout& layout,
+                                 const synth::MeshSynthesis& synthesis) {
+  const ptm::Ptm sample_ptm =
+      synth::FromOrthonormalPlanes(synthesis.sample_planes, synthesis.format);
+  return GivenFromPhotoFaces(surface, layout, synthesis, synth::PtmSample(sample_ptm),
+                             PtmPatchFeatures(synthesis));
+}
+
+UnseenFillSummary FillUnseenFaces(const mesh::TriangleMesh& mesh, synth::MeshSynthesis& synthesis,
+                                  const UnseenFillOptions& options,
+                                  const ProgressCallback& progress) {
+  UnseenFillSummary summary;
+  // The synthesis's own sample, whose features are its orthonormal coefficients.
+  const ptm::Ptm sample_ptm =
+      synth::FromOrthonormalPlanes(synthesis.sample_planes, synthesis.format);
+  const synth::PtmSample sample(sample_ptm);
+  const auto unseen = QuiltUnseenFaces(mesh, synthesis, sample, PtmPatchFeatures(synthesis),
+                                       options, progress, summary);
+  if (!unseen) return summary;
+  // The sample's values at the lookup, turned from the sample's frame into the
+  // face's (the coefficients of a frame turned by the angle).
+  const std::vector<cv::Mat> planes = synthesis.sample_planes;
+  const int polynomials = synthesis.CoefficientPlanes() / 6;
+  synthesis.filled = summary.filled;
+  synthesis.fill = [unseen, planes, polynomials](int face, const Eigen::Vector2d& p, float* out) {
+    Eigen::Vector2d at;
+    double face_to_sample = 0;
+    if (!unseen->At(face, p, &at, &face_to_sample)) return false;
+    for (std::size_t k = 0; k < planes.size(); ++k)
+      out[k] = static_cast<float>(synth::BilinearClamped(planes[k], at.x() - 0.5, at.y() - 0.5));
+    const Eigen::Matrix<double, 6, 6> to_face = ptm::OrthonormalFrameRotation(face_to_sample);
+    for (int poly = 0; poly < polynomials; ++poly) {
+      Eigen::Map<Eigen::Matrix<float, 6, 1>> c(out + poly * 6);
+      c = (to_face * c.cast<double>()).cast<float>();
+    }
+    return true;
+  };
+  return summary;
+}
+
+UnseenFillSummary FillUnseenFaces(const mesh::TriangleMesh& mesh,
+                                  synth::BtfMeshSynthesis& synthesis,
+                                  const synth::BtfSample& sample, const UnseenFillOptions& options,
+                                  const ProgressCallback& progress) {
+  UnseenFillSummary summary;
+  // What a placed face shows: the geometry maps where its lookup (seams
+  // included) reads the sample; they do not turn with the frame.
+  const FaceFeatures features_of = [&](int face, const Eigen::Vector2d& p, float* out) {
+    sample.FeaturesAt(synthesis.Lookup(face, p).sample_px, out);
+    return true;
+  };
+  const auto unseen =
+      QuiltUnseenFaces(mesh, synthesis, sample, features_of, options, progress, summary);
+  if (!unseen) return summary;
+  synthesis.filled = summary.filled;
+  synthesis.fill = [unseen](int face, const Eigen::Vector2d& p, Eigen::Vector2d* sample_px,
+                            double* face_to_sample_rad) {
+    return unseen->At(face, p, sample_px, face_to_sample_rad);
+  };
   return summary;
 }
 

@@ -8,6 +8,8 @@
 #include "mesh/mesh.h"
 #include "quilt/dense_surface.h"
 #include "quilt/surface_quilting.h"
+#include "synth/btf_sample.h"
+#include "synth/mesh_btf.h"
 #include "synth/mesh_synthesis.h"
 
 // The main job's `--fill-unseen graphcut` (issue 32): the faces no photo sees
@@ -51,6 +53,15 @@ GivenSamples SamplesOfPhotoFaces(const DenseSurface& surface, const atlas::Atlas
 /// Nothing changes when every face was placed from photos.
 UnseenFillSummary FillUnseenFaces(const mesh::TriangleMesh& mesh, synth::MeshSynthesis& synthesis,
                                   const UnseenFillOptions& options,
+                                  const ProgressCallback& progress = {});
+
+/// The same for a BTF synthesis: the sample's geometry maps are matched (the
+/// given ones where each placed face's lookup reads, seams included), and the
+/// quilt's lookups become the filled faces' (BtfMeshSynthesis::fill), with
+/// photo-consistency factors of 1.
+UnseenFillSummary FillUnseenFaces(const mesh::TriangleMesh& mesh,
+                                  synth::BtfMeshSynthesis& synthesis,
+                                  const synth::BtfSample& sample, const UnseenFillOptions& options,
                                   const ProgressCallback& progress = {});
 
 }  // namespace texlume::quilt

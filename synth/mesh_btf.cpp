@@ -29,6 +29,12 @@ BtfSampleLookup BtfMeshSynthesis::Lookup(int face, const Eigen::Vector2d& p) con
     const TrianglePatch& patch = patches[static_cast<std::size_t>(f)];
     BtfSampleLookup out;
     out.source_face = f;
+    // d_sample = R(fill) d_f and d_f = R(angle) d_asked.
+    if (!filled.empty() && filled[static_cast<std::size_t>(f)] &&
+        fill(f, q, &out.sample_px, &out.angle_rad)) {
+      out.angle_rad += angle;
+      return out;
+    }
     const Eigen::Vector2d in_patch((q.x() - patch.x_min) / texel_size,
                                    (patch.y_max - q.y()) / texel_size);  // texels, y down
     out.sample_px = Eigen::Vector2d(patch.sample_x, patch.sample_y) + in_patch;
@@ -56,7 +62,9 @@ BtfSampleLookup BtfMeshSynthesis::Lookup(int face, const Eigen::Vector2d& p) con
   const cv::Mat& label = labels[static_cast<std::size_t>(face)];
   const int i = static_cast<int>(std::floor((p.x() - patch.x_min) / texel_size));
   const int j = static_cast<int>(std::floor((patch.y_max - p.y()) / texel_size));
-  if (label.empty() || i < 0 || j < 0 || i >= label.cols || j >= label.rows) return own(face, p, 0);
+  const bool is_filled = !filled.empty() && filled[static_cast<std::size_t>(face)];
+  if (is_filled || label.empty() || i < 0 || j < 0 || i >= label.cols || j >= label.rows)
+    return own(face, p, 0);
   const int l = label.at<std::uint8_t>(j, i);
   if (l == 0) return own(face, p, 0);
   const Unfolding& u = unfoldings[static_cast<std::size_t>(face)][static_cast<std::size_t>(l - 1)];

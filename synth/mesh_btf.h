@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -69,8 +70,19 @@ struct BtfMeshSynthesis : TriangleSynthesis {
   double seam_cost_per_link = 0;        ///< mean E_smooth term of a cut pair (geometry-map units)
   double edge_cost_per_link = 0;  ///< the same for a straight seam along the mesh edge (no cut)
   double seconds_seams = 0;
+  /// Faces whose lookups another engine supplies in place of their patch (the
+  /// graph-cut fill of the faces no photo sees, quilt/unseen_fill.h): per face
+  /// whether it does (empty: none), and its sample position and the turn from
+  /// the face frame into the sample's at a point of the face frame (false where
+  /// it has none, and the patch is read). Factors of 1.
+  std::vector<bool> filled;
+  std::function<bool(int face, const Eigen::Vector2d& p_in_frame, Eigen::Vector2d* sample_px,
+                     double* face_to_sample_rad)>
+      fill;
 
-  /// The sample texel a point of face `face` (its triangle frame, world units) shows.
+  /// The sample texel a point of face `face` (its triangle frame, world units)
+  /// shows: a filled face's fill; else its patch, or across a seam the
+  /// neighbour's (that neighbour's fill when it is filled).
   BtfSampleLookup Lookup(int face, const Eigen::Vector2d& p_in_frame) const;
 };
 

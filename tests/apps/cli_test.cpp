@@ -613,7 +613,7 @@ TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
                     &out),
             2);
   EXPECT_NE(out.find("--work-patch is for --engine graphcut"), std::string::npos) << out;
-  // --fill-unseen: one of two words; not for the graph-cut engine, nor (yet) a BTF (2).
+  // --fill-unseen: one of two words, and not for the graph-cut engine (2).
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
                     "--sample-texel-size 0.01 --out f --fill-unseen blur",
                     &out),
@@ -623,11 +623,6 @@ TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
       Texlume("synth" + inputs + " --fill-unseen graphcut --out " + (tmp / "bad").string(), &out),
       2);
   EXPECT_NE(out.find("--fill-unseen is not taken by --engine graphcut"), std::string::npos) << out;
-  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --btf e --out f "
-                    "--fill-unseen graphcut",
-                    &out),
-            2);
-  EXPECT_NE(out.find("not yet --btf"), std::string::npos) << out;
   // A sample smaller than the smallest work patch: an input error naming it (1).
   cv::imwrite((tmp / "tiny.png").string(), cv::Mat(12, 12, CV_8UC3, cv::Scalar(90, 120, 150)));
   EXPECT_EQ(Texlume("synth --engine graphcut --mesh " + scene +

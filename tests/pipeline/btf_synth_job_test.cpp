@@ -18,6 +18,7 @@
 #include "pipeline/synth_job.h"
 #include "ptm/fit.h"
 #include "ptm/ptm_io.h"
+#include "quilt/unseen_fill.h"
 #include "render/btf_shading.h"
 #include "synth/mesh_btf.h"
 #include "tests/small_scene.h"
@@ -128,6 +129,49 @@ TEST_F(MeshBtfTest, EveryTrianglePatchLiesInTheSampleMostFromThePhotos) {
   const auto [lo, hi] = std::minmax_element(s.photo_gains.begin(), s.photo_gains.end());
   EXPECT_GT(*lo, 0.4);
   EXPECT_LT(*hi, 2.5);
+}
+
+// --fill-unseen graphcut with a BTF sample (quilt/unseen_fill.h): the faces no
+// photo placed read the quilt of the geometry maps (in the sample, factors of
+// 1, moved off their overlap-only patches); a face the photos placed keeps its
+// lookups where no filled face is next to it.
+TEST_F(MeshBtfTest, GraphCutFillQuiltsTheUnseenFacesOnTheGeometryMaps) {
+  synth::BtfMeshSynthesis s = *synthesis_;
+  quilt::UnseenFillOptions o;
+  o.atlas.atlas_size = 1024;
+  o.quilt.work_patch_levels = 16;
+  const quilt::UnseenFillSummary fill =
+      quilt::FillUnseenFaces(inputs_->mesh, s, synth::BtfSample(*sample_), o);
+  EXPECT_EQ(fill.faces, s.num_from_neighbours + s.num_random);
+  ASSERT_GT(fill.faces, 0u);
+  EXPECT_GT(fill.stats.patches, 1u);
+  std::size_t moved = 0, kept = 0;
+  for (std::size_t f = 0; f < s.patches.size(); ++f) {
+    const synth::TrianglePatch& patch = s.patches[f];
+    const Eigen::Vector2d centre =
+        (patch.corners_in_frame[0] + patch.corners_in_frame[1] + patch.corners_in_frame[2]) / 3;
+    const synth::BtfSampleLookup before = synthesis_->Lookup(static_cast<int>(f), centre);
+    const synth::BtfSampleLookup after = s.Lookup(static_cast<int>(f), centre);
+    if (fill.filled[f]) {
+      EXPECT_EQ(after.source_face, static_cast<int>(f));
+      EXPECT_EQ(after.colour_gain, Eigen::Vector3f::Ones());
+      EXPECT_GE(after.sample_px.minCoeff(), 0.0);
+      EXPECT_LE(after.sample_px.x(), sample_->width);
+      EXPECT_LE(after.sample_px.y(), sample_->height);
+      moved += (after.sample_px - before.sample_px).norm() > 1.0;
+      continue;
+    }
+    bool next_to_filled = false;
+    for (const synth::Unfolding& u : s.unfoldings[f])
+      next_to_filled =
+          next_to_filled || (u.face >= 0 && fill.filled[static_cast<std::size_t>(u.face)]);
+    if (next_to_filled) continue;
+    EXPECT_EQ(after.sample_px, before.sample_px) << "face " << f;
+    EXPECT_EQ(after.angle_rad, before.angle_rad) << "face " << f;
+    ++kept;
+  }
+  EXPECT_GT(moved, fill.faces / 2);
+  EXPECT_GT(kept, s.num_from_photos / 2);
 }
 
 TEST_F(MeshBtfTest, GraphCutSeamsCostNoMoreThanTheStraightMeshEdge) {

@@ -9,6 +9,7 @@
 #include "core/errors.h"
 #include "ptm/coefficient_space.h"
 #include "quilt/patch_energy.h"
+#include "tests/quilt/sample_ptms.h"
 
 namespace texlume::quilt {
 namespace {
@@ -25,18 +26,6 @@ ptm::Ptm RandomPtm(int width, int height, unsigned seed) {
   return p;
 }
 
-// A PTM lit most from +x everywhere (L = 0.4 lu + 0.5).
-ptm::Ptm LitFromPlusX() {
-  ptm::Ptm p;
-  p.Resize(ptm::PtmFormat::kLrgb, 32, 32);
-  for (std::size_t t = 0; t < p.NumTexels(); ++t) {
-    p.Coefficients(t)[3] = 0.4f;
-    p.Coefficients(t)[5] = 0.5f;
-  }
-  std::fill(p.colour.begin(), p.colour.end(), 1.0f);
-  return p;
-}
-
 std::vector<cv::Mat> Crop(const RotatedCopy& copy, const cv::Rect& r) {
   std::vector<cv::Mat> out;
   for (const cv::Mat& plane : copy.planes) out.push_back(plane(r).clone());
@@ -46,7 +35,7 @@ std::vector<cv::Mat> Crop(const RotatedCopy& copy, const cv::Rect& r) {
 // Turned a quarter turn counter-clockwise, a surface lit most from +x is lit
 // most from +y: the features turn with the texels.
 TEST(RotatedSample, AQuarterTurnCarriesTheLightResponseFromXToY) {
-  const ptm::Ptm ptm = LitFromPlusX();  // PtmSample keeps a reference
+  const ptm::Ptm ptm = testing::LitFromPlusX(32);  // PtmSample keeps a reference
   const synth::PtmSample sample(ptm);
   RotatedSample rotated(sample);
   const RotatedCopy& copy = rotated.Copy(RotatedSample::kRotations / 4);

@@ -7,29 +7,14 @@
 #include <set>
 
 #include "core/errors.h"
+#include "datasets_synthetic/material.h"
 #include "datasets_synthetic/shapes.h"
 #include "quilt/quilt_atlases.h"
 #include "synth/btf_sample.h"
+#include "tests/quilt/sample_ptms.h"
 
 namespace texlume::quilt {
 namespace {
-
-// An LRGB PTM of smooth random coefficients (seeded): structure a seam shows.
-ptm::Ptm SmoothPtm(int side, unsigned seed) {
-  ptm::Ptm p;
-  p.Resize(ptm::PtmFormat::kLrgb, side, side);
-  cv::RNG rng(seed);
-  for (int m = 0; m < 6; ++m) {
-    cv::Mat coarse(side / 8, side / 8, CV_32FC1), plane;
-    rng.fill(coarse, cv::RNG::UNIFORM, -0.3, 0.3);
-    cv::resize(coarse, plane, cv::Size(side, side), 0, 0, cv::INTER_CUBIC);
-    for (int t = 0; t < side * side; ++t)
-      p.Coefficients(static_cast<std::size_t>(t))[m] =
-          plane.at<float>(t / side, t % side) + (m == 5 ? 0.5f : 0.0f);
-  }
-  std::fill(p.colour.begin(), p.colour.end(), 1.0f);
-  return p;
-}
 
 struct Surface {
   synth::PatchGeometry geometry;
@@ -95,7 +80,7 @@ double MeanStepError(const Surface& s, const QuiltResult& r) {
 // One work patch large enough for the whole plane copies the sample onto it in
 // one piece: every sample synthesised, neighbours one texel apart in the sample.
 TEST(QuiltSurface, OnePatchCopiesTheSampleInOnePiece) {
-  const ptm::Ptm ptm = SmoothPtm(64, 1);
+  const ptm::Ptm ptm = datasets::SmoothRandomPtm(64, 1);
   const synth::PtmSample sample(ptm);
   const Surface s = MakeSurface(datasets::MakeGridPlane(2, 0.3), 0.01, atlas::AtlasMode::kCharts);
   QuiltOptions o;
@@ -114,7 +99,7 @@ TEST(QuiltSurface, OnePatchCopiesTheSampleInOnePiece) {
 // Per-triangle boxes make every face a chart: one patch still runs across
 // their borders as across texels inside them (the charts' rigid maps).
 TEST(QuiltSurface, OnePatchRunsOnAcrossChartBorders) {
-  const ptm::Ptm ptm = SmoothPtm(64, 2);
+  const ptm::Ptm ptm = datasets::SmoothRandomPtm(64, 2);
   const synth::PtmSample sample(ptm);
   const Surface s =
       MakeSurface(datasets::MakeGridPlane(2, 0.3), 0.01, atlas::AtlasMode::kPerTriangle);
@@ -132,7 +117,7 @@ TEST(QuiltSurface, OnePatchRunsOnAcrossChartBorders) {
 // whose seams cost less than cuts between unrelated texels; the same seed
 // gives the same result.
 TEST(QuiltSurface, SmallPatchesCoverAClosedSurfaceDeterministically) {
-  const ptm::Ptm ptm = SmoothPtm(64, 3);
+  const ptm::Ptm ptm = datasets::SmoothRandomPtm(64, 3);
   const synth::PtmSample sample(ptm);
   const Surface s = MakeSurface(datasets::MakeIcosphere(1, 0.25), 0.02, atlas::AtlasMode::kCharts);
   QuiltOptions o;
@@ -151,7 +136,7 @@ TEST(QuiltSurface, SmallPatchesCoverAClosedSurfaceDeterministically) {
 // With a field, each patch turns the sample's x axis along it (to the nearest
 // of the 72 rotations, 5 degrees apart).
 TEST(QuiltSurface, TurnsTheSampleAlongTheField) {
-  const ptm::Ptm ptm = SmoothPtm(64, 5);
+  const ptm::Ptm ptm = datasets::SmoothRandomPtm(64, 5);
   const synth::PtmSample sample(ptm);
   const mesh::TriangleMesh plane = datasets::MakeGridPlane(2, 0.3);
   const Surface s = MakeSurface(plane, 0.01, atlas::AtlasMode::kCharts);
@@ -177,7 +162,7 @@ TEST(QuiltSurface, TurnsTheSampleAlongTheField) {
 // faces on each edge of the line): every sample is synthesised, by several
 // patches linked across chart borders.
 TEST(QuiltSurface, CoversDisconnectedAndNonManifoldMeshes) {
-  const ptm::Ptm smooth = SmoothPtm(96, 5);
+  const ptm::Ptm smooth = datasets::SmoothRandomPtm(96, 5);
   const synth::PtmSample sample(smooth);
   mesh::TriangleMesh crossed = datasets::MakeCrossedPlanes(4, 0.3);
   mesh::TriangleMesh sphere = datasets::MakeIcosphere(2, 0.15);
@@ -194,7 +179,7 @@ TEST(QuiltSurface, CoversDisconnectedAndNonManifoldMeshes) {
 }
 
 TEST(QuiltSurface, RefusesASampleSmallerThanTheSmallestPatch) {
-  const ptm::Ptm ptm = SmoothPtm(16, 4);  // copies of 11 texels
+  const ptm::Ptm ptm = datasets::SmoothRandomPtm(16, 4);  // copies of 11 texels
   const synth::PtmSample sample(ptm);
   const Surface s = MakeSurface(datasets::MakeGridPlane(1, 0.1), 0.01, atlas::AtlasMode::kCharts);
   QuiltOptions o;
@@ -207,13 +192,7 @@ TEST(QuiltSurface, RefusesASampleSmallerThanTheSmallestPatch) {
 // lit most from its +x is, in the atlas, lit most from the direction the
 // sample's x axis takes there.
 TEST(BakeQuiltedAtlases, TurnsTheLightResponseWithTheLookup) {
-  ptm::Ptm lit;
-  lit.Resize(ptm::PtmFormat::kLrgb, 64, 64);
-  for (std::size_t t = 0; t < lit.NumTexels(); ++t) {
-    lit.Coefficients(t)[3] = 0.4f;
-    lit.Coefficients(t)[5] = 0.5f;
-  }
-  std::fill(lit.colour.begin(), lit.colour.end(), 1.0f);
+  const ptm::Ptm lit = testing::LitFromPlusX(64);
   const synth::PtmSample sample(lit);
   const Surface s = MakeSurface(datasets::MakeGridPlane(2, 0.3), 0.01, atlas::AtlasMode::kCharts);
   QuiltOptions o;

@@ -6,42 +6,16 @@
 #include <numbers>
 #include <opencv2/imgproc.hpp>
 
+#include "datasets_synthetic/material.h"
 #include "datasets_synthetic/shapes.h"
 #include "ptm/coefficient_space.h"
 #include "synth/planar_synthesis.h"
+#include "tests/quilt/sample_ptms.h"
 
 namespace texlume::quilt {
 namespace {
 
-// An LRGB PTM of smooth random coefficients (seeded): structure a seam shows.
-ptm::Ptm SmoothPtm(int side, unsigned seed) {
-  ptm::Ptm p;
-  p.Resize(ptm::PtmFormat::kLrgb, side, side);
-  cv::RNG rng(seed);
-  for (int m = 0; m < 6; ++m) {
-    cv::Mat coarse(side / 8, side / 8, CV_32FC1), plane;
-    rng.fill(coarse, cv::RNG::UNIFORM, -0.3, 0.3);
-    cv::resize(coarse, plane, cv::Size(side, side), 0, 0, cv::INTER_CUBIC);
-    for (int t = 0; t < side * side; ++t)
-      p.Coefficients(static_cast<std::size_t>(t))[m] =
-          plane.at<float>(t / side, t % side) + (m == 5 ? 0.5f : 0.0f);
-  }
-  std::fill(p.colour.begin(), p.colour.end(), 1.0f);
-  return p;
-}
-
-// The same PTM everywhere, lit most from its +x axis: where it lies turned,
-// its coefficients say which way.
-ptm::Ptm LitFromPlusX(int side) {
-  ptm::Ptm lit;
-  lit.Resize(ptm::PtmFormat::kLrgb, side, side);
-  for (std::size_t t = 0; t < lit.NumTexels(); ++t) {
-    lit.Coefficients(t)[3] = 0.4f;
-    lit.Coefficients(t)[5] = 0.5f;
-  }
-  std::fill(lit.colour.begin(), lit.colour.end(), 1.0f);
-  return lit;
-}
+using testing::LitFromPlusX;
 
 Eigen::Vector3d FaceCentre(const mesh::TriangleMesh& mesh, std::size_t f) {
   const auto& face = mesh.faces[f];
@@ -155,7 +129,7 @@ TEST(FillUnseenFaces, TurnsTheQuiltIntoEachFaceFrame) {
 // half of a one-patch copy of the sample over a plane, one large patch finds
 // the same copy and continues it over the other half.
 TEST(QuiltSurface, GivenSamplesAreKeptAndContinued) {
-  const ptm::Ptm ptm = SmoothPtm(64, 5);
+  const ptm::Ptm ptm = datasets::SmoothRandomPtm(64, 5);
   const synth::PtmSample sample(ptm);
   const mesh::TriangleMesh plane = datasets::MakeGridPlane(2, 0.3);
   const synth::PatchGeometry g = synth::MakePatchGeometry(
