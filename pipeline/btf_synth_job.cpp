@@ -94,6 +94,7 @@ class BtfSynthJob {
   // geometry maps (quilt/unseen_fill.h).
   void FillUnseenFaces() {
     AnnounceStep(progress_, "quilting the faces no photo sees (graph cut)");
+    pipeline::RequireFillMemory(job_, inputs_.mesh, synthesis_.texel_size, sample_.Components());
     summary_.unseen_fill =
         quilt::FillUnseenFaces(inputs_.mesh, synthesis_, synth::BtfSample(sample_),
                                pipeline::UnseenFillOptionsOf(job_, so_.seed), progress_);

@@ -140,16 +140,10 @@ class QuiltJob {
     summary_.seconds_sample = SecondsSince(start);
   }
 
-  // Per dense sample: lookup, patch, features, links, index: about 64 bytes
-  // plus 4 per feature; remembered seams (Kwatra's old seams: two feature
-  // vectors and a hash node, on at most about one link in two); the stretch
-  // of the charts adds up to 1.25^2. Refused before anything is allocated.
+  // Refused before anything is allocated (quilt::QuiltingBytes).
   void RequireSurfaceMemory(int features) const {
-    const std::vector<double> areas = mesh::FaceAreas(mesh_);
-    const double area = std::accumulate(areas.begin(), areas.end(), 0.0);
-    const double samples = 1.6 * area / std::pow(texel_size_, 2);
     RequireMemory(
-        samples * (64 + 4.0 * features + 0.5 * (2 * 4.0 * features + 96)), "the dense surface",
+        quilt::QuiltingBytes(mesh_, texel_size_, features), "the dense surface",
         options_.mesh_file.string() + " at a texel size of " + std::to_string(texel_size_));
   }
 

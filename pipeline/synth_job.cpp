@@ -280,6 +280,13 @@ quilt::UnseenFillOptions UnseenFillOptionsOf(const SynthJobOptions& job, std::ui
   return fill;
 }
 
+void RequireFillMemory(const SynthJobOptions& job, const mesh::TriangleMesh& mesh,
+                       double texel_size, int features) {
+  RequireMemory(quilt::QuiltingBytes(mesh, texel_size, features),
+                "the dense surface of --fill-unseen graphcut",
+                job.mesh_file.string() + " at a texel size of " + std::to_string(texel_size));
+}
+
 nlohmann::json FillUnseenSettingsJson(const SynthJobOptions& job) {
   nlohmann::json settings = {{"fill_unseen", FillUnseenName(job.fill_unseen)}};
   if (job.fill_unseen == FillUnseen::kGraphcut)
@@ -423,6 +430,8 @@ class SynthJob {
   // synthesis's sample (quilt/unseen_fill.h).
   void FillUnseenFaces() {
     AnnounceStep(progress_, "quilting the faces no photo sees (graph cut)");
+    RequireFillMemory(options_, inputs_.mesh, synthesis_.texel_size,
+                      synthesis_.CoefficientPlanes());
     summary_.unseen_fill =
         quilt::FillUnseenFaces(inputs_.mesh, synthesis_,
                                UnseenFillOptionsOf(options_, options_.synthesis.seed), progress_);

@@ -31,6 +31,10 @@ const char* FillUnseenName(FillUnseen fill);
 struct SynthJobOptions;
 /// The graph-cut fill's options for a job (its charts; `seed` the synthesis's).
 quilt::UnseenFillOptions UnseenFillOptionsOf(const SynthJobOptions& job, std::uint64_t seed);
+/// Refuses, with the estimate, a graph-cut fill whose dense surface over the
+/// whole mesh (`features` per sample) the memory limit cannot hold.
+void RequireFillMemory(const SynthJobOptions& job, const mesh::TriangleMesh& mesh,
+                       double texel_size, int features);
 /// The manifest's settings of the fill ("fill_unseen", and r_w and T_c when graph cut).
 nlohmann::json FillUnseenSettingsJson(const SynthJobOptions& job);
 /// The manifest's summary of a graph-cut fill ("unseen_fill").

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <utility>
 
 namespace texlume::quilt {
@@ -176,6 +177,13 @@ Eigen::Vector3d DenseSurface::PointInWorld(int s) const {
   const DenseSample& d = samples_[static_cast<std::size_t>(s)];
   const mesh::TriangleFrame& f = frames_[static_cast<std::size_t>(d.face)];
   return f.origin_in_world + d.p_in_frame.x() * f.x_axis + d.p_in_frame.y() * f.y_axis;
+}
+
+double QuiltingBytes(const mesh::TriangleMesh& mesh, double texel_size, int features) {
+  const std::vector<double> areas = mesh::FaceAreas(mesh);
+  const double area = std::accumulate(areas.begin(), areas.end(), 0.0);
+  const double samples = 1.6 * area / (texel_size * texel_size);
+  return samples * (64 + 4.0 * features + 0.5 * (2 * 4.0 * features + 96));
 }
 
 }  // namespace texlume::quilt

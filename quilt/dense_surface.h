@@ -28,6 +28,14 @@ struct DenseSample {
   Eigen::Vector2d p_in_frame = Eigen::Vector2d::Zero();  ///< texel centre, face frame, world units
 };
 
+/// The memory quilting a mesh's dense surface at `texel_size` (world units)
+/// with `features` features per sample takes, bytes: per sample its lookup,
+/// patch, features, links and index (about 64 bytes plus 4 per feature) and
+/// the remembered seams (Kwatra's old seams: two feature vectors and a hash
+/// node, on at most about one link in two); the charts' stretch adds up to
+/// 1.25^2 samples per unit of area.
+double QuiltingBytes(const mesh::TriangleMesh& mesh, double texel_size, int features);
+
 class DenseSurface {
  public:
   /// Samples every texel inside a face of `layout` (atlas::VisitAtlasTexels,

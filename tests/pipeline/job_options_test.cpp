@@ -1,10 +1,13 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.h"
+#include "core/memory_budget.h"
+#include "datasets_synthetic/shapes.h"
 #include "model/baselines.h"
 #include "pipeline/jobs.h"
 #include "pipeline/render_job.h"
 #include "pipeline/synth_job.h"
+#include "tests/test_util.h"
 
 namespace texlume::synth {
 namespace {
@@ -66,6 +69,23 @@ TEST(SynthJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
   o.atlas.gutter = 0;
   EXPECT_THROW(o.Check(), OptionError);
   EXPECT_THROW(pipeline::RunSynthJob(o), OptionError);
+}
+
+// A graph-cut fill whose dense surface the memory limit cannot hold is refused
+// up front, naming the mesh and giving the estimate (quilt::QuiltingBytes).
+TEST(SynthJobOptions, AGraphCutFillTheMemoryCannotHoldIsRefusedWithTheEstimate) {
+  pipeline::SynthJobOptions job;
+  job.mesh_file = "statue.ply";
+  const mesh::TriangleMesh sphere = datasets::MakeIcosphere(3, 1.0);  // area about 12.5
+  const double bytes = quilt::QuiltingBytes(sphere, 0.001, 6);
+  EXPECT_GT(bytes, 1.6 * 12.0 / 1e-6 * 64);
+  SetMemoryLimitBytes(static_cast<std::uint64_t>(bytes / 2));
+  const std::string message =
+      testing::InputErrorMessage([&] { pipeline::RequireFillMemory(job, sphere, 0.001, 6); });
+  SetMemoryLimitBytes(0);
+  EXPECT_NE(message.find("statue.ply"), std::string::npos) << message;
+  EXPECT_NE(message.find("--fill-unseen graphcut"), std::string::npos) << message;
+  EXPECT_NO_THROW(pipeline::RequireFillMemory(job, sphere, 0.01, 6));  // 100 times fewer samples
 }
 
 TEST(RenderJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
