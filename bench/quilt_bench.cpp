@@ -167,8 +167,7 @@ void QuiltMeshes(const synth::PtmSample& sample, int levels, double texel) {
     const quilt::QuiltStats& st = run.result.stats;
     std::printf("| %s | %zu | %zu | %zu | %zu | %d | %zu | %zu | %zu | %.2f | %.4f | %.1f |\n",
                 name, mesh.faces.size(), run.samples, run.texels_inside, run.synthesised,
-                run.charts, run.links_across_charts, st.patches, st.forced,
-                st.seam_cost / std::max<std::size_t>(st.cut_links, 1) / st.random_pair_cost,
+                run.charts, run.links_across_charts, st.patches, st.forced, quilt::SeamShare(st),
                 AtlasEnergy(run.atlases.ptms, run.atlases.coverage, rotated), Seconds(t0));
   }
 }
@@ -222,8 +221,7 @@ void QuiltMaterials(int levels, double texel) {
       const quilt::QuiltStats& st = run.result.stats;
       std::printf("| %s | %s | %zu | %zu | %.2f | %.2f | %.4f | %.2f |\n", name.c_str(),
                   random ? "random placement" : "graph-cut quilting", st.patches, st.forced,
-                  st.seam_cost / std::max<std::size_t>(st.cut_links, 1) / st.random_pair_cost,
-                  SampleReused(run.result, fitted.width, fitted.height),
+                  quilt::SeamShare(st), SampleReused(run.result, fitted.width, fitted.height),
                   AtlasEnergy(run.atlases.ptms, run.atlases.coverage, rotated), st.seconds);
       std::fflush(stdout);
     }
@@ -254,7 +252,7 @@ void QuiltSphere(const ptm::Ptm& sample_ptm, int levels, double texel, const cha
                 : run_kind == 1 ? "graph-cut, old seams not kept"
                                 : "random placement",
                 s.patches, 1000 * s.seconds / std::max<std::size_t>(s.patches, 1), s.seconds,
-                s.forced, s.seam_cost / std::max<std::size_t>(s.cut_links, 1) / s.random_pair_cost,
+                s.forced, quilt::SeamShare(s),
                 SampleReused(run.result, sample_ptm.width, sample_ptm.height),
                 AtlasEnergy(run.atlases.ptms, run.atlases.coverage, rotated));
     if (run_kind == 0) {

@@ -220,8 +220,8 @@ int main(int argc, char** argv) {
     const quilt::QuiltStats& q = fill.stats;
     std::printf("| %s | %zu | %zu | %zu | %zu | %.2f | %.4f | %.2f | %.3f | %.4f | %.1f | %.1f |\n",
                 run.name.c_str(), fill.faces, fill.samples, q.patches, q.forced,
-                q.cut_links ? q.seam_cost / q.cut_links / q.random_pair_cost : 0.0, g.energy,
-                g.edge_ratio, rg.mean_psnr, rg.mean_ssim, fill.seconds, graphcut.seconds_synthesis);
+                quilt::SeamShare(q), g.energy, g.edge_ratio, rg.mean_psnr, rg.mean_ssim,
+                fill.seconds, graphcut.seconds_synthesis);
     std::fflush(stdout);
   }
   return 0;

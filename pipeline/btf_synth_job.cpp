@@ -22,6 +22,7 @@ void BtfSynthJobOptions::Check() const {
   job.CheckInputsAndLayout();
   if (btf.empty()) throw OptionError("synth --btf needs a BTF capture or factorisation folder");
   if (components < 1) throw OptionError("components must be >= 1");
+  if (job.fill_unseen == FillUnseen::kGraphcut) job.fill_quilt.Check();
   if (!(synthesis.sample_texel_size >= 0.0))
     throw OptionError("sample texel size must be >= 0 (0: the capture's)");
   synth::BtfMeshSynthesisOptions resolved = synthesis;

@@ -525,11 +525,8 @@ void RunQuiltCommandJob(const QuiltJobOptions& options, std::ostream& out, std::
   const quilt::QuiltStats& q = s.stats;
   out << "Quilted " << s.samples << " surface samples of " << s.faces << " triangles with "
       << q.patches << " graph-cut patches (" << q.forced << " above the seam threshold; seam cost "
-      << (q.cut_links && q.random_pair_cost > 0
-              ? q.seam_cost / static_cast<double>(q.cut_links) / q.random_pair_cost
-              : 0.0)
-      << " of an unrelated cut) into " << s.atlases << " atlas(es), " << s.charts
-      << " charts, occupancy " << s.occupancy << ", in " << s.seconds_total
+      << quilt::SeamShare(q) << " of an unrelated cut) into " << s.atlases << " atlas(es), "
+      << s.charts << " charts, occupancy " << s.occupancy << ", in " << s.seconds_total
       << " s: " << options.out_dir.string() << " (see manifest.json)\n";
 }
 

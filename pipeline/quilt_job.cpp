@@ -41,6 +41,7 @@ void QuiltJobOptions::Check() const {
   if (!field_direction_in_world.allFinite() || !(field_direction_in_world.norm() > 0))
     throw OptionError("--tangent-field must be a non-zero direction");
   atlas.Check();
+  CheckWorldUnit(mm_per_world_unit);
 }
 
 bool QuiltJobOptions::BtfSample() const {
@@ -287,9 +288,7 @@ class QuiltJob {
   }
 
   std::string SeamText(const quilt::QuiltStats& q) const {
-    const double share = q.cut_links && q.random_pair_cost > 0
-                             ? q.seam_cost / static_cast<double>(q.cut_links) / q.random_pair_cost
-                             : 0.0;
+    const double share = quilt::SeamShare(q);
     char text[96];
     std::snprintf(text, sizeof text, "%.2f of a cut between unrelated texels (T_c %.2f)", share,
                   options_.quilt.seam_threshold);

@@ -296,16 +296,13 @@ nlohmann::json FillUnseenSettingsJson(const SynthJobOptions& job) {
 }
 
 nlohmann::json UnseenFillJson(const quilt::UnseenFillSummary& fill) {
-  const quilt::QuiltStats& q = fill.stats;
-  const double seam =
-      q.cut_links && q.random_pair_cost > 0 ? q.seam_cost / q.cut_links / q.random_pair_cost : 0.0;
   return {{"engine", "graphcut"},
           {"faces", fill.faces},
           {"samples", fill.samples},
           {"given_samples", fill.given_samples},
-          {"patches", q.patches},
-          {"forced", q.forced},
-          {"seam_cost_per_cut_link_over_unrelated", seam}};
+          {"patches", fill.stats.patches},
+          {"forced", fill.stats.forced},
+          {"seam_cost_per_cut_link_over_unrelated", quilt::SeamShare(fill.stats)}};
 }
 
 void SynthJobOptions::Check() const {
@@ -588,9 +585,13 @@ class SynthJob {
     report.view_folder = options_.out_dir.string();
     report.texel_size = options_.synthesis.sample_texel_size;
     report.mm_per_world_unit = options_.mm_per_world_unit;
-    report.timings_s = {{"load", s.seconds_load},           {"visibility", s.seconds_visibility},
-                        {"synthesis", s.seconds_synthesis}, {"unseen fill", s.unseen_fill.seconds},
-                        {"atlas", s.seconds_atlas},         {"baselines", s.seconds_baselines}};
+    report.timings_s = {{"load", s.seconds_load},
+                        {"visibility", s.seconds_visibility},
+                        {"synthesis", s.seconds_synthesis},
+                        {"atlas", s.seconds_atlas},
+                        {"baselines", s.seconds_baselines}};
+    if (options_.fill_unseen == FillUnseen::kGraphcut)
+      report.timings_s.insert(report.timings_s.begin() + 3, {"unseen fill", s.unseen_fill.seconds});
     report.links = {
         {"model.glb", "model.glb"}, {"model.obj", "model.obj"}, {"manifest.json", "manifest.json"}};
     summary_.seconds_report = report::WriteReport(folder, report, progress_).seconds;

@@ -591,6 +591,12 @@ class SurfaceQuilter {
 
 }  // namespace
 
+double SeamShare(const QuiltStats& stats) {
+  return stats.cut_links && stats.random_pair_cost > 0
+             ? stats.seam_cost / static_cast<double>(stats.cut_links) / stats.random_pair_cost
+             : 0.0;
+}
+
 QuiltResult QuiltSurface(const DenseSurface& surface, const atlas::AtlasLayout& layout,
                          const synth::MaterialSample& sample, const QuiltOptions& options,
                          const ProgressCallback& progress, const GivenSamples* given) {

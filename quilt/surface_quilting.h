@@ -68,6 +68,10 @@ struct QuiltStats {
   double seconds = 0;
 };
 
+/// The mean seam cost per cut link as a share of T_c's unit (a cut between
+/// unrelated texels); 0 without cuts.
+double SeamShare(const QuiltStats& stats);
+
 struct QuiltResult {
   std::vector<SampleLookup> lookups;  ///< per dense sample
   std::vector<int> patch_of;          ///< per dense sample: the patch that wrote it

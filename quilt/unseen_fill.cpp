@@ -22,6 +22,8 @@ class UnseenQuilt {
       : layout_(std::move(layout)), surface_(std::move(surface)), quilt_(std::move(quilt)) {
     lookup_.emplace(surface_, quilt_, layout_, reach);
   }
+  UnseenQuilt(const UnseenQuilt&) = delete;  // the lookup refers to the members
+  UnseenQuilt& operator=(const UnseenQuilt&) = delete;
 
   // The sample position at a point of a face's frame, and the turn from the
   // face frame into the sample's (d_sample = R(angle) d_face): the sample lies
@@ -116,12 +118,17 @@ FaceFeatures PtmPatchFeatures(const synth::MeshSynthesis& synthesis) {
   };
 }
 
+// The synthesis's own sample as a PTM, whose features (as a PtmSample) are
+// its orthonormal coefficients.
+ptm::Ptm SamplePtmOf(const synth::MeshSynthesis& synthesis) {
+  return synth::FromOrthonormalPlanes(synthesis.sample_planes, synthesis.format);
+}
+
 }  // namespace
 
 GivenSamples SamplesOfPhotoFaces(const DenseSurface& surface, const atlas::AtlasLayout& layout,
                                  const synth::MeshSynthesis& synthesis) {
-  const ptm::Ptm sample_ptm =
-      synth::FromOrthonormalPlanes(synthesis.sample_planes, synthesis.format);
+  const ptm::Ptm sample_ptm = SamplePtmOf(synthesis);
   return GivenFromPhotoFaces(surface, layout, synthesis, synth::PtmSample(sample_ptm),
                              PtmPatchFeatures(synthesis));
 }
@@ -130,9 +137,7 @@ UnseenFillSummary FillUnseenFaces(const mesh::TriangleMesh& mesh, synth::MeshSyn
                                   const UnseenFillOptions& options,
                                   const ProgressCallback& progress) {
   UnseenFillSummary summary;
-  // The synthesis's own sample, whose features are its orthonormal coefficients.
-  const ptm::Ptm sample_ptm =
-      synth::FromOrthonormalPlanes(synthesis.sample_planes, synthesis.format);
+  const ptm::Ptm sample_ptm = SamplePtmOf(synthesis);
   const synth::PtmSample sample(sample_ptm);
   const auto unseen = QuiltUnseenFaces(mesh, synthesis, sample, PtmPatchFeatures(synthesis),
                                        options, progress, summary);
@@ -164,9 +169,15 @@ UnseenFillSummary FillUnseenFaces(const mesh::TriangleMesh& mesh,
                                   const ProgressCallback& progress) {
   UnseenFillSummary summary;
   // What a placed face shows: the geometry maps where its lookup (seams
-  // included) reads the sample; they do not turn with the frame.
+  // included) reads the sample; they do not turn with the frame. Where its
+  // seam band takes a face the fill replaces, what it will show is the fill's:
+  // not given.
   const FaceFeatures features_of = [&](int face, const Eigen::Vector2d& p, float* out) {
-    sample.FeaturesAt(synthesis.Lookup(face, p).sample_px, out);
+    const synth::BtfSampleLookup look = synthesis.Lookup(face, p);
+    if (synthesis.patches[static_cast<std::size_t>(look.source_face)].source !=
+        synth::PatchSource::kPhotos)
+      return false;
+    sample.FeaturesAt(look.sample_px, out);
     return true;
   };
   const auto unseen =

@@ -29,7 +29,7 @@ struct UnseenFillOptions {
 
 struct UnseenFillSummary {
   std::size_t faces = 0;          ///< faces filled (placed by no photo)
-  std::vector<bool> filled;       ///< per face: filled (empty when none is)
+  std::vector<bool> filled;       ///< per face: filled
   std::size_t samples = 0;        ///< dense samples in them, quilted
   std::size_t given_samples = 0;  ///< dense samples of the faces the photos placed
   QuiltStats stats;
