@@ -9,7 +9,7 @@
 #include "core/errors.h"
 #include "ptm/coefficient_space.h"
 #include "quilt/patch_energy.h"
-#include "tests/quilt/sample_ptms.h"
+#include "tests/quilt/lit_samples.h"
 
 namespace texlume::quilt {
 namespace {

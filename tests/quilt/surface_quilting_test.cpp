@@ -11,7 +11,7 @@
 #include "datasets_synthetic/shapes.h"
 #include "quilt/quilt_atlases.h"
 #include "synth/btf_sample.h"
-#include "tests/quilt/sample_ptms.h"
+#include "tests/quilt/lit_samples.h"
 
 namespace texlume::quilt {
 namespace {
@@ -221,20 +221,7 @@ TEST(BakeQuiltedAtlases, TurnsTheLightResponseWithTheLookup) {
 // most from the direction the sample's x axis takes in the atlas, as the PTM
 // bake above.
 TEST(BakeQuiltedBtfAtlases, HoldsTheLookupAndTurnsTheLightWithIt) {
-  btf::BtfFactorisation lit;
-  lit.width = lit.height = 64;
-  lit.texel_size = 0.01;
-  lit.views = {Eigen::Vector3d::UnitZ()};
-  for (int k = 0; k < 8; ++k) {
-    const double a = k * std::numbers::pi / 4, e = std::numbers::pi / 4;
-    lit.lights.emplace_back(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
-  }
-  lit.geometry = Eigen::MatrixXf::Ones(64 * 64, 1);
-  lit.appearance.resize(8 * 3, 1);
-  for (int k = 0; k < 8; ++k)
-    lit.appearance.middleRows(k * 3, 3).setConstant(
-        static_cast<float>(0.1 + 0.3 * std::max(0.0, lit.lights[static_cast<std::size_t>(k)].x())));
-  lit.singular_values = {1.0};
+  const btf::BtfFactorisation lit = testing::LitBtfFromPlusX(64);
   const synth::BtfSample sample(lit);
   const Surface s = MakeSurface(datasets::MakeGridPlane(2, 0.3), 0.01, atlas::AtlasMode::kCharts);
   QuiltOptions o;

@@ -9,8 +9,10 @@
 #include "datasets_synthetic/material.h"
 #include "datasets_synthetic/shapes.h"
 #include "ptm/coefficient_space.h"
+#include "synth/btf_sample.h"
+#include "synth/mesh_btf.h"
 #include "synth/planar_synthesis.h"
-#include "tests/quilt/sample_ptms.h"
+#include "tests/quilt/lit_samples.h"
 
 namespace texlume::quilt {
 namespace {
@@ -123,6 +125,46 @@ TEST(FillUnseenFaces, TurnsTheQuiltIntoEachFaceFrame) {
     const double tolerance = patch.source == synth::PatchSource::kPhotos ? 1e-6 : 0.02;
     for (int m = 0; m < 6; ++m) EXPECT_NEAR(filled[m], own[m], tolerance) << "face " << f;
   }
+}
+
+// The BTF fill turns the same way: a BTF quilted along the face frames' x axes
+// (the cylinder's axis) on faces whose charts lie at angles to them reads, in
+// every filled face, the sample turned by no more than the 5 degrees between
+// the 72 rotations from the face frame; the placed faces read their patches.
+TEST(FillUnseenFaces, TurnsTheBtfQuiltIntoEachFaceFrame) {
+  const mesh::TriangleMesh mesh = datasets::MakeCylinder(24, 4, 0.5, 1.0);
+  const btf::BtfFactorisation lit = testing::LitBtfFromPlusX(64);
+  synth::BtfMeshSynthesis s;
+  synth::PatchGeometry g = synth::MakePatchGeometry(
+      mesh, 0.02, 4, synth::TangentFrame::kSmoothField, Eigen::Vector3d::UnitZ());
+  s.patches = std::move(g.patches);
+  s.unfoldings = std::move(g.unfoldings);
+  s.texel_size = 0.02;
+  s.labels.resize(s.patches.size());  // no seams
+  for (std::size_t f = 0; f < s.patches.size(); ++f)
+    s.patches[f].source =
+        FaceCentre(mesh, f).x() > 0 ? synth::PatchSource::kPhotos : synth::PatchSource::kNeighbours;
+  const synth::BtfMeshSynthesis patches_only = s;
+  UnseenFillOptions o;
+  o.atlas = Charts();
+  o.quilt.work_patch_levels = 8;
+  const UnseenFillSummary summary = FillUnseenFaces(mesh, s, synth::BtfSample(lit), o);
+  EXPECT_GT(summary.faces, 10u);
+  std::size_t checked = 0;
+  for (std::size_t f = 0; f < s.patches.size(); ++f) {
+    const synth::TrianglePatch& patch = s.patches[f];
+    if (std::abs(patch.frame.z_axis.z()) > 0.5 || std::abs(FaceCentre(mesh, f).z()) > 0.2) continue;
+    const Eigen::Vector2d centre =
+        (patch.corners_in_frame[0] + patch.corners_in_frame[1] + patch.corners_in_frame[2]) / 3;
+    const synth::BtfSampleLookup look = s.Lookup(static_cast<int>(f), centre);
+    if (patch.source == synth::PatchSource::kPhotos) {
+      EXPECT_EQ(look.sample_px, patches_only.Lookup(static_cast<int>(f), centre).sample_px);
+      continue;
+    }
+    EXPECT_LT(std::abs(std::remainder(look.angle_rad, 2 * std::numbers::pi)), 0.06) << "face " << f;
+    ++checked;
+  }
+  EXPECT_GT(checked, 5u);
 }
 
 // Given samples keep their texture, and the quilt grows out from them: given
