@@ -10,14 +10,17 @@
 namespace texlume::testing {
 
 /// Runs COLMAP's own structure from motion on the CPU (feature_extractor with
-/// one PINHOLE camera, exhaustive_matcher, mapper) over a folder of photos, in
-/// `work`. With `pinhole_params` ("fx,fy,cx,cy") the camera is taken as
-/// calibrated (its intrinsics fixed), as for a camera whose calibration is
+/// one PINHOLE camera, a matcher, mapper) over a folder of photos, in `work`.
+/// `sequential_overlap` > 0 matches each photo with the next that many by name
+/// (sequential_matcher: photos named in the order they were taken, as on a
+/// ring); 0 matches every pair (exhaustive_matcher). With `pinhole_params` ("fx,fy,cx,cy") the
+/// camera is taken as calibrated (its intrinsics fixed), as for a camera whose calibration is
 /// known; else COLMAP estimates them. Returns the first model's folder (work/sparse/0), or an empty
 /// path after a test failure naming the step that failed, with its log.
 inline std::filesystem::path RunColmapSfm(const std::filesystem::path& images,
                                           const std::filesystem::path& work,
-                                          const std::string& pinhole_params = "") {
+                                          const std::string& pinhole_params = "",
+                                          int sequential_overlap = 0) {
   const std::string calibrated =
       pinhole_params.empty() ? std::string() : " --ImageReader.camera_params " + pinhole_params;
   const std::string fixed_intrinsics = pinhole_params.empty()
@@ -32,7 +35,11 @@ inline std::filesystem::path RunColmapSfm(const std::filesystem::path& images,
           " --SiftExtraction.use_gpu 0 --ImageReader.single_camera 1"
           " --ImageReader.camera_model PINHOLE" +
           calibrated,
-      colmap + "exhaustive_matcher --database_path " + db + " --SiftMatching.use_gpu 0",
+      colmap +
+          (sequential_overlap > 0 ? "sequential_matcher --SequentialMatching.overlap " +
+                                        std::to_string(sequential_overlap)
+                                  : std::string("exhaustive_matcher")) +
+          " --database_path " + db + " --SiftMatching.use_gpu 0",
       colmap + "mapper --database_path " + db + " --image_path " + images.string() +
           " --output_path " + (work / "sparse").string() + fixed_intrinsics};
   for (const std::string& step : steps) {

@@ -641,7 +641,8 @@ TEST(Cli, SynthGraphcutQuiltsABtfIntoABtfModelFolder) {
   TempDir tmp;
   const std::string scene = WriteColourSampleScene(tmp, 40);
   const std::string inputs = " --engine graphcut --mesh " + scene +
-                             "/object/mesh.ply --atlas-size 512 --work-patch 8 --components 8";
+                             "/object/mesh.ply --atlas-size 512 --work-patch 8 --components 8 "
+                             "--no-report";
   std::string out;
   ASSERT_EQ(Texlume("synth" + inputs + " --btf " + scene + "/material/btf --out " +
                         (tmp / "model").string(),
