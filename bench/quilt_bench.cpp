@@ -207,9 +207,7 @@ void QuiltMaterials(int levels, double texel) {
         std::filesystem::temp_directory_path() / ("texlume_quilt_bench_" + name);
     if (!std::filesystem::exists(work / "material/capture/lights.lp"))
       datasets::GenerateScene(datasets::MaterialOnlySceneOptions(kind, 256, 40), work);
-    const ptm::RtiCapture capture =
-        ptm::ReadRtiCapture(work / "material/capture/lights.lp", work / "material/capture");
-    const ptm::Ptm fitted = ptm::FitPtmFromFiles(capture.files, capture.lights, {}).ptm;
+    const ptm::Ptm fitted = datasets::FitSceneSample(work);
     const synth::PtmSample sample(fitted);
     quilt::RotatedSample rotated(sample);
     for (const bool random : {false, true}) {

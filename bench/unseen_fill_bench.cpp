@@ -58,19 +58,10 @@ Args Parse(int argc, char** argv) {
 }
 
 datasets::SceneOptions Scene(const Args& a) {
-  datasets::SceneOptions o;
-  o.shape = a.shape;
+  datasets::SceneOptions o =
+      datasets::SmallObjectSceneOptions(a.shape, datasets::MaterialKind::kStone);
   o.seed = a.seed;
-  o.material.texel_size = 0.004;
   o.num_images = a.images;
-  o.image_width = 320;
-  o.image_height = 240;
-  o.focal_px = 300;
-  o.capture_size = 128;
-  o.num_capture_lights = 24;
-  o.num_held_out_capture_lights = 0;
-  o.write_btf = false;
-  o.write_surface = false;
   o.num_held_out_views = 2;
   o.held_out_lights_per_view = 2;
   return o;
@@ -177,9 +168,7 @@ int main(int argc, char** argv) {
   const Args args = Parse(argc, argv);
   const fs::path scene = args.work / "scene";
   datasets::GenerateScene(Scene(args), scene);
-  const ptm::RtiCapture rti =
-      ptm::ReadRtiCapture(scene / "material/capture/lights.lp", scene / "material/capture");
-  const ptm::Ptm sample = ptm::FitPtmFromFiles(rti.files, rti.lights, {}).ptm;
+  const ptm::Ptm sample = datasets::FitSceneSample(scene);
   ptm::WritePtmExr(sample, args.work / "sample.exr");
   pipeline::SynthJobOptions job;
   job.model_dir = scene / "object/sparse";

@@ -17,6 +17,7 @@
 #include "core/partial_output.h"
 #include "datasets_synthetic/object_scene.h"
 #include "ptm/exr_io.h"
+#include "ptm/fit.h"
 #include "sfm/colmap_io.h"
 
 namespace texlume::datasets {
@@ -129,6 +130,29 @@ Eigen::Vector3d TurnedRandomly(const Eigen::Vector3d& direction, double rms_deg,
 }
 
 }  // namespace
+
+SceneOptions SmallObjectSceneOptions(SceneShape shape, MaterialKind kind) {
+  SceneOptions o;
+  o.shape = shape;
+  o.material.kind = kind;
+  o.material.texel_size = 0.004;
+  o.num_images = 12;
+  o.image_width = 320;
+  o.image_height = 240;
+  o.focal_px = 300;
+  o.capture_size = 128;
+  o.num_capture_lights = 24;
+  o.num_held_out_capture_lights = 0;
+  o.write_btf = false;
+  o.write_surface = false;
+  return o;
+}
+
+ptm::Ptm FitSceneSample(const std::filesystem::path& scene_dir) {
+  const std::filesystem::path capture = scene_dir / "material/capture";
+  const ptm::RtiCapture rti = ptm::ReadRtiCapture(capture / "lights.lp", capture);
+  return ptm::FitPtmFromFiles(rti.files, rti.lights, {}).ptm;
+}
 
 SceneOptions MaterialOnlySceneOptions(MaterialKind kind, int capture_size, int capture_lights) {
   SceneOptions o;

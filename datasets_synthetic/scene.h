@@ -10,6 +10,7 @@
 #include "datasets_synthetic/photo_sensor.h"
 #include "datasets_synthetic/renderer.h"
 #include "datasets_synthetic/shapes.h"
+#include "ptm/ptm.h"
 #include "sfm/camera_models.h"
 #include "sfm/lights.h"
 
@@ -83,6 +84,16 @@ struct SceneOptions {
 /// (4 rays per sample) and light directions 2 degrees off. `texlume scene` uses
 /// these by default; `--clean` gives the clean scene.
 void UseRealisticCapture(SceneOptions& options);
+
+/// The small object scene the tests and benches share: 12 photos of 320 x 240
+/// (focal 300 px), a 128-texel material capture under 24 lights with texels of
+/// 0.004 world units, no held-out capture lights, no BTF, no surface photos.
+/// Callers set the rest (held-out views, relief, BTF).
+SceneOptions SmallObjectSceneOptions(SceneShape shape, MaterialKind kind);
+
+/// The sample PTM fitted (ptm::FitPtmFromFiles, default settings) to the
+/// material capture of a scene GenerateScene wrote into `scene_dir`.
+ptm::Ptm FitSceneSample(const std::filesystem::path& scene_dir);
 
 /// Settings for a scene used only for its material outputs (captures, planar
 /// surface): a plane object with 3 tiny photos, no BTF, no held-out views.

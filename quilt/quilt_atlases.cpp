@@ -41,19 +41,19 @@ int NearestSample(const DenseSurface& surface, const QuiltResult& quilt,
   return best;
 }
 
-float BilinearClamped(const cv::Mat& plane, double x, double y) {
-  x = std::clamp(x - 0.5, 0.0, plane.cols - 1.0);
-  y = std::clamp(y - 0.5, 0.0, plane.rows - 1.0);
-  const int x0 = std::min(static_cast<int>(x), std::max(plane.cols - 2, 0));
-  const int y0 = std::min(static_cast<int>(y), std::max(plane.rows - 2, 0));
-  const int x1 = std::min(x0 + 1, plane.cols - 1), y1 = std::min(y0 + 1, plane.rows - 1);
-  const double fx = x - x0, fy = y - y0;
-  return static_cast<float>(
-      (1 - fy) * ((1 - fx) * plane.at<float>(y0, x0) + fx * plane.at<float>(y0, x1)) +
-      fy * ((1 - fx) * plane.at<float>(y1, x0) + fx * plane.at<float>(y1, x1)));
-}
-
 }  // namespace
+
+void SampleValuesTurned(const std::vector<cv::Mat>& values, int polynomials,
+                        const Eigen::Vector2d& sample_px, double turn_rad, float* out) {
+  for (std::size_t k = 0; k < values.size(); ++k)
+    out[k] = static_cast<float>(
+        synth::BilinearClamped(values[k], sample_px.x() - 0.5, sample_px.y() - 0.5));
+  const Eigen::Matrix<double, 6, 6> turn = ptm::OrthonormalFrameRotation(turn_rad);
+  for (int poly = 0; poly < polynomials; ++poly) {
+    Eigen::Map<Eigen::Matrix<float, 6, 1>> c(out + poly * 6);
+    c = (turn * c.cast<double>()).cast<float>();
+  }
+}
 
 QuiltedSurfaceLookup::QuiltedSurfaceLookup(const DenseSurface& surface, const QuiltResult& quilt,
                                            const atlas::AtlasLayout& layout, int gutter)
@@ -96,15 +96,7 @@ atlas::Atlases BakeQuiltedAtlases(const DenseSurface& surface, const QuiltResult
           std::fill_n(out, num_planes, 0.0f);
           return;
         }
-        for (int k = 0; k < num_planes; ++k)
-          out[k] = BilinearClamped(values[static_cast<std::size_t>(k)], at.x(), at.y());
-        const Eigen::Matrix<double, 6, 6> to_atlas = ptm::OrthonormalFrameRotation(-a);
-        for (int poly = 0; poly < polynomials; ++poly) {
-          Eigen::Matrix<double, 6, 1> o;
-          for (int i = 0; i < 6; ++i) o[i] = out[poly * 6 + i];
-          o = to_atlas * o;
-          for (int i = 0; i < 6; ++i) out[poly * 6 + i] = static_cast<float>(o[i]);
-        }
+        SampleValuesTurned(values, polynomials, at, -a, out);
       },
       progress);
   atlas::Atlases atlases;

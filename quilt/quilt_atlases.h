@@ -34,6 +34,13 @@ class QuiltedSurfaceLookup {
   int reach_;
 };
 
+/// A PTM sample's values (orthonormal coefficients, then LRGB colour: `values`,
+/// PtmSample::Values) at a sample position (texels, centres at +0.5), bilinear
+/// and clamped, with the coefficients of each of `polynomials` polynomials
+/// taken into a frame turned by `turn_rad` (ptm::OrthonormalFrameRotation).
+void SampleValuesTurned(const std::vector<cv::Mat>& values, int polynomials,
+                        const Eigen::Vector2d& sample_px, double turn_rad, float* out);
+
 /// The PTM atlases of a quilted surface, by the common baker
 /// (atlas::BakeAtlasPlanes) through QuiltedSurfaceLookup. The sample's values (orthonormal
 /// coefficients and LRGB colour, PtmSample::Values) are read at the lookup's

@@ -151,13 +151,7 @@ UnseenFillSummary FillUnseenFaces(const mesh::TriangleMesh& mesh, synth::MeshSyn
     Eigen::Vector2d at;
     double face_to_sample = 0;
     if (!unseen->At(face, p, &at, &face_to_sample)) return false;
-    for (std::size_t k = 0; k < planes.size(); ++k)
-      out[k] = static_cast<float>(synth::BilinearClamped(planes[k], at.x() - 0.5, at.y() - 0.5));
-    const Eigen::Matrix<double, 6, 6> to_face = ptm::OrthonormalFrameRotation(face_to_sample);
-    for (int poly = 0; poly < polynomials; ++poly) {
-      Eigen::Map<Eigen::Matrix<float, 6, 1>> c(out + poly * 6);
-      c = (to_face * c.cast<double>()).cast<float>();
-    }
+    SampleValuesTurned(planes, polynomials, at, face_to_sample, out);
     return true;
   };
   return summary;

@@ -21,7 +21,6 @@
 #include "quilt/unseen_fill.h"
 #include "render/btf_shading.h"
 #include "synth/mesh_btf.h"
-#include "tests/small_scene.h"
 #include "tests/test_util.h"
 
 namespace texlume::btf {
@@ -32,8 +31,8 @@ class MeshBtfTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     tmp_ = new testing::TempDir;
-    datasets::SceneOptions o =
-        testing::SmallObjectScene(datasets::SceneShape::kSphere, datasets::MaterialKind::kStone);
+    datasets::SceneOptions o = datasets::SmallObjectSceneOptions(datasets::SceneShape::kSphere,
+                                                                 datasets::MaterialKind::kStone);
     o.material.relief_height = 0.012;
     o.material.specular = 0.5;  // view-dependent: a PTM cannot hold it
     o.capture_size = 96;

@@ -20,7 +20,6 @@
 #include "sfm/alignment.h"
 #include "sfm/colmap_io.h"
 #include "tests/colmap_runner.h"
-#include "tests/small_scene.h"
 #include "tests/test_util.h"
 
 namespace texlume::pipeline {
@@ -106,7 +105,7 @@ TEST(ColmapModel, RealisticPhotosAndColmapsOwnCamerasKeepTheStructureFlatLacks) 
   const sfm::Reconstruction aligned = sfm::TransformedIntoReference(estimate, a);
   sfm::WriteModel(aligned, tmp / "colmap_model", sfm::ModelFormat::kBinary);
   const double reprojection_px = RmsReprojectionDifference(truth, aligned);
-  ptm::WritePtmExr(testing::FitSceneSample(scene), tmp / "sample.exr");
+  ptm::WritePtmExr(datasets::FitSceneSample(scene), tmp / "sample.exr");
 
   SynthJobOptions job;
   job.model_dir = tmp / "colmap_model";

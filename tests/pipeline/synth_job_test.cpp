@@ -33,7 +33,6 @@
 #include "sfm/colmap_io.h"
 #include "sfm/lights.h"
 #include "synth/mesh_synthesis.h"
-#include "tests/small_scene.h"
 #include "tests/test_util.h"
 
 namespace texlume::synth {
@@ -44,14 +43,14 @@ class MeshPipelineTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     tmp_ = new testing::TempDir;
-    datasets::SceneOptions o =
-        testing::SmallObjectScene(datasets::SceneShape::kSphere, datasets::MaterialKind::kStone);
+    datasets::SceneOptions o = datasets::SmallObjectSceneOptions(datasets::SceneShape::kSphere,
+                                                                 datasets::MaterialKind::kStone);
     o.material.relief_height = 0.012;
     o.num_held_out_views = 2;
     o.held_out_lights_per_view = 2;
     o.held_out_scale = 2;
     datasets::GenerateScene(o, tmp_->path() / "scene");
-    ptm::WritePtmExr(testing::FitSceneSample(tmp_->path() / "scene"), tmp_->path() / "sample.exr");
+    ptm::WritePtmExr(datasets::FitSceneSample(tmp_->path() / "scene"), tmp_->path() / "sample.exr");
     job_ = new pipeline::SynthJobOptions(Job(tmp_->path() / "model"));
     const int threads = omp_get_max_threads();
     omp_set_num_threads(2);  // OutputsAreTheSameOnOneThreadAndOnTwo compares with one

@@ -7,10 +7,10 @@
 #include <cstdio>
 #include <numbers>
 
+#include "datasets_synthetic/scene.h"
 #include "pipeline/synth_job.h"
 #include "synth/mesh_synthesis.h"
 #include "synth/tangent_field.h"
-#include "tests/small_scene.h"
 #include "tests/test_util.h"
 
 namespace texlume::synth {
@@ -29,11 +29,11 @@ double LineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 // with the photos better (paper 003 eq. 3, summed over the constraint views).
 TEST(PhotoFrames, BricksOnAColumnRunAroundItAndMatchThePhotosBetter) {
   testing::TempDir tmp;
-  datasets::SceneOptions o =
-      testing::SmallObjectScene(datasets::SceneShape::kCylinder, datasets::MaterialKind::kBrick);
+  datasets::SceneOptions o = datasets::SmallObjectSceneOptions(datasets::SceneShape::kCylinder,
+                                                               datasets::MaterialKind::kBrick);
   o.num_held_out_views = 0;
   datasets::GenerateScene(o, tmp.path() / "scene");
-  const ptm::Ptm sample = testing::FitSceneSample(tmp.path() / "scene");
+  const ptm::Ptm sample = datasets::FitSceneSample(tmp.path() / "scene");
   pipeline::SynthJobOptions job;
   const std::filesystem::path object = tmp.path() / "scene/object";
   job.model_dir = object / "sparse";
