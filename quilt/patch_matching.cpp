@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 
@@ -124,6 +125,22 @@ RotatedCopy RotatedSample::Make(int rotation) const {
   return copy;
 }
 
+std::vector<cv::Mat> RotatedSample::TurnPlanes(int rotation,
+                                               const std::vector<cv::Mat>& sample_planes) const {
+  // SamplePosition as an affine map from copy pixel indices to sample pixel
+  // indices (centres at +0.5 on both sides).
+  const double a = AngleOf(rotation), c = std::cos(a), s = std::sin(a);
+  const double h = side_ / 2.0 - 0.5;
+  cv::Mat copy_to_sample =
+      (cv::Mat_<double>(2, 3) << c, -s, sample_.Width() / 2.0 - 0.5 - c * h + s * h, s, c,
+       sample_.Height() / 2.0 - 0.5 - s * h - c * h);
+  std::vector<cv::Mat> turned(sample_planes.size());
+  for (std::size_t p = 0; p < sample_planes.size(); ++p)
+    cv::warpAffine(sample_planes[p], turned[p], copy_to_sample, cv::Size(side_, side_),
+                   cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+  return turned;
+}
+
 const RotatedCopy& RotatedSample::Copy(int rotation) {
   if (rotation < 0 || rotation >= kRotations)
     throw std::out_of_range("RotatedSample::Copy: rotation " + std::to_string(rotation));
@@ -135,6 +152,12 @@ const RotatedCopy& RotatedSample::Copy(int rotation) {
   cache_.push_front(Make(rotation));
   if (cache_.size() > budget_) cache_.pop_back();
   return cache_.front();
+}
+
+cv::Mat EntirePatchCosts(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
+                         const cv::Mat& work_mask) {
+  CheckWorkImage(copy, work_planes, work_mask);
+  return MaskedSsdBySpectra(copy, work_planes, work_mask) / std::max(cv::sum(work_mask)[0], 1.0);
 }
 
 Placement MatchEntirePatch(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,

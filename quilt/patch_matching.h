@@ -50,6 +50,10 @@ class RotatedSample {
   /// The sample position (texels, x right, y down, centres at +0.5) that a
   /// copy's point (same convention) shows.
   Eigen::Vector2d SamplePosition(int rotation, const Eigen::Vector2d& copy_px) const;
+  /// Planes of the sample's size (CV_32FC1: the sample relit, say) turned as
+  /// the copy `rotation` turns the sample (bilinear; values, not features:
+  /// nothing in them is turned).
+  std::vector<cv::Mat> TurnPlanes(int rotation, const std::vector<cv::Mat>& sample_planes) const;
 
  private:
   RotatedCopy Make(int rotation) const;
@@ -65,7 +69,8 @@ class RotatedSample {
 struct Placement {
   int rotation = 0;
   int x = 0, y = 0;
-  double cost = 0;  ///< SSD over the synthesised texels / their number
+  double cost = 0;         ///< SSD over the synthesised texels / their number
+  bool by_photos = false;  ///< chosen among an image term's best (PatchImageTerm)
 };
 
 /// The placement of `copy` that best matches the work image's synthesised
@@ -74,6 +79,11 @@ struct Placement {
 /// the copy. Ties go to the first in raster order.
 Placement MatchEntirePatch(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
                            const cv::Mat& work_mask);
+/// The cost MatchEntirePatch minimises at every placement of `copy` (the SSD
+/// over the synthesised texels over their number): CV_32FC1 of
+/// (side - width + 1) x (side - height + 1), placement (x, y) at column x, row y.
+cv::Mat EntirePatchCosts(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
+                         const cv::Mat& work_mask);
 /// The same by nested loops (the reference of tests and the bench).
 Placement MatchEntirePatchBruteForce(const RotatedCopy& copy,
                                      const std::vector<cv::Mat>& work_planes,

@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "ptm/coefficient_space.h"
 #include "synth/min_cut.h"
+#include "synth/triangle_parts.h"
 
 namespace texlume::quilt {
 
@@ -23,6 +24,7 @@ void QuiltOptions::Check() const {
   if (!(shrink > 0.0 && shrink < 1.0)) throw OptionError("the work patch shrink must be in (0, 1)");
   if (!(max_area_distortion >= 1.0)) throw OptionError("T_d must be at least 1");
   if (!(seam_threshold > 0.0)) throw OptionError("--seam-threshold must be positive");
+  if (image_top_k < 1) throw OptionError("--top-k must be at least 1");
   if (random_orientation && !field_in_world.empty())
     throw OptionError("give a field or a random orientation, not both");
 }
@@ -77,13 +79,14 @@ class SurfaceQuilter {
  public:
   SurfaceQuilter(const DenseSurface& surface, const atlas::AtlasLayout& layout,
                  const synth::MaterialSample& sample, const QuiltOptions& options,
-                 const GivenSamples* given)
+                 const GivenSamples* given, PatchImageTerm* image_term)
       : surface_(surface),
         layout_(layout),
         sample_(sample),
         options_(options),
         rotated_(sample),
         features_(sample.NumFeatures()),
+        image_term_(image_term),
         rng_(options.seed) {
     if (2 * options.min_work_patch_levels + 1 > rotated_.side())
       throw InputError("the " + sample.Name() + " sample",
@@ -138,17 +141,16 @@ class SurfaceQuilter {
   // Per face, its atlas frame's axes in the world (x right, y up) and normal.
   void MakeFaceAxes() {
     for (std::size_t f = 0; f < layout_.faces.size(); ++f) {
-      const mesh::TriangleFrame& frame = surface_.FrameOf(static_cast<int>(f));
-      const double a = layout_.faces[f].AtlasFrameAngle();
-      const Eigen::Vector3d x = std::cos(a) * frame.x_axis + std::sin(a) * frame.y_axis;
-      atlas_x_.push_back(x);
-      atlas_y_.push_back(frame.z_axis.cross(x));
-      normal_.push_back(frame.z_axis);
+      const AtlasAxes axes = AtlasAxesOf(surface_, layout_, static_cast<int>(f));
+      atlas_x_.push_back(axes.x);
+      atlas_y_.push_back(axes.y);
+      normal_.push_back(axes.normal);
       if (options_.field_in_world.empty()) {
-        field_in_chart_rad_.push_back(-a);  // the face frame's x axis, in the atlas frame
+        // the face frame's x axis, in the atlas frame
+        field_in_chart_rad_.push_back(-layout_.faces[f].AtlasFrameAngle());
       } else {
         const Eigen::Vector3d& v = options_.field_in_world[f];
-        field_in_chart_rad_.push_back(std::atan2(v.dot(atlas_y_.back()), v.dot(x)));
+        field_in_chart_rad_.push_back(std::atan2(v.dot(axes.y), v.dot(axes.x)));
       }
     }
   }
@@ -343,6 +345,7 @@ class SurfaceQuilter {
     const bool cheap = mean_cost <= options_.seam_threshold * result_.stats.random_pair_cost;
     if (!cheap && !smallest && !options_.random_placement) return 0;
     result_.stats.forced += !cheap && !options_.random_placement;
+    result_.stats.photo_patches += placement.by_photos;
     ++result_.stats.accepted_at_levels[levels];
     result_.stats.cut_links += fit.cut_links;
     result_.stats.seam_cost += fit.seam_cost;
@@ -362,12 +365,63 @@ class SurfaceQuilter {
     return RotatedSample::RotationNearest(std::atan2(mean.y(), mean.x()));
   }
 
-  // Entire-patch matching against the synthesised part of the work image; a
-  // random placement when nothing is synthesised yet.
+  // Entire-patch matching against the synthesised part of the work image,
+  // among the photos' best placements when an image term scores the patch; a
+  // random placement when nothing constrains it.
   Placement MatchPlacement(const WorkPatch& patch, const RotatedCopy& copy) {
-    std::vector<cv::Mat> planes(static_cast<std::size_t>(features_));
+    std::vector<cv::Mat> planes;
+    cv::Mat mask;
+    SynthesisedFeatures(patch, planes, mask);
+    const bool overlap = cv::countNonZero(mask) > 0;
+    if (image_term_ && !options_.random_placement) {
+      const PatchImageTerm::Score score = image_term_->Placements(
+          patch.samples[0].sample, WorkImageSamples(patch), mask.size(), copy.rotation, rotated_);
+      if (!score.rms.empty()) return AmongPhotosBest(score, copy, planes, mask, overlap);
+    }
+    if (overlap && !options_.random_placement) return MatchEntirePatch(copy, planes, mask);
+    Placement random;
+    random.rotation = copy.rotation;
+    random.x = std::uniform_int_distribution<int>(0, copy.side() - patch.width)(rng_);
+    random.y = std::uniform_int_distribution<int>(0, copy.side() - patch.height)(rng_);
+    return random;
+  }
+
+  // Algorithm 2 of paper 003 on the work patch: of the image term's best
+  // placements, the one whose overlap with the synthesised part costs least.
+  Placement AmongPhotosBest(const PatchImageTerm::Score& score, const RotatedCopy& copy,
+                            const std::vector<cv::Mat>& planes, const cv::Mat& mask,
+                            bool overlap) const {
+    const auto candidates = synth::BestPlacements(score.rms, score.stride, options_.image_top_k);
+    TEXLUME_CHECK(!candidates.empty(), "an image term scored no placement");
+    Placement best;
+    best.rotation = copy.rotation;
+    best.by_photos = true;
+    best.x = candidates[0].second.x, best.y = candidates[0].second.y;
+    if (!overlap) return best;
+    const cv::Mat costs = EntirePatchCosts(copy, planes, mask);
+    best.cost = std::numeric_limits<double>::infinity();
+    for (const auto& [rms, at] : candidates)
+      if (costs.at<float>(at.y, at.x) < best.cost)
+        best.cost = costs.at<float>(at.y, at.x), best.x = at.x, best.y = at.y;
+    return best;
+  }
+
+  std::vector<WorkImageSample> WorkImageSamples(const WorkPatch& patch) const {
+    std::vector<WorkImageSample> samples;
+    samples.reserve(patch.samples.size());
+    for (const PatchSample& p : patch.samples) {
+      const auto [x, y] = Pixel(patch, p);
+      samples.push_back({p.sample, x, y});
+    }
+    return samples;
+  }
+
+  // The work image: the synthesised samples' features turned into the work
+  // frame, and the mask of the pixels they cover.
+  void SynthesisedFeatures(const WorkPatch& patch, std::vector<cv::Mat>& planes, cv::Mat& mask) {
+    planes.resize(static_cast<std::size_t>(features_));
     for (cv::Mat& plane : planes) plane = cv::Mat::zeros(patch.height, patch.width, CV_32FC1);
-    cv::Mat mask = cv::Mat::zeros(patch.height, patch.width, CV_32FC1);
+    mask = cv::Mat::zeros(patch.height, patch.width, CV_32FC1);
     std::vector<float> f(static_cast<std::size_t>(features_));
     for (const PatchSample& p : patch.samples) {
       if (!Synthesised(p.sample)) continue;
@@ -379,13 +433,6 @@ class SurfaceQuilter {
         planes[static_cast<std::size_t>(c)].at<float>(y, x) = f[static_cast<std::size_t>(c)];
       mask.at<float>(y, x) = 1.0f;
     }
-    if (cv::countNonZero(mask) > 0 && !options_.random_placement)
-      return MatchEntirePatch(copy, planes, mask);
-    Placement random;
-    random.rotation = copy.rotation;
-    random.x = std::uniform_int_distribution<int>(0, copy.side() - patch.width)(rng_);
-    random.y = std::uniform_int_distribution<int>(0, copy.side() - patch.height)(rng_);
-    return random;
   }
 
   static std::pair<int, int> Pixel(const WorkPatch& patch, const PatchSample& p) {
@@ -578,6 +625,7 @@ class SurfaceQuilter {
   const QuiltOptions options_;
   RotatedSample rotated_;
   const int features_;
+  PatchImageTerm* image_term_;
   std::mt19937_64 rng_;
   std::vector<Eigen::Vector3d> atlas_x_, atlas_y_, normal_;
   std::vector<double> field_in_chart_rad_;
@@ -591,6 +639,13 @@ class SurfaceQuilter {
 
 }  // namespace
 
+AtlasAxes AtlasAxesOf(const DenseSurface& surface, const atlas::AtlasLayout& layout, int face) {
+  const mesh::TriangleFrame& frame = surface.FrameOf(face);
+  const double a = layout.faces[static_cast<std::size_t>(face)].AtlasFrameAngle();
+  const Eigen::Vector3d x = std::cos(a) * frame.x_axis + std::sin(a) * frame.y_axis;
+  return {x, frame.z_axis.cross(x), frame.z_axis};
+}
+
 double SeamShare(const QuiltStats& stats) {
   return stats.cut_links && stats.random_pair_cost > 0
              ? stats.seam_cost / static_cast<double>(stats.cut_links) / stats.random_pair_cost
@@ -599,12 +654,13 @@ double SeamShare(const QuiltStats& stats) {
 
 QuiltResult QuiltSurface(const DenseSurface& surface, const atlas::AtlasLayout& layout,
                          const synth::MaterialSample& sample, const QuiltOptions& options,
-                         const ProgressCallback& progress, const GivenSamples* given) {
+                         const ProgressCallback& progress, const GivenSamples* given,
+                         PatchImageTerm* image_term) {
   options.Check();
   if (!options.field_in_world.empty() && options.field_in_world.size() != layout.faces.size())
     throw std::invalid_argument("QuiltSurface: one field vector per face");
   if (surface.size() == 0) return {};
-  return SurfaceQuilter(surface, layout, sample, options, given).Run(progress);
+  return SurfaceQuilter(surface, layout, sample, options, given, image_term).Run(progress);
 }
 
 }  // namespace texlume::quilt

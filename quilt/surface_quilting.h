@@ -44,6 +44,9 @@ struct QuiltOptions {
   /// Old seams kept as nodes of later cuts (Kwatra et al. 2003); false: a cut
   /// sees only the values there now (an ablation).
   bool keep_old_seams = true;
+  /// With an image term (PatchImageTerm): the placements the photos score best
+  /// that the overlap then chooses among (paper 003's top_k, Algorithm 2).
+  int image_top_k = 12;
   std::uint64_t seed = 1;
   void Check() const;
 };
@@ -62,6 +65,7 @@ struct QuiltStats {
   std::size_t patches = 0;
   std::map<int, std::size_t> accepted_at_levels;  ///< r_w -> patches accepted there
   std::size_t forced = 0;                         ///< accepted at the smallest r_w above T_c
+  std::size_t photo_patches = 0;                  ///< placed among the photos' best (an image term)
   std::size_t cut_links = 0;    ///< links whose two samples came from different patches
   double seam_cost = 0;         ///< summed over the cut links (feature units)
   double random_pair_cost = 0;  ///< T_c's unit: a cut between unrelated texels
@@ -87,12 +91,44 @@ struct GivenSamples {
   std::vector<float> features;  ///< per dense sample, NumFeatures() values, chart's atlas frame
 };
 
+/// A face's atlas frame in the world: x right and y up as its chart lies in
+/// the atlas, and the face normal.
+struct AtlasAxes {
+  Eigen::Vector3d x, y, normal;
+};
+AtlasAxes AtlasAxesOf(const DenseSurface& surface, const atlas::AtlasLayout& layout, int face);
+
+/// A sample of a work patch as an image term sees it: the dense sample and its
+/// pixel in the work image (rows down). The work frame is the atlas frame of
+/// the seed's chart (AtlasAxesOf the seed's face).
+struct WorkImageSample {
+  int sample = 0;
+  int x = 0, y = 0;
+};
+
+/// Paper 003's image term (eq. 3) on a work patch, beyond paper 004: how far
+/// the sample relit under the photos' lights differs from the photos at every
+/// placement of a rotated copy over the work image (quilt/image_term.h).
+class PatchImageTerm {
+ public:
+  virtual ~PatchImageTerm() = default;
+  struct Score {
+    cv::Mat rms;     ///< CV_32FC1 over placements, as EntirePatchCosts; empty: no photo
+    int stride = 1;  ///< placements one photo pixel spans (BestPlacements' stride)
+  };
+  virtual Score Placements(int seed, const std::vector<WorkImageSample>& samples,
+                           cv::Size work_size, int rotation, const RotatedSample& rotated) = 0;
+};
+
 /// Quilts `sample` over `surface`. `layout` is the layout the surface was built
 /// from (chart frames). `given`: samples that keep their texture (may be null).
-/// Deterministic for a seed.
+/// `image_term` (may be null): each patch is placed, of the image term's
+/// image_top_k best placements, at the one whose overlap costs least
+/// (Algorithm 2 of paper 003 on the work patch); a patch no photo sees is
+/// matched as without. Deterministic for a seed.
 QuiltResult QuiltSurface(const DenseSurface& surface, const atlas::AtlasLayout& layout,
                          const synth::MaterialSample& sample, const QuiltOptions& options,
-                         const ProgressCallback& progress = {},
-                         const GivenSamples* given = nullptr);
+                         const ProgressCallback& progress = {}, const GivenSamples* given = nullptr,
+                         PatchImageTerm* image_term = nullptr);
 
 }  // namespace texlume::quilt

@@ -45,7 +45,8 @@ std::array<double, 3> PhotoLinearSums(const RectifiedView& r, PhotoDomain domain
   return sums;
 }
 
-// Divides rectified planes by a photo's white balance (linear factors).
+}  // namespace
+
 void TakeOutWhiteBalance(const std::array<double, 3>& white_balance, PhotoDomain domain,
                          std::vector<cv::Mat>& planes) {
   for (std::size_t c = 0; c < 3; ++c) {
@@ -63,8 +64,6 @@ void TakeOutWhiteBalance(const std::array<double, 3>& white_balance, PhotoDomain
       }
   }
 }
-
-}  // namespace
 
 void TriangleEngineOptions::Check() const {
   if (!(sample_texel_size > 0.0) || !std::isfinite(sample_texel_size))
@@ -96,18 +95,9 @@ TriangleEngine::TriangleEngine(const mesh::TriangleMesh& mesh,
 }
 
 TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
-  options_.Check();
   const auto start = std::chrono::steady_clock::now();
   const std::size_t num_faces = mesh_.faces.size();
-  TEXLUME_CHECK(visibility_.triangles.size() == num_faces,
-                "visibility is computed for the engine's mesh");
-  const double t = options_.sample_texel_size;
-  result_.texel_size = t;
-  score_margin_ = sample_.Blendable() ? 0.5 * options_.strip * t : 0.0;
-  SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, options_.tangent_frame,
-                                 options_.field_direction_in_world));
-  TurnFramesToPhotos();
-  EstimatePhotometry(progress);
+  PrepareStages(true, progress);
 
   // Breadth first from the best-seen face (Algorithm 2, step 2).
   const std::vector<int> order =
@@ -125,6 +115,27 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
   if (correction_) correction_->Finish(*this, progress);
   result_.seconds_synthesis = SecondsSince(start);
   return std::move(result_);
+}
+
+const TriangleSynthesis& TriangleEngine::Prepare(const ProgressCallback& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  PrepareStages(false, progress);
+  result_.seconds_synthesis = SecondsSince(start);
+  return result_;
+}
+
+void TriangleEngine::PrepareStages(bool patches_in_sample, const ProgressCallback& progress) {
+  options_.Check();
+  TEXLUME_CHECK(visibility_.triangles.size() == mesh_.faces.size(),
+                "visibility is computed for the engine's mesh");
+  const double t = options_.sample_texel_size;
+  result_.texel_size = t;
+  patches_in_sample_ = patches_in_sample;
+  score_margin_ = sample_.Blendable() ? 0.5 * options_.strip * t : 0.0;
+  SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, options_.tangent_frame,
+                                 options_.field_direction_in_world));
+  TurnFramesToPhotos();
+  EstimatePhotometry(progress);
 }
 
 void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
@@ -148,7 +159,8 @@ void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
                     " texels at a texel size of " + std::to_string(t) +
                     " world units (a larger --sample-texel-size needs fewer)",
                 "mesh");
-  if (geometry.widest > sample_.Width() || geometry.tallest > sample_.Height()) {
+  if (patches_in_sample_ &&
+      (geometry.widest > sample_.Width() || geometry.tallest > sample_.Height())) {
     throw InputError(
         "mesh", "the largest triangle needs a patch of " + std::to_string(geometry.widest) + " x " +
                     std::to_string(geometry.tallest) + " texels (strip included) but the " +

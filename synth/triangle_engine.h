@@ -117,6 +117,11 @@ struct TriangleSynthesis {
 
 class TriangleEngine;
 
+/// Divides a photo's R, G and B planes (in `domain`) by its white balance
+/// (linear factors, TriangleSynthesis::white_balance).
+void TakeOutWhiteBalance(const std::array<double, 3>& white_balance, PhotoDomain domain,
+                         std::vector<cv::Mat>& planes);
+
 /// The engine's "correct" and "transfer detail" stages for one kind of sample:
 /// after a face seen in photos is placed, its patch is made to agree with the
 /// photos (PTM: the most probable change of the luminance coefficients; BTF:
@@ -156,6 +161,13 @@ class TriangleEngine {
   /// the patches would not fit the sample or would exceed max_texels.
   TriangleSynthesis Run(const ProgressCallback& progress = {});
 
+  /// The stages before placement alone (set-up, frames turned to the photos,
+  /// photometry), for an engine that places the sample itself (the graph-cut
+  /// engine's image term, quilt/image_term.h): the result's patches hold the
+  /// frames (placements unset), with the photo gains, white balance, light
+  /// response and photo blur. Patches larger than the sample are not refused.
+  const TriangleSynthesis& Prepare(const ProgressCallback& progress = {});
+
   /// Rectifies a photo that sees face `face` on the patch grid at density
   /// `level` (< 0: the photo's own). False when the photo is not among the
   /// engine's, the grid exceeds the reduced sample, or fewer than
@@ -169,6 +181,8 @@ class TriangleEngine {
   const TriangleSynthesis& result() const { return result_; }
 
  private:
+  // Stages 1 to 2a; `patches_in_sample`: refuse patches larger than the sample.
+  void PrepareStages(bool patches_in_sample, const ProgressCallback& progress);
   // Stage 1: frames, patch rectangles and unfoldings; refused when too large.
   void SetUpPatches(PatchGeometry geometry);
   // Stage 1b: frames turned to the photos (synth/tangent_field.h).
@@ -224,6 +238,7 @@ class TriangleEngine {
   /// blended sample (its blending zone, so that a blend mixes two
   /// photo-corrected patches), none for a sample that is cut.
   double score_margin_ = 0.0;
+  bool patches_in_sample_ = true;
   TriangleSynthesis result_;
 };
 

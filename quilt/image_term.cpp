@@ -1,0 +1,174 @@
+#include "quilt/image_term.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "core/image_io.h"
+#include "synth/template_match.h"
+#include "synth/triangle_parts.h"
+
+namespace texlume::quilt {
+namespace {
+
+// A Gaussian as wide as a photo pixel's footprint sampled bilinearly, in
+// photo pixels: a box of one pixel (sigma 1/sqrt 12) and the interpolation's
+// tent (the same again).
+constexpr double kPixelFootprintSigma = 0.41;
+
+// The bilinear RGB value of a CV_32FC3 photo at a COLMAP pixel position
+// (top-left corner convention); false outside the photo.
+bool PhotoAt(const cv::Mat& photo, const Eigen::Vector2d& px, float rgb[3]) {
+  const double x = px.x() - 0.5, y = px.y() - 0.5;
+  if (!(x >= 0 && y >= 0 && x <= photo.cols - 1 && y <= photo.rows - 1)) return false;
+  const int x0 = std::min(static_cast<int>(x), photo.cols - 2);
+  const int y0 = std::min(static_cast<int>(y), photo.rows - 2);
+  const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
+  const cv::Vec3f* r0 = photo.ptr<cv::Vec3f>(y0);
+  const cv::Vec3f* r1 = photo.ptr<cv::Vec3f>(y0 + 1);
+  for (int c = 0; c < 3; ++c)
+    rgb[c] = (1 - fy) * ((1 - fx) * r0[x0][c] + fx * r0[x0 + 1][c]) +
+             fy * ((1 - fx) * r1[x0][c] + fx * r1[x0 + 1][c]);
+  return true;
+}
+
+// A direction of the work frame turned by -rad about its normal.
+Eigen::Vector3d TurnedBack(const Eigen::Vector3d& d, double rad) {
+  const double c = std::cos(rad), s = std::sin(rad);
+  return {c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z()};
+}
+
+}  // namespace
+
+PhotoImageTerm::PhotoImageTerm(const DenseSurface& surface, const atlas::AtlasLayout& layout,
+                               const synth::MaterialSample& sample, const PhotoEvidence& photos,
+                               const ImageTermOptions& options)
+    : surface_(surface), layout_(layout), sample_(sample), photos_(photos), options_(options) {
+  for (std::size_t n = 0; n < photos.photos.size(); ++n)
+    photo_index_[photos.photos[n].image_id] = n;
+}
+
+PatchImageTerm::Score PhotoImageTerm::Placements(int seed,
+                                                 const std::vector<WorkImageSample>& samples,
+                                                 cv::Size work_size, int rotation,
+                                                 const RotatedSample& rotated) {
+  Score score;
+  const std::vector<View> views = ViewsOf(surface_.samples()[static_cast<std::size_t>(seed)].face);
+  for (const View& view : views) {
+    std::vector<cv::Mat> photo;
+    cv::Mat mask;
+    const int count = PhotoPlanes(view, samples, work_size, photo, mask);
+    const double r2 = view.px_per_texel * view.px_per_texel;
+    if (count * std::min(r2, 1.0) < options_.min_photo_pixels) continue;
+    const std::vector<cv::Mat>& relit = RelitCopy(seed, view, rotation, rotated);
+    const Relit& cached = relit_.at(view.photo);
+    if (score.rms.empty()) {
+      const int side = rotated.side();
+      score.rms = cv::Mat::zeros(side - work_size.height + 1, side - work_size.width + 1, CV_32FC1);
+      score.stride = std::max(1, static_cast<int>(std::floor(1.0 / view.px_per_texel)));
+    }
+    // Eq. 3 of paper 003 for this photo (RMS over its pixels and R, G, B).
+    synth::AddImageScore(synth::MaskedSsd(relit, cached.energy, photo, mask), count, 1.0, 1.0,
+                         score.rms);
+  }
+  return score;
+}
+
+std::vector<PhotoImageTerm::View> PhotoImageTerm::ViewsOf(int face) const {
+  std::vector<View> views;
+  const atlas::FacePlacement& placement = layout_.faces[static_cast<std::size_t>(face)];
+  const auto& c = placement.corners_px;  // atlas pixels are texels
+  const double texels2 =
+      0.5 * std::abs((c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x());
+  for (const sfm::TriangleView& view :
+       synth::ConstrainingViews(photos_.visibility.triangles[static_cast<std::size_t>(face)],
+                                options_.all_views, options_.max_views)) {
+    const auto it = photo_index_.find(view.image_id);
+    if (it == photo_index_.end()) continue;
+    views.push_back(
+        {it->second, std::sqrt(std::max(view.projected_area_px, 1e-6f) / std::max(texels2, 1e-9))});
+  }
+  return views;
+}
+
+bool PhotoImageTerm::SeesFully(std::size_t photo, int face) const {
+  const sfm::ImageId id = photos_.photos[photo].image_id;
+  for (const sfm::TriangleView& v :
+       photos_.visibility.triangles[static_cast<std::size_t>(face)].views)
+    if (v.image_id == id) return v.fully_visible;
+  return false;
+}
+
+int PhotoImageTerm::PhotoPlanes(const View& view, const std::vector<WorkImageSample>& samples,
+                                cv::Size work_size, std::vector<cv::Mat>& planes,
+                                cv::Mat& mask) const {
+  const synth::MeshPhoto& photo = photos_.photos[view.photo];
+  const sfm::Image& image = photos_.reconstruction.images.at(photo.image_id);
+  planes.assign(3, cv::Mat());
+  for (cv::Mat& plane : planes) plane = cv::Mat::zeros(work_size, CV_32FC1);
+  mask = cv::Mat::zeros(work_size, CV_32FC1);
+  int count = 0;
+  std::map<int, bool> seen;  // per face met
+  for (const WorkImageSample& w : samples) {
+    const int face = surface_.samples()[static_cast<std::size_t>(w.sample)].face;
+    auto it = seen.find(face);
+    if (it == seen.end()) it = seen.emplace(face, SeesFully(view.photo, face)).first;
+    if (!it->second || mask.at<float>(w.y, w.x) > 0) continue;
+    const auto px = photos_.reconstruction.Project(image, surface_.PointInWorld(w.sample));
+    float rgb[3];
+    if (!px || !PhotoAt(photo.image, *px, rgb)) continue;
+    for (int c = 0; c < 3; ++c) {
+      const float v = rgb[c];
+      planes[static_cast<std::size_t>(c)].at<float>(w.y, w.x) =
+          sample_.Domain() == synth::PhotoDomain::kLinear ? SrgbToLinear(v) : v;
+    }
+    mask.at<float>(w.y, w.x) = 1.0f;
+    ++count;
+  }
+  if (!photos_.photometry.white_balance.empty())
+    synth::TakeOutWhiteBalance(photos_.photometry.white_balance[view.photo], sample_.Domain(),
+                               planes);
+  return count;
+}
+
+synth::FaceLighting PhotoImageTerm::LightingOf(int seed, const View& view, double copy_rad) const {
+  const int face = surface_.samples()[static_cast<std::size_t>(seed)].face;
+  const AtlasAxes axes = AtlasAxesOf(surface_, layout_, face);
+  const auto in_work = [&](const Eigen::Vector3d& d) {
+    return TurnedBack(Eigen::Vector3d(d.dot(axes.x), d.dot(axes.y), d.dot(axes.normal)), copy_rad);
+  };
+  const synth::MeshPhoto& photo = photos_.photos[view.photo];
+  const sfm::Image& image = photos_.reconstruction.images.at(photo.image_id);
+  const Eigen::Vector3d origin = surface_.FrameOf(face).origin_in_world;
+  synth::FaceLighting lighting;
+  lighting.view_in_frame = in_work((image.ProjectionCenter() - origin).normalized());
+  for (const sfm::ObjectLight& light : photo.lights)
+    lighting.lights.emplace_back(in_work(light.DirectionFrom(origin)), light.intensity);
+  lighting.response = photos_.photometry.light_response;
+  return lighting;
+}
+
+const std::vector<cv::Mat>& PhotoImageTerm::RelitCopy(int seed, const View& view, int rotation,
+                                                      const RotatedSample& rotated) {
+  const int face = surface_.samples()[static_cast<std::size_t>(seed)].face;
+  Relit& relit = relit_[view.photo];
+  if (relit.face == face && relit.rotation == rotation) return relit.planes;
+  const double gain =
+      photos_.photometry.photo_gains.empty() ? 1.0 : photos_.photometry.photo_gains[view.photo];
+  relit.planes = rotated.TurnPlanes(
+      rotation, sample_.Relight(sample_.Reduced(0),
+                                LightingOf(seed, view, RotatedSample::AngleOf(rotation)), gain));
+  // The photo's resolution and blur (photo pixels) in texels.
+  const double blur_px =
+      photos_.photometry.photo_blur.empty() ? 0.0 : photos_.photometry.photo_blur[view.photo];
+  const double footprint_px = view.px_per_texel < 1.0 ? kPixelFootprintSigma : 0.0;
+  const double sigma = std::hypot(footprint_px, blur_px) / view.px_per_texel;
+  if (sigma > 0.3)
+    for (cv::Mat& plane : relit.planes) cv::GaussianBlur(plane, plane, cv::Size(), sigma);
+  relit.energy = synth::PlaneEnergy(relit.planes);
+  relit.face = face;
+  relit.rotation = rotation;
+  return relit.planes;
+}
+
+}  // namespace texlume::quilt

@@ -1,0 +1,85 @@
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "atlas/atlas.h"
+#include "quilt/dense_surface.h"
+#include "quilt/surface_quilting.h"
+#include "sfm/reconstruction.h"
+#include "sfm/visibility.h"
+#include "synth/material_sample.h"
+#include "synth/triangle_engine.h"
+
+// Paper 003's image term on the graph-cut engine's work patches (issue 32,
+// beyond paper 004; docs/quilting.md, "Following the photos"): the sample,
+// relit under a photo's lights and seen through the photo's resolution and
+// blur, against the photo at every placement of the rotated copy (eq. 3,
+// RMS per photo, summed over the photos that see the seed's face fully).
+
+namespace texlume::quilt {
+
+/// The photos and their calibration against the sample: photo gains, white
+/// balance, light response and blur (synth::TriangleEngine::Prepare). Every
+/// reference must outlive the image term.
+struct PhotoEvidence {
+  const sfm::Reconstruction& reconstruction;
+  const sfm::VisibilityResult& visibility;  ///< of the surface's mesh
+  const std::vector<synth::MeshPhoto>& photos;
+  const synth::TriangleSynthesis& photometry;
+};
+
+struct ImageTermOptions {
+  bool all_views = true;     ///< every photo that sees the seed's face fully, not only the best
+  int max_views = 4;         ///< most photos per patch
+  int min_photo_pixels = 6;  ///< fewest photo pixels over the work patch for a photo to count
+};
+
+/// The image term of a work patch. Inside the patch the lighting is the seed
+/// face's (paper 003 takes one lighting per triangle too); each sample's photo
+/// value is the photo where the sample projects, on faces the photo sees fully.
+class PhotoImageTerm : public PatchImageTerm {
+ public:
+  PhotoImageTerm(const DenseSurface& surface, const atlas::AtlasLayout& layout,
+                 const synth::MaterialSample& sample, const PhotoEvidence& photos,
+                 const ImageTermOptions& options);
+
+  Score Placements(int seed, const std::vector<WorkImageSample>& samples, cv::Size work_size,
+                   int rotation, const RotatedSample& rotated) override;
+
+ private:
+  struct View {
+    std::size_t photo = 0;
+    double px_per_texel = 1.0;  ///< the photo's density over the seed's face
+  };
+  // The photos that see the seed's face fully, best first.
+  std::vector<View> ViewsOf(int face) const;
+  // The photo at every work sample whose face it sees fully (sample domain,
+  // white balance taken out); returns the pixels set in `mask`.
+  int PhotoPlanes(const View& view, const std::vector<WorkImageSample>& samples, cv::Size work_size,
+                  std::vector<cv::Mat>& planes, cv::Mat& mask) const;
+  // The seed's lighting in the photo, in the sample's own frame once the copy
+  // turns it by `copy_rad` within the work frame.
+  synth::FaceLighting LightingOf(int seed, const View& view, double copy_rad) const;
+  // The copy relit under the view's lighting at the seed, blurred as the photo sees it.
+  const std::vector<cv::Mat>& RelitCopy(int seed, const View& view, int rotation,
+                                        const RotatedSample& rotated);
+  bool SeesFully(std::size_t photo, int face) const;
+
+  const DenseSurface& surface_;
+  const atlas::AtlasLayout& layout_;
+  const synth::MaterialSample& sample_;
+  const PhotoEvidence& photos_;
+  const ImageTermOptions options_;
+  std::map<sfm::ImageId, std::size_t> photo_index_;
+  struct Relit {
+    int face = -1, rotation = -1;
+    std::vector<cv::Mat> planes;
+    cv::Mat energy;
+  };
+  std::map<std::size_t, Relit> relit_;  ///< per photo, the last copy relit (a retry reuses it)
+};
+
+}  // namespace texlume::quilt
