@@ -24,10 +24,11 @@ struct SynthWords {
 
 void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords& w) {
   pipeline::SynthJobOptions& j = o.job;
-  sub->add_option("--model", j.model_dir, "COLMAP model folder (required by --engine triangle)");
-  sub->add_option("--images", j.images_dir, "the object photos (required by --engine triangle)");
-  sub->add_option("--lights", j.lights_file,
-                  "object-lights JSON (docs/lights.md; required by --engine triangle)");
+  sub->add_option(
+      "--model", j.model_dir,
+      "COLMAP model folder (required by --engine triangle; graphcut: photos to follow)");
+  sub->add_option("--images", j.images_dir, "the object photos (with --model)");
+  sub->add_option("--lights", j.lights_file, "object-lights JSON (docs/lights.md; with --model)");
   sub->add_option("--mesh", j.mesh_file, "coarse mesh in the model's frame")->required();
   sub->add_option("--out", j.out_dir, "the model folder to write")->required();
   auto* sample =
@@ -76,7 +77,7 @@ void BindEngine(CLI::App* sub, synth::MeshSynthesisOptions& s, SynthWords& w) {
 // Graph-cut surface quilting (paper 004 §III, docs/quilting.md).
 void BindQuilting(CLI::App* sub, pipeline::QuiltJobOptions& q, SynthWords& w) {
   sub->add_option("--engine", w.engine,
-                  "triangle (paper 003, from the photos) or graphcut (paper 004, no photos)")
+                  "triangle (paper 003, from the photos) or graphcut (paper 004; photos optional)")
       ->check(OneOf({"triangle", "graphcut"}, "give triangle or graphcut"))
       ->capture_default_str();
   sub->add_option("--fill-unseen", w.fill_unseen,
@@ -161,36 +162,53 @@ void BindAtlas(CLI::App* sub, atlas::AtlasOptions& a, SynthWords& w) {
   sub->add_flag("--no-report", w.no_report, "do not write report.html");
 }
 
+// `--engine graphcut` with --model, --images and --lights: the photos to
+// follow and the settings that calibrate them and score placements; those
+// settings are refused without photos.
+void TakePhotos(const CLI::App* sub, const SynthWords& w, const pipeline::SynthCommandOptions& o,
+                pipeline::QuiltJobOptions& q) {
+  const pipeline::SynthJobOptions& j = o.job;
+  q.model_dir = j.model_dir;
+  q.images_dir = j.images_dir;
+  q.lights_file = j.lights_file;
+  if (!q.Photos() || j.images_dir.empty() || j.lights_file.empty()) {
+    for (const char* name : {"--model", "--images", "--lights"})
+      if (sub->count(name) > 0)
+        throw UsageError("--engine graphcut follows photos with --model, --images and --lights");
+    for (const char* name :
+         {"--top-k", "--best-view-only", "--max-views", "--tangent-frame", "--max-buffer-size",
+          "--no-light-response", "--no-white-balance", "--no-photo-blur"})
+      if (sub->count(name) > 0)
+        throw UsageError(std::string(name) +
+                         " is for --engine graphcut with photos (--model, --images, --lights)");
+    return;
+  }
+  q.visibility = j.visibility;
+  synth::TriangleEngineOptions& e = q.photo_engine;
+  e.top_k = j.synthesis.top_k;
+  e.all_views = !w.best_view_only;
+  e.max_views = j.synthesis.max_views;
+  e.light_response = !w.no_light_response;
+  e.white_balance = !w.no_white_balance;
+  e.photo_blur = !w.no_photo_blur;
+  e.seed = j.synthesis.seed;
+  if (w.tangent_frame == "first-edge") e.tangent_frame = synth::TangentFrame::kFirstEdge;
+  if (w.tangent_frame == "photos") e.tangent_frame = synth::TangentFrame::kPhotos;
+  if (!w.tangent_field.empty()) e.tangent_frame = synth::TangentFrame::kSmoothField;
+}
+
 // `--engine graphcut`: the quilting job's Options from the command's. What it
 // does not take yet is refused, not ignored.
 pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
                                        const pipeline::SynthCommandOptions& o,
                                        pipeline::QuiltJobOptions q) {
-  for (const char* name : {"--model",
-                           "--fill-unseen",
-                           "--images",
-                           "--lights",
-                           "--seam-band",
-                           "--strip",
-                           "--top-k",
-                           "--best-view-only",
-                           "--max-views",
-                           "--tangent-frame",
-                           "--max-subdivisions",
-                           "--max-buffer-size",
-                           "--correction-iterations",
-                           "--correction-noise",
-                           "--correction-sigma",
-                           "--correction-prior-shrink",
-                           "--no-additive-correction",
-                           "--no-channel-correction",
-                           "--no-detail-transfer",
-                           "--no-light-response",
-                           "--no-white-balance",
-                           "--no-photo-blur"})
+  for (const char* name :
+       {"--fill-unseen", "--seam-band", "--strip", "--max-subdivisions", "--correction-iterations",
+        "--correction-noise", "--correction-sigma", "--correction-prior-shrink",
+        "--no-additive-correction", "--no-channel-correction", "--no-detail-transfer"})
     if (sub->count(name) > 0)
-      throw UsageError(std::string(name) +
-                       " is not taken by --engine graphcut so far (docs/quilting.md)");
+      throw UsageError(std::string(name) + " is not taken by --engine graphcut (docs/quilting.md)");
+  TakePhotos(sub, w, o, q);
   q.mesh_file = o.job.mesh_file;
   q.sample_file = o.btf.empty() ? o.job.sample_file : o.btf;
   if (q.sample_file.empty()) throw UsageError("--sample or --btf is required");

@@ -17,6 +17,7 @@
 #include "model/model_io.h"
 #include "pipeline/report_pictures.h"
 #include "pipeline/synth_job.h"
+#include "quilt/image_term.h"
 #include "quilt/quilt_atlases.h"
 #include "quilt/vector_field.h"
 #include "report/report.h"
@@ -40,8 +41,37 @@ void QuiltJobOptions::Check() const {
     throw OptionError("give --field or --orientation random, not both");
   if (!field_direction_in_world.allFinite() || !(field_direction_in_world.norm() > 0))
     throw OptionError("--tangent-field must be a non-zero direction");
+  CheckPhotos();
   atlas.Check();
   CheckWorldUnit(mm_per_world_unit);
+}
+
+void QuiltJobOptions::CheckPhotos() const {
+  const int given = !model_dir.empty() + !images_dir.empty() + !lights_file.empty();
+  if (given != 0 && given != 3)
+    throw OptionError(
+        "synth --engine graphcut follows photos with --model, --images and --lights together");
+  if (!Photos()) return;
+  synth::TriangleEngineOptions engine = photo_engine;
+  engine.sample_texel_size = 1.0;  // the job's, checked above
+  engine.Check();
+  if (photo_engine.tangent_frame == synth::TangentFrame::kFirstEdge)
+    throw OptionError(
+        "--tangent-frame first_edge gives no field to quilt along; give auto, photos or "
+        "smooth_field");
+}
+
+nlohmann::json QuiltJobOptions::PhotosJson() const {
+  if (!Photos()) return nullptr;
+  return {{"top_k", photo_engine.top_k},
+          {"all_views", photo_engine.all_views},
+          {"max_views", photo_engine.max_views},
+          {"min_photo_pixels", photo_engine.min_photo_pixels},
+          {"tangent_frame", synth::TangentFrameName(photo_engine.tangent_frame)},
+          {"light_response", photo_engine.light_response},
+          {"white_balance", photo_engine.white_balance},
+          {"photo_blur", photo_engine.photo_blur},
+          {"max_buffer_size", visibility.max_buffer_dimension}};
 }
 
 bool QuiltJobOptions::BtfSample() const {
@@ -64,6 +94,7 @@ nlohmann::json QuiltJobOptions::ToJson() const {
       {"field_direction_in_world",
        {field_direction_in_world.x(), field_direction_in_world.y(), field_direction_in_world.z()}},
       {"field", field_file.empty() ? nlohmann::json(nullptr) : nlohmann::json(field_file.string())},
+      {"photos", PhotosJson()},
       {"seed", quilt.seed},
       {"atlas_size", atlas.atlas_size},
       {"gutter", atlas.gutter},
@@ -87,6 +118,7 @@ class QuiltJob {
     AnnounceStep(progress_, "reading the inputs");
     Load();
     LayOut();
+    CalibratePhotos();
     Quilt();
     Bake();
     AnnounceStep(progress_, "writing the model folder");
@@ -97,10 +129,14 @@ class QuiltJob {
 
  private:
   void Load() {
-    mesh::LoadedMesh loaded = mesh::LoadMesh(options_.mesh_file);
-    for (const std::string& problem : loaded.report.Problems())
-      summary_.warnings.push_back(options_.mesh_file.string() + ": " + problem);
-    mesh_ = std::move(loaded.mesh);
+    if (options_.Photos()) {
+      LoadPhotos();
+    } else {
+      mesh::LoadedMesh loaded = mesh::LoadMesh(options_.mesh_file);
+      for (const std::string& problem : loaded.report.Problems())
+        summary_.warnings.push_back(options_.mesh_file.string() + ": " + problem);
+      mesh_ = std::move(loaded.mesh);
+    }
     if (mesh_.faces.empty()) throw InputError(options_.mesh_file.string(), "has no triangles");
     summary_.faces = mesh_.faces.size();
     texel_size_ = options_.sample_texel_size;
@@ -113,6 +149,64 @@ class QuiltJob {
     if (!options_.field_file.empty())
       quilt_options_.field_in_world =
           quilt::InterpolateField(mesh_, quilt::ReadFieldFile(options_.field_file, mesh_));
+    if (options_.Photos()) ComputeVisibility();
+  }
+
+  // The COLMAP model, the lights, the mesh (in the model's frame) and the
+  // photos, as the main job reads them (LoadSynthInputs).
+  SynthJobOptions PhotoInputs() const {
+    SynthJobOptions job;
+    job.model_dir = options_.model_dir;
+    job.images_dir = options_.images_dir;
+    job.lights_file = options_.lights_file;
+    job.mesh_file = options_.mesh_file;
+    job.visibility = options_.visibility;
+    job.max_subdivisions = 0;  // quilting takes triangles of any size
+    return job;
+  }
+
+  void LoadPhotos() {
+    const auto start = std::chrono::steady_clock::now();
+    AnnounceStep(progress_, "reading the photos");
+    inputs_ = LoadSynthInputs(PhotoInputs());
+    summary_.warnings.insert(summary_.warnings.end(), inputs_.warnings.begin(),
+                             inputs_.warnings.end());
+    mesh_ = inputs_.mesh;
+    summary_.photos_used = inputs_.photos.size();
+    summary_.seconds_photos = SecondsSince(start);
+  }
+
+  // Which faces each photo sees (refused when most are seen by none: a mesh
+  // in another frame).
+  void ComputeVisibility() {
+    const auto start = std::chrono::steady_clock::now();
+    AnnounceStep(progress_, "visibility");
+    PrepareSynthMesh(inputs_, PhotoInputs(), std::numeric_limits<int>::max(), texel_size_, 2,
+                     progress_);
+    summary_.seconds_photos += SecondsSince(start);
+  }
+
+  // The photos calibrated against the sample (gains, white balance, light
+  // response, blur: synth::TriangleEngine::Prepare), and the frames that give
+  // the field when the photos orient the sample.
+  void CalibratePhotos() {
+    if (!options_.Photos()) return;
+    const auto start = std::chrono::steady_clock::now();
+    AnnounceStep(progress_, "calibrating the photos against the sample");
+    engine_options_ = options_.photo_engine;
+    engine_options_.sample_texel_size = texel_size_;
+    engine_options_.field_direction_in_world = options_.field_direction_in_world;
+    const bool field_given = !options_.field_file.empty() || options_.quilt.random_orientation;
+    if (field_given) engine_options_.tangent_frame = synth::TangentFrame::kSmoothField;
+    engine_ = std::make_unique<synth::TriangleEngine>(mesh_, inputs_.reconstruction,
+                                                      inputs_.visibility, inputs_.photos, *matched_,
+                                                      engine_options_, nullptr);
+    const synth::TriangleSynthesis& photometry = engine_->Prepare(progress_);
+    if (!field_given && photometry.tangent_frame == synth::TangentFrame::kPhotos)
+      for (const synth::TrianglePatch& patch : photometry.patches)
+        quilt_options_.field_in_world.push_back(patch.frame.x_axis);
+    summary_.photo_calibration = EngineSummaryJson(photometry);
+    summary_.seconds_photometry = SecondsSince(start);
   }
 
   // The sample, and the one the quilting matches: a BTF (its geometry maps), a
@@ -188,7 +282,17 @@ class QuiltJob {
   }
 
   void Quilt() {
-    result_ = quilt::QuiltSurface(surface_, layout_, *matched_, quilt_options_, progress_);
+    std::optional<quilt::PhotoImageTerm> image_term;
+    if (engine_) {
+      evidence_.emplace(quilt::PhotoEvidence{inputs_.reconstruction, inputs_.visibility,
+                                             inputs_.photos, engine_->result()});
+      const synth::TriangleEngineOptions& e = engine_options_;
+      image_term.emplace(surface_, layout_, *matched_, *evidence_,
+                         quilt::ImageTermOptions{e.all_views, e.max_views, e.min_photo_pixels});
+      quilt_options_.image_top_k = e.top_k;
+    }
+    result_ = quilt::QuiltSurface(surface_, layout_, *matched_, quilt_options_, progress_, nullptr,
+                                  image_term ? &*image_term : nullptr);
     summary_.stats = result_.stats;
     summary_.seconds_quilting = result_.stats.seconds;
   }
@@ -217,14 +321,8 @@ class QuiltJob {
   }
 
   void Write() {
-    model::TexturedModel model;
-    model.mesh = mesh_;
-    model.atlases = ptms_;
-    for (const atlas::FacePlacement& fp : layout_.faces) {
-      model.face_atlas.push_back(fp.atlas);
-      model.corner_px.push_back({fp.corners_px[0].cast<float>(), fp.corners_px[1].cast<float>(),
-                                 fp.corners_px[2].cast<float>()});
-    }
+    if (!options_.Photos()) inputs_.mesh = mesh_;  // no cameras: the model is not turned
+    const model::TexturedModel model = TexturedModelOf(inputs_, ptms_, layout_.faces);
     nlohmann::json record = Record();
     std::optional<model::BtfModelFiles> files;
     if (btf_sample_) {
@@ -245,17 +343,28 @@ class QuiltJob {
     report::ReportInputs report;
     report.title = "texlume synth --engine graphcut: " + options_.mesh_file.filename().string();
     report.intro =
-        "The mesh covered with the material sample by graph-cut quilting on a dense resampling "
-        "of its surface (paper 004 \u00a7III), without photos: nothing ties the texture to the "
-        "object's own. Below, the model from four views around it, each under a light from "
-        "above the camera's left, beside flat shading with the model's mean colour.";
+        options_.Photos()
+            ? "The mesh covered with the material sample by graph-cut quilting on a dense "
+              "resampling of its surface (paper 004 \u00a7III), each patch placed where the "
+              "sample relit under the photos' lights agrees best with the photos (paper 003's "
+              "image term). Below, the model from some of the photos' views under their lights "
+              "beside the photo (divided by its estimated exposure) and flat shading."
+            : "The mesh covered with the material sample by graph-cut quilting on a dense "
+              "resampling of its surface (paper 004 \u00a7III), without photos: nothing ties the "
+              "texture to the object's own. Below, the model from four views around it, each "
+              "under a light from above the camera's left, beside flat shading with the model's "
+              "mean colour.";
     report.model = &model;
     ReportScene scene;
     scene.model = &model;
     scene.flat_albedo = MeanHeadOnColour(model);
     scene.sample = btf_sample_ ? nullptr : &sample_.ptm;
-    scene.views = ViewsAroundMesh(mesh_, 4, 400, 300);
-    report.views_heading = "Views around the model (no photos to compare with)";
+    if (engine_) {
+      AddPhotoViews(inputs_, options_.images_dir, engine_->result().photo_gains, report, scene);
+    } else {
+      scene.views = ViewsAroundMesh(mesh_, 4, 400, 300);
+      report.views_heading = "Views around the model (no photos to compare with)";
+    }
     DrawReportPictures(scene, report, progress_);
     const quilt::QuiltStats& q = summary_.stats;
     report.facts = {
@@ -264,7 +373,7 @@ class QuiltJob {
         {"dense samples", std::to_string(summary_.samples) + " (" +
                               std::to_string(summary_.chart_seam_links) + " links across charts)"},
         {"patches", std::to_string(q.patches) + " (" + std::to_string(q.forced) +
-                        " forced at the smallest work patch)"},
+                        " forced at the smallest work patch" + PhotoPatchesText() + ")"},
         {"seam cost per cut link", SeamText(q)},
         {"sample and atlas texel size", WorldLengthText(texel_size_, options_.mm_per_world_unit)},
         {"atlases", std::to_string(summary_.atlases) + " of " +
@@ -272,19 +381,26 @@ class QuiltJob {
                         std::to_string(summary_.charts) + " charts"}};
     for (const std::string& w : summary_.warnings) report.facts.emplace_back("warning", w);
     report.inputs = {{"mesh", options_.mesh_file}};
+    if (engine_) report.inputs = InputFiles(PhotoInputs(), inputs_.model_folder);
     if (!options_.BtfSample()) report.inputs.emplace_back("sample", options_.sample_file);
     report.view_folder = options_.out_dir.string();
     report.texel_size = texel_size_;
     report.mm_per_world_unit = options_.mm_per_world_unit;
     report.occupancy = summary_.occupancy;
-    report.timings_s = {{"sample", summary_.seconds_sample},
-                        {"layout", summary_.seconds_layout},
-                        {"quilting", summary_.seconds_quilting},
-                        {"atlas", summary_.seconds_atlas}};
+    report.timings_s = {
+        {"sample", summary_.seconds_sample},     {"photos and visibility", summary_.seconds_photos},
+        {"layout", summary_.seconds_layout},     {"photo calibration", summary_.seconds_photometry},
+        {"quilting", summary_.seconds_quilting}, {"atlas", summary_.seconds_atlas}};
     report.links = {
         {"model.glb", "model.glb"}, {"model.obj", "model.obj"}, {"manifest.json", "manifest.json"}};
     report::WriteReport(folder, report, progress_);
     summary_.seconds_report = SecondsSince(start);
+  }
+
+  std::string PhotoPatchesText() const {
+    if (!engine_) return "";
+    return ", " + std::to_string(summary_.stats.photo_patches) + " placed by " +
+           std::to_string(summary_.photos_used) + " photos";
   }
 
   std::string SeamText(const quilt::QuiltStats& q) const {
@@ -319,9 +435,11 @@ class QuiltJob {
     nlohmann::json settings = options_.ToJson();
     settings["sample_texel_size"] = texel_size_;  // a BTF's own when not given
     if (btf_sample_) settings["btf_components"] = btf_.Components();
+    nlohmann::json inputs = {{"mesh", options_.mesh_file.string()},
+                             {"sample", options_.sample_file.string()}};
+    if (options_.Photos()) inputs.update(PhotoInputs().InputsJson());
     return {{"command", "synth"},
-            {"inputs",
-             {{"mesh", options_.mesh_file.string()}, {"sample", options_.sample_file.string()}}},
+            {"inputs", inputs},
             {"settings", settings},
             {"summary",
              {{"sample_kind", summary_.sample_kind},
@@ -332,6 +450,9 @@ class QuiltJob {
               {"patches", q.patches},
               {"accepted_at_work_patch_levels", accepted},
               {"forced_patches", q.forced},
+              {"photos_used", summary_.photos_used},
+              {"patches_placed_by_photos", q.photo_patches},
+              {"photos", summary_.photo_calibration},
               {"seam_cost_per_cut_link", per_link},
               {"unrelated_cut_cost", q.random_pair_cost},
               {"atlases", summary_.atlases},
@@ -340,7 +461,9 @@ class QuiltJob {
             {"warnings", summary_.warnings},
             {"timings_s",
              {{"sample", summary_.seconds_sample},
+              {"photos_and_visibility", summary_.seconds_photos},
               {"layout", summary_.seconds_layout},
+              {"photo_calibration", summary_.seconds_photometry},
               {"quilting", summary_.seconds_quilting},
               {"quilting_per_patch",
                summary_.seconds_quilting / std::max<double>(1.0, static_cast<double>(q.patches))},
@@ -353,6 +476,10 @@ class QuiltJob {
   const ProgressCallback& progress_;
   quilt::QuiltOptions quilt_options_;  ///< the options', with the interpolated field
   mesh::TriangleMesh mesh_;
+  SynthInputs inputs_;  ///< with photos: the COLMAP model, photos and visibility
+  synth::TriangleEngineOptions engine_options_;
+  std::unique_ptr<synth::TriangleEngine> engine_;  ///< with photos: their calibration
+  std::optional<quilt::PhotoEvidence> evidence_;
   double texel_size_ = 0;  ///< world units per sample texel (the BTF's own when not given)
   Sample sample_;
   btf::BtfFactorisation btf_;

@@ -10,10 +10,13 @@
 #include "atlas/atlas.h"
 #include "core/progress.h"
 #include "quilt/surface_quilting.h"
+#include "sfm/visibility.h"
+#include "synth/triangle_engine.h"
 
 // `texlume synth --engine graphcut` (issue 32, docs/quilting.md): graph-cut
-// quilting of a sample over a mesh without photos (paper 004 §III), baked into
-// PTM atlases and written as a model folder.
+// quilting of a sample over a mesh (paper 004 §III), without photos or
+// following them through paper 003's image term, baked into PTM atlases (or a
+// BTF's files) and written as a model folder.
 
 namespace texlume::pipeline {
 
@@ -24,6 +27,18 @@ struct QuiltJobOptions {
   std::filesystem::path sample_file;
   int btf_components = 40;        ///< kept when factorising a BTF capture (paper 004: 40)
   std::filesystem::path out_dir;  ///< the model folder written
+  /// Photos to follow (all three, or none): the COLMAP model, the photos and
+  /// their object lights, as for the main job; the mesh is then in the model's
+  /// frame. Each work patch is placed among the placements whose relit sample
+  /// agrees best with the photos (quilt/image_term.h).
+  std::filesystem::path model_dir, images_dir, lights_file;
+  sfm::VisibilityOptions visibility;
+  /// With photos: the per-triangle engine's settings that calibrate them
+  /// against the sample and score placements (top_k, all_views, max_views,
+  /// light response, white balance, photo blur) and, without a field file,
+  /// the frames that give the field (tangent_frame: kAuto follows the photos
+  /// for an anisotropic sample). Its texel size is the job's.
+  synth::TriangleEngineOptions photo_engine;
   /// Key vectors orienting the sample (quilt/vector_field.h); empty: the world
   /// direction below laid onto every face (synth::TangentFrame::kSmoothField).
   std::filesystem::path field_file;
@@ -43,7 +58,15 @@ struct QuiltJobOptions {
   nlohmann::json ToJson() const;
   /// Whether `sample_file` is a BTF folder (a directory).
   bool BtfSample() const;
+  /// Whether photos are given (model_dir, images_dir and lights_file).
+  bool Photos() const { return !model_dir.empty(); }
+  /// The photo settings as the manifest records them (null without photos).
+  nlohmann::json PhotosJson() const;
 
+ private:
+  void CheckPhotos() const;
+
+ public:
   static atlas::AtlasOptions ConformalAtlas() {
     atlas::AtlasOptions o;
     o.flattening = atlas::ChartFlattening::kConformal;
@@ -54,12 +77,17 @@ struct QuiltJobOptions {
 struct QuiltJobSummary {
   std::string sample_kind;  ///< "PTM", "colour" or "BTF"
   std::size_t faces = 0, samples = 0, links = 0, chart_seam_links = 0;
+  std::size_t photos_used = 0;  ///< with photos
+  /// With photos: the photo gains and the frames the photos gave (the
+  /// manifest's "photos", EngineSummaryJson).
+  nlohmann::json photo_calibration;
   quilt::QuiltStats stats;
   std::size_t atlases = 0, charts = 0;
   double occupancy = 0.0;
   std::vector<std::string> warnings;
-  double seconds_sample = 0, seconds_layout = 0, seconds_quilting = 0, seconds_atlas = 0,
-         seconds_preview = 0, seconds_report = 0, seconds_total = 0;
+  double seconds_sample = 0, seconds_photos = 0, seconds_layout = 0, seconds_photometry = 0,
+         seconds_quilting = 0, seconds_atlas = 0, seconds_preview = 0, seconds_report = 0,
+         seconds_total = 0;
 };
 
 /// Reads the mesh and the sample, lays the faces out in charts, quilts the

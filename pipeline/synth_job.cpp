@@ -363,6 +363,26 @@ model::TexturedModel TexturedModelOf(const SynthInputs& inputs, std::vector<ptm:
   return model;
 }
 
+void AddPhotoViews(const SynthInputs& inputs, const fs::path& images_dir,
+                   const std::vector<double>& photo_gains, report::ReportInputs& report,
+                   ReportScene& scene) {
+  for (std::size_t i = 0; i < inputs.photos.size(); ++i) {
+    const synth::MeshPhoto& p = inputs.photos[i];
+    const sfm::Image& image = inputs.reconstruction.images.at(p.image_id);
+    report.photos.push_back({p.name, images_dir / p.name, p.lights, p.image});
+    render::PictureView view;
+    view.name = p.name;
+    view.camera = inputs.reconstruction.cameras.at(image.camera_id);
+    view.cam_from_world = image.cam_from_world;
+    view.lights = p.lights;
+    view.reference_image = images_dir / p.name;
+    view.reference = p.image;
+    view.reference_gain = i < photo_gains.size() ? photo_gains[i] : 1.0;
+    scene.views.push_back(std::move(view));
+  }
+  report.views_heading = "Photo views under the photos' lights";
+}
+
 namespace {
 
 // The main job's steps, each a method, sharing the inputs, the synthesis and
@@ -528,26 +548,6 @@ class SynthJob {
     return record;
   }
 
-  // The photos and their views (under their lights, beside the photo divided by its gain).
-  void AddPhotoViews(report::ReportInputs& report, ReportScene& scene) const {
-    const std::vector<synth::MeshPhoto>& photos = inputs_.photos;
-    for (std::size_t i = 0; i < photos.size(); ++i) {
-      const synth::MeshPhoto& p = photos[i];
-      const sfm::Image& image = inputs_.reconstruction.images.at(p.image_id);
-      report.photos.push_back({p.name, options_.images_dir / p.name, p.lights, p.image});
-      render::PictureView view;
-      view.name = p.name;
-      view.camera = inputs_.reconstruction.cameras.at(image.camera_id);
-      view.cam_from_world = image.cam_from_world;
-      view.lights = p.lights;
-      view.reference_image = options_.images_dir / p.name;
-      view.reference = p.image;
-      view.reference_gain = i < synthesis_.photo_gains.size() ? synthesis_.photo_gains[i] : 1.0;
-      scene.views.push_back(std::move(view));
-    }
-    report.views_heading = "Photo views under the photos' lights";
-  }
-
   void WriteModelReport(const fs::path& folder) {
     const SynthJobSummary& s = summary_;
     report::ReportInputs report;
@@ -565,7 +565,7 @@ class SynthJob {
     scene.flat_albedo = flat_albedo_;
     scene.baked = baked_;
     scene.sample = &sample_.ptm;
-    AddPhotoViews(report, scene);
+    AddPhotoViews(inputs_, options_.images_dir, synthesis_.photo_gains, report, scene);
     std::vector<std::vector<sfm::ObjectLight>> photo_lights;
     for (const report::ReportPhoto& p : report.photos) photo_lights.push_back(p.lights);
     report.light_plots = {LightPlotOfModel("the photos' lights", photo_lights, model_)};

@@ -13,6 +13,7 @@
 #include "core/progress.h"
 #include "model/baselines.h"
 #include "model/model_io.h"
+#include "pipeline/report_pictures.h"
 #include "quilt/surface_quilting.h"
 #include "quilt/unseen_fill.h"
 #include "render/model_render.h"
@@ -175,6 +176,12 @@ model::TexturedModel TexturedModelOf(const SynthInputs& inputs, std::vector<ptm:
 /// triangles are seen by no photo (a mesh in another frame), or when the
 /// patches would not fit in memory. Nothing is written on error.
 SynthJobSummary RunSynthJob(const SynthJobOptions& options, const ProgressCallback& progress = {});
+
+/// The photos into a report, and their views into its scene: each photo's
+/// camera under its lights, beside the photo divided by its gain.
+void AddPhotoViews(const SynthInputs& inputs, const std::filesystem::path& images_dir,
+                   const std::vector<double>& photo_gains, report::ReportInputs& report,
+                   ReportScene& scene);
 
 /// The atlas settings as the manifests record them (shared by the PTM and BTF jobs).
 nlohmann::json AtlasSettingsJson(const atlas::AtlasOptions& atlas);

@@ -590,9 +590,19 @@ TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
   nlohmann::json render;
   ASSERT_EQ(RenderHeldOut(tmp, scene, &out, &render), 0) << out;
   EXPECT_GT(render["metrics"]["mean_psnr_db"].get<double>(), 10.0);
-  // Photos are not taken by this engine yet: refused, not ignored (2).
+  // Photos to follow need --model, --images and --lights together, and the
+  // photos' settings need photos (2); with all three, the photos are read (a
+  // lights file that is not there: an input error naming it, 1).
   EXPECT_EQ(Texlume("synth" + inputs + " --model a --out " + (tmp / "bad").string(), &out), 2);
-  EXPECT_NE(out.find("--model"), std::string::npos) << out;
+  EXPECT_NE(out.find("--model, --images and --lights"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth" + inputs + " --top-k 3 --out " + (tmp / "bad").string(), &out), 2);
+  EXPECT_NE(out.find("--top-k is for --engine graphcut with photos"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth" + inputs + " --model " + scene + "/object/sparse --images " + scene +
+                        "/object/images --lights " + (tmp / "no_lights.json").string() + " --out " +
+                        (tmp / "bad").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("no_lights.json"), std::string::npos) << out;
   EXPECT_EQ(Texlume("synth --engine graphcut --mesh m --sample s --out o", &out), 2);
   EXPECT_NE(out.find("sample-texel-size"), std::string::npos) << out;
   EXPECT_EQ(Texlume("synth" + inputs + " --engine quilting --out o", &out), 2);

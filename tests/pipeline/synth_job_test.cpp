@@ -23,6 +23,7 @@
 #include "model/baselines.h"
 #include "model/model_io.h"
 #include "model/web_model.h"
+#include "pipeline/quilt_job.h"
 #include "pipeline/render_job.h"
 #include "pipeline/report_pictures.h"
 #include "ptm/coefficient_space.h"
@@ -400,6 +401,45 @@ TEST_F(MeshPipelineTest, GraphCutFillQuiltsOnlyTheFacesNoPhotoPlaced) {
       nlohmann::json::parse(testing::ReadText(tmp_->path() / "model_fill/manifest.json"));
   EXPECT_EQ(manifest["settings"]["fill_unseen"], "graphcut");
   EXPECT_EQ(manifest["summary"]["unseen_fill"]["faces"].get<std::size_t>(), fill.unseen_fill.faces);
+}
+
+// The graph-cut engine following the photos (quilt/image_term.h): the photos
+// are calibrated against the sample, most patches are placed among the
+// photos' best placements, and the model folder and report record it.
+TEST_F(MeshPipelineTest, GraphCutEngineFollowsThePhotos) {
+  pipeline::QuiltJobOptions q;
+  q.model_dir = job_->model_dir;
+  q.images_dir = job_->images_dir;
+  q.lights_file = job_->lights_file;
+  q.mesh_file = job_->mesh_file;
+  q.sample_file = job_->sample_file;
+  q.sample_texel_size = 0.008;  // 4 texels of the sample's own: a fast run
+  q.out_dir = tmp_->path() / "graphcut_photos";
+  q.atlas.atlas_size = 512;
+  const pipeline::QuiltJobSummary s = pipeline::RunQuiltJob(q);
+  std::printf("graph-cut with photos: %zu patches, %zu placed by the photos, %.1f s\n",
+              s.stats.patches, s.stats.photo_patches, s.seconds_total);
+  EXPECT_EQ(s.photos_used, 12u);
+  EXPECT_GT(s.stats.photo_patches, s.stats.patches / 2);
+  EXPECT_LE(s.stats.photo_patches, s.stats.patches);
+  const fs::path out = tmp_->path() / "graphcut_photos";
+  const nlohmann::json manifest = nlohmann::json::parse(testing::ReadText(out / "manifest.json"));
+  EXPECT_EQ(manifest["inputs"]["model"], job_->model_dir.string());
+  EXPECT_EQ(manifest["settings"]["photos"]["top_k"].get<int>(), 12);
+  EXPECT_EQ(manifest["summary"]["patches_placed_by_photos"].get<std::size_t>(),
+            s.stats.photo_patches);
+  EXPECT_EQ(manifest["summary"]["photos"]["photo_gains"].size(), 12u);
+  EXPECT_TRUE(manifest["timings_s"].contains("photo_calibration"));
+  // The report compares the model with the photos, and every picture it links exists.
+  const std::string html = testing::ReadText(out / "report.html");
+  EXPECT_NE(html.find("Photo views"), std::string::npos);
+  for (const std::string& link : testing::ReportLinks(html))
+    EXPECT_TRUE(fs::exists(out / link)) << link;
+  // Photos need all three inputs.
+  q.lights_file.clear();
+  q.out_dir = tmp_->path() / "graphcut_bad";
+  EXPECT_THROW(pipeline::RunQuiltJob(q), OptionError);
+  EXPECT_FALSE(fs::exists(q.out_dir));
 }
 
 // What each pass (detail transfer, the photo-consistency prior's shrink) adds under
