@@ -5,6 +5,7 @@
 #include <cmath>
 #include <complex>
 #include <deque>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <queue>
@@ -23,96 +24,6 @@ namespace {
 
 std::int64_t Key(int x, int y) {
   return (static_cast<std::int64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
-}
-
-/// Least-squares conformal map of the faces (texel units): per face the chart
-/// coordinates of its corners, or false when the system is singular. The
-/// energy is, per face T of area A_T, A_T |grad u - R90 grad v|^2, zero exactly
-/// when the map satisfies the Cauchy-Riemann equations u_x = v_y, u_y = -v_x
-/// (Lévy et al. 2002, eq. 3), with two vertices pinned far apart.
-bool Lscm(const mesh::TriangleMesh& mesh, const std::vector<synth::TrianglePatch>& patches,
-          const std::vector<int>& faces, double t, std::vector<Corners>* uv) {
-  std::unordered_map<int, int> local;
-  std::vector<int> vertex_of_local;
-  for (const int f : faces)
-    for (const int v : mesh.faces[static_cast<std::size_t>(f)])
-      if (local.emplace(v, static_cast<int>(vertex_of_local.size())).second)
-        vertex_of_local.push_back(v);
-  const int n = static_cast<int>(vertex_of_local.size());
-  // Pins: the vertex farthest from the first, and the one farthest from it.
-  auto point = [&](int l) {
-    return mesh.vertices[static_cast<std::size_t>(vertex_of_local[static_cast<std::size_t>(l)])];
-  };
-  auto farthest_from = [&](int l0) {
-    int best = l0;
-    double d_best = -1;
-    for (int l = 0; l < n; ++l) {
-      const double d = (point(l) - point(l0)).squaredNorm();
-      if (d > d_best) d_best = d, best = l;
-    }
-    return best;
-  };
-  const int pin_a = farthest_from(0);
-  const int pin_b = farthest_from(pin_a);
-  if (pin_a == pin_b) return false;
-  const Eigen::Vector2d pin_a_uv(0.0, 0.0);
-  const Eigen::Vector2d pin_b_uv((point(pin_b) - point(pin_a)).norm() / t, 0.0);
-  // Unknowns: u then v of every free vertex.
-  std::vector<int> column(static_cast<std::size_t>(n), -1);
-  int num_free = 0;
-  for (int l = 0; l < n; ++l)
-    if (l != pin_a && l != pin_b) column[static_cast<std::size_t>(l)] = num_free++;
-  std::vector<Eigen::Triplet<double>> entries;
-  std::vector<double> rhs;
-  const int rows = 2 * static_cast<int>(faces.size());
-  rhs.assign(static_cast<std::size_t>(rows), 0.0);
-  for (std::size_t i = 0; i < faces.size(); ++i) {
-    const int f = faces[i];
-    const Corners c = FrameCornersTexels(patches[static_cast<std::size_t>(f)], t);
-    const double twice_area = Cross(c[1] - c[0], c[2] - c[0]);
-    if (!(twice_area > 1e-12)) continue;  // degenerate: no conformal constraint
-    const double s = std::sqrt(0.5 * twice_area);
-    const int r1 = 2 * static_cast<int>(i), r2 = r1 + 1;
-    for (std::size_t k = 0; k < 3; ++k) {
-      // grad phi_k = R90(e_k) / (2A), e_k the edge opposite corner k (counter-clockwise).
-      const Eigen::Vector2d e = c[(k + 2) % 3] - c[(k + 1) % 3];
-      const double gx = -e.y() / twice_area, gy = e.x() / twice_area;
-      const int l = local.at(mesh.faces[static_cast<std::size_t>(f)][k]);
-      // r1 = s (u_x - v_y), r2 = s (u_y + v_x).
-      const double cu1 = s * gx, cv1 = -s * gy, cu2 = s * gy, cv2 = s * gx;
-      const int col = column[static_cast<std::size_t>(l)];
-      if (col >= 0) {
-        entries.emplace_back(r1, col, cu1);
-        entries.emplace_back(r1, num_free + col, cv1);
-        entries.emplace_back(r2, col, cu2);
-        entries.emplace_back(r2, num_free + col, cv2);
-      } else {
-        const Eigen::Vector2d& p = l == pin_a ? pin_a_uv : pin_b_uv;
-        rhs[static_cast<std::size_t>(r1)] -= cu1 * p.x() + cv1 * p.y();
-        rhs[static_cast<std::size_t>(r2)] -= cu2 * p.x() + cv2 * p.y();
-      }
-    }
-  }
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(2 * num_free);
-  if (num_free > 0) {
-    Eigen::SparseMatrix<double> a(rows, 2 * num_free);
-    a.setFromTriplets(entries.begin(), entries.end());
-    const Eigen::Map<const Eigen::VectorXd> b(rhs.data(), rows);
-    const Eigen::SparseMatrix<double> normal = a.transpose() * a;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
-    if (solver.info() != Eigen::Success) return false;
-    x = solver.solve(a.transpose() * b);
-    if (solver.info() != Eigen::Success || !x.allFinite()) return false;
-  }
-  uv->assign(faces.size(), Corners{});
-  for (std::size_t i = 0; i < faces.size(); ++i)
-    for (std::size_t k = 0; k < 3; ++k) {
-      const int l = local.at(mesh.faces[static_cast<std::size_t>(faces[i])][k]);
-      const int col = column[static_cast<std::size_t>(l)];
-      (*uv)[i][k] = col >= 0 ? Eigen::Vector2d(x[col], x[num_free + col])
-                             : (l == pin_a ? pin_a_uv : pin_b_uv);
-    }
-  return true;
 }
 
 /// Whether a flattening is usable: no flipped face, the chart's texel box
@@ -196,6 +107,92 @@ std::vector<std::vector<int>> ConnectedParts(
 }
 
 }  // namespace
+
+bool LeastSquaresConformalMap(const mesh::TriangleMesh& mesh,
+                              const std::function<Corners(int face)>& corners_texels,
+                              const std::vector<int>& faces, double t, std::vector<Corners>* uv) {
+  std::unordered_map<int, int> local;
+  std::vector<int> vertex_of_local;
+  for (const int f : faces)
+    for (const int v : mesh.faces[static_cast<std::size_t>(f)])
+      if (local.emplace(v, static_cast<int>(vertex_of_local.size())).second)
+        vertex_of_local.push_back(v);
+  const int n = static_cast<int>(vertex_of_local.size());
+  // Pins: the vertex farthest from the first, and the one farthest from it.
+  auto point = [&](int l) {
+    return mesh.vertices[static_cast<std::size_t>(vertex_of_local[static_cast<std::size_t>(l)])];
+  };
+  auto farthest_from = [&](int l0) {
+    int best = l0;
+    double d_best = -1;
+    for (int l = 0; l < n; ++l) {
+      const double d = (point(l) - point(l0)).squaredNorm();
+      if (d > d_best) d_best = d, best = l;
+    }
+    return best;
+  };
+  const int pin_a = farthest_from(0);
+  const int pin_b = farthest_from(pin_a);
+  if (pin_a == pin_b) return false;
+  const Eigen::Vector2d pin_a_uv(0.0, 0.0);
+  const Eigen::Vector2d pin_b_uv((point(pin_b) - point(pin_a)).norm() / t, 0.0);
+  // Unknowns: u then v of every free vertex.
+  std::vector<int> column(static_cast<std::size_t>(n), -1);
+  int num_free = 0;
+  for (int l = 0; l < n; ++l)
+    if (l != pin_a && l != pin_b) column[static_cast<std::size_t>(l)] = num_free++;
+  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<double> rhs;
+  const int rows = 2 * static_cast<int>(faces.size());
+  rhs.assign(static_cast<std::size_t>(rows), 0.0);
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const int f = faces[i];
+    const Corners c = corners_texels(f);
+    const double twice_area = Cross(c[1] - c[0], c[2] - c[0]);
+    if (!(twice_area > 1e-12)) continue;  // degenerate: no conformal constraint
+    const double s = std::sqrt(0.5 * twice_area);
+    const int r1 = 2 * static_cast<int>(i), r2 = r1 + 1;
+    for (std::size_t k = 0; k < 3; ++k) {
+      // grad phi_k = R90(e_k) / (2A), e_k the edge opposite corner k (counter-clockwise).
+      const Eigen::Vector2d e = c[(k + 2) % 3] - c[(k + 1) % 3];
+      const double gx = -e.y() / twice_area, gy = e.x() / twice_area;
+      const int l = local.at(mesh.faces[static_cast<std::size_t>(f)][k]);
+      // r1 = s (u_x - v_y), r2 = s (u_y + v_x).
+      const double cu1 = s * gx, cv1 = -s * gy, cu2 = s * gy, cv2 = s * gx;
+      const int col = column[static_cast<std::size_t>(l)];
+      if (col >= 0) {
+        entries.emplace_back(r1, col, cu1);
+        entries.emplace_back(r1, num_free + col, cv1);
+        entries.emplace_back(r2, col, cu2);
+        entries.emplace_back(r2, num_free + col, cv2);
+      } else {
+        const Eigen::Vector2d& p = l == pin_a ? pin_a_uv : pin_b_uv;
+        rhs[static_cast<std::size_t>(r1)] -= cu1 * p.x() + cv1 * p.y();
+        rhs[static_cast<std::size_t>(r2)] -= cu2 * p.x() + cv2 * p.y();
+      }
+    }
+  }
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(2 * num_free);
+  if (num_free > 0) {
+    Eigen::SparseMatrix<double> a(rows, 2 * num_free);
+    a.setFromTriplets(entries.begin(), entries.end());
+    const Eigen::Map<const Eigen::VectorXd> b(rhs.data(), rows);
+    const Eigen::SparseMatrix<double> normal = a.transpose() * a;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
+    if (solver.info() != Eigen::Success) return false;
+    x = solver.solve(a.transpose() * b);
+    if (solver.info() != Eigen::Success || !x.allFinite()) return false;
+  }
+  uv->assign(faces.size(), Corners{});
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const int l = local.at(mesh.faces[static_cast<std::size_t>(faces[i])][k]);
+      const int col = column[static_cast<std::size_t>(l)];
+      (*uv)[i][k] = col >= 0 ? Eigen::Vector2d(x[col], x[num_free + col])
+                             : (l == pin_a ? pin_a_uv : pin_b_uv);
+    }
+  return true;
+}
 
 namespace {
 
@@ -448,7 +445,11 @@ std::vector<std::vector<ChartFace>> MakeConformalCharts(
     work.pop_front();
     std::vector<Corners> uv;
     if (faces.size() == 1 ||
-        (Lscm(mesh, patches, faces, t, &uv) && ScaleAndCheck(patches, faces, t, options, uv))) {
+        (LeastSquaresConformalMap(
+             mesh,
+             [&](int f) { return FrameCornersTexels(patches[static_cast<std::size_t>(f)], t); },
+             faces, t, &uv) &&
+         ScaleAndCheck(patches, faces, t, options, uv))) {
       std::vector<ChartFace> chart;
       for (std::size_t i = 0; i < faces.size(); ++i) {
         const Corners c = FrameCornersTexels(patches[static_cast<std::size_t>(faces[i])], t);

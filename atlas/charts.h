@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "mesh/mesh.h"
@@ -74,6 +75,18 @@ std::vector<std::vector<ChartFace>> MakeConformalCharts(
     const mesh::TriangleMesh& mesh, const std::vector<synth::TrianglePatch>& patches,
     const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
     const ConformalChartOptions& options, ConformalChartStats* stats = nullptr);
+
+/// The least-squares conformal map (LSCM, Lévy et al. 2002, eq. 3) of a
+/// connected set of faces, in texels of `texel_size` world units (y up): per
+/// face, its corners' chart coordinates. `corners_texels(f)`: face f's corners
+/// in its triangle frame, texels (chart_parts::FrameCornersTexels). Two
+/// vertices far apart are pinned at their distance in the world, so the map's
+/// scale is near 1. False when the system is singular.
+bool LeastSquaresConformalMap(
+    const mesh::TriangleMesh& mesh,
+    const std::function<std::array<Eigen::Vector2d, 3>(int face)>& corners_texels,
+    const std::vector<int>& faces, double texel_size,
+    std::vector<std::array<Eigen::Vector2d, 3>>* corners_uv);
 
 /// Which edge of a strip's seed face lies on the band line (after preferring
 /// one along the charted region or the mesh border).

@@ -123,7 +123,7 @@ Quilted QuiltMesh(const mesh::TriangleMesh& mesh, const synth::PtmSample& sample
   o.flattening = atlas::ChartFlattening::kConformal;
   const atlas::AtlasLayout layout = atlas::LayoutAtlases(mesh, g.patches, g.unfoldings, texel, o);
   const quilt::DenseSurface surface =
-      quilt::DenseSurface::Build(layout, g.patches, g.unfoldings, texel);
+      quilt::DenseSurface::Build(mesh, layout, g.patches, g.unfoldings, texel);
   Quilted out;
   out.samples = surface.size();
   out.charts = layout.num_charts;
@@ -159,17 +159,21 @@ void QuiltMeshes(const synth::PtmSample& sample, int levels, double texel) {
       {"two spheres (disconnected)", datasets::JoinMeshes(sphere, apart)},
       {"crossed planes (non-manifold)", datasets::MakeCrossedPlanes(16, 0.8)},
       {"scan-like (irregular, lumpy)", datasets::MakeScanLikeMesh(6, 0.5, 0.1, 1)}};
-  for (const auto& [name, mesh] : meshes) {
-    quilt::QuiltOptions q;
-    q.work_patch_levels = levels;
-    const auto t0 = std::chrono::steady_clock::now();
-    const Quilted run = QuiltMesh(mesh, sample, texel, q);
-    const quilt::QuiltStats& st = run.result.stats;
-    std::printf("| %s | %zu | %zu | %zu | %zu | %d | %zu | %zu | %zu | %.2f | %.4f | %.1f |\n",
-                name, mesh.faces.size(), run.samples, run.texels_inside, run.synthesised,
-                run.charts, run.links_across_charts, st.patches, st.forced, quilt::SeamShare(st),
-                AtlasEnergy(run.atlases.ptms, run.atlases.coverage, rotated), Seconds(t0));
-  }
+  for (const auto& [name, mesh] : meshes)
+    for (const bool conformal : {true, false}) {
+      quilt::QuiltOptions q;
+      q.work_patch_levels = levels;
+      q.conformal_work_images = conformal;
+      const auto t0 = std::chrono::steady_clock::now();
+      const Quilted run = QuiltMesh(mesh, sample, texel, q);
+      const quilt::QuiltStats& st = run.result.stats;
+      std::printf("| %s%s | %zu | %zu | %zu | %zu | %d | %zu | %zu | %zu | %.2f | %.4f | %.1f |\n",
+                  name, conformal ? "" : ", rigid chart maps", mesh.faces.size(), run.samples,
+                  run.texels_inside, run.synthesised, run.charts, run.links_across_charts,
+                  st.patches, st.forced, quilt::SeamShare(st),
+                  AtlasEnergy(run.atlases.ptms, run.atlases.coverage, rotated), Seconds(t0));
+      std::fflush(stdout);
+    }
 }
 
 // Per face of the icosphere, the world's z axis laid onto it (x near the poles):
@@ -237,17 +241,19 @@ void QuiltSphere(const ptm::Ptm& sample_ptm, int levels, double texel, const cha
       "| | patches | ms per patch | s | forced | seam cost / unrelated cut | sample reused "
       "| nearest-patch energy |\n|---|---|---|---|---|---|---|---|\n");
   std::string accepted;
-  for (const int run_kind : {0, 1, 2}) {
+  for (const int run_kind : {0, 1, 3, 2}) {
     const bool random = run_kind == 2;
     quilt::QuiltOptions q;
     q.work_patch_levels = levels;
     q.random_placement = random;
     q.keep_old_seams = run_kind != 1;
+    q.conformal_work_images = run_kind != 3;
     const Quilted run = QuiltIcosphere(sample, 3, texel, q);
     const quilt::QuiltStats& s = run.result.stats;
     std::printf("| %s | %zu | %.1f | %.2f | %zu | %.2f | %.2f | %.4f |\n",
                 run_kind == 0   ? "graph-cut quilting"
                 : run_kind == 1 ? "graph-cut, old seams not kept"
+                : run_kind == 3 ? "graph-cut, rigid chart maps across charts"
                                 : "random placement",
                 s.patches, 1000 * s.seconds / std::max<std::size_t>(s.patches, 1), s.seconds,
                 s.forced, quilt::SeamShare(s),

@@ -273,8 +273,8 @@ class QuiltJob {
                                          options_.field_direction_in_world);
     layout_ = atlas::LayoutAtlases(mesh_, geometry_.patches, geometry_.unfoldings, texel_size_,
                                    options_.atlas, progress_);
-    surface_ =
-        quilt::DenseSurface::Build(layout_, geometry_.patches, geometry_.unfoldings, texel_size_);
+    surface_ = quilt::DenseSurface::Build(mesh_, layout_, geometry_.patches, geometry_.unfoldings,
+                                          texel_size_);
     summary_.samples = surface_.size();
     summary_.links = surface_.links();
     summary_.chart_seam_links = surface_.chart_seam_links();

@@ -5,6 +5,9 @@
 #include <numeric>
 #include <utility>
 
+#include "atlas/chart_parts.h"
+#include "atlas/charts.h"
+
 namespace texlume::quilt {
 
 // Builds a DenseSurface in three steps: the samples, the links inside charts,
@@ -154,11 +157,33 @@ class DenseSurfaceBuilder {
   std::vector<std::pair<int, int>> edges_;
 };
 
-DenseSurface DenseSurface::Build(const atlas::AtlasLayout& layout,
+DenseSurface DenseSurface::Build(const mesh::TriangleMesh& mesh, const atlas::AtlasLayout& layout,
                                  const std::vector<synth::TrianglePatch>& patches,
                                  const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
                                  double texel_size) {
-  return DenseSurfaceBuilder(layout, patches, unfoldings, texel_size).Build();
+  DenseSurface surface = DenseSurfaceBuilder(layout, patches, unfoldings, texel_size).Build();
+  surface.mesh_ = mesh;
+  for (const synth::TrianglePatch& patch : patches)
+    surface.corners_texels_.push_back(atlas::chart_parts::FrameCornersTexels(patch, texel_size));
+  return surface;
+}
+
+bool DenseSurface::ConformalMap(
+    const std::vector<int>& faces,
+    std::vector<std::pair<Eigen::Matrix2d, Eigen::Vector2d>>* frame_to_chart) const {
+  std::vector<atlas::chart_parts::Corners> uv;
+  if (!atlas::LeastSquaresConformalMap(
+          mesh_, [&](int f) { return corners_texels_[static_cast<std::size_t>(f)]; }, faces,
+          texel_size_, &uv))
+    return false;
+  frame_to_chart->clear();
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const atlas::ChartFace map = atlas::chart_parts::AffineBetween(
+        faces[i], corners_texels_[static_cast<std::size_t>(faces[i])], uv[i]);
+    if (!map.linear.allFinite() || !(map.linear.determinant() > 0)) return false;
+    frame_to_chart->emplace_back(map.linear, map.translation);
+  }
+  return true;
 }
 
 std::span<const int> DenseSurface::Neighbours(int s) const {

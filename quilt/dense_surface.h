@@ -39,9 +39,10 @@ double QuiltingBytes(const mesh::TriangleMesh& mesh, double texel_size, int feat
 class DenseSurface {
  public:
   /// Samples every texel inside a face of `layout` (atlas::VisitAtlasTexels,
-  /// the first face wins on a shared edge) and links them. `patches` and
-  /// `unfoldings` are those the layout was made from (synth::PatchGeometry).
-  static DenseSurface Build(const atlas::AtlasLayout& layout,
+  /// the first face wins on a shared edge) and links them. `mesh`, `patches`
+  /// and `unfoldings` are those the layout was made from (synth::PatchGeometry);
+  /// the surface keeps the mesh and the faces' corners (ConformalMap).
+  static DenseSurface Build(const mesh::TriangleMesh& mesh, const atlas::AtlasLayout& layout,
                             const std::vector<synth::TrianglePatch>& patches,
                             const std::vector<std::array<synth::Unfolding, 3>>& unfoldings,
                             double texel_size);
@@ -59,6 +60,11 @@ class DenseSurface {
     return frames_[static_cast<std::size_t>(face)];
   }
   double texel_size() const { return texel_size_; }
+  /// The least-squares conformal map of connected faces (atlas::
+  /// LeastSquaresConformalMap): per face, the map from its frame (texels) into
+  /// the chart (texels, y up); false when it has none.
+  bool ConformalMap(const std::vector<int>& faces,
+                    std::vector<std::pair<Eigen::Matrix2d, Eigen::Vector2d>>* frame_to_chart) const;
 
   std::size_t links() const { return adjacency_.size() / 2; }
   std::size_t chart_seam_links() const { return chart_seam_links_; }
@@ -70,6 +76,8 @@ class DenseSurface {
   friend class DenseSurfaceBuilder;
 
   std::vector<mesh::TriangleFrame> frames_;  ///< per face
+  mesh::TriangleMesh mesh_;
+  std::vector<std::array<Eigen::Vector2d, 3>> corners_texels_;  ///< per face, in its frame
   double texel_size_ = 0;
   std::vector<DenseSample> samples_;
   std::vector<cv::Mat> index_;  ///< per atlas, CV_32SC1: sample or -1

@@ -53,14 +53,15 @@ PatchImageTerm::Score PhotoImageTerm::Placements(int seed,
                                                  cv::Size work_size, int rotation,
                                                  const RotatedSample& rotated) {
   Score score;
-  const std::vector<View> views = ViewsOf(surface_.samples()[static_cast<std::size_t>(seed)].face);
+  const int face = surface_.samples()[static_cast<std::size_t>(seed)].face;
+  const std::vector<View> views = ViewsOf(face);
   for (const View& view : views) {
     std::vector<cv::Mat> photo;
     cv::Mat mask;
     const int count = PhotoPlanes(view, samples, work_size, photo, mask);
     const double r2 = view.px_per_texel * view.px_per_texel;
     if (count * std::min(r2, 1.0) < options_.min_photo_pixels) continue;
-    const std::vector<cv::Mat>& relit = RelitCopy(seed, view, rotation, rotated);
+    const std::vector<cv::Mat>& relit = RelitCopy(face, view, rotation, rotated);
     const Relit& cached = relit_.at(view.photo);
     if (score.rms.empty()) {
       const int side = rotated.side();
@@ -113,7 +114,7 @@ int PhotoImageTerm::PhotoPlanes(const View& view, const std::vector<WorkImageSam
     const int face = surface_.samples()[static_cast<std::size_t>(w.sample)].face;
     auto it = seen.find(face);
     if (it == seen.end()) it = seen.emplace(face, SeesFully(view.photo, face)).first;
-    if (!it->second || mask.at<float>(w.y, w.x) > 0) continue;
+    if (w.synthesised || !it->second || mask.at<float>(w.y, w.x) > 0) continue;
     const auto px = photos_.reconstruction.Project(image, surface_.PointInWorld(w.sample));
     float rgb[3];
     if (!px || !PhotoAt(photo.image, *px, rgb)) continue;
@@ -131,8 +132,7 @@ int PhotoImageTerm::PhotoPlanes(const View& view, const std::vector<WorkImageSam
   return count;
 }
 
-synth::FaceLighting PhotoImageTerm::LightingOf(int seed, const View& view, double copy_rad) const {
-  const int face = surface_.samples()[static_cast<std::size_t>(seed)].face;
+synth::FaceLighting PhotoImageTerm::LightingOf(int face, const View& view, double copy_rad) const {
   const AtlasAxes axes = AtlasAxesOf(surface_, layout_, face);
   const auto in_work = [&](const Eigen::Vector3d& d) {
     return TurnedBack(Eigen::Vector3d(d.dot(axes.x), d.dot(axes.y), d.dot(axes.normal)), copy_rad);
@@ -148,16 +148,15 @@ synth::FaceLighting PhotoImageTerm::LightingOf(int seed, const View& view, doubl
   return lighting;
 }
 
-const std::vector<cv::Mat>& PhotoImageTerm::RelitCopy(int seed, const View& view, int rotation,
+const std::vector<cv::Mat>& PhotoImageTerm::RelitCopy(int face, const View& view, int rotation,
                                                       const RotatedSample& rotated) {
-  const int face = surface_.samples()[static_cast<std::size_t>(seed)].face;
   Relit& relit = relit_[view.photo];
   if (relit.face == face && relit.rotation == rotation) return relit.planes;
   const double gain =
       photos_.photometry.photo_gains.empty() ? 1.0 : photos_.photometry.photo_gains[view.photo];
   relit.planes = rotated.TurnPlanes(
       rotation, sample_.Relight(sample_.Reduced(0),
-                                LightingOf(seed, view, RotatedSample::AngleOf(rotation)), gain));
+                                LightingOf(face, view, RotatedSample::AngleOf(rotation)), gain));
   // The photo's resolution and blur (photo pixels) in texels.
   const double blur_px =
       photos_.photometry.photo_blur.empty() ? 0.0 : photos_.photometry.photo_blur[view.photo];

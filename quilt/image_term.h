@@ -16,8 +16,9 @@
 // Paper 003's image term on the graph-cut engine's work patches (issue 32,
 // beyond paper 004; docs/quilting.md, "Following the photos"): the sample,
 // relit under a photo's lights and seen through the photo's resolution and
-// blur, against the photo at every placement of the rotated copy (eq. 3,
-// RMS per photo, summed over the photos that see the seed's face fully).
+// blur, against the photo over the samples the patch is to synthesise at every
+// placement of the rotated copy (eq. 3, RMS per photo, summed over the photos
+// that see the seed's face fully).
 
 namespace texlume::quilt {
 
@@ -32,14 +33,17 @@ struct PhotoEvidence {
 };
 
 struct ImageTermOptions {
-  bool all_views = true;     ///< every photo that sees the seed's face fully, not only the best
+  bool all_views = true;     ///< every photo that sees the seed's face fully, not the best only
   int max_views = 4;         ///< most photos per patch
-  int min_photo_pixels = 6;  ///< fewest photo pixels over the work patch for a photo to count
+  int min_photo_pixels = 6;  ///< fewest photo pixels over the samples to synthesise, per photo
 };
 
 /// The image term of a work patch. Inside the patch the lighting is the seed
-/// face's (paper 003 takes one lighting per triangle too); each sample's photo
-/// value is the photo where the sample projects, on faces the photo sees fully.
+/// face's (paper 003 takes one lighting per triangle too; the face holding
+/// most of the samples to synthesise did no better: docs/quilting.md).
+/// Each sample the patch is to synthesise is compared with the photo where it projects, on
+/// faces the photo sees fully; samples already synthesised are not (the cut
+/// mostly keeps them).
 class PhotoImageTerm : public PatchImageTerm {
  public:
   PhotoImageTerm(const DenseSurface& surface, const atlas::AtlasLayout& layout,
@@ -54,17 +58,18 @@ class PhotoImageTerm : public PatchImageTerm {
     std::size_t photo = 0;
     double px_per_texel = 1.0;  ///< the photo's density over the seed's face
   };
-  // The photos that see the seed's face fully, best first.
+  // The photos that see a face fully, best first.
   std::vector<View> ViewsOf(int face) const;
   // The photo at every work sample whose face it sees fully (sample domain,
   // white balance taken out); returns the pixels set in `mask`.
   int PhotoPlanes(const View& view, const std::vector<WorkImageSample>& samples, cv::Size work_size,
                   std::vector<cv::Mat>& planes, cv::Mat& mask) const;
-  // The seed's lighting in the photo, in the sample's own frame once the copy
-  // turns it by `copy_rad` within the work frame.
-  synth::FaceLighting LightingOf(int seed, const View& view, double copy_rad) const;
-  // The copy relit under the view's lighting at the seed, blurred as the photo sees it.
-  const std::vector<cv::Mat>& RelitCopy(int seed, const View& view, int rotation,
+  // The seed face's lighting in the photo (its atlas frame is the work
+  // frame), in the sample's own frame once the copy turns it
+  // by `copy_rad` within the work frame.
+  synth::FaceLighting LightingOf(int face, const View& view, double copy_rad) const;
+  // The copy relit under the view's lighting of a face, blurred as the photo sees it.
+  const std::vector<cv::Mat>& RelitCopy(int face, const View& view, int rotation,
                                         const RotatedSample& rotated);
   bool SeesFully(std::size_t photo, int face) const;
 

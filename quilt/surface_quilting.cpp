@@ -251,8 +251,41 @@ class SurfaceQuilter {
         }
       frontier.swap(next);
     }
+    if (chart_maps.size() > 1 && options_.conformal_work_images) FlattenConformally(patch);
     patch.fits = FrameWorkImage(patch);
     patch.distortion = AreaDistortion(patch);
+  }
+
+  // The paper's work image for a patch across charts: the least-squares
+  // conformal map of the faces under it (Lévy et al. 2002), each sample placed
+  // by its face's map, the seed at the origin. The charts' rigid maps stay
+  // when the faces have no such map.
+  void FlattenConformally(WorkPatch& patch) const {
+    std::vector<int> faces;
+    std::unordered_map<int, std::size_t> index;  // face -> in faces
+    for (const PatchSample& p : patch.samples) {
+      const int f = surface_.samples()[static_cast<std::size_t>(p.sample)].face;
+      if (index.emplace(f, faces.size()).second) faces.push_back(f);
+    }
+    std::vector<std::pair<Eigen::Matrix2d, Eigen::Vector2d>> maps;  // frame -> chart, texels
+    if (!surface_.ConformalMap(faces, &maps)) return;
+    const double t = surface_.texel_size();
+    const auto chart_px = [&](const PatchSample& p) {
+      const DenseSample& d = surface_.samples()[static_cast<std::size_t>(p.sample)];
+      const auto& [linear, translation] = maps[index.at(d.face)];
+      const Eigen::Vector2d q = linear * (d.p_in_frame / t) + translation;
+      return Eigen::Vector2d(q.x(), -q.y());  // rows down
+    };
+    const Eigen::Vector2d seed = chart_px(patch.samples[0]);
+    for (PatchSample& p : patch.samples) {
+      const DenseSample& d = surface_.samples()[static_cast<std::size_t>(p.sample)];
+      const Eigen::Matrix2d& linear = maps[index.at(d.face)].first;
+      p.w = chart_px(p) - seed;
+      // The atlas frame's x axis lies at AtlasFrameAngle in the face frame; the
+      // map turns the face frame by the angle of its first column.
+      p.chart_to_work_rad = layout_.faces[static_cast<std::size_t>(d.face)].AtlasFrameAngle() +
+                            std::atan2(linear(1, 0), linear(0, 0));
+    }
   }
 
   static Eigen::Vector2d Centre(const DenseSample& d) { return {d.x + 0.5, d.y + 0.5}; }
@@ -411,7 +444,7 @@ class SurfaceQuilter {
     samples.reserve(patch.samples.size());
     for (const PatchSample& p : patch.samples) {
       const auto [x, y] = Pixel(patch, p);
-      samples.push_back({p.sample, x, y});
+      samples.push_back({p.sample, x, y, Synthesised(p.sample)});
     }
     return samples;
   }

@@ -28,6 +28,10 @@ struct QuiltOptions {
   /// summed squared link lengths in the work image over those on the surface,
   /// either way round.
   double max_area_distortion = 4.0;
+  /// A work patch across charts is flattened by the least-squares conformal
+  /// map of the faces under it (the paper); false: the charts' rigid maps
+  /// chained across their borders (an ablation).
+  bool conformal_work_images = true;
   /// T_c: largest mean seam cost per cut link, as a fraction of the cost of a
   /// cut between two unrelated sample texels (the sample's own feature spread).
   double seam_threshold = 0.6;
@@ -104,6 +108,7 @@ AtlasAxes AtlasAxesOf(const DenseSurface& surface, const atlas::AtlasLayout& lay
 struct WorkImageSample {
   int sample = 0;
   int x = 0, y = 0;
+  bool synthesised = false;  ///< before this patch (given, or an earlier patch's)
 };
 
 /// Paper 003's image term (eq. 3) on a work patch, beyond paper 004: how far

@@ -91,8 +91,8 @@ std::shared_ptr<const UnseenQuilt> QuiltUnseenFaces(const mesh::TriangleMesh& me
   if (summary.faces == 0) return nullptr;
   atlas::AtlasLayout layout = atlas::LayoutAtlases(mesh, synthesis.patches, synthesis.unfoldings,
                                                    synthesis.texel_size, options.atlas, progress);
-  DenseSurface surface =
-      DenseSurface::Build(layout, synthesis.patches, synthesis.unfoldings, synthesis.texel_size);
+  DenseSurface surface = DenseSurface::Build(mesh, layout, synthesis.patches, synthesis.unfoldings,
+                                             synthesis.texel_size);
   const GivenSamples given = GivenFromPhotoFaces(surface, layout, synthesis, sample, features_of);
   QuiltResult quilt = QuiltSurface(surface, layout, sample, options.quilt, progress, &given);
   summary.stats = quilt.stats;

@@ -26,7 +26,7 @@ Dense MakeDense(const mesh::TriangleMesh& mesh, double texel, atlas::AtlasMode m
   o.atlas_size = 1024;
   o.max_chart_size = 256;
   d.layout = atlas::LayoutAtlases(mesh, d.geometry.patches, d.geometry.unfoldings, texel, o);
-  d.surface = DenseSurface::Build(d.layout, d.geometry.patches, d.geometry.unfoldings, texel);
+  d.surface = DenseSurface::Build(mesh, d.layout, d.geometry.patches, d.geometry.unfoldings, texel);
   return d;
 }
 

@@ -31,7 +31,7 @@ Surface MakeSurface(const mesh::TriangleMesh& mesh, double texel, atlas::AtlasMo
   o.flattening = atlas::ChartFlattening::kRigid;
   o.atlas_size = 512;
   s.layout = atlas::LayoutAtlases(mesh, s.geometry.patches, s.geometry.unfoldings, texel, o);
-  s.dense = DenseSurface::Build(s.layout, s.geometry.patches, s.geometry.unfoldings, texel);
+  s.dense = DenseSurface::Build(mesh, s.layout, s.geometry.patches, s.geometry.unfoldings, texel);
   return s;
 }
 
@@ -97,20 +97,24 @@ TEST(QuiltSurface, OnePatchCopiesTheSampleInOnePiece) {
 }
 
 // Per-triangle boxes make every face a chart: one patch still runs across
-// their borders as across texels inside them (the charts' rigid maps).
+// their borders as across texels inside them, whether its work image is the
+// conformal map of its faces (the paper) or the charts' rigid maps chained.
 TEST(QuiltSurface, OnePatchRunsOnAcrossChartBorders) {
   const ptm::Ptm ptm = datasets::SmoothRandomPtm(64, 2);
   const synth::PtmSample sample(ptm);
   const Surface s =
       MakeSurface(datasets::MakeGridPlane(2, 0.3), 0.01, atlas::AtlasMode::kPerTriangle);
   ASSERT_GT(s.dense.chart_seam_links(), 0u);
-  QuiltOptions o;
-  o.work_patch_levels = 64;
-  const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o);
-  EXPECT_EQ(r.stats.patches, 1u);
-  EXPECT_LT(MeanLookupGap(s, r, false), 1e-4);
-  EXPECT_LT(MeanLookupGap(s, r, true), 1e-4);
-  EXPECT_LT(MeanStepError(s, r), 1e-4);
+  for (const bool conformal : {true, false}) {
+    QuiltOptions o;
+    o.work_patch_levels = 64;
+    o.conformal_work_images = conformal;
+    const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o);
+    EXPECT_EQ(r.stats.patches, 1u);
+    EXPECT_LT(MeanLookupGap(s, r, false), 1e-4) << conformal;
+    EXPECT_LT(MeanLookupGap(s, r, true), 1e-4) << conformal;
+    EXPECT_LT(MeanStepError(s, r), 1e-4) << conformal;
+  }
 }
 
 // Small patches on a closed surface: everything synthesised, by many patches
