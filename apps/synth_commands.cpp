@@ -162,6 +162,14 @@ void BindAtlas(CLI::App* sub, atlas::AtlasOptions& a, SynthWords& w) {
   sub->add_flag("--no-report", w.no_report, "do not write report.html");
 }
 
+// The frames --tangent-frame and --tangent-field ask for (`auto`: `otherwise`).
+synth::TangentFrame TangentFrameOf(const SynthWords& w, synth::TangentFrame otherwise) {
+  if (!w.tangent_field.empty()) return synth::TangentFrame::kSmoothField;
+  if (w.tangent_frame == "first-edge") return synth::TangentFrame::kFirstEdge;
+  if (w.tangent_frame == "photos") return synth::TangentFrame::kPhotos;
+  return otherwise;
+}
+
 // `--engine graphcut` with --model, --images and --lights: the photos to
 // follow and the settings that calibrate them and score placements; those
 // settings are refused without photos.
@@ -192,9 +200,7 @@ void TakePhotos(const CLI::App* sub, const SynthWords& w, const pipeline::SynthC
   e.white_balance = !w.no_white_balance;
   e.photo_blur = !w.no_photo_blur;
   e.seed = j.synthesis.seed;
-  if (w.tangent_frame == "first-edge") e.tangent_frame = synth::TangentFrame::kFirstEdge;
-  if (w.tangent_frame == "photos") e.tangent_frame = synth::TangentFrame::kPhotos;
-  if (!w.tangent_field.empty()) e.tangent_frame = synth::TangentFrame::kSmoothField;
+  e.tangent_frame = TangentFrameOf(w, e.tangent_frame);
 }
 
 // `--engine graphcut`: the quilting job's Options from the command's. What it
@@ -268,10 +274,8 @@ void Resolve(const CLI::App* sub, const SynthWords& w, const quilt::QuiltOptions
   s.photo_blur = !w.no_photo_blur;
   if (!w.prior_shrink.empty() && w.prior_shrink != "auto")
     s.correction_prior_shrink = std::stod(w.prior_shrink);
-  if (w.tangent_frame == "first-edge") s.tangent_frame = synth::TangentFrame::kFirstEdge;
-  if (w.tangent_frame == "photos") s.tangent_frame = synth::TangentFrame::kPhotos;
+  s.tangent_frame = TangentFrameOf(w, s.tangent_frame);
   if (!w.tangent_field.empty()) {
-    s.tangent_frame = synth::TangentFrame::kSmoothField;
     s.field_direction_in_world =
         Eigen::Vector3d(w.tangent_field[0], w.tangent_field[1], w.tangent_field[2]);
   }

@@ -1,6 +1,7 @@
 // Graph-cut quilting benchmarks (issue 32).
 // Run: build/bench/quilt_bench [--sample S] [--ptm FILE] [--levels R] [--texel T]
 //                               [--compare MODEL_DIR]
+//        build/bench/quilt_bench --ptm FILE --models DIR,DIR,...  (their energies only)
 // Entire-patch matching (paper 004 §III-B) by FFT against brute force: a random
 // LRGB PTM sample of S x S texels (default 256) is turned to several of the 72
 // rotations; work images of 16, 32 and 64 texels a side, half synthesised (a
@@ -76,14 +77,14 @@ double SampleReused(const quilt::QuiltResult& r, int width, int height) {
 
 // The nearest-patch energy of a model's PTM atlases against the sample.
 double AtlasEnergy(const std::vector<ptm::Ptm>& ptms, const std::vector<cv::Mat>& inside,
-                   quilt::RotatedSample& rotated) {
+                   quilt::RotatedSample& rotated, int windows_per_atlas = 192) {
   double sum = 0;
   int windows = 0;
   for (std::size_t a = 0; a < ptms.size(); ++a) {
     std::vector<cv::Mat> planes = synth::ToOrthonormalPlanes(ptms[a]);
     planes.resize(rotated.Copy(0).planes.size());  // the coefficients: the sample's features
     quilt::PatchEnergyOptions o;
-    o.windows = 192;
+    o.windows = windows_per_atlas;
     const quilt::PatchEnergy e = quilt::NearestPatchEnergy(planes, inside[a], rotated, o);
     sum += e.per_texel * e.windows;
     windows += e.windows;
@@ -288,6 +289,27 @@ void QuiltSphere(const ptm::Ptm& sample_ptm, int levels, double texel, const cha
   }
 }
 
+// The nearest-patch energy of model folders' atlases against the sample, over
+// 4 times the windows of the tables above: texlume synth's engines on one mesh
+// at one texel size.
+void ModelEnergies(const ptm::Ptm& sample_ptm, const std::string& folders) {
+  const synth::PtmSample sample(sample_ptm);
+  quilt::RotatedSample rotated(sample);
+  std::printf(
+      "| model folder | atlases | nearest-patch energy (768 windows per atlas) |\n"
+      "|---|---|---|\n");
+  std::size_t begin = 0;
+  while (begin < folders.size()) {
+    const std::size_t end = std::min(folders.find(',', begin), folders.size());
+    const std::string folder = folders.substr(begin, end - begin);
+    const model::TexturedModel m = model::ReadModelFolder(folder);
+    std::printf("| %s | %zu | %.4f |\n", folder.c_str(), m.atlases.size(),
+                AtlasEnergy(m.atlases, InsideMasks(m), rotated, 768));
+    std::fflush(stdout);
+    begin = end + 1;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -295,12 +317,18 @@ int main(int argc, char** argv) {
   double texel = 0.004;
   const char* ptm_file = nullptr;
   const char* compare = nullptr;
+  const char* models = nullptr;
   for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--models")) models = argv[i + 1];
     if (!std::strcmp(argv[i], "--sample")) side = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--ptm")) ptm_file = argv[i + 1];
     if (!std::strcmp(argv[i], "--levels")) levels = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--texel")) texel = std::atof(argv[i + 1]);
     if (!std::strcmp(argv[i], "--compare")) compare = argv[i + 1];
+  }
+  if (models && ptm_file) {
+    ModelEnergies(ptm::ReadPtmFile(ptm_file), models);
+    return 0;
   }
   const ptm::Ptm sample_ptm = RandomPtm(side, 1), work_ptm = RandomPtm(96, 2);
   const synth::PtmSample sample(sample_ptm), work_sample(work_ptm);

@@ -55,10 +55,15 @@ void QuiltJobOptions::CheckPhotos() const {
   synth::TriangleEngineOptions engine = photo_engine;
   engine.sample_texel_size = 1.0;  // the job's, checked above
   engine.Check();
+  visibility.Check();
   if (photo_engine.tangent_frame == synth::TangentFrame::kFirstEdge)
     throw OptionError(
-        "--tangent-frame first_edge gives no field to quilt along; give auto, photos or "
-        "smooth_field");
+        "--tangent-frame first-edge gives no field to quilt along; give auto or photos, or "
+        "--tangent-field");
+  if (photo_engine.tangent_frame == synth::TangentFrame::kPhotos &&
+      (!field_file.empty() || quilt.random_orientation))
+    throw OptionError(
+        "--tangent-frame photos is a field: give it, --field or --orientation random, not two");
 }
 
 nlohmann::json QuiltJobOptions::PhotosJson() const {
@@ -196,6 +201,7 @@ class QuiltJob {
     engine_options_ = options_.photo_engine;
     engine_options_.sample_texel_size = texel_size_;
     engine_options_.field_direction_in_world = options_.field_direction_in_world;
+    engine_options_.strip = 2;  // as the layout's patches: the calibration rectifies faces whole
     const bool field_given = !options_.field_file.empty() || options_.quilt.random_orientation;
     if (field_given) engine_options_.tangent_frame = synth::TangentFrame::kSmoothField;
     engine_ = std::make_unique<synth::TriangleEngine>(mesh_, inputs_.reconstruction,
@@ -387,10 +393,14 @@ class QuiltJob {
     report.texel_size = texel_size_;
     report.mm_per_world_unit = options_.mm_per_world_unit;
     report.occupancy = summary_.occupancy;
-    report.timings_s = {
-        {"sample", summary_.seconds_sample},     {"photos and visibility", summary_.seconds_photos},
-        {"layout", summary_.seconds_layout},     {"photo calibration", summary_.seconds_photometry},
-        {"quilting", summary_.seconds_quilting}, {"atlas", summary_.seconds_atlas}};
+    report.timings_s = {{"sample", summary_.seconds_sample},
+                        {"layout", summary_.seconds_layout},
+                        {"quilting", summary_.seconds_quilting},
+                        {"atlas", summary_.seconds_atlas}};
+    if (engine_)
+      report.timings_s.insert(report.timings_s.begin() + 1,
+                              {{"photos and visibility", summary_.seconds_photos},
+                               {"photo calibration", summary_.seconds_photometry}});
     report.links = {
         {"model.glb", "model.glb"}, {"model.obj", "model.obj"}, {"manifest.json", "manifest.json"}};
     report::WriteReport(folder, report, progress_);

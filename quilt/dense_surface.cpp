@@ -1,7 +1,9 @@
 #include "quilt/dense_surface.h"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <utility>
 
@@ -168,9 +170,38 @@ DenseSurface DenseSurface::Build(const mesh::TriangleMesh& mesh, const atlas::At
   return surface;
 }
 
+bool DenseSurface::EdgeConnected(const std::vector<int>& faces) const {
+  std::map<std::pair<int, int>, std::vector<std::size_t>> faces_of_edge;
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const auto& v = mesh_.faces[static_cast<std::size_t>(faces[i])];
+    for (int k = 0; k < 3; ++k)
+      faces_of_edge[std::minmax(v[static_cast<std::size_t>(k)],
+                                v[static_cast<std::size_t>((k + 1) % 3)])]
+          .push_back(i);
+  }
+  std::vector<std::vector<std::size_t>> neighbours(faces.size());
+  for (const auto& [edge, on] : faces_of_edge)
+    for (const std::size_t a : on)
+      for (const std::size_t b : on)
+        if (a != b) neighbours[a].push_back(b);
+  std::vector<bool> reached(faces.size(), false);
+  std::vector<std::size_t> stack{0};
+  reached[0] = true;
+  std::size_t count = 1;
+  while (!stack.empty()) {
+    const std::size_t a = stack.back();
+    stack.pop_back();
+    for (const std::size_t b : neighbours[a])
+      if (!reached[b]) reached[b] = true, ++count, stack.push_back(b);
+  }
+  return count == faces.size();
+}
+
 bool DenseSurface::ConformalMap(
     const std::vector<int>& faces,
     std::vector<std::pair<Eigen::Matrix2d, Eigen::Vector2d>>* frame_to_chart) const {
+  // Faces joined only at a vertex turn freely about it: no unique map.
+  if (faces.empty() || !EdgeConnected(faces)) return false;
   std::vector<atlas::chart_parts::Corners> uv;
   if (!atlas::LeastSquaresConformalMap(
           mesh_, [&](int f) { return corners_texels_[static_cast<std::size_t>(f)]; }, faces,
@@ -180,7 +211,10 @@ bool DenseSurface::ConformalMap(
   for (std::size_t i = 0; i < faces.size(); ++i) {
     const atlas::ChartFace map = atlas::chart_parts::AffineBetween(
         faces[i], corners_texels_[static_cast<std::size_t>(faces[i])], uv[i]);
+    // A flipped face, or one scaled beyond 4 either way: no usable map.
     if (!map.linear.allFinite() || !(map.linear.determinant() > 0)) return false;
+    const Eigen::Vector2d scales = Eigen::JacobiSVD<Eigen::Matrix2d>(map.linear).singularValues();
+    if (!(scales.maxCoeff() <= 4.0 && scales.minCoeff() >= 0.25)) return false;
     frame_to_chart->emplace_back(map.linear, map.translation);
   }
   return true;

@@ -60,9 +60,10 @@ class DenseSurface {
     return frames_[static_cast<std::size_t>(face)];
   }
   double texel_size() const { return texel_size_; }
-  /// The least-squares conformal map of connected faces (atlas::
+  /// The least-squares conformal map of faces joined by edges (atlas::
   /// LeastSquaresConformalMap): per face, the map from its frame (texels) into
-  /// the chart (texels, y up); false when it has none.
+  /// the chart (texels, y up); false when they are not joined by edges, or a
+  /// face is flipped or scaled beyond 4 either way.
   bool ConformalMap(const std::vector<int>& faces,
                     std::vector<std::pair<Eigen::Matrix2d, Eigen::Vector2d>>* frame_to_chart) const;
 
@@ -74,6 +75,7 @@ class DenseSurface {
 
  private:
   friend class DenseSurfaceBuilder;
+  bool EdgeConnected(const std::vector<int>& faces) const;
 
   std::vector<mesh::TriangleFrame> frames_;  ///< per face
   mesh::TriangleMesh mesh_;

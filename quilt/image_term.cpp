@@ -54,6 +54,7 @@ PatchImageTerm::Score PhotoImageTerm::Placements(int seed,
                                                  const RotatedSample& rotated) {
   Score score;
   const int face = surface_.samples()[static_cast<std::size_t>(seed)].face;
+  if (relit_face_ != face) relit_.clear(), relit_face_ = face;  // a retry keeps them
   const std::vector<View> views = ViewsOf(face);
   for (const View& view : views) {
     std::vector<cv::Mat> photo;
@@ -134,24 +135,20 @@ int PhotoImageTerm::PhotoPlanes(const View& view, const std::vector<WorkImageSam
 
 synth::FaceLighting PhotoImageTerm::LightingOf(int face, const View& view, double copy_rad) const {
   const AtlasAxes axes = AtlasAxesOf(surface_, layout_, face);
-  const auto in_work = [&](const Eigen::Vector3d& d) {
-    return TurnedBack(Eigen::Vector3d(d.dot(axes.x), d.dot(axes.y), d.dot(axes.normal)), copy_rad);
-  };
+  mesh::TriangleFrame work{surface_.FrameOf(face).origin_in_world, axes.x, axes.y, axes.normal};
   const synth::MeshPhoto& photo = photos_.photos[view.photo];
-  const sfm::Image& image = photos_.reconstruction.images.at(photo.image_id);
-  const Eigen::Vector3d origin = surface_.FrameOf(face).origin_in_world;
-  synth::FaceLighting lighting;
-  lighting.view_in_frame = in_work((image.ProjectionCenter() - origin).normalized());
-  for (const sfm::ObjectLight& light : photo.lights)
-    lighting.lights.emplace_back(in_work(light.DirectionFrom(origin)), light.intensity);
-  lighting.response = photos_.photometry.light_response;
+  synth::FaceLighting lighting = synth::LightingInFrame(
+      work, photos_.reconstruction.images.at(photo.image_id).ProjectionCenter(), photo.lights,
+      photos_.photometry.light_response);
+  lighting.view_in_frame = TurnedBack(lighting.view_in_frame, copy_rad);
+  for (auto& [l, intensity] : lighting.lights) l = TurnedBack(l, copy_rad);
   return lighting;
 }
 
 const std::vector<cv::Mat>& PhotoImageTerm::RelitCopy(int face, const View& view, int rotation,
                                                       const RotatedSample& rotated) {
   Relit& relit = relit_[view.photo];
-  if (relit.face == face && relit.rotation == rotation) return relit.planes;
+  if (relit.rotation == rotation) return relit.planes;
   const double gain =
       photos_.photometry.photo_gains.empty() ? 1.0 : photos_.photometry.photo_gains[view.photo];
   relit.planes = rotated.TurnPlanes(
@@ -161,11 +158,11 @@ const std::vector<cv::Mat>& PhotoImageTerm::RelitCopy(int face, const View& view
   const double blur_px =
       photos_.photometry.photo_blur.empty() ? 0.0 : photos_.photometry.photo_blur[view.photo];
   const double footprint_px = view.px_per_texel < 1.0 ? kPixelFootprintSigma : 0.0;
-  const double sigma = std::hypot(footprint_px, blur_px) / view.px_per_texel;
+  const double sigma =
+      std::min(std::hypot(footprint_px, blur_px) / view.px_per_texel, rotated.side() / 4.0);
   if (sigma > 0.3)
     for (cv::Mat& plane : relit.planes) cv::GaussianBlur(plane, plane, cv::Size(), sigma);
   relit.energy = synth::PlaneEnergy(relit.planes);
-  relit.face = face;
   relit.rotation = rotation;
   return relit.planes;
 }

@@ -76,15 +76,18 @@ class PhotoImageTerm : public PatchImageTerm {
   const DenseSurface& surface_;
   const atlas::AtlasLayout& layout_;
   const synth::MaterialSample& sample_;
-  const PhotoEvidence& photos_;
+  const PhotoEvidence photos_;  ///< references only
   const ImageTermOptions options_;
   std::map<sfm::ImageId, std::size_t> photo_index_;
   struct Relit {
-    int face = -1, rotation = -1;
+    int rotation = -1;
     std::vector<cv::Mat> planes;
     cv::Mat energy;
   };
-  std::map<std::size_t, Relit> relit_;  ///< per photo, the last copy relit (a retry reuses it)
+  /// Per photo, the copy last relit for relit_face_'s lighting (a retry of the
+  /// same seed reuses it; another face clears them all).
+  std::map<std::size_t, Relit> relit_;
+  int relit_face_ = -1;
 };
 
 }  // namespace texlume::quilt

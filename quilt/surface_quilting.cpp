@@ -258,8 +258,10 @@ class SurfaceQuilter {
 
   // The paper's work image for a patch across charts: the least-squares
   // conformal map of the faces under it (Lévy et al. 2002), each sample placed
-  // by its face's map, the seed at the origin. The charts' rigid maps stay
-  // when the faces have no such map.
+  // by its face's map, then turned so that the seed's chart keeps its atlas
+  // frame (the work frame an image term lays the photos' lights in) and the
+  // seed lies at the origin. The charts' rigid maps stay when the faces have
+  // no such map.
   void FlattenConformally(WorkPatch& patch) const {
     std::vector<int> faces;
     std::unordered_map<int, std::size_t> index;  // face -> in faces
@@ -270,21 +272,21 @@ class SurfaceQuilter {
     std::vector<std::pair<Eigen::Matrix2d, Eigen::Vector2d>> maps;  // frame -> chart, texels
     if (!surface_.ConformalMap(faces, &maps)) return;
     const double t = surface_.texel_size();
-    const auto chart_px = [&](const PatchSample& p) {
+    for (PatchSample& p : patch.samples) {
       const DenseSample& d = surface_.samples()[static_cast<std::size_t>(p.sample)];
       const auto& [linear, translation] = maps[index.at(d.face)];
       const Eigen::Vector2d q = linear * (d.p_in_frame / t) + translation;
-      return Eigen::Vector2d(q.x(), -q.y());  // rows down
-    };
-    const Eigen::Vector2d seed = chart_px(patch.samples[0]);
-    for (PatchSample& p : patch.samples) {
-      const DenseSample& d = surface_.samples()[static_cast<std::size_t>(p.sample)];
-      const Eigen::Matrix2d& linear = maps[index.at(d.face)].first;
-      p.w = chart_px(p) - seed;
+      p.w = Eigen::Vector2d(q.x(), -q.y());  // rows down
       // The atlas frame's x axis lies at AtlasFrameAngle in the face frame; the
-      // map turns the face frame by the angle of its first column.
+      // map turns the face frame by its rotation (polar decomposition).
       p.chart_to_work_rad = layout_.faces[static_cast<std::size_t>(d.face)].AtlasFrameAngle() +
-                            std::atan2(linear(1, 0), linear(0, 0));
+                            std::atan2(linear(1, 0) - linear(0, 1), linear(0, 0) + linear(1, 1));
+    }
+    const double seed_rad = patch.samples[0].chart_to_work_rad;
+    const Eigen::Vector2d seed_w = patch.samples[0].w;
+    for (PatchSample& p : patch.samples) {
+      p.w = PixelRotation(-seed_rad) * (p.w - seed_w);
+      p.chart_to_work_rad -= seed_rad;
     }
   }
 
@@ -429,13 +431,13 @@ class SurfaceQuilter {
     Placement best;
     best.rotation = copy.rotation;
     best.by_photos = true;
-    best.x = candidates[0].second.x, best.y = candidates[0].second.y;
-    if (!overlap) return best;
-    const cv::Mat costs = EntirePatchCosts(copy, planes, mask);
-    best.cost = std::numeric_limits<double>::infinity();
-    for (const auto& [rms, at] : candidates)
-      if (costs.at<float>(at.y, at.x) < best.cost)
-        best.cost = costs.at<float>(at.y, at.x), best.x = at.x, best.y = at.y;
+    std::size_t chosen = 0;
+    if (overlap) {
+      const cv::Mat costs = EntirePatchCosts(copy, planes, mask);
+      chosen = synth::ClosestToNeighbours(
+          candidates, [&](int x, int y) { return costs.at<float>(y, x); }, &best.cost);
+    }
+    best.x = candidates[chosen].second.x, best.y = candidates[chosen].second.y;
     return best;
   }
 

@@ -10,6 +10,20 @@
 #include "synth/template_match.h"
 
 namespace texlume::synth {
+
+FaceLighting LightingInFrame(const mesh::TriangleFrame& frame,
+                             const Eigen::Vector3d& camera_centre_in_world,
+                             const std::vector<sfm::ObjectLight>& lights,
+                             const ptm::LightResponse& response) {
+  const Eigen::Vector3d& origin = frame.origin_in_world;
+  FaceLighting lighting;
+  lighting.view_in_frame = frame.DirectionInFrame((camera_centre_in_world - origin).normalized());
+  for (const sfm::ObjectLight& light : lights)
+    lighting.lights.emplace_back(frame.DirectionInFrame(light.DirectionFrom(origin)),
+                                 light.intensity);
+  lighting.response = response;
+  return lighting;
+}
 namespace {
 
 // The PTM's raw coefficient planes (a0..a5 per polynomial, then LRGB colour).

@@ -8,7 +8,9 @@
 #include <utility>
 #include <vector>
 
+#include "mesh/triangle_frame.h"
 #include "ptm/ptm.h"
+#include "sfm/lights.h"
 #include "synth/triangle_parts.h"
 
 namespace texlume::synth {
@@ -33,6 +35,14 @@ struct FaceLighting {
   std::vector<std::pair<Eigen::Vector3d, double>> lights;
   ptm::LightResponse response;
 };
+
+/// The lighting of a point in a photo, in a frame there (a face's, or a chart's
+/// laid on the face): the direction towards the camera centre and every light
+/// of the photo, with the response.
+FaceLighting LightingInFrame(const mesh::TriangleFrame& frame,
+                             const Eigen::Vector3d& camera_centre_in_world,
+                             const std::vector<sfm::ObjectLight>& lights,
+                             const ptm::LightResponse& response);
 
 /// A material sample as the synthesis engines see it (DESIGN.md, "Engines and
 /// samples"). An engine never looks inside a sample: it compares feature

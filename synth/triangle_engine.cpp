@@ -208,17 +208,10 @@ bool TriangleEngine::Rectify(std::size_t face, const sfm::TriangleView& view, Re
         for (int i = 0; i < tw; ++i) plane.at<float>(j, i) = SrgbToLinear(plane.at<float>(j, i));
   if (!result_.white_balance.empty())
     TakeOutWhiteBalance(result_.white_balance[it->second], sample_.Domain(), out.planes);
-  const Eigen::Vector3d& origin = patch.frame.origin_in_world;
-  out.lighting.view_in_frame =
-      patch.frame.DirectionInFrame((image.ProjectionCenter() - origin).normalized());
+  out.lighting =
+      LightingInFrame(patch.frame, image.ProjectionCenter(), photo.lights, result_.light_response);
   out.steep = !sample_.ViewDependent() || out.lighting.view_in_frame.z() > 0.5;
-  out.lighting.lights.clear();
-  out.lighting.response = result_.light_response;
-  for (const sfm::ObjectLight& light : photo.lights) {
-    const Eigen::Vector3d l = patch.frame.DirectionInFrame(light.DirectionFrom(origin));
-    out.lighting.lights.emplace_back(l, light.intensity);
-    out.steep = out.steep && l.z() > 0.5;
-  }
+  for (const auto& [l, intensity] : out.lighting.lights) out.steep = out.steep && l.z() > 0.5;
   out.photo = it->second;
   out.view = view;
   out.level = level;

@@ -194,20 +194,30 @@ std::vector<std::pair<float, cv::Point>> BestPlacements(const cv::Mat& score, in
   return all;
 }
 
+std::size_t ClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& candidates,
+                                const std::function<double(int, int)>& overlap_error,
+                                double* error) {
+  double best = std::numeric_limits<double>::infinity();
+  std::size_t chosen = 0;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const double e = overlap_error(candidates[i].second.x, candidates[i].second.y);
+    if (e < best) best = e, chosen = i;
+  }
+  if (error) *error = best;
+  return chosen;
+}
+
 void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& candidates,
                              const std::function<double(int, int)>& overlap_error,
                              TrianglePatch& patch) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const auto& [score, at] : candidates) {
-    const double e = overlap_error(at.x, at.y);
-    if (e < best) {
-      best = e;
-      patch.sample_x = at.x;
-      patch.sample_y = at.y;
-      patch.image_score = score;
-      patch.overlap_error = e;
-    }
-  }
+  if (candidates.empty()) return;
+  double error = 0;
+  const auto& [score, at] = candidates[ClosestToNeighbours(candidates, overlap_error, &error)];
+  if (!(error < std::numeric_limits<double>::infinity())) return;
+  patch.sample_x = at.x;
+  patch.sample_y = at.y;
+  patch.image_score = score;
+  patch.overlap_error = error;
 }
 
 PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double t, int strip,

@@ -165,6 +165,11 @@ int BestSeenFace(const sfm::VisibilityResult& visibility);
 void AddImageScore(const cv::Mat& ssd, int count, double rx, double ry, cv::Mat& total);
 /// The k lowest placements of a score map, looking every `stride` texels, best first.
 std::vector<std::pair<float, cv::Point>> BestPlacements(const cv::Mat& score, int stride, int k);
+/// Of the image score's candidates (BestPlacements), the index of the one with the
+/// least `overlap_error(sample_x, sample_y)`, the first on a tie (and that error).
+std::size_t ClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& candidates,
+                                const std::function<double(int, int)>& overlap_error,
+                                double* error = nullptr);
 /// Algorithm 2's second constraint: of the image score's candidates (BestPlacements),
 /// the one with the least `overlap_error(sample_x, sample_y)` (the first on a tie)
 /// becomes the patch's placement, with its image score and overlap error.

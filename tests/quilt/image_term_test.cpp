@@ -56,12 +56,14 @@ void RawAt(const ptm::Ptm& ptm, const Eigen::Vector2d& p, float out[9]) {
 
 // One photo from straight above (1.5 photo pixels per texel), rendered from
 // the truth (the sample turned by `truth_rad`) under a light from the upper right.
-PhotographedPlane Photograph(const ptm::Ptm& ptm, double truth_rad) {
+PhotographedPlane Photograph(const ptm::Ptm& ptm, double truth_rad,
+                             atlas::AtlasMode mode = atlas::AtlasMode::kCharts) {
   PhotographedPlane s;
   s.truth_rad = truth_rad;
   s.geometry = synth::MakePatchGeometry(s.mesh, kTexel, 4, synth::TangentFrame::kFirstEdge,
                                         Eigen::Vector3d::UnitZ());
   atlas::AtlasOptions o;
+  o.mode = mode;
   o.flattening = atlas::ChartFlattening::kRigid;
   o.atlas_size = 256;
   s.layout = atlas::LayoutAtlases(s.mesh, s.geometry.patches, s.geometry.unfoldings, kTexel, o);
@@ -154,6 +156,23 @@ TEST(PhotoImageTerm, TurnsTheLightsWithTheCopy) {
   QuiltOptions o;
   o.work_patch_levels = 12;
   o.field_in_world.assign(s.mesh.faces.size(), Eigen::Vector3d::UnitY());
+  const PhotoEvidence evidence{s.reconstruction, s.visibility, s.photos, s.photometry};
+  PhotoImageTerm term(s.dense, s.layout, sample, evidence, {});
+  const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o, {}, nullptr, &term);
+  EXPECT_GT(ShareAtTruth(s, r), 0.95);
+}
+
+// Every face its own chart: patches cross charts, and their work images are
+// the conformal maps of their faces, turned so that the seed's chart keeps its
+// atlas frame (the frame the photos' lights are laid in).
+TEST(PhotoImageTerm, FollowsThePhotoAcrossCharts) {
+  const ptm::Ptm ptm = datasets::SmoothRandomPtm(128, 5);
+  const synth::PtmSample sample(ptm);
+  const PhotographedPlane s = Photograph(ptm, 0.0, atlas::AtlasMode::kPerTriangle);
+  ASSERT_GT(s.dense.chart_seam_links(), 0u);
+  QuiltOptions o;
+  o.work_patch_levels = 12;
+  o.field_in_world.assign(s.mesh.faces.size(), Eigen::Vector3d::UnitX());
   const PhotoEvidence evidence{s.reconstruction, s.visibility, s.photos, s.photometry};
   PhotoImageTerm term(s.dense, s.layout, sample, evidence, {});
   const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o, {}, nullptr, &term);
