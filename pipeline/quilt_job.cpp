@@ -140,20 +140,21 @@ class QuiltJob {
       mesh::LoadedMesh loaded = mesh::LoadMesh(options_.mesh_file);
       for (const std::string& problem : loaded.report.Problems())
         summary_.warnings.push_back(options_.mesh_file.string() + ": " + problem);
-      mesh_ = std::move(loaded.mesh);
+      inputs_.mesh = std::move(loaded.mesh);
     }
-    if (mesh_.faces.empty()) throw InputError(options_.mesh_file.string(), "has no triangles");
-    summary_.faces = mesh_.faces.size();
+    if (inputs_.mesh.faces.empty())
+      throw InputError(options_.mesh_file.string(), "has no triangles");
+    summary_.faces = inputs_.mesh.faces.size();
     texel_size_ = options_.sample_texel_size;
     if (texel_size_ > 0) RequireSurfaceMemory(3);  // before the sample is read, at least
     LoadSample();
-    RefuseSampleLargerThanMesh(mesh_, texel_size_, options_.mesh_file);
+    RefuseSampleLargerThanMesh(inputs_.mesh, texel_size_, options_.mesh_file);
     RequireSurfaceMemory(matched_->NumFeatures());
     RefuseSampleSmallerThanWorkPatch();
     RequireCopyMemory();
     if (!options_.field_file.empty())
-      quilt_options_.field_in_world =
-          quilt::InterpolateField(mesh_, quilt::ReadFieldFile(options_.field_file, mesh_));
+      quilt_options_.field_in_world = quilt::InterpolateField(
+          inputs_.mesh, quilt::ReadFieldFile(options_.field_file, inputs_.mesh));
     if (options_.Photos()) ComputeVisibility();
   }
 
@@ -176,7 +177,6 @@ class QuiltJob {
     inputs_ = LoadSynthInputs(PhotoInputs());
     summary_.warnings.insert(summary_.warnings.end(), inputs_.warnings.begin(),
                              inputs_.warnings.end());
-    mesh_ = inputs_.mesh;
     summary_.photos_used = inputs_.photos.size();
     summary_.seconds_photos = SecondsSince(start);
   }
@@ -204,7 +204,7 @@ class QuiltJob {
     engine_options_.strip = 2;  // as the layout's patches: the calibration rectifies faces whole
     const bool field_given = !options_.field_file.empty() || options_.quilt.random_orientation;
     if (field_given) engine_options_.tangent_frame = synth::TangentFrame::kSmoothField;
-    engine_ = std::make_unique<synth::TriangleEngine>(mesh_, inputs_.reconstruction,
+    engine_ = std::make_unique<synth::TriangleEngine>(inputs_.mesh, inputs_.reconstruction,
                                                       inputs_.visibility, inputs_.photos, *matched_,
                                                       engine_options_, nullptr);
     const synth::TriangleSynthesis& photometry = engine_->Prepare(progress_);
@@ -244,7 +244,7 @@ class QuiltJob {
   // Refused before anything is allocated (quilt::QuiltingBytes).
   void RequireSurfaceMemory(int features) const {
     RequireMemory(
-        quilt::QuiltingBytes(mesh_, texel_size_, features), "the dense surface",
+        quilt::QuiltingBytes(inputs_.mesh, texel_size_, features), "the dense surface",
         options_.mesh_file.string() + " at a texel size of " + std::to_string(texel_size_));
   }
 
@@ -275,12 +275,13 @@ class QuiltJob {
     const auto start = std::chrono::steady_clock::now();
     // The face frames' x axes: the world direction laid onto each face, the
     // field the sample follows when no field file is given.
-    geometry_ = synth::MakePatchGeometry(mesh_, texel_size_, 2, synth::TangentFrame::kSmoothField,
-                                         options_.field_direction_in_world);
-    layout_ = atlas::LayoutAtlases(mesh_, geometry_.patches, geometry_.unfoldings, texel_size_,
-                                   options_.atlas, progress_);
-    surface_ = quilt::DenseSurface::Build(mesh_, layout_, geometry_.patches, geometry_.unfoldings,
-                                          texel_size_);
+    geometry_ =
+        synth::MakePatchGeometry(inputs_.mesh, texel_size_, 2, synth::TangentFrame::kSmoothField,
+                                 options_.field_direction_in_world);
+    layout_ = atlas::LayoutAtlases(inputs_.mesh, geometry_.patches, geometry_.unfoldings,
+                                   texel_size_, options_.atlas, progress_);
+    surface_ = quilt::DenseSurface::Build(inputs_.mesh, layout_, geometry_.patches,
+                                          geometry_.unfoldings, texel_size_);
     summary_.samples = surface_.size();
     summary_.links = surface_.links();
     summary_.chart_seam_links = surface_.chart_seam_links();
@@ -327,7 +328,7 @@ class QuiltJob {
   }
 
   void Write() {
-    if (!options_.Photos()) inputs_.mesh = mesh_;  // no cameras: the model is not turned
+    // Without photos the reconstruction has no cameras: the model is not turned.
     const model::TexturedModel model = TexturedModelOf(inputs_, ptms_, layout_.faces);
     nlohmann::json record = Record();
     std::optional<model::BtfModelFiles> files;
@@ -368,7 +369,7 @@ class QuiltJob {
     if (engine_) {
       AddPhotoViews(inputs_, options_.images_dir, engine_->result().photo_gains, report, scene);
     } else {
-      scene.views = ViewsAroundMesh(mesh_, 4, 400, 300);
+      scene.views = ViewsAroundMesh(inputs_.mesh, 4, 400, 300);
       report.views_heading = "Views around the model (no photos to compare with)";
     }
     DrawReportPictures(scene, report, progress_);
@@ -485,8 +486,8 @@ class QuiltJob {
   const QuiltJobOptions& options_;
   const ProgressCallback& progress_;
   quilt::QuiltOptions quilt_options_;  ///< the options', with the interpolated field
-  mesh::TriangleMesh mesh_;
-  SynthInputs inputs_;  ///< with photos: the COLMAP model, photos and visibility
+  /// The mesh; with photos also the COLMAP model, the photos and visibility.
+  SynthInputs inputs_;
   synth::TriangleEngineOptions engine_options_;
   std::unique_ptr<synth::TriangleEngine> engine_;  ///< with photos: their calibration
   std::optional<quilt::PhotoEvidence> evidence_;

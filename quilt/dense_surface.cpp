@@ -3,8 +3,8 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <numeric>
+#include <unordered_map>
 #include <utility>
 
 #include "atlas/chart_parts.h"
@@ -165,36 +165,27 @@ DenseSurface DenseSurface::Build(const mesh::TriangleMesh& mesh, const atlas::At
                                  double texel_size) {
   DenseSurface surface = DenseSurfaceBuilder(layout, patches, unfoldings, texel_size).Build();
   surface.mesh_ = mesh;
+  surface.face_neighbours_ = mesh::FaceNeighbours(mesh);
   for (const synth::TrianglePatch& patch : patches)
     surface.corners_texels_.push_back(atlas::chart_parts::FrameCornersTexels(patch, texel_size));
   return surface;
 }
 
 bool DenseSurface::EdgeConnected(const std::vector<int>& faces) const {
-  std::map<std::pair<int, int>, std::vector<std::size_t>> faces_of_edge;
-  for (std::size_t i = 0; i < faces.size(); ++i) {
-    const auto& v = mesh_.faces[static_cast<std::size_t>(faces[i])];
-    for (int k = 0; k < 3; ++k)
-      faces_of_edge[std::minmax(v[static_cast<std::size_t>(k)],
-                                v[static_cast<std::size_t>((k + 1) % 3)])]
-          .push_back(i);
-  }
-  std::vector<std::vector<std::size_t>> neighbours(faces.size());
-  for (const auto& [edge, on] : faces_of_edge)
-    for (const std::size_t a : on)
-      for (const std::size_t b : on)
-        if (a != b) neighbours[a].push_back(b);
-  std::vector<bool> reached(faces.size(), false);
-  std::vector<std::size_t> stack{0};
-  reached[0] = true;
+  std::unordered_map<int, bool> reached;  // face of the set -> reached from the first
+  for (const int f : faces) reached[f] = false;
+  std::vector<int> stack{faces[0]};
+  reached[faces[0]] = true;
   std::size_t count = 1;
   while (!stack.empty()) {
-    const std::size_t a = stack.back();
+    const int f = stack.back();
     stack.pop_back();
-    for (const std::size_t b : neighbours[a])
-      if (!reached[b]) reached[b] = true, ++count, stack.push_back(b);
+    for (const int n : face_neighbours_[static_cast<std::size_t>(f)]) {
+      const auto it = reached.find(n);
+      if (it != reached.end() && !it->second) it->second = true, ++count, stack.push_back(n);
+    }
   }
-  return count == faces.size();
+  return count == reached.size();
 }
 
 bool DenseSurface::ConformalMap(

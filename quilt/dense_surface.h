@@ -79,6 +79,7 @@ class DenseSurface {
 
   std::vector<mesh::TriangleFrame> frames_;  ///< per face
   mesh::TriangleMesh mesh_;
+  std::vector<std::array<int, 3>> face_neighbours_;             ///< mesh::FaceNeighbours
   std::vector<std::array<Eigen::Vector2d, 3>> corners_texels_;  ///< per face, in its frame
   double texel_size_ = 0;
   std::vector<DenseSample> samples_;

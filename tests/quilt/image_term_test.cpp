@@ -122,6 +122,18 @@ double ShareAtTruth(const PhotographedPlane& s, const QuiltResult& r) {
   return static_cast<double>(near) / static_cast<double>(s.dense.size());
 }
 
+// The plane quilted in small work patches along a world direction, with the
+// photo's image term.
+QuiltResult QuiltFollowingThePhoto(const PhotographedPlane& s, const synth::PtmSample& sample,
+                                   const Eigen::Vector3d& field_in_world) {
+  QuiltOptions o;
+  o.work_patch_levels = 12;
+  o.field_in_world.assign(s.mesh.faces.size(), field_in_world);
+  const PhotoEvidence evidence{s.reconstruction, s.visibility, s.photos, s.photometry};
+  PhotoImageTerm term(s.dense, s.layout, sample, evidence, {});
+  return QuiltSurface(s.dense, s.layout, sample, o, {}, nullptr, &term);
+}
+
 // With the image term, the quilt puts the sample where the photo shows it:
 // most patches are placed among the photo's best placements, and nearly every
 // sample looks up the position the photo was rendered from. Without it, the
@@ -131,12 +143,10 @@ TEST(PhotoImageTerm, PlacesTheSampleWhereThePhotoShowsIt) {
   const synth::PtmSample sample(ptm);
   const PhotographedPlane s = Photograph(ptm, 0.0);
   ASSERT_TRUE(s.visibility.triangles[0].views[0].fully_visible);
+  const QuiltResult with = QuiltFollowingThePhoto(s, sample, Eigen::Vector3d::UnitX());
   QuiltOptions o;
   o.work_patch_levels = 12;
   o.field_in_world.assign(s.mesh.faces.size(), Eigen::Vector3d::UnitX());
-  const PhotoEvidence evidence{s.reconstruction, s.visibility, s.photos, s.photometry};
-  PhotoImageTerm term(s.dense, s.layout, sample, evidence, {});
-  const QuiltResult with = QuiltSurface(s.dense, s.layout, sample, o, {}, nullptr, &term);
   const QuiltResult without = QuiltSurface(s.dense, s.layout, sample, o);
   ASSERT_GT(with.stats.patches, 3u);
   // Patches that only fill gaps too small for a photo pixel match the overlap alone.
@@ -153,12 +163,7 @@ TEST(PhotoImageTerm, TurnsTheLightsWithTheCopy) {
   const ptm::Ptm ptm = datasets::SmoothRandomPtm(128, 4);
   const synth::PtmSample sample(ptm);
   const PhotographedPlane s = Photograph(ptm, std::numbers::pi / 2);
-  QuiltOptions o;
-  o.work_patch_levels = 12;
-  o.field_in_world.assign(s.mesh.faces.size(), Eigen::Vector3d::UnitY());
-  const PhotoEvidence evidence{s.reconstruction, s.visibility, s.photos, s.photometry};
-  PhotoImageTerm term(s.dense, s.layout, sample, evidence, {});
-  const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o, {}, nullptr, &term);
+  const QuiltResult r = QuiltFollowingThePhoto(s, sample, Eigen::Vector3d::UnitY());
   EXPECT_GT(ShareAtTruth(s, r), 0.95);
 }
 
@@ -170,12 +175,7 @@ TEST(PhotoImageTerm, FollowsThePhotoAcrossCharts) {
   const synth::PtmSample sample(ptm);
   const PhotographedPlane s = Photograph(ptm, 0.0, atlas::AtlasMode::kPerTriangle);
   ASSERT_GT(s.dense.chart_seam_links(), 0u);
-  QuiltOptions o;
-  o.work_patch_levels = 12;
-  o.field_in_world.assign(s.mesh.faces.size(), Eigen::Vector3d::UnitX());
-  const PhotoEvidence evidence{s.reconstruction, s.visibility, s.photos, s.photometry};
-  PhotoImageTerm term(s.dense, s.layout, sample, evidence, {});
-  const QuiltResult r = QuiltSurface(s.dense, s.layout, sample, o, {}, nullptr, &term);
+  const QuiltResult r = QuiltFollowingThePhoto(s, sample, Eigen::Vector3d::UnitX());
   EXPECT_GT(ShareAtTruth(s, r), 0.95);
 }
 
