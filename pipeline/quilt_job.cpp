@@ -263,12 +263,20 @@ class QuiltJob {
   }
 
   // The sample's rotated copies the quilting keeps (8, each with its planes and
-  // their spectra: quilt::RotatedSample).
+  // their spectra: quilt::RotatedSample) and, with photos, what the image term
+  // keeps (quilt::PhotoImageTerm): the sample relit once (3 planes) and, per view
+  // of one seed face, a relit copy (3 planes and their energy).
   void RequireCopyMemory() const {
     const double side =
         std::floor(std::min(matched_->Width(), matched_->Height()) / std::numbers::sqrt2);
-    RequireMemory(8 * side * side * (2.0 * matched_->NumFeatures() + 2) * 4 * 1.2,
-                  "the sample's rotated copies", options_.sample_file.string());
+    double bytes = 8 * side * side * (2.0 * matched_->NumFeatures() + 2) * 4 * 1.2;
+    if (options_.Photos()) {
+      const synth::TriangleEngineOptions& e = options_.photo_engine;
+      const double views = e.all_views ? std::max(e.max_views, 1) : 1;
+      const double sample_texels = static_cast<double>(matched_->Width()) * matched_->Height();
+      bytes += (3 * sample_texels + views * 4 * side * side) * 4;
+    }
+    RequireMemory(bytes, "the sample's rotated copies", options_.sample_file.string());
   }
 
   void LayOut() {

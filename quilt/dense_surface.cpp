@@ -233,7 +233,9 @@ double QuiltingBytes(const mesh::TriangleMesh& mesh, double texel_size, int feat
   const std::vector<double> areas = mesh::FaceAreas(mesh);
   const double area = std::accumulate(areas.begin(), areas.end(), 0.0);
   const double samples = 1.6 * area / (texel_size * texel_size);
-  return samples * (64 + 4.0 * features + 0.5 * (2 * 4.0 * features + 96));
+  const double per_face = 96 + 12 + 12 + 48 + 12;  // frame, face, neighbours, corners, vertex
+  return samples * (64 + 4.0 * features + 0.5 * (2 * 4.0 * features + 96)) +
+         per_face * static_cast<double>(mesh.faces.size());
 }
 
 }  // namespace texlume::quilt

@@ -33,7 +33,8 @@ struct DenseSample {
 /// patch, features, links and index (about 64 bytes plus 4 per feature) and
 /// the remembered seams (Kwatra's old seams: two feature vectors and a hash
 /// node, on at most about one link in two); the charts' stretch adds up to
-/// 1.25^2 samples per unit of area.
+/// 1.25^2 samples per unit of area. Per face, the surface keeps the mesh, the
+/// face frames, neighbours and corners (about 180 bytes).
 double QuiltingBytes(const mesh::TriangleMesh& mesh, double texel_size, int features);
 
 class DenseSurface {

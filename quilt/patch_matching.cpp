@@ -36,22 +36,30 @@ cv::Mat Spectrum(const cv::Mat& plane, int dft_size) {
 // sum_c sum M (T_c - I_c)^2 at every placement, expanded as in
 // synth::MaskedSsd: corr(E, M) - 2 sum_c corr(I_c, M T_c) + sum_c sum M T_c^2,
 // the correlations summed in the frequency domain (one inverse DFT). The copy
-// is padded to at least its side, so placements inside it never wrap.
+// is padded to at least its side, so placements inside it never wrap. Only the
+// work image's rows are transformed forward (the rest is zero padding) and only
+// the placements' rows back.
 cv::Mat MaskedSsdBySpectra(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
                            const cv::Mat& mask) {
-  cv::Mat sum, term, masked;
-  cv::mulSpectrums(copy.energy_spectrum, Spectrum(mask, copy.dft_size), sum, 0, true);
+  const int n = copy.dft_size;
+  cv::Mat padded = cv::Mat::zeros(n, n, CV_32FC1), spectrum, term, sum, masked;
+  const cv::Rect work(0, 0, mask.cols, mask.rows);
+  mask.copyTo(padded(work));
+  cv::dft(padded, spectrum, 0, mask.rows);
+  cv::mulSpectrums(copy.energy_spectrum, spectrum, sum, 0, true);
   double constant = 0;
   for (std::size_t c = 0; c < work_planes.size(); ++c) {
     cv::multiply(work_planes[c], mask, masked);
     constant += masked.dot(work_planes[c]);
-    cv::mulSpectrums(copy.plane_spectra[c], Spectrum(masked, copy.dft_size), term, 0, true);
+    masked.copyTo(padded(work));
+    cv::dft(padded, spectrum, 0, mask.rows);
+    cv::mulSpectrums(copy.plane_spectra[c], spectrum, term, 0, true);
     cv::scaleAdd(term, -2.0, sum, sum);
   }
+  const cv::Size placements(copy.side() - mask.cols + 1, copy.side() - mask.rows + 1);
   cv::Mat full;
-  cv::dft(sum, full, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
-  cv::Mat ssd =
-      full(cv::Rect(0, 0, copy.side() - mask.cols + 1, copy.side() - mask.rows + 1)) + constant;
+  cv::dft(sum, full, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT, placements.height);
+  cv::Mat ssd = full(cv::Rect(cv::Point(0, 0), placements)) + constant;
   cv::max(ssd, 0.0, ssd);
   return ssd;
 }

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <numbers>
 
@@ -191,17 +192,18 @@ TEST_F(MeshBtfTest, GraphCutSeamsCostNoMoreThanTheStraightMeshEdge) {
   EXPECT_LT(switched, total / 4);
 }
 
-TEST_F(MeshBtfTest, BothSidesOfAnEdgeSeeTheSameSampleTexelAndFrame) {
-  // A point on a shared edge, looked up from either face: where both choose the
-  // same patch, they must agree on the sample position and on the sample-frame
-  // direction of a world tangent (the rotation each lookup reports).
-  const synth::BtfMeshSynthesis& s = *synthesis_;
-  const mesh::TriangleMesh& mesh = inputs_->mesh;
+// Points on the shared edges of `mesh`, looked up from either face: where both
+// choose the same patch, they must agree on the sample position and on the
+// sample-frame direction of a world tangent (the rotation each lookup reports).
+// Only the edges `edge_wanted(f, g)` accepts are visited. Returns the number of
+// points compared.
+int CheckEdgeAgreement(const synth::BtfMeshSynthesis& s, const mesh::TriangleMesh& mesh,
+                       const std::function<bool(std::size_t, int)>& edge_wanted) {
   int compared = 0;
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     for (int k = 0; k < 3; ++k) {
       const synth::Unfolding& u = s.unfoldings[f][static_cast<std::size_t>(k)];
-      if (u.face < 0) continue;
+      if (u.face < 0 || !edge_wanted(f, u.face)) continue;
       const Eigen::Vector3d a = mesh.Corner(f, k), b = mesh.Corner(f, (k + 1) % 3);
       for (double w : {0.3, 0.5, 0.7}) {
         const Eigen::Vector3d x = a + w * (b - a);
@@ -222,8 +224,34 @@ TEST_F(MeshBtfTest, BothSidesOfAnEdgeSeeTheSameSampleTexelAndFrame) {
       }
     }
   }
+  return compared;
+}
+
+TEST_F(MeshBtfTest, BothSidesOfAnEdgeSeeTheSameSampleTexelAndFrame) {
+  const int compared =
+      CheckEdgeAgreement(*synthesis_, inputs_->mesh, [](std::size_t, int) { return true; });
   RecordProperty("edge_points_compared", compared);
   EXPECT_GT(compared, 1920 * 3 / 2);  // most edge points agree on a source
+}
+
+// --fill-unseen graphcut: where a placed face's seam crosses into a filled
+// neighbour, the placed face reads the neighbour's quilt, as the neighbour does
+// (a filled face reads only its own quilt, so every point compared is a seam
+// crossing into it).
+TEST_F(MeshBtfTest, SeamsCrossingIntoAFilledFaceReadItsQuilt) {
+  synth::BtfMeshSynthesis s = *synthesis_;
+  quilt::UnseenFillOptions o;
+  o.atlas.atlas_size = 1024;
+  o.quilt.work_patch_levels = 16;
+  const quilt::UnseenFillSummary fill =
+      quilt::FillUnseenFaces(inputs_->mesh, s, synth::BtfSample(*sample_), o);
+  ASSERT_GT(fill.faces, 0u);
+  const auto filled = [&](int f) { return fill.filled[static_cast<std::size_t>(f)] != 0; };
+  const int compared = CheckEdgeAgreement(s, inputs_->mesh, [&](std::size_t f, int g) {
+    return filled(static_cast<int>(f)) != filled(g);
+  });
+  RecordProperty("edge_points_compared", compared);
+  EXPECT_GT(compared, 20);  // 94 of the points on edges between filled and placed faces
 }
 
 TEST_F(MeshBtfTest, ModelFolderHoldsCoordinatesGeometryAtlasesAndAPtmPreview) {
