@@ -18,7 +18,7 @@
 // per cut link against a cut between unrelated texels, the share of the sample
 // reused, and the nearest-patch energy of the baked atlas (quilt/patch_energy.h;
 // also of the model folder MODEL_DIR's atlases, e.g. the per-triangle engine's
-// with the same sample); then the time from about 12k to 800k samples. Last,
+// with the same sample); then the time from about 12k to 1M samples. Last,
 // meshes of several kinds quilted alike (a handle, creases, two components, a
 // non-manifold line, an irregular lumpy 81920-face scan-like mesh): coverage,
 // charts, seams, energy and time; and samples of several kinds (the scene
@@ -330,8 +330,9 @@ void QuiltSphere(const ptm::Ptm& sample_ptm, int levels, double texel, const cha
   std::printf("\nTime against the dense samples (graph-cut quilting, same sample and r_w):\n");
   std::printf(
       "| icosphere faces | samples | patches | s | us per sample |\n|---|---|---|---|---|\n");
-  for (const auto& [subdivisions, t] : {std::pair{3, 4 * texel}, std::pair{3, 2 * texel},
-                                        std::pair{3, texel}, std::pair{4, texel / 2}}) {
+  for (const auto& [subdivisions, t] :
+       {std::pair{3, 4 * texel}, std::pair{3, 2 * texel}, std::pair{3, texel},
+        std::pair{4, texel / 2}, std::pair{4, texel / 2.3}}) {
     quilt::QuiltOptions q;
     q.work_patch_levels = levels;
     const Quilted run = QuiltIcosphere(sample, subdivisions, t, q);
