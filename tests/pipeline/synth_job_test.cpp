@@ -238,6 +238,19 @@ TEST_F(MeshPipelineTest, BlendingMakesEdgesContinuous) {
   EXPECT_LT(blended, 0.05 * raw);
 }
 
+// The atlas pixels a face's corners span, with a pixel of margin on each side.
+template <typename Corners>
+cv::Rect FaceBox(const Corners& corners) {
+  double x0 = corners[0].x(), x1 = x0, y0 = corners[0].y(), y1 = y0;
+  for (const auto& c : corners) {
+    x0 = std::min<double>(x0, c.x()), x1 = std::max<double>(x1, c.x());
+    y0 = std::min<double>(y0, c.y()), y1 = std::max<double>(y1, c.y());
+  }
+  const int left = static_cast<int>(std::floor(x0)) - 1, top = static_cast<int>(std::floor(y0)) - 1;
+  return {left, top, static_cast<int>(std::ceil(x1)) + 2 - left,
+          static_cast<int>(std::ceil(y1)) + 2 - top};
+}
+
 TEST_F(MeshPipelineTest, AtlasFacesDoNotOverlapAndChartsPackTighter) {
   const model::TexturedModel model = model::ReadModelFolder(tmp_->path() / "model");
   std::vector<cv::Mat> owner;
@@ -246,18 +259,22 @@ TEST_F(MeshPipelineTest, AtlasFacesDoNotOverlapAndChartsPackTighter) {
   int overlaps = 0;
   for (std::size_t f = 0; f < model.mesh.faces.size(); ++f) {
     cv::Mat& o = owner[static_cast<std::size_t>(model.face_atlas[f])];
+    // The face's texels strictly inside it, drawn in its bounding box (with a
+    // texel of margin for the erosion).
+    const cv::Rect box = cv::Rect(0, 0, o.cols, o.rows) & FaceBox(model.corner_px[f]);
     std::vector<cv::Point> poly;
     for (const auto& c : model.corner_px[f])
-      poly.emplace_back(static_cast<int>(std::lround(c.x() * 16)),
-                        static_cast<int>(std::lround(c.y() * 16)));
-    cv::Mat mask = cv::Mat::zeros(o.size(), CV_8UC1);
+      poly.emplace_back(static_cast<int>(std::lround((c.x() - box.x) * 16)),
+                        static_cast<int>(std::lround((c.y() - box.y) * 16)));
+    cv::Mat mask = cv::Mat::zeros(box.size(), CV_8UC1);
     cv::fillConvexPoly(mask, poly, 255, cv::LINE_8, 4);
     cv::erode(mask, mask, cv::Mat());  // texels strictly inside
-    for (int y = 0; y < o.rows; ++y)
-      for (int x = 0; x < o.cols; ++x)
+    for (int y = 0; y < box.height; ++y)
+      for (int x = 0; x < box.width; ++x)
         if (mask.at<std::uint8_t>(y, x)) {
-          if (o.at<int>(y, x) >= 0) ++overlaps;
-          o.at<int>(y, x) = static_cast<int>(f);
+          int& owner_of = o.at<int>(box.y + y, box.x + x);
+          if (owner_of >= 0) ++overlaps;
+          owner_of = static_cast<int>(f);
         }
   }
   EXPECT_EQ(overlaps, 0);
