@@ -211,6 +211,7 @@ class QuiltJob {
     if (!field_given && photometry.tangent_frame == synth::TangentFrame::kPhotos)
       for (const synth::TrianglePatch& patch : photometry.patches)
         quilt_options_.field_in_world.push_back(patch.frame.x_axis);
+    light_response_ = photometry.light_response;
     summary_.photo_calibration = EngineSummaryJson(photometry);
     summary_.seconds_photometry = SecondsSince(start);
   }
@@ -337,7 +338,8 @@ class QuiltJob {
 
   void Write() {
     // Without photos the reconstruction has no cameras: the model is not turned.
-    const model::TexturedModel model = TexturedModelOf(inputs_, ptms_, layout_.faces);
+    model::TexturedModel model = TexturedModelOf(inputs_, ptms_, layout_.faces);
+    model.light_response = light_response_;  // as the photos showed it (the identity without)
     nlohmann::json record = Record();
     std::optional<model::BtfModelFiles> files;
     if (btf_sample_) {
@@ -498,6 +500,7 @@ class QuiltJob {
   SynthInputs inputs_;
   synth::TriangleEngineOptions engine_options_;
   std::unique_ptr<synth::TriangleEngine> engine_;  ///< with photos: their calibration
+  ptm::LightResponse light_response_;              ///< theirs, for the model
   std::optional<quilt::PhotoEvidence> evidence_;
   double texel_size_ = 0;  ///< world units per sample texel (the BTF's own when not given)
   Sample sample_;

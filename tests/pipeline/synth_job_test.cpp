@@ -447,6 +447,11 @@ TEST_F(MeshPipelineTest, GraphCutEngineFollowsThePhotos) {
             s.stats.photo_patches);
   EXPECT_EQ(manifest["summary"]["photos"]["photo_gains"].size(), 12u);
   EXPECT_TRUE(manifest["timings_s"].contains("photo_calibration"));
+  // The model answers light as the photos showed, as the main job's does.
+  const model::TexturedModel model = model::ReadModelFolder(out);
+  EXPECT_FALSE(model.light_response.IsIdentity());
+  EXPECT_EQ(model::LightResponseJson(model.light_response),
+            manifest["summary"]["photos"]["light_response"]);
   // The report compares the model with the photos, and every picture it links exists.
   const std::string html = testing::ReadText(out / "report.html");
   EXPECT_NE(html.find("Photo views"), std::string::npos);
