@@ -382,6 +382,11 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--part")) {
       only_matching = !std::strcmp(argv[i + 1], "matching");
       sweep = !std::strcmp(argv[i + 1], "parameters");
+      if (!only_matching && !sweep) {
+        std::fprintf(stderr, "quilt_bench: --part is matching or parameters, not %s\n",
+                     argv[i + 1]);
+        return 2;
+      }
     }
   }
   if (sweep) {

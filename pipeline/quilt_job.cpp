@@ -265,8 +265,10 @@ class QuiltJob {
 
   // The sample's rotated copies the quilting keeps (8, each with its planes and
   // their spectra: quilt::RotatedSample) and, with photos, what the image term
-  // keeps (quilt::PhotoImageTerm): the sample relit once (3 planes) and, per view
-  // of one seed face, a relit copy (3 planes and their energy).
+  // keeps (quilt::PhotoImageTerm): the sample's relight planes at full size
+  // (MaterialSample::Reduced(0)), the sample relit (3 planes, while a copy is
+  // relit) and, per view of one seed face, a relit copy (3 planes and their
+  // energy).
   void RequireCopyMemory() const {
     const double side =
         std::floor(std::min(matched_->Width(), matched_->Height()) / std::numbers::sqrt2);
@@ -275,7 +277,7 @@ class QuiltJob {
       const synth::TriangleEngineOptions& e = options_.photo_engine;
       const double views = e.all_views ? std::max(e.max_views, 1) : 1;
       const double sample_texels = static_cast<double>(matched_->Width()) * matched_->Height();
-      bytes += (3 * sample_texels + views * 4 * side * side) * 4;
+      bytes += ((matched_->NumRelightPlanes() + 3) * sample_texels + views * 4 * side * side) * 4;
     }
     RequireMemory(bytes, "the sample's rotated copies", options_.sample_file.string());
   }

@@ -233,9 +233,22 @@ double QuiltingBytes(const mesh::TriangleMesh& mesh, double texel_size, int feat
   const std::vector<double> areas = mesh::FaceAreas(mesh);
   const double area = std::accumulate(areas.begin(), areas.end(), 0.0);
   const double samples = 1.6 * area / (texel_size * texel_size);
-  const double per_face = 96 + 12 + 12 + 48 + 12;  // frame, face, neighbours, corners, vertex
+  // Per face: the surface's frame, mesh face, neighbours and corners, and a
+  // vertex or more (an unshared mesh has three); the job's patch geometry (a
+  // triangle patch and its three unfoldings) and atlas placement.
+  const double per_face = sizeof(mesh::TriangleFrame) + 3 * sizeof(int) + 3 * sizeof(int) +
+                          3 * sizeof(Eigen::Vector2d) + 3 * sizeof(Eigen::Vector3d) +
+                          sizeof(synth::TrianglePatch) + 3 * sizeof(synth::Unfolding) +
+                          sizeof(atlas::FacePlacement);
   return samples * (64 + 4.0 * features + 0.5 * (2 * 4.0 * features + 96)) +
          per_face * static_cast<double>(mesh.faces.size());
+}
+
+AtlasAxes AtlasAxesOf(const DenseSurface& surface, const atlas::AtlasLayout& layout, int face) {
+  const mesh::TriangleFrame& frame = surface.FrameOf(face);
+  const double a = layout.faces[static_cast<std::size_t>(face)].AtlasFrameAngle();
+  const Eigen::Vector3d x = std::cos(a) * frame.x_axis + std::sin(a) * frame.y_axis;
+  return {x, frame.z_axis.cross(x), frame.z_axis};
 }
 
 }  // namespace texlume::quilt

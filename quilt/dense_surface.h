@@ -34,7 +34,8 @@ struct DenseSample {
 /// the remembered seams (Kwatra's old seams: two feature vectors and a hash
 /// node, on at most about one link in two); the charts' stretch adds up to
 /// 1.25^2 samples per unit of area. Per face, the surface keeps the mesh, the
-/// face frames, neighbours and corners (about 180 bytes).
+/// face frames, neighbours and corners, and the job its patch geometry and
+/// atlas placement.
 double QuiltingBytes(const mesh::TriangleMesh& mesh, double texel_size, int features);
 
 class DenseSurface {
@@ -88,5 +89,12 @@ class DenseSurface {
   std::vector<int> offsets_, adjacency_;
   std::size_t chart_seam_links_ = 0, open_directions_ = 0;
 };
+
+/// A face's atlas frame in the world: x right and y up as its chart lies in
+/// the atlas, and the face normal.
+struct AtlasAxes {
+  Eigen::Vector3d x, y, normal;
+};
+AtlasAxes AtlasAxesOf(const DenseSurface& surface, const atlas::AtlasLayout& layout, int face);
 
 }  // namespace texlume::quilt

@@ -494,13 +494,6 @@ class SurfaceQuilter {
 
 }  // namespace
 
-AtlasAxes AtlasAxesOf(const DenseSurface& surface, const atlas::AtlasLayout& layout, int face) {
-  const mesh::TriangleFrame& frame = surface.FrameOf(face);
-  const double a = layout.faces[static_cast<std::size_t>(face)].AtlasFrameAngle();
-  const Eigen::Vector3d x = std::cos(a) * frame.x_axis + std::sin(a) * frame.y_axis;
-  return {x, frame.z_axis.cross(x), frame.z_axis};
-}
-
 double SeamShare(const QuiltStats& stats) {
   return stats.cut_links && stats.random_pair_cost > 0
              ? stats.seam_cost / static_cast<double>(stats.cut_links) / stats.random_pair_cost

@@ -95,13 +95,6 @@ struct GivenSamples {
   std::vector<float> features;  ///< per dense sample, NumFeatures() values, chart's atlas frame
 };
 
-/// A face's atlas frame in the world: x right and y up as its chart lies in
-/// the atlas, and the face normal.
-struct AtlasAxes {
-  Eigen::Vector3d x, y, normal;
-};
-AtlasAxes AtlasAxesOf(const DenseSurface& surface, const atlas::AtlasLayout& layout, int face);
-
 /// A sample of a work patch as an image term sees it: the dense sample and its
 /// pixel in the work image (rows down). The work frame is the atlas frame of
 /// the seed's chart (AtlasAxesOf the seed's face).

@@ -4,8 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "quilt/surface_quilting.h"
-
 namespace texlume::quilt {
 namespace {
 
@@ -16,14 +14,15 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 Eigen::Vector2d Centre(const DenseSample& d) { return {d.x + 0.5, d.y + 0.5}; }
 
-}  // namespace
-
+// A rotation of y-up angle `rad` acting on pixel vectors (rows down).
 Eigen::Matrix2d PixelRotation(double rad) {
   const double c = std::cos(rad), s = std::sin(rad);
   Eigen::Matrix2d m;
   m << c, s, -s, c;
   return m;
 }
+
+}  // namespace
 
 WorkPatchBuilder::WorkPatchBuilder(const DenseSurface& surface, const atlas::AtlasLayout& layout,
                                    int copy_side, bool conformal)

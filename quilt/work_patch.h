@@ -60,7 +60,4 @@ class WorkPatchBuilder {
   std::vector<Eigen::Vector3d> atlas_x_, atlas_y_, normal_;  ///< per face, world
 };
 
-/// A rotation of y-up angle `rad` acting on pixel vectors (rows down).
-Eigen::Matrix2d PixelRotation(double rad);
-
 }  // namespace texlume::quilt

@@ -91,6 +91,8 @@ class MaterialSample {
   /// What Relight reads, reduced to a photo density level (r = 2^(-level/4)
   /// photo pixels per texel; ReduceToDensityLevel), cached.
   const ReducedPlanes& Reduced(int level) const;
+  /// How many planes Reduced() reduces (each of the sample's size at level 0).
+  int NumRelightPlanes() const { return static_cast<int>(RelightPlanes().size()); }
   /// The reduced sample relit under a face's lighting times a gain: 3 planes
   /// (R, G, B) of the reduced size, in Domain().
   virtual std::vector<cv::Mat> Relight(const ReducedPlanes& reduced, const FaceLighting& lighting,

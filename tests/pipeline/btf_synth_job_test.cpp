@@ -195,10 +195,14 @@ TEST_F(MeshBtfTest, GraphCutSeamsCostNoMoreThanTheStraightMeshEdge) {
 // Points on the shared edges of `mesh`, looked up from either face: where both
 // choose the same patch, they must agree on the sample position and on the
 // sample-frame direction of a world tangent (the rotation each lookup reports).
-// Only the edges `edge_wanted(f, g)` accepts are visited. Returns the number of
-// points compared.
-int CheckEdgeAgreement(const synth::BtfMeshSynthesis& s, const mesh::TriangleMesh& mesh,
-                       const std::function<bool(std::size_t, int)>& edge_wanted) {
+// Only the edges `edge_wanted(f, g)` accepts are visited; `compared(f, p, l)`
+// sees each point compared (p in f's frame, l its lookup from f). Returns the
+// number of points compared.
+int CheckEdgeAgreement(
+    const synth::BtfMeshSynthesis& s, const mesh::TriangleMesh& mesh,
+    const std::function<bool(std::size_t, int)>& edge_wanted,
+    const std::function<void(std::size_t, const Eigen::Vector2d&, const synth::BtfSampleLookup&)>&
+        compared_point = {}) {
   int compared = 0;
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     for (int k = 0; k < 3; ++k) {
@@ -214,6 +218,7 @@ int CheckEdgeAgreement(const synth::BtfMeshSynthesis& s, const mesh::TriangleMes
         const synth::BtfSampleLookup lh = s.Lookup(u.face, fh.PointInFrame(x).head<2>());
         if (lf.source_face != lh.source_face) continue;
         ++compared;
+        if (compared_point) compared_point(f, ff.PointInFrame(x).head<2>(), lf);
         EXPECT_NEAR((lf.sample_px - lh.sample_px).norm(), 0.0, 1e-6) << f << " " << k;
         const Eigen::Vector3d d = (b - a).normalized();
         const Eigen::Vector2d df =
@@ -247,11 +252,24 @@ TEST_F(MeshBtfTest, SeamsCrossingIntoAFilledFaceReadItsQuilt) {
       quilt::FillUnseenFaces(inputs_->mesh, s, synth::BtfSample(*sample_), o);
   ASSERT_GT(fill.faces, 0u);
   const auto filled = [&](int f) { return fill.filled[static_cast<std::size_t>(f)] != 0; };
-  const int compared = CheckEdgeAgreement(s, inputs_->mesh, [&](std::size_t f, int g) {
-    return filled(static_cast<int>(f)) != filled(g);
-  });
+  // Seen from the placed face, a point whose lookup moved off the neighbour's
+  // overlap-only patch (what it read before the fill) reads the quilt, not the
+  // old patch. Each edge is visited from both faces.
+  int from_placed = 0, moved = 0;
+  const int compared = CheckEdgeAgreement(
+      s, inputs_->mesh,
+      [&](std::size_t f, int g) { return filled(static_cast<int>(f)) != filled(g); },
+      [&](std::size_t f, const Eigen::Vector2d& p, const synth::BtfSampleLookup& after) {
+        if (filled(static_cast<int>(f))) return;
+        ++from_placed;
+        const synth::BtfSampleLookup before = synthesis_->Lookup(static_cast<int>(f), p);
+        moved += (after.sample_px - before.sample_px).norm() > 1.0;
+      });
   RecordProperty("edge_points_compared", compared);
-  EXPECT_GT(compared, 20);  // 94 of the points on edges between filled and placed faces
+  RecordProperty("seen_from_the_placed_face", from_placed);
+  RecordProperty("moved_onto_the_quilt", moved);
+  EXPECT_GT(from_placed, 10);
+  EXPECT_GT(moved, from_placed / 2);
 }
 
 TEST_F(MeshBtfTest, ModelFolderHoldsCoordinatesGeometryAtlasesAndAPtmPreview) {
