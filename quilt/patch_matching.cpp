@@ -1,6 +1,8 @@
 #include "quilt/patch_matching.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -23,6 +25,20 @@ Placement BestOf(const cv::Mat& ssd, int rotation, double overlap) {
       if (row[x] < best.cost) best.cost = row[x], best.x = x, best.y = y;
   }
   best.cost /= std::max(overlap, 1.0);
+  return best;
+}
+
+// The transform size for a copy of side n: the smallest 2^a, 3 * 2^a or
+// 5 * 2^a at least n. OpenCV's optimal sizes (any 2^a 3^b 5^c) are smaller but
+// can be slower: 375 = 3 * 5^3 (a 512^2 sample's copies) transforms 1.7 times
+// slower than 384.
+int FastDftSize(int n) {
+  int best = std::numeric_limits<int>::max();
+  for (const int odd : {1, 3, 5}) {
+    int m = odd;
+    while (m < n) m *= 2;
+    best = std::min(best, m);
+  }
   return best;
 }
 
@@ -126,7 +142,7 @@ RotatedCopy RotatedSample::Make(int rotation) const {
         copy.planes[static_cast<std::size_t>(c)].at<float>(y, x) = f[static_cast<std::size_t>(c)];
     }
   copy.energy = synth::PlaneEnergy(copy.planes);
-  copy.dft_size = cv::getOptimalDFTSize(side_);
+  copy.dft_size = FastDftSize(side_);
   for (const cv::Mat& plane : copy.planes)
     copy.plane_spectra.push_back(Spectrum(plane, copy.dft_size));
   copy.energy_spectrum = Spectrum(copy.energy, copy.dft_size);
