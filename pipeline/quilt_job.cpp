@@ -204,16 +204,63 @@ class QuiltJob {
     engine_options_.strip = 2;  // as the layout's patches: the calibration rectifies faces whole
     const bool field_given = !options_.field_file.empty() || options_.quilt.random_orientation;
     if (field_given) engine_options_.tangent_frame = synth::TangentFrame::kSmoothField;
-    engine_ = std::make_unique<synth::TriangleEngine>(inputs_.mesh, inputs_.reconstruction,
-                                                      inputs_.visibility, inputs_.photos, *matched_,
-                                                      engine_options_, nullptr);
+    MakeCalibrationMesh();
+    engine_ = std::make_unique<synth::TriangleEngine>(CalibrationMesh(), inputs_.reconstruction,
+                                                      CalibrationVisibility(), inputs_.photos,
+                                                      *matched_, engine_options_, nullptr);
     const synth::TriangleSynthesis& photometry = engine_->Prepare(progress_);
     if (!field_given && photometry.tangent_frame == synth::TangentFrame::kPhotos)
-      for (const synth::TrianglePatch& patch : photometry.patches)
-        quilt_options_.field_in_world.push_back(patch.frame.x_axis);
+      for (std::size_t f = 0; f < inputs_.mesh.faces.size(); ++f)
+        quilt_options_.field_in_world.push_back(photometry.patches[CentralChild(f)].frame.x_axis);
     light_response_ = photometry.light_response;
     summary_.photo_calibration = EngineSummaryJson(photometry);
+    summary_.photo_calibration["mesh_subdivisions"] = calibration_subdivisions_;
     summary_.seconds_photometry = SecondsSince(start);
+  }
+
+  // The calibration rectifies whole faces into the sample: faces whose patch
+  // does not fit it are left out of it. When some do not fit, it runs on a
+  // midpoint subdivision of the mesh (with its own visibility), as the main job
+  // subdivides its mesh; the quilt keeps the mesh as given.
+  void MakeCalibrationMesh() {
+    const int side = std::min(matched_->Width(), matched_->Height());
+    const auto fits = [&](const mesh::TriangleMesh& m) {
+      for (std::size_t f = 0; f < m.faces.size(); ++f)
+        for (int k = 0; k < 3; ++k)
+          if ((m.Corner(f, (k + 1) % 3) - m.Corner(f, k)).norm() / texel_size_ +
+                  2 * engine_options_.strip + 2 >
+              side)
+            return false;
+      return true;
+    };
+    calibration_subdivisions_ = 0;
+    calibration_mesh_ = inputs_.mesh;
+    while (!fits(calibration_mesh_) && calibration_subdivisions_ < kMostCalibrationSubdivisions &&
+           calibration_mesh_.faces.size() * 4 <= kMostCalibrationFaces) {
+      calibration_mesh_ = mesh::SubdivideMidpoint(calibration_mesh_);
+      ++calibration_subdivisions_;
+    }
+    if (calibration_subdivisions_ == 0) return;
+    calibration_visibility_ = sfm::ComputeVisibility(calibration_mesh_, inputs_.reconstruction,
+                                                     PhotoInputs().visibility, progress_);
+    summary_.warnings.push_back(
+        "calibrated the photos on the mesh subdivided " +
+        std::to_string(calibration_subdivisions_) +
+        " time(s), so that its triangles fit the sample (the quilt keeps the mesh)" +
+        (fits(calibration_mesh_) ? std::string()
+                                 : "; some still do not fit, and the calibration leaves them out"));
+  }
+  const mesh::TriangleMesh& CalibrationMesh() const {
+    return calibration_subdivisions_ ? calibration_mesh_ : inputs_.mesh;
+  }
+  const sfm::VisibilityResult& CalibrationVisibility() const {
+    return calibration_subdivisions_ ? calibration_visibility_ : inputs_.visibility;
+  }
+  // The calibration face at the centre of face f (mesh::SubdivideMidpoint puts
+  // a face's middle child, coplanar and concentric with it, fourth).
+  std::size_t CentralChild(std::size_t f) const {
+    for (int k = 0; k < calibration_subdivisions_; ++k) f = 4 * f + 3;
+    return f;
   }
 
   // The sample, and the one the quilting matches: a BTF (its geometry maps), a
@@ -503,6 +550,12 @@ class QuiltJob {
   synth::TriangleEngineOptions engine_options_;
   std::unique_ptr<synth::TriangleEngine> engine_;  ///< with photos: their calibration
   ptm::LightResponse light_response_;              ///< theirs, for the model
+  /// With photos whose calibration needs smaller faces: the mesh subdivided.
+  static constexpr int kMostCalibrationSubdivisions = 6;
+  static constexpr std::size_t kMostCalibrationFaces = std::size_t{1} << 20;
+  int calibration_subdivisions_ = 0;
+  mesh::TriangleMesh calibration_mesh_;
+  sfm::VisibilityResult calibration_visibility_;
   std::optional<quilt::PhotoEvidence> evidence_;
   double texel_size_ = 0;  ///< world units per sample texel (the BTF's own when not given)
   Sample sample_;

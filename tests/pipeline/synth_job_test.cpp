@@ -19,6 +19,7 @@
 #include "core/errors.h"
 #include "core/memory_budget.h"
 #include "datasets_synthetic/scene.h"
+#include "datasets_synthetic/shapes.h"
 #include "mesh/mesh.h"
 #include "model/baselines.h"
 #include "model/model_io.h"
@@ -462,6 +463,57 @@ TEST_F(MeshPipelineTest, GraphCutEngineFollowsThePhotos) {
   q.out_dir = tmp_->path() / "graphcut_bad";
   EXPECT_THROW(pipeline::RunQuiltJob(q), OptionError);
   EXPECT_FALSE(fs::exists(q.out_dir));
+}
+
+// Triangles far larger than the sample (the graph-cut engine's own case): the
+// photos are calibrated on a midpoint subdivision of the mesh, whose faces fit
+// the sample, instead of on no face at all (gains of 1 and the identity).
+TEST_F(MeshPipelineTest, GraphCutEngineCalibratesLargeTrianglesOnASubdivision) {
+  const mesh::TriangleMesh sphere = mesh::LoadMesh(job_->mesh_file).mesh;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& v : sphere.vertices) centre += v;
+  centre /= static_cast<double>(sphere.vertices.size());
+  double radius = 0;
+  for (const Eigen::Vector3d& v : sphere.vertices) radius += (v - centre).norm();
+  radius /= static_cast<double>(sphere.vertices.size());
+  mesh::TriangleMesh coarse = datasets::MakeIcosphere(0, radius);  // 20 faces
+  for (Eigen::Vector3d& v : coarse.vertices) v += centre;
+  const fs::path coarse_file = tmp_->path() / "icosahedron.ply";
+  {
+    std::ofstream ply(coarse_file);
+    ply << "ply\nformat ascii 1.0\nelement vertex " << coarse.vertices.size()
+        << "\nproperty double x\nproperty double y\nproperty double z\nelement face "
+        << coarse.faces.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const Eigen::Vector3d& v : coarse.vertices)
+      ply << v.x() << " " << v.y() << " " << v.z() << "\n";
+    for (const auto& f : coarse.faces) ply << "3 " << f[0] << " " << f[1] << " " << f[2] << "\n";
+  }
+  const ptm::Ptm sample = ptm::ReadPtmExr(job_->sample_file);
+  const int side = std::min(sample.width, sample.height);
+  const double edge = (coarse.Corner(0, 1) - coarse.Corner(0, 0)).norm();
+  pipeline::QuiltJobOptions q;
+  q.model_dir = job_->model_dir;
+  q.images_dir = job_->images_dir;
+  q.lights_file = job_->lights_file;
+  q.mesh_file = coarse_file;
+  q.sample_file = job_->sample_file;
+  q.sample_texel_size = edge / (1.5 * side);  // a face spans 1.5 samples; a quarter of it fits
+  q.out_dir = tmp_->path() / "graphcut_icosahedron";
+  q.atlas.atlas_size = 512;
+  q.write_report = false;
+  const pipeline::QuiltJobSummary s = pipeline::RunQuiltJob(q);
+  const nlohmann::json manifest =
+      nlohmann::json::parse(testing::ReadText(q.out_dir / "manifest.json"));
+  const nlohmann::json& photos = manifest["summary"]["photos"];
+  EXPECT_GE(photos["mesh_subdivisions"].get<int>(), 1);
+  std::size_t calibrated = 0;
+  for (const auto& gain : photos["photo_gains"]) calibrated += gain.get<double>() != 1.0;
+  EXPECT_EQ(calibrated, s.photos_used);
+  EXPECT_FALSE(model::ReadModelFolder(q.out_dir).light_response.IsIdentity());
+  bool warned = false;
+  for (const std::string& w : s.warnings) warned = warned || w.find("subdivided") != w.npos;
+  EXPECT_TRUE(warned);
+  EXPECT_GT(s.stats.photo_patches, 0u);
 }
 
 // What each pass (detail transfer, the photo-consistency prior's shrink) adds under
