@@ -1,5 +1,6 @@
 #include "pipeline/quilt_job.h"
 
+#include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -211,7 +212,7 @@ class QuiltJob {
     const synth::TriangleSynthesis& photometry = engine_->Prepare(progress_);
     if (!field_given && photometry.tangent_frame == synth::TangentFrame::kPhotos)
       for (std::size_t f = 0; f < inputs_.mesh.faces.size(); ++f)
-        quilt_options_.field_in_world.push_back(photometry.patches[CentralChild(f)].frame.x_axis);
+        quilt_options_.field_in_world.push_back(FieldOfFace(f, photometry));
     light_response_ = photometry.light_response;
     summary_.photo_calibration = EngineSummaryJson(photometry);
     summary_.photo_calibration["mesh_subdivisions"] = calibration_subdivisions_;
@@ -234,21 +235,29 @@ class QuiltJob {
       return true;
     };
     calibration_subdivisions_ = 0;
-    calibration_mesh_ = inputs_.mesh;
-    while (!fits(calibration_mesh_) && calibration_subdivisions_ < kMostCalibrationSubdivisions &&
-           calibration_mesh_.faces.size() * 4 <= kMostCalibrationFaces) {
-      calibration_mesh_ = mesh::SubdivideMidpoint(calibration_mesh_);
+    if (fits(inputs_.mesh)) return;
+    while (calibration_subdivisions_ < kMostCalibrationSubdivisions &&
+           CalibrationMesh().faces.size() * 4 <= kMostCalibrationFaces &&
+           !fits(CalibrationMesh())) {
+      calibration_mesh_ = mesh::SubdivideMidpoint(CalibrationMesh());
       ++calibration_subdivisions_;
     }
-    if (calibration_subdivisions_ == 0) return;
+    const bool all_fit = fits(CalibrationMesh());
+    if (calibration_subdivisions_ == 0) {
+      summary_.warnings.push_back(
+          "some triangles do not fit the sample, and the photo calibration leaves them out (the "
+          "mesh has too many faces to subdivide for it)");
+      return;
+    }
     calibration_visibility_ = sfm::ComputeVisibility(calibration_mesh_, inputs_.reconstruction,
                                                      PhotoInputs().visibility, progress_);
-    summary_.warnings.push_back(
-        "calibrated the photos on the mesh subdivided " +
-        std::to_string(calibration_subdivisions_) +
-        " time(s), so that its triangles fit the sample (the quilt keeps the mesh)" +
-        (fits(calibration_mesh_) ? std::string()
-                                 : "; some still do not fit, and the calibration leaves them out"));
+    summary_.warnings.push_back("calibrated the photos on the mesh subdivided " +
+                                std::to_string(calibration_subdivisions_) +
+                                " time(s), so that its triangles fit the sample (the quilt "
+                                "keeps the mesh)" +
+                                (all_fit ? std::string()
+                                         : "; some still do not fit, and the calibration "
+                                           "leaves them out"));
   }
   const mesh::TriangleMesh& CalibrationMesh() const {
     return calibration_subdivisions_ ? calibration_mesh_ : inputs_.mesh;
@@ -256,11 +265,22 @@ class QuiltJob {
   const sfm::VisibilityResult& CalibrationVisibility() const {
     return calibration_subdivisions_ ? calibration_visibility_ : inputs_.visibility;
   }
-  // The calibration face at the centre of face f (mesh::SubdivideMidpoint puts
-  // a face's middle child, coplanar and concentric with it, fourth).
-  std::size_t CentralChild(std::size_t f) const {
-    for (int k = 0; k < calibration_subdivisions_; ++k) f = 4 * f + 3;
-    return f;
+  // The line field of face f from the calibration's frames: mesh::SubdivideMidpoint
+  // makes faces 4f to 4f + 3 of face f, so after k subdivisions its faces are
+  // [f 4^k, (f + 1) 4^k). Their x axes, as lines (d and -d alike), averaged:
+  // the main eigenvector of the sum of d d^T, signed as the first one.
+  Eigen::Vector3d FieldOfFace(std::size_t f, const synth::TriangleSynthesis& photometry) const {
+    if (calibration_subdivisions_ == 0) return photometry.patches[f].frame.x_axis;
+    const std::size_t children = std::size_t{1} << (2 * calibration_subdivisions_);
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (std::size_t c = f * children; c < (f + 1) * children; ++c) {
+      const Eigen::Vector3d& d = photometry.patches[c].frame.x_axis;
+      scatter += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+    Eigen::Vector3d line = eigen.eigenvectors().col(2);
+    const Eigen::Vector3d& first = photometry.patches[f * children].frame.x_axis;
+    return line.dot(first) < 0 ? Eigen::Vector3d(-line) : line;
   }
 
   // The sample, and the one the quilting matches: a BTF (its geometry maps), a

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <iomanip>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -467,7 +468,8 @@ TEST_F(MeshPipelineTest, GraphCutEngineFollowsThePhotos) {
 
 // Triangles far larger than the sample (the graph-cut engine's own case): the
 // photos are calibrated on a midpoint subdivision of the mesh, whose faces fit
-// the sample, instead of on no face at all (gains of 1 and the identity).
+// the sample, instead of on no face at all (gains of 1 and the identity), and
+// the photos' line field comes from the subdivision's frames.
 TEST_F(MeshPipelineTest, GraphCutEngineCalibratesLargeTrianglesOnASubdivision) {
   const mesh::TriangleMesh sphere = mesh::LoadMesh(job_->mesh_file).mesh;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -481,7 +483,8 @@ TEST_F(MeshPipelineTest, GraphCutEngineCalibratesLargeTrianglesOnASubdivision) {
   const fs::path coarse_file = tmp_->path() / "icosahedron.ply";
   {
     std::ofstream ply(coarse_file);
-    ply << "ply\nformat ascii 1.0\nelement vertex " << coarse.vertices.size()
+    ply << std::setprecision(17) << "ply\nformat ascii 1.0\nelement vertex "
+        << coarse.vertices.size()
         << "\nproperty double x\nproperty double y\nproperty double z\nelement face "
         << coarse.faces.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
     for (const Eigen::Vector3d& v : coarse.vertices)
@@ -501,11 +504,13 @@ TEST_F(MeshPipelineTest, GraphCutEngineCalibratesLargeTrianglesOnASubdivision) {
   q.out_dir = tmp_->path() / "graphcut_icosahedron";
   q.atlas.atlas_size = 512;
   q.write_report = false;
+  q.photo_engine.tangent_frame = synth::TangentFrame::kPhotos;  // the field from the calibration
   const pipeline::QuiltJobSummary s = pipeline::RunQuiltJob(q);
   const nlohmann::json manifest =
       nlohmann::json::parse(testing::ReadText(q.out_dir / "manifest.json"));
   const nlohmann::json& photos = manifest["summary"]["photos"];
-  EXPECT_GE(photos["mesh_subdivisions"].get<int>(), 1);
+  EXPECT_EQ(photos["mesh_subdivisions"].get<int>(), 1);
+  EXPECT_EQ(photos["tangent_frame"], "photos");
   std::size_t calibrated = 0;
   for (const auto& gain : photos["photo_gains"]) calibrated += gain.get<double>() != 1.0;
   EXPECT_EQ(calibrated, s.photos_used);
