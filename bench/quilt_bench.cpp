@@ -194,6 +194,17 @@ std::vector<Eigen::Vector3d> UpField(const mesh::TriangleMesh& mesh) {
   return field;
 }
 
+// The scene generator's capture of a material (256^2 under 40 lights, kept in
+// the temporary folder between runs) fitted as an LRGB PTM.
+ptm::Ptm CaptureOf(datasets::MaterialKind kind) {
+  const std::filesystem::path work =
+      std::filesystem::temp_directory_path() /
+      ("texlume_quilt_bench_" + std::string(datasets::MaterialKindName(kind)));
+  if (!std::filesystem::exists(work / "material/capture/lights.lp"))
+    datasets::GenerateScene(datasets::MaterialOnlySceneOptions(kind, 256, 40), work);
+  return datasets::FitSceneSample(work);
+}
+
 // Samples of several kinds (issue 32): the scene generator's stone (stochastic),
 // brick (structured) and grooves (directional) captures, 256^2 under 40 lights,
 // fitted into LRGB PTMs and quilted over the icosphere along the up field,
@@ -210,11 +221,7 @@ void QuiltMaterials(int levels, double texel) {
        {datasets::MaterialKind::kStone, datasets::MaterialKind::kBrick,
         datasets::MaterialKind::kGrooves}) {
     const std::string name(datasets::MaterialKindName(kind));
-    const std::filesystem::path work =
-        std::filesystem::temp_directory_path() / ("texlume_quilt_bench_" + name);
-    if (!std::filesystem::exists(work / "material/capture/lights.lp"))
-      datasets::GenerateScene(datasets::MaterialOnlySceneOptions(kind, 256, 40), work);
-    const ptm::Ptm fitted = datasets::FitSceneSample(work);
+    const ptm::Ptm fitted = CaptureOf(kind);
     const synth::PtmSample sample(fitted);
     quilt::RotatedSample rotated(sample);
     for (const bool random : {false, true}) {
@@ -250,11 +257,7 @@ void SweepParameters(double texel) {
        {datasets::MaterialKind::kStone, datasets::MaterialKind::kBrick,
         datasets::MaterialKind::kGrooves}) {
     const std::string name(datasets::MaterialKindName(kind));
-    const std::filesystem::path work =
-        std::filesystem::temp_directory_path() / ("texlume_quilt_bench_" + name);
-    if (!std::filesystem::exists(work / "material/capture/lights.lp"))
-      datasets::GenerateScene(datasets::MaterialOnlySceneOptions(kind, 256, 40), work);
-    const ptm::Ptm fitted = datasets::FitSceneSample(work);
+    const ptm::Ptm fitted = CaptureOf(kind);
     const synth::PtmSample sample(fitted);
     quilt::RotatedSample rotated(sample);
     for (const auto& [levels, threshold] : settings) {

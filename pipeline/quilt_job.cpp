@@ -226,13 +226,7 @@ class QuiltJob {
   void MakeCalibrationMesh() {
     const int side = std::min(matched_->Width(), matched_->Height());
     const auto fits = [&](const mesh::TriangleMesh& m) {
-      for (std::size_t f = 0; f < m.faces.size(); ++f)
-        for (int k = 0; k < 3; ++k)
-          if ((m.Corner(f, (k + 1) % 3) - m.Corner(f, k)).norm() / texel_size_ +
-                  2 * engine_options_.strip + 2 >
-              side)
-            return false;
-      return true;
+      return LargestPatchSide(m, texel_size_, engine_options_.strip) <= side;
     };
     calibration_subdivisions_ = 0;
     if (fits(inputs_.mesh)) return;

@@ -196,6 +196,14 @@ nlohmann::json AtlasSettingsJson(const atlas::AtlasOptions& atlas) {
           {"chart_stretch", atlas.max_chart_stretch}};
 }
 
+double LargestPatchSide(const mesh::TriangleMesh& mesh, double sample_texel_size, int strip) {
+  double widest = 0;
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    for (int k = 0; k < 3; ++k)
+      widest = std::max(widest, (mesh.Corner(f, (k + 1) % 3) - mesh.Corner(f, k)).norm());
+  return widest / sample_texel_size + 2 * strip + 2;
+}
+
 void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int sample_side,
                       double sample_texel_size, int strip, const ProgressCallback& progress) {
   const sfm::Reconstruction& reconstruction = inputs.reconstruction;
@@ -204,17 +212,7 @@ void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int s
   RefuseSampleLargerThanMesh(mesh, sample_texel_size, options.mesh_file);
   // Visibility (and subdivision while the largest triangle does not fit the sample).
   auto t = std::chrono::steady_clock::now();
-  auto largest_patch = [&](const mesh::TriangleMesh& m) {
-    double widest = 0;
-    for (std::size_t f = 0; f < m.faces.size(); ++f) {
-      double longest = 0;
-      for (int k = 0; k < 3; ++k)
-        longest = std::max(longest, (m.Corner(f, (k + 1) % 3) - m.Corner(f, k)).norm());
-      widest = std::max(widest, longest);
-    }
-    return widest / sample_texel_size + 2 * strip + 2;
-  };
-  while (largest_patch(mesh) > sample_side &&
+  while (LargestPatchSide(mesh, sample_texel_size, strip) > sample_side &&
          inputs.subdivisions < static_cast<std::size_t>(options.max_subdivisions)) {
     mesh = mesh::SubdivideMidpoint(mesh);
     ++inputs.subdivisions;

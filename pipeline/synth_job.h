@@ -135,9 +135,14 @@ struct SynthInputs {
 /// (sample and out_dir are not touched). Throws InputError as RunSynthJob describes.
 SynthInputs LoadSynthInputs(const SynthJobOptions& options);
 
-/// Splits the mesh while its largest patch (longest edge / sample_texel_size +
-/// 2 strip texels) exceeds `sample_side` texels (up to options.max_subdivisions
-/// times) and computes visibility. Throws InputError when most triangles are
+/// The side (sample texels) of the largest triangle patch of `mesh`: its
+/// longest edge at `sample_texel_size`, with a strip of `strip` texels and a
+/// texel of margin on each side. A triangle fits a sample no narrower.
+double LargestPatchSide(const mesh::TriangleMesh& mesh, double sample_texel_size, int strip);
+
+/// Splits the mesh while its largest patch (LargestPatchSide) exceeds
+/// `sample_side` texels (up to options.max_subdivisions times) and computes
+/// visibility. Throws InputError when most triangles are
 /// seen by no usable photo (a mesh in another frame).
 void PrepareSynthMesh(SynthInputs& inputs, const SynthJobOptions& options, int sample_side,
                       double sample_texel_size, int strip, const ProgressCallback& progress = {});

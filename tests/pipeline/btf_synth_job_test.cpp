@@ -55,6 +55,7 @@ class MeshBtfTest : public ::testing::Test {
                                  inputs_->photos, *sample_, Options()));
   }
   static void TearDownTestSuite() {
+    delete filled_;
     delete synthesis_;
     delete inputs_;
     delete job_;
@@ -101,13 +102,32 @@ class MeshBtfTest : public ::testing::Test {
     r.btf_as_btf = as_btf;
     return pipeline::RunRenderJob(r);
   }
+  // The synthesis with --fill-unseen graphcut (quilt/unseen_fill.h) applied,
+  // made once for the tests that need it.
+  struct FilledSynthesis {
+    synth::BtfMeshSynthesis synthesis;
+    quilt::UnseenFillSummary fill;
+  };
+  static const FilledSynthesis& Filled() {
+    if (!filled_) {
+      filled_ = new FilledSynthesis{*synthesis_, {}};
+      quilt::UnseenFillOptions o;
+      o.atlas.atlas_size = 1024;
+      o.quilt.work_patch_levels = 16;
+      filled_->fill =
+          quilt::FillUnseenFaces(inputs_->mesh, filled_->synthesis, synth::BtfSample(*sample_), o);
+    }
+    return *filled_;
+  }
   static testing::TempDir* tmp_;
+  static FilledSynthesis* filled_;
   static BtfFactorisation* sample_;
   static pipeline::SynthJobOptions* job_;
   static pipeline::SynthInputs* inputs_;
   static synth::BtfMeshSynthesis* synthesis_;
 };
 testing::TempDir* MeshBtfTest::tmp_ = nullptr;
+MeshBtfTest::FilledSynthesis* MeshBtfTest::filled_ = nullptr;
 BtfFactorisation* MeshBtfTest::sample_ = nullptr;
 pipeline::SynthJobOptions* MeshBtfTest::job_ = nullptr;
 pipeline::SynthInputs* MeshBtfTest::inputs_ = nullptr;
@@ -136,12 +156,8 @@ TEST_F(MeshBtfTest, EveryTrianglePatchLiesInTheSampleMostFromThePhotos) {
 // 1, moved off their overlap-only patches); a face the photos placed keeps its
 // lookups where no filled face is next to it.
 TEST_F(MeshBtfTest, GraphCutFillQuiltsTheUnseenFacesOnTheGeometryMaps) {
-  synth::BtfMeshSynthesis s = *synthesis_;
-  quilt::UnseenFillOptions o;
-  o.atlas.atlas_size = 1024;
-  o.quilt.work_patch_levels = 16;
-  const quilt::UnseenFillSummary fill =
-      quilt::FillUnseenFaces(inputs_->mesh, s, synth::BtfSample(*sample_), o);
+  const synth::BtfMeshSynthesis& s = Filled().synthesis;
+  const quilt::UnseenFillSummary& fill = Filled().fill;
   EXPECT_EQ(fill.faces, s.num_from_neighbours + s.num_random);
   ASSERT_GT(fill.faces, 0u);
   EXPECT_GT(fill.stats.patches, 1u);
@@ -244,12 +260,8 @@ TEST_F(MeshBtfTest, BothSidesOfAnEdgeSeeTheSameSampleTexelAndFrame) {
 // (a filled face reads only its own quilt, so every point compared is a seam
 // crossing into it).
 TEST_F(MeshBtfTest, SeamsCrossingIntoAFilledFaceReadItsQuilt) {
-  synth::BtfMeshSynthesis s = *synthesis_;
-  quilt::UnseenFillOptions o;
-  o.atlas.atlas_size = 1024;
-  o.quilt.work_patch_levels = 16;
-  const quilt::UnseenFillSummary fill =
-      quilt::FillUnseenFaces(inputs_->mesh, s, synth::BtfSample(*sample_), o);
+  const synth::BtfMeshSynthesis& s = Filled().synthesis;
+  const quilt::UnseenFillSummary& fill = Filled().fill;
   ASSERT_GT(fill.faces, 0u);
   const auto filled = [&](int f) { return fill.filled[static_cast<std::size_t>(f)] != 0; };
   // Seen from the placed face, a point whose lookup moved off the neighbour's
