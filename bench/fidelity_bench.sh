@@ -17,7 +17,10 @@
 # grazing held-out lights). With ABLATIONS=1 it also builds the model without each
 # of the main job's passes, one at a time (rows no_detail_transfer, shrink_0 and
 # shrink_1: the photo-consistency prior centred on the quilted patch or on the
-# sample's mean instead of the estimate, and no_correction).
+# sample's mean instead of the estimate, and no_correction). With BTF=1 the scenes
+# also hold a BTF capture of the material (BTF_ARGS, by default 256 x 256 texels,
+# 13 views x 40 lights) and a row "btf" renders the model `texlume synth --btf`
+# builds from it: a model that keeps the capture's own images, shadows included.
 # Usage: bench/fidelity_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [SHAPES (sphere cylinder)]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -28,6 +31,10 @@ work=${2:-$(mktemp -d)}
 shapes=${3:-sphere cylinder}
 clean=()
 if [ "${CLEAN:-0}" = 1 ]; then clean=(--clean); fi
+btf_capture=(--no-btf)
+if [ "${BTF:-0}" = 1 ]; then
+  read -r -a btf_capture <<< "${BTF_ARGS:---btf-size 256 --btf-views 13 --btf-lights 40}"
+fi
 mkdir -p "$work"
 for shape in $shapes; do
   dir="$work/$shape"
@@ -35,10 +42,13 @@ for shape in $shapes; do
   for instance in scene other; do
     seed=()
     if [ "$instance" = other ]; then seed=(--material-seed 1001); fi
+    if [ "${BTF:-0}" = 1 ] && [ ! -d "$dir/$instance/material/btf" ]; then
+      rm -rf "${dir:?}/$instance"  # written without a BTF capture
+    fi
     if [ ! -f "$dir/$instance/scene.json" ]; then
-      echo "fidelity_bench: $shape $instance ${clean[*]}" >&2
-      "$texlume" scene --out "$dir/$instance" --kind "$shape" --held-out-scale 2 --no-btf \
-        "${clean[@]}" "${seed[@]}" ${SCENE_ARGS:-} > /dev/null
+      echo "fidelity_bench: $shape $instance ${clean[*]} ${btf_capture[*]}" >&2
+      "$texlume" scene --out "$dir/$instance" --kind "$shape" --held-out-scale 2 \
+        "${btf_capture[@]}" "${clean[@]}" "${seed[@]}" ${SCENE_ARGS:-} > /dev/null
     fi
   done
   object="$dir/scene/object"
@@ -53,14 +63,16 @@ for shape in $shapes; do
     "$texlume" render --model "$model" --cameras "$held/sparse" --lights "$held/lights.json" \
       --out "$dir/render_$name" "$@" > /dev/null
   }
-  synth() {  # NAME COLMAP_MODEL [synth options]
+  synth() {  # NAME COLMAP_MODEL [synth options: by default the PTM sample]
     local name=$1 cameras=$2
     shift 2
+    local sample=(--sample "$dir/sample.ptm" --sample-texel-size 0.002)
+    if [ "$#" -gt 0 ] && [ "$1" = --btf ]; then sample=(); fi
     rm -rf "$dir/model_$name"
     local start=$SECONDS
     "$texlume" synth --model "$cameras" --images "$object/images" \
       --lights "$object/lights.json" --mesh "$object/mesh.ply" --no-report \
-      --sample "$dir/sample.ptm" --sample-texel-size 0.002 --out "$dir/model_$name" "$@" > /dev/null
+      "${sample[@]}" --out "$dir/model_$name" "$@" > /dev/null
     echo "synth $name: $((SECONDS - start)) s" >&2
     render "$name" "$dir/model_$name"
   }
@@ -93,6 +105,10 @@ for shape in $shapes; do
       synth colmap "$dir/colmap_model"
       rows+=(texlume_colmap="$dir/render_colmap")
     fi
+  fi
+  if [ "${BTF:-0}" = 1 ]; then
+    synth btf "$object/sparse" --btf "$dir/scene/material/btf"
+    rows+=(btf="$dir/render_btf")
   fi
   if [ "${ABLATIONS:-0}" = 1 ]; then
     synth no_detail_transfer "$object/sparse" --no-detail-transfer

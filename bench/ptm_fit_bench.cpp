@@ -1,8 +1,10 @@
-// PTM fitting benchmarks (issue 4). Run: build/bench/ptm_fit_bench [--images N] [--size S]
-// 1. Throughput: N synthetic RTI images of S x S pixels (default 50 of 2048 x 2048,
-//    4.2 MP) are written as PNG once, then in one run: decoding every band of every
-//    image alone (the baseline), and decode + least-squares fit + .ptm write.
-//    Reports the ratio and the process's peak memory (run with two values of N to
+// PTM fitting benchmarks (issues 4 and 33). Run: build/bench/ptm_fit_bench [--images N]
+//   [--size S | --width W --height H] [--format png|jpg] [--part all|throughput]
+// 1. Throughput: N synthetic RTI images of S x S (or W x H) pixels (default 50 of
+//    2048 x 2048, 4.2 MP; issue 33 measures 50 JPEGs of 6000 x 4000, 24 MP) are
+//    written once, then in one run: decoding every band of every image alone on one
+//    thread (the baseline), and decode + least-squares fit + .ptm write, LRGB and RGB.
+//    Reports the ratios and the process's peak memory (run with two values of N to
 //    see that memory does not grow with the number of images beyond one band).
 // 2. Leave-out quality: on a synthetic stone capture (texlume scene), PSNR of the
 //    PTM relit at the 10 held-out lights, least squares vs robust.
@@ -30,6 +32,7 @@
 #include "datasets_synthetic/scene.h"
 #include "ptm/fit.h"
 #include "ptm/hsh.h"
+#include "ptm/image_bands.h"
 #include "ptm/ptm_io.h"
 #include "render/fidelity.h"
 #include "sfm/lights.h"
@@ -49,53 +52,69 @@ double PeakRssMiB() {
   return usage.ru_maxrss / 1024.0;
 }
 
-// Writes (once) n images of a smooth random PTM relit at dome lights.
-std::vector<fs::path> ThroughputImages(int n, int size, const fs::path& dir,
-                                       std::vector<Eigen::Vector3d>* lights) {
+// Writes (once) n images of width x height pixels of a smooth random PTM relit at
+// dome lights, as PNG or JPEG (quality 90, as cameras write them).
+std::vector<fs::path> ThroughputImages(int n, cv::Size size, const std::string& format,
+                                       const fs::path& dir, std::vector<Eigen::Vector3d>* lights) {
   *lights = datasets::DomeLights(n, 15, 80, 0.0);
   fs::create_directories(dir);
   std::vector<fs::path> files;
   cv::Mat a[6];
-  std::mt19937 rng(1);
+  cv::RNG rng(1);
   for (int i = 0; i < 6; ++i) {
     cv::Mat small(16, 16, CV_32FC1);
-    cv::randu(small, -0.25, 0.25);
-    cv::resize(small, a[i], cv::Size(size, size), 0, 0, cv::INTER_CUBIC);
+    rng.fill(small, cv::RNG::UNIFORM, -0.25, 0.25);
+    cv::resize(small, a[i], size, 0, 0, cv::INTER_CUBIC);
   }
+  cv::Mat grain(size, CV_32FC1);  // fine texture, so that JPEG has detail to code
+  rng.fill(grain, cv::RNG::NORMAL, 0.0, 0.03);
   for (int k = 0; k < n; ++k) {
-    files.push_back(dir / ("img_" + std::to_string(k) + ".png"));
+    files.push_back(dir / ("img_" + std::to_string(k) + "." + format));
     if (fs::exists(files.back())) continue;
     const auto b = ptm::PtmBasis((*lights)[static_cast<std::size_t>(k)].x(),
                                  (*lights)[static_cast<std::size_t>(k)].y());
-    cv::Mat image(size, size, CV_8UC3);
-    for (int y = 0; y < size; ++y) {
-      for (int x = 0; x < size; ++x) {
-        double l = 0.55;
-        for (int i = 0; i < 6; ++i) l += b[static_cast<std::size_t>(i)] * a[i].at<float>(y, x);
-        const auto v = static_cast<std::uint8_t>(std::clamp(std::lround(255 * l), 0L, 255L));
-        image.at<cv::Vec3b>(y, x) =
-            cv::Vec3b(v, static_cast<std::uint8_t>(v * 0.9), static_cast<std::uint8_t>(v * 0.8));
-      }
-    }
-    cv::imwrite(files.back().string(), image);
+    cv::Mat l = grain + 0.55;
+    for (int i = 0; i < 6; ++i) l += b[static_cast<std::size_t>(i)] * a[i];
+    cv::Mat image;
+    cv::merge(std::vector<cv::Mat>{0.8 * l, 0.9 * l, l}, image);  // BGR
+    image.convertTo(image, CV_8UC3, 255.0);
+    const std::string tmp = files.back().string() + ".tmp." + format;
+    cv::imwrite(tmp, image, {cv::IMWRITE_JPEG_QUALITY, 90});
+    fs::rename(tmp, files.back());
   }
   return files;
 }
 
+// Every band of every image decoded alone, in the file's own 8-bit values, on one
+// thread: what a reader must do at the least.
 double DecodeOnly(const std::vector<fs::path>& files, int band_rows) {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::unique_ptr<OIIO::ImageInput>> inputs;
   for (const auto& f : files) inputs.push_back(OIIO::ImageInput::open(f.string()));
   const int width = inputs[0]->spec().width, height = inputs[0]->spec().height;
-  std::vector<float> band(static_cast<std::size_t>(band_rows) * width * 3);
+  std::vector<std::uint8_t> band(static_cast<std::size_t>(band_rows) * width * 3);
   double checksum = 0;
   for (int y0 = 0; y0 < height; y0 += band_rows) {
     const int rows = std::min(band_rows, height - y0);
     for (auto& in : inputs) {
-      in->read_scanlines(0, 0, y0, y0 + rows, 0, 0, 3, OIIO::TypeDesc::FLOAT, band.data());
+      in->read_scanlines(0, 0, y0, y0 + rows, 0, 0, 3, OIIO::TypeDesc::UINT8, band.data());
       checksum += band[0];
     }
   }
+  if (checksum < 0) std::printf("impossible\n");
+  return Seconds(t0);
+}
+
+// The same through ptm::ImageBands: the next band decoded by every hardware thread
+// while nothing is done with the current one (how fast the fit's reader can go).
+double DecodeBands(const std::vector<fs::path>& files, int band_rows) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ptm::ImageBands bands(files);
+  double checksum = 0;
+  bands.ForEach<std::uint8_t>(
+      band_rows,
+      [&](const std::vector<const std::uint8_t*>& pixels, int, int) { checksum += pixels[0][0]; },
+      {}, "decode");
   if (checksum < 0) std::printf("impossible\n");
   return Seconds(t0);
 }
@@ -205,36 +224,66 @@ void PtmAgainstHsh(const fs::path& work, bool realistic) {
   }
 }
 
+// Section 1: decode + fit + write against decoding alone, LRGB and RGB, the
+// decode-only baseline measured before and after the fits (its mean is the ratio's
+// denominator: the machine's speed drifts).
+void Throughput(int n, cv::Size image_size, const std::string& format, const fs::path& work) {
+  std::vector<Eigen::Vector3d> lights;
+  std::printf("Preparing %d %s images of %dx%d in %s ...\n", n, format.c_str(), image_size.width,
+              image_size.height, work.c_str());
+  const auto files =
+      ThroughputImages(n, image_size, format,
+                       work / ("n" + std::to_string(n) + "_" + std::to_string(image_size.width) +
+                               "x" + std::to_string(image_size.height)),
+                       &lights);
+  const int band_rows = ptm::FitOptions{}.band_rows;
+  const double decode_before = DecodeOnly(files, band_rows);
+  double full[2], fit_seconds[2];
+  for (const ptm::PtmFormat format_out : {ptm::PtmFormat::kLrgb, ptm::PtmFormat::kRgb}) {
+    const int f = format_out == ptm::PtmFormat::kLrgb ? 0 : 1;
+    ptm::FitOptions options;
+    options.format = format_out;
+    const auto t0 = std::chrono::steady_clock::now();
+    const ptm::FitResult fit = ptm::FitPtmFromFiles(files, lights, options);
+    ptm::WritePtmFile(fit.ptm, work / "bench.ptm");
+    full[f] = Seconds(t0);
+    fit_seconds[f] = fit.seconds;
+  }
+  const double decode_after = DecodeOnly(files, band_rows);
+  const double decode_bands = DecodeBands(files, band_rows);
+  const double decode = 0.5 * (decode_before + decode_after);
+  const double megapixels = image_size.area() / 1e6;
+  std::printf("Throughput: %d %s images x %.1f MP\n", n, format.c_str(), megapixels);
+  std::printf("  decode only (8-bit, one thread)  %.2f s (%.2f before the fits, %.2f after)\n",
+              decode, decode_before, decode_after);
+  std::printf("  decode only, every thread (ptm::ImageBands)  %.2f s\n", decode_bands);
+  for (int f = 0; f < 2; ++f) {
+    std::printf(
+        "  %s decode + fit + write  %.2f s  (ratio %.2f; decode + fit %.2f s, write %.2f s; "
+        "%.1f M texel-images per second)\n",
+        f == 0 ? "LRGB" : "RGB ", full[f], full[f] / decode, fit_seconds[f],
+        full[f] - fit_seconds[f], n * megapixels / full[f]);
+  }
+  std::printf("  peak memory %.0f MiB\n", PeakRssMiB());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  int n = 50, size = 2048;
+  int n = 50, size = 2048, width = 0, height = 0;
+  std::string format = "png", part = "all";
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--images")) n = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--size")) size = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--width")) width = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--height")) height = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--format")) format = argv[i + 1];
+    if (!std::strcmp(argv[i], "--part")) part = argv[i + 1];
   }
   const fs::path work = fs::temp_directory_path() / "texlume_ptm_bench";
-  std::vector<Eigen::Vector3d> lights;
-  std::printf("Preparing %d images of %dx%d in %s ...\n", n, size, size, work.c_str());
-  const auto files = ThroughputImages(
-      n, size, work / ("n" + std::to_string(n) + "_" + std::to_string(size)), &lights);
-  ptm::FitOptions options;
-  const double decode = DecodeOnly(files, options.band_rows);
-  const auto t0 = std::chrono::steady_clock::now();
-  const ptm::FitResult fit = ptm::FitPtmFromFiles(files, lights, options);
-  ptm::WritePtmFile(fit.ptm, work / "bench.ptm");
-  const double full = Seconds(t0);
-  const double megapixels = size * static_cast<double>(size) / 1e6;
-  std::printf("Throughput: %d images x %.1f MP\n", n, megapixels);
-  std::printf("  decode only            %.2f s\n", decode);
-  std::printf(
-      "  decode + fit + write   %.2f s  (ratio %.2f, fit+write add %.0f %%; of which decode + fit "
-      "%.2f s, write %.2f s)\n",
-      full, full / decode, 100 * (full / decode - 1), fit.seconds, full - fit.seconds);
-  std::printf(
-      "  %.1f M texel-images per second; peak memory %.0f MiB (output PTM %.0f MiB)\n",
-      n * megapixels / full, PeakRssMiB(),
-      fit.ptm.coefficients.size() * 4.0 / (1 << 20) + fit.ptm.colour.size() * 4.0 / (1 << 20));
+  if (part == "all" || part == "throughput")
+    Throughput(n, cv::Size(width > 0 ? width : size, height > 0 ? height : size), format, work);
+  if (part == "throughput") return 0;
 
   // Leave-out quality on a synthetic capture.
   const datasets::SceneOptions scene =

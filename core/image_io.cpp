@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <type_traits>
 
 #include "core/bounded_memory_reader.h"
 #include "core/errors.h"
@@ -115,22 +116,26 @@ ImageReader::ImageReader(const fs::path& path)
   width_ = spec.width;
   height_ = spec.height;
   channels_ = spec.nchannels;
+  eight_bit_ = spec.format == OIIO::TypeDesc::UINT8;
 }
 
 ImageReader::~ImageReader() = default;
 ImageReader::ImageReader(ImageReader&&) noexcept = default;
 ImageReader& ImageReader::operator=(ImageReader&&) noexcept = default;
 
-void ImageReader::ReadRows(int y0, int y1, int channels, float* out) {
+template <typename Sample>
+void ImageReader::ReadRowsAs(int y0, int y1, int channels, Sample* out) {
+  const OIIO::TypeDesc type =
+      std::is_same_v<Sample, float> ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8;
   const int read = std::min(channels_, channels);
   const std::size_t pixels = static_cast<std::size_t>(y1 - y0) * static_cast<std::size_t>(width_);
-  std::vector<float> raw;
-  float* target = out;
+  std::vector<Sample> raw;
+  Sample* target = out;
   if (read != channels) {
     raw.resize(pixels * static_cast<std::size_t>(read));
     target = raw.data();
   }
-  if (!in_->in->read_scanlines(0, 0, y0, y1, 0, 0, read, OIIO::TypeDesc::FLOAT, target))
+  if (!in_->in->read_scanlines(0, 0, y0, y1, 0, 0, read, type, target))
     throw InputError(path_.string(), "cannot read rows " + std::to_string(y0) + ".." +
                                          std::to_string(y1) + ": " + in_->in->geterror());
   if (read == channels) return;
@@ -138,6 +143,14 @@ void ImageReader::ReadRows(int y0, int y1, int channels, float* out) {
     for (int c = 0; c < channels; ++c)
       out[i * static_cast<std::size_t>(channels) + static_cast<std::size_t>(c)] =
           raw[i * static_cast<std::size_t>(read) + static_cast<std::size_t>(std::min(c, read - 1))];
+}
+
+void ImageReader::ReadRows(int y0, int y1, int channels, float* out) {
+  ReadRowsAs(y0, y1, channels, out);
+}
+
+void ImageReader::ReadRows(int y0, int y1, int channels, std::uint8_t* out) {
+  ReadRowsAs(y0, y1, channels, out);
 }
 
 cv::Mat ReadPhotoRgb(const fs::path& path) {

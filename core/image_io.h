@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <opencv2/core.hpp>
@@ -34,17 +35,26 @@ class ImageReader {
   int width() const { return width_; }
   int height() const { return height_; }
   int channels() const { return channels_; }
+  /// Whether the file stores 8-bit samples (JPEG, most PNGs and TIFFs).
+  bool eight_bit() const { return eight_bit_; }
   const std::filesystem::path& path() const { return path_; }
 
   /// Rows [y0, y1) into `out` (row-major, `channels` floats per pixel): the
   /// file's first channels; a grey file's channel repeated.
   void ReadRows(int y0, int y1, int channels, float* out);
+  /// The same as 8-bit values (0..255, the file's own for an eight_bit() file:
+  /// no conversion on the way).
+  void ReadRows(int y0, int y1, int channels, std::uint8_t* out);
 
  private:
+  template <typename Sample>
+  void ReadRowsAs(int y0, int y1, int channels, Sample* out);
+
   struct Input;
   std::unique_ptr<Input> in_;
   std::filesystem::path path_;
   int width_ = 0, height_ = 0, channels_ = 0;
+  bool eight_bit_ = false;
 };
 
 /// An 8-bit grey image of exactly `width` x `height` pixels decoded from `bytes`

@@ -17,6 +17,7 @@
 #include "core/file_util.h"
 #include "core/image_io.h"
 #include "ptm/image_bands.h"
+#include "ptm/least_squares_bands.h"
 #include "sfm/lights.h"
 
 namespace texlume::ptm {
@@ -63,108 +64,98 @@ void RobustRefine(const MatrixX6& basis, const std::vector<double>& values,
   ceres::Solve(solver_options, &problem, &summary);
 }
 
-// Fits every texel of a band. pixels[k] holds the band of image k (rows x width x 3).
-class BandFitter {
+// The robust fit of every texel of a band (FitOptions::robust): least squares over
+// the usable samples, then the Cauchy loss (RobustRefine). pixels[k] holds the band
+// of image k (rows x width x 3, [0, 1]).
+class RobustBandFitter {
  public:
-  BandFitter(const std::vector<Eigen::Vector3d>& lights, const FitOptions& options)
+  RobustBandFitter(const std::vector<Eigen::Vector3d>& lights, const FitOptions& options)
       : options_(options), basis_(LightMatrix(lights)) {
     pseudo_inverse_ = basis_.completeOrthogonalDecomposition().pseudoInverse();
-    gram_ = basis_.transpose() * basis_;
   }
 
   void Fit(const std::vector<const float*>& pixels, int rows, int width, int first_row, Ptm& ptm,
            std::vector<float>& residual) const {
-    const std::size_t k_count = pixels.size();
     const long texels = static_cast<long>(rows) * width;
 #pragma omp parallel
     {
       // Per-thread buffers, reused for every texel (no allocation in the loop).
-      std::vector<Eigen::Vector3d> rgb(k_count);
-      std::vector<char> usable(k_count, 1);
-      std::vector<double> values(k_count);
+      Texel texel_buffers(pixels.size());
 #pragma omp for schedule(dynamic, 256)
       for (long t = 0; t < texels; ++t) {
         const std::size_t local = static_cast<std::size_t>(t);
         const std::size_t texel =
             static_cast<std::size_t>(first_row) * static_cast<std::size_t>(width) + local;
-        for (std::size_t k = 0; k < k_count; ++k) {
-          const float* p = pixels[k] + local * 3;
-          rgb[k] = Eigen::Vector3d(p[0], p[1], p[2]);
-          usable[k] = !options_.robust || (rgb[k].maxCoeff() < options_.saturation_threshold &&
-                                           rgb[k].maxCoeff() > options_.shadow_threshold);
-        }
-        double sum_sq = 0.0;
-        if (ptm.format == PtmFormat::kLrgb) {
-          // Chromaticity: luminance-weighted mean colour, largest channel 1.
-          Eigen::Vector3d c = Eigen::Vector3d::Zero();
-          for (std::size_t k = 0; k < k_count; ++k) {
-            if (usable[k]) c += rgb[k].mean() * rgb[k];
-          }
-          c = c.maxCoeff() > 1e-9 ? Eigen::Vector3d(c / c.maxCoeff()) : Eigen::Vector3d::Ones();
-          const Eigen::Vector3d c_scaled = c / c.squaredNorm();
-          for (std::size_t k = 0; k < k_count; ++k) values[k] = rgb[k].dot(c_scaled);
-          double a[6];
-          Solve(values, a);
-          if (options_.robust) RobustRefine(basis_, values, usable, options_.robust_scale, a);
-          float* out = ptm.Coefficients(texel);
-          for (int i = 0; i < 6; ++i) out[i] = static_cast<float>(a[i]);
-          for (int ch = 0; ch < 3; ++ch) {
-            ptm.colour[texel * 3 + static_cast<std::size_t>(ch)] = static_cast<float>(c[ch]);
-          }
-          if (options_.robust) {
-            for (std::size_t k = 0; k < k_count; ++k) {
-              sum_sq += (Predict(k, a) * c - rgb[k]).squaredNorm();
-            }
-          } else {
-            // At the least-squares solution, sum |L_k c - rgb_k|^2 =
-            // sum |rgb_k|^2 - |c|^2 a^T (A^T A) a: no second pass over the samples.
-            double energy = 0.0;
-            for (std::size_t k = 0; k < k_count; ++k) energy += rgb[k].squaredNorm();
-            sum_sq = std::max(0.0, energy - c.squaredNorm() * Quadratic(a));
-          }
-        } else {
-          for (int ch = 0; ch < 3; ++ch) {
-            for (std::size_t k = 0; k < k_count; ++k) values[k] = rgb[k][ch];
-            double a[6];
-            Solve(values, a);
-            if (options_.robust) RobustRefine(basis_, values, usable, options_.robust_scale, a);
-            float* out = ptm.Coefficients(texel, ch);
-            for (int i = 0; i < 6; ++i) out[i] = static_cast<float>(a[i]);
-            if (options_.robust) {
-              for (std::size_t k = 0; k < k_count; ++k) {
-                const double d = Predict(k, a) - values[k];
-                sum_sq += d * d;
-              }
-            } else {
-              double energy = 0.0;
-              for (double v : values) energy += v * v;
-              sum_sq += std::max(0.0, energy - Quadratic(a));
-            }
-          }
-        }
-        residual[texel] =
-            static_cast<float>(std::sqrt(sum_sq / (3.0 * static_cast<double>(k_count))));
+        Load(pixels, local, texel_buffers);
+        residual[texel] = static_cast<float>(FitTexel(texel_buffers, texel, ptm));
       }
     }
   }
 
  private:
-  // Least squares: a = A^+ values (one 6 x N product).
-  void Solve(const std::vector<double>& values, double* a) const {
+  struct Texel {
+    explicit Texel(std::size_t k_count) : rgb(k_count), usable(k_count, 1), values(k_count) {}
+    std::vector<Eigen::Vector3d> rgb;
+    std::vector<char> usable;
+    std::vector<double> values;
+  };
+
+  void Load(const std::vector<const float*>& pixels, std::size_t local, Texel& t) const {
+    for (std::size_t k = 0; k < pixels.size(); ++k) {
+      const float* p = pixels[k] + local * 3;
+      t.rgb[k] = Eigen::Vector3d(p[0], p[1], p[2]);
+      t.usable[k] = t.rgb[k].maxCoeff() < options_.saturation_threshold &&
+                    t.rgb[k].maxCoeff() > options_.shadow_threshold;
+    }
+  }
+
+  // Fits one texel; returns its residual RMS over lights and channels.
+  double FitTexel(Texel& t, std::size_t texel, Ptm& ptm) const {
+    const std::size_t k_count = t.rgb.size();
+    double sum_sq = 0.0;
+    if (ptm.format == PtmFormat::kLrgb) {
+      // Chromaticity: luminance-weighted mean colour of the usable samples, largest 1.
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (std::size_t k = 0; k < k_count; ++k) {
+        if (t.usable[k]) c += t.rgb[k].mean() * t.rgb[k];
+      }
+      c = c.maxCoeff() > 1e-9 ? Eigen::Vector3d(c / c.maxCoeff()) : Eigen::Vector3d::Ones();
+      const Eigen::Vector3d c_scaled = c / c.squaredNorm();
+      for (std::size_t k = 0; k < k_count; ++k) t.values[k] = t.rgb[k].dot(c_scaled);
+      double a[6];
+      SolveRobust(t, a);
+      float* out = ptm.Coefficients(texel);
+      for (int i = 0; i < 6; ++i) out[i] = static_cast<float>(a[i]);
+      for (int ch = 0; ch < 3; ++ch)
+        ptm.colour[texel * 3 + static_cast<std::size_t>(ch)] = static_cast<float>(c[ch]);
+      for (std::size_t k = 0; k < k_count; ++k)
+        sum_sq += (Predict(k, a) * c - t.rgb[k]).squaredNorm();
+    } else {
+      for (int ch = 0; ch < 3; ++ch) {
+        for (std::size_t k = 0; k < k_count; ++k) t.values[k] = t.rgb[k][ch];
+        double a[6];
+        SolveRobust(t, a);
+        float* out = ptm.Coefficients(texel, ch);
+        for (int i = 0; i < 6; ++i) out[i] = static_cast<float>(a[i]);
+        for (std::size_t k = 0; k < k_count; ++k) {
+          const double d = Predict(k, a) - t.values[k];
+          sum_sq += d * d;
+        }
+      }
+    }
+    return std::sqrt(sum_sq / (3.0 * static_cast<double>(k_count)));
+  }
+
+  // Least squares a = A^+ values (one 6 x N product), then the Cauchy loss.
+  void SolveRobust(const Texel& t, double* a) const {
     for (int i = 0; i < 6; ++i) {
       double sum = 0.0;
-      for (std::size_t k = 0; k < values.size(); ++k) {
-        sum += pseudo_inverse_(i, static_cast<Eigen::Index>(k)) * values[k];
+      for (std::size_t k = 0; k < t.values.size(); ++k) {
+        sum += pseudo_inverse_(i, static_cast<Eigen::Index>(k)) * t.values[k];
       }
       a[i] = sum;
     }
-  }
-  // a^T (A^T A) a
-  double Quadratic(const double* a) const {
-    double q = 0.0;
-    for (int i = 0; i < 6; ++i)
-      for (int j = 0; j < 6; ++j) q += a[i] * gram_(i, j) * a[j];
-    return q;
+    RobustRefine(basis_, t.values, t.usable, options_.robust_scale, a);
   }
   double Predict(std::size_t k, const double* a) const {
     double v = 0.0;
@@ -175,7 +166,6 @@ class BandFitter {
   const FitOptions& options_;
   MatrixX6 basis_;
   Eigen::Matrix<double, 6, Eigen::Dynamic> pseudo_inverse_;
-  Matrix6 gram_;
 };
 
 void Finish(FitResult& result, std::chrono::steady_clock::time_point start) {
@@ -324,10 +314,14 @@ FitResult FitPtm(const std::vector<ImageRgb>& images, const std::vector<Eigen::V
   result.ptm.Resize(options.format, width, height);
   result.residual_rms.assign(result.ptm.NumTexels(), 0.0f);
   result.num_images = images.size();
-  const BandFitter fitter(lights, options);
   std::vector<const float*> pixels;
   for (const auto& image : images) pixels.push_back(image.pixels.data());
-  fitter.Fit(pixels, height, width, 0, result.ptm, result.residual_rms);
+  if (options.robust) {
+    RobustBandFitter(lights, options)
+        .Fit(pixels, height, width, 0, result.ptm, result.residual_rms);
+  } else {
+    LeastSquaresBands(lights).Fit(pixels, 1.0, height, width, 0, result.ptm, result.residual_rms);
+  }
   Finish(result, start);
   return result;
 }
@@ -345,13 +339,31 @@ FitResult FitPtmFromFiles(const std::vector<std::filesystem::path>& files,
   result.ptm.Resize(options.format, bands.width(), bands.height());
   result.residual_rms.assign(result.ptm.NumTexels(), 0.0f);
   result.num_images = files.size();
-  const BandFitter fitter(lights, options);
-  bands.ForEach(
-      options.band_rows,
-      [&](const std::vector<const float*>& pixels, int y0, int rows) {
-        fitter.Fit(pixels, rows, bands.width(), y0, result.ptm, result.residual_rms);
-      },
-      progress, "fit");
+  if (options.robust) {
+    const RobustBandFitter fitter(lights, options);
+    bands.ForEach<float>(
+        options.band_rows,
+        [&](const std::vector<const float*>& pixels, int y0, int rows) {
+          fitter.Fit(pixels, rows, bands.width(), y0, result.ptm, result.residual_rms);
+        },
+        progress, "fit");
+  } else if (bands.eight_bit()) {  // the camera's own bytes: no conversion on the way
+    const LeastSquaresBands fitter(lights);
+    bands.ForEach<std::uint8_t>(
+        options.band_rows,
+        [&](const std::vector<const std::uint8_t*>& pixels, int y0, int rows) {
+          fitter.Fit(pixels, 255.0, rows, bands.width(), y0, result.ptm, result.residual_rms);
+        },
+        progress, "fit");
+  } else {
+    const LeastSquaresBands fitter(lights);
+    bands.ForEach<float>(
+        options.band_rows,
+        [&](const std::vector<const float*>& pixels, int y0, int rows) {
+          fitter.Fit(pixels, 1.0, rows, bands.width(), y0, result.ptm, result.residual_rms);
+        },
+        progress, "fit");
+  }
   Finish(result, start);
   return result;
 }

@@ -101,7 +101,7 @@ HshFitResult FitHshFromFiles(const std::vector<std::filesystem::path>& files,
   hsh.coefficients.assign(hsh.NumTexels() * 3 * static_cast<std::size_t>(terms), 0.0f);
   double residual_sum = 0;
   const auto n = static_cast<Eigen::Index>(lights.size());
-  bands.ForEach(
+  bands.ForEach<float>(
       band_rows,
       [&](const std::vector<const float*>& pixels, int y0, int rows) {
         const auto texels = static_cast<std::int64_t>(rows) * hsh.width;

@@ -9,7 +9,7 @@
 
 namespace texlume::ptm {
 
-ImageBands::ImageBands(const std::vector<std::filesystem::path>& files) {
+ImageBands::ImageBands(const std::vector<std::filesystem::path>& files, int decode_threads) {
   for (const auto& file : files) {
     ImageReader in(file);
     if (inputs_.empty()) {
@@ -23,22 +23,48 @@ ImageBands::ImageBands(const std::vector<std::filesystem::path>& files) {
     }
     inputs_.push_back(std::move(in));
   }
+  const int hardware = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
+  decode_threads_ = std::clamp(decode_threads > 0 ? decode_threads : hardware, 1,
+                               std::max(1, static_cast<int>(inputs_.size())));
 }
 
-void ImageBands::Read(int y0, int band_rows, std::vector<std::vector<float>>& band) {
+bool ImageBands::eight_bit() const {
+  return std::all_of(inputs_.begin(), inputs_.end(),
+                     [](const ImageReader& in) { return in.eight_bit(); });
+}
+
+// Images k = t, t + T, t + 2T, ... on thread t: each image's reader decodes its
+// rows in order, on one thread at a time.
+template <typename Sample>
+void ImageBands::Read(int y0, int band_rows, std::vector<std::vector<Sample>>& band) {
   const int rows = std::min(band_rows, height_ - y0);
-  for (std::size_t k = 0; k < inputs_.size(); ++k)
-    inputs_[k].ReadRows(y0, y0 + rows, 3, band[k].data());
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(decode_threads_));
+  auto decode = [&](int t) {
+    try {
+      for (std::size_t k = static_cast<std::size_t>(t); k < inputs_.size();
+           k += static_cast<std::size_t>(decode_threads_))
+        inputs_[k].ReadRows(y0, y0 + rows, 3, band[k].data());
+    } catch (...) {
+      errors[static_cast<std::size_t>(t)] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < decode_threads_; ++t) threads.emplace_back(decode, t);
+  decode(0);
+  for (auto& thread : threads) thread.join();
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
 }
 
+template <typename Sample>
 void ImageBands::ForEach(
     int band_rows,
-    const std::function<void(const std::vector<const float*>& pixels, int y0, int rows)>& process,
+    const std::function<void(const std::vector<const Sample*>& pixels, int y0, int rows)>& process,
     const ProgressCallback& progress, const char* stage) {
-  const std::size_t band_floats = static_cast<std::size_t>(band_rows) * width_ * 3;
+  const std::size_t band_samples = static_cast<std::size_t>(band_rows) * width_ * 3;
   // Two bands: the next one is decoded while the current one is processed.
-  std::vector<std::vector<float>> bands[2];
-  for (auto& set : bands) set.assign(inputs_.size(), std::vector<float>(band_floats));
+  std::vector<std::vector<Sample>> bands[2];
+  for (auto& set : bands) set.assign(inputs_.size(), std::vector<Sample>(band_samples));
   if (height_ > 0) Read(0, band_rows, bands[0]);
   for (int b = 0, y0 = 0; y0 < height_; ++b, y0 += band_rows) {
     const int rows = std::min(band_rows, height_ - y0);
@@ -54,7 +80,7 @@ void ImageBands::ForEach(
         }
       });
     }
-    std::vector<const float*> pixels;
+    std::vector<const Sample*> pixels;
     for (const auto& image_band : bands[b % 2]) pixels.push_back(image_band.data());
     try {
       process(pixels, y0, rows);
@@ -68,5 +94,12 @@ void ImageBands::ForEach(
       progress(stage, static_cast<std::size_t>(y0 + rows), static_cast<std::size_t>(height_));
   }
 }
+
+template void ImageBands::ForEach<float>(
+    int, const std::function<void(const std::vector<const float*>&, int, int)>&,
+    const ProgressCallback&, const char*);
+template void ImageBands::ForEach<std::uint8_t>(
+    int, const std::function<void(const std::vector<const std::uint8_t*>&, int, int)>&,
+    const ProgressCallback&, const char*);
 
 }  // namespace texlume::ptm

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <vector>
@@ -12,28 +13,35 @@ namespace texlume::ptm {
 /// An RTI capture's images read together a band of rows at a time (the one image
 /// reader, core/image_io.h), so that fitting needs memory for one band of every
 /// image, not for every image. The next band is decoded while the current one is
-/// processed.
+/// processed, its images shared among `decode_threads` threads.
 class ImageBands {
  public:
   /// Opens every file; throws InputError naming a file whose size differs from the
-  /// first one's.
-  explicit ImageBands(const std::vector<std::filesystem::path>& files);
+  /// first one's. decode_threads 0: one per hardware thread.
+  explicit ImageBands(const std::vector<std::filesystem::path>& files, int decode_threads = 0);
 
   int width() const { return width_; }
   int height() const { return height_; }
+  /// Whether every file stores 8-bit samples, so that ForEach<std::uint8_t> reads
+  /// them without conversion.
+  bool eight_bit() const;
 
   /// Calls `process(pixels, y0, rows)` for each band of `band_rows` rows, top to
-  /// bottom: pixels[k] holds image k's rows [y0, y0 + rows) as RGB floats in [0, 1].
+  /// bottom: pixels[k] holds image k's rows [y0, y0 + rows) as interleaved RGB,
+  /// floats in [0, 1] or 8-bit values 0..255 (Sample float or std::uint8_t).
   /// Reports progress as `stage` over the rows.
-  void ForEach(
-      int band_rows,
-      const std::function<void(const std::vector<const float*>& pixels, int y0, int rows)>& process,
-      const ProgressCallback& progress, const char* stage);
+  template <typename Sample>
+  void ForEach(int band_rows,
+               const std::function<void(const std::vector<const Sample*>& pixels, int y0,
+                                        int rows)>& process,
+               const ProgressCallback& progress, const char* stage);
 
  private:
-  void Read(int y0, int band_rows, std::vector<std::vector<float>>& band);
+  template <typename Sample>
+  void Read(int y0, int band_rows, std::vector<std::vector<Sample>>& band);
   std::vector<ImageReader> inputs_;
   int width_ = 0, height_ = 0;
+  int decode_threads_ = 1;
 };
 
 }  // namespace texlume::ptm

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -25,42 +27,127 @@ namespace {
 constexpr double kMaxPtmScale = 1e6;  // the message below says 1e6
 constexpr std::int64_t kMaxPtmBias = 1000000;
 
+// x rounded half away from zero (as std::lround) and clamped to 0..255; NaN is 0.
+// Exact in double (a float plus 0.5 needs no rounding below 2^28), and branch-free
+// so that the encoding loops vectorise.
+inline std::uint8_t RoundToByte(float x) {
+  const double clamped = std::min(x > 0.0f ? static_cast<double>(x) : 0.0, 255.0);
+  return static_cast<std::uint8_t>(static_cast<int>(clamped + 0.5));
+}
+
 // Quantisation of one coefficient index: coefficient = (byte - bias) * scale.
 struct Quantiser {
   float scale = 1.0f;
   int bias = 0;
-  std::uint8_t Encode(float v) const {
-    return static_cast<std::uint8_t>(std::clamp(std::lround(v / scale + bias), 0L, 255L));
-  }
+  std::uint8_t Encode(float v) const { return RoundToByte(v / scale + bias); }
 };
 
-Quantiser MakeQuantiser(std::vector<float> values) {
-  Quantiser q;
-  if (values.empty()) return q;
-  const std::size_t lo_i = values.size() / 1000, hi_i = values.size() - 1 - values.size() / 1000;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(lo_i),
-                   values.end());
-  const float lo = std::min(0.0f, values[lo_i]);
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(hi_i),
-                   values.end());
-  const float hi = std::max(0.0f, values[hi_i]);
-  q.scale = hi > lo ? (hi - lo) / 255.0f : 1.0f;
-  q.bias = static_cast<int>(std::lround(-lo / q.scale));
-  return q;
+// A float's bits as an unsigned key in the float's order (IEEE 754: the sign bit
+// flipped for a positive value, every bit for a negative one).
+std::uint32_t OrderedKey(float v) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
 }
 
+// The values 255 a_i of each coefficient index i over every texel and polynomial
+// (a: 6 floats per texel and polynomial), and of each the values of two ranks,
+// found exactly in two passes over the coefficients without a copy of them: a
+// histogram of the keys' top 16 bits finds each rank's bin, then only that bin's
+// values are sorted.
+class CoefficientRanks {
+ public:
+  static constexpr std::uint32_t kBins = 1 << 16;
+
+  CoefficientRanks(const std::vector<float>& a, std::array<std::size_t, 2> ranks)
+      : a_(a), ranks_(ranks), count_(a.size() / 6) {}
+
+  // The value of rank ranks[r] among index i's values, for every i and r.
+  std::array<std::array<float, 2>, 6> Values() {
+    FindBins(CountBins());
+    return Select();
+  }
+
+ private:
+  float Value(std::size_t j, std::size_t i) const { return 255.0f * a_[j * 6 + i]; }
+
+  std::vector<std::size_t> CountBins() const {  // [i * kBins + bin]
+    std::vector<std::size_t> bins(6 * kBins, 0);
+#pragma omp parallel
+    {
+      std::vector<std::uint32_t> local(6 * kBins, 0);
+#pragma omp for schedule(static) nowait
+      for (std::size_t j = 0; j < count_; ++j)
+        for (std::size_t i = 0; i < 6; ++i) ++local[i * kBins + (OrderedKey(Value(j, i)) >> 16)];
+#pragma omp critical
+      for (std::size_t b = 0; b < bins.size(); ++b) bins[b] += local[b];
+    }
+    return bins;
+  }
+
+  void FindBins(const std::vector<std::size_t>& bins) {
+    for (std::size_t i = 0; i < 6; ++i) {
+      for (std::size_t r = 0; r < 2; ++r) {
+        std::size_t seen = 0;
+        std::uint32_t b = 0;
+        while (seen + bins[i * kBins + b] <= ranks_[r]) seen += bins[i * kBins + b++];
+        bin_[i][r] = b, below_[i][r] = seen;
+      }
+    }
+  }
+
+  std::array<std::array<float, 2>, 6> Select() const {
+    std::array<std::array<std::vector<float>, 2>, 6> in_bin;
+#pragma omp parallel
+    {
+      std::array<std::array<std::vector<float>, 2>, 6> local;
+#pragma omp for schedule(static) nowait
+      for (std::size_t j = 0; j < count_; ++j) {
+        for (std::size_t i = 0; i < 6; ++i) {
+          const float v = Value(j, i);
+          const std::uint32_t b = OrderedKey(v) >> 16;
+          for (std::size_t r = 0; r < 2; ++r)
+            if (b == bin_[i][r]) local[i][r].push_back(v);
+        }
+      }
+#pragma omp critical
+      for (std::size_t i = 0; i < 6; ++i)
+        for (std::size_t r = 0; r < 2; ++r)
+          in_bin[i][r].insert(in_bin[i][r].end(), local[i][r].begin(), local[i][r].end());
+    }
+    std::array<std::array<float, 2>, 6> values;
+    for (std::size_t i = 0; i < 6; ++i) {
+      for (std::size_t r = 0; r < 2; ++r) {
+        auto& v = in_bin[i][r];
+        const auto nth = v.begin() + static_cast<std::ptrdiff_t>(ranks_[r] - below_[i][r]);
+        std::nth_element(v.begin(), nth, v.end());
+        values[i][r] = *nth;
+      }
+    }
+    return values;
+  }
+
+  const std::vector<float>& a_;
+  std::array<std::size_t, 2> ranks_;
+  std::size_t count_;
+  std::array<std::array<std::uint32_t, 2>, 6> bin_{};
+  std::array<std::array<std::size_t, 2>, 6> below_{};
+};
+
 // Quantisers per coefficient index, over every texel (and channel for RGB), in
-// 0-255 units.
+// 0-255 units: the range between the 0.1 % and 99.9 % quantiles, widened to hold 0,
+// in 255 steps.
 std::array<Quantiser, 6> Quantisers(const Ptm& ptm) {
   std::array<Quantiser, 6> q;
-  for (int i = 0; i < 6; ++i) {
-    std::vector<float> values;
-    values.reserve(ptm.NumTexels() * static_cast<std::size_t>(ptm.NumPolynomials()));
-    for (std::size_t t = 0; t < ptm.NumTexels(); ++t) {
-      for (int p = 0; p < ptm.NumPolynomials(); ++p)
-        values.push_back(255.0f * ptm.Coefficients(t, p)[i]);
-    }
-    q[static_cast<std::size_t>(i)] = MakeQuantiser(std::move(values));
+  const std::size_t count = ptm.coefficients.size() / 6;
+  if (count == 0) return q;
+  const auto values =
+      CoefficientRanks(ptm.coefficients, {count / 1000, count - 1 - count / 1000}).Values();
+  for (std::size_t i = 0; i < 6; ++i) {
+    const float lo = std::min(0.0f, values[i][0]);
+    const float hi = std::max(0.0f, values[i][1]);
+    q[i].scale = hi > lo ? (hi - lo) / 255.0f : 1.0f;
+    q[i].bias = static_cast<int>(std::lround(-lo / q[i].scale));
   }
   return q;
 }
@@ -362,6 +449,27 @@ Ptm PtmFromPlanes(const PtmHeader& h, const BytePlanes& planes) {
 
 }  // namespace
 
+namespace {
+
+// Writes rows height - 1 down to 0 (a .ptm's order), each `row_bytes` made by
+// encode_row(y, bytes); a block of rows is encoded in parallel at a time.
+template <typename EncodeRow>
+void WriteRowsBottomUp(std::ostream& out, int height, std::size_t row_bytes,
+                       const EncodeRow& encode_row) {
+  constexpr int kBlockRows = 64;
+  std::vector<char> block(row_bytes * kBlockRows);
+  for (int top = height - 1; top >= 0; top -= kBlockRows) {
+    const int rows = std::min(kBlockRows, top + 1);
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < rows; ++r)
+      encode_row(top - r, block.data() + static_cast<std::size_t>(r) * row_bytes);
+    out.write(block.data(),
+              static_cast<std::streamsize>(static_cast<std::size_t>(rows) * row_bytes));
+  }
+}
+
+}  // namespace
+
 void WritePtm(const Ptm& ptm, std::ostream& out) {
   const auto q = Quantisers(ptm);
   out << "PTM_1.2\n"
@@ -373,32 +481,22 @@ void WritePtm(const Ptm& ptm, std::ostream& out) {
   out << "\n";
   for (int i = 0; i < 6; ++i) out << (i ? " " : "") << q[static_cast<std::size_t>(i)].bias;
   out << "\n";
-  std::vector<char> row(static_cast<std::size_t>(ptm.width) * 6);
+  const auto width = static_cast<std::size_t>(ptm.width);
   for (int p = 0; p < ptm.NumPolynomials(); ++p) {
-    for (int y = ptm.height - 1; y >= 0; --y) {  // bottom to top
-      for (int x = 0; x < ptm.width; ++x) {
-        const float* a = ptm.Coefficients(static_cast<std::size_t>(y) * ptm.width + x, p);
-        for (int i = 0; i < 6; ++i) {
-          row[static_cast<std::size_t>(x) * 6 + static_cast<std::size_t>(i)] =
-              static_cast<char>(q[static_cast<std::size_t>(i)].Encode(255.0f * a[i]));
-        }
+    WriteRowsBottomUp(out, ptm.height, width * 6, [&](int y, char* row) {
+      for (std::size_t x = 0; x < width; ++x) {
+        const float* a = ptm.Coefficients(static_cast<std::size_t>(y) * width + x, p);
+        for (std::size_t i = 0; i < 6; ++i)
+          row[x * 6 + i] = static_cast<char>(q[i].Encode(255.0f * a[i]));
       }
-      out.write(row.data(), static_cast<std::streamsize>(row.size()));
-    }
+    });
   }
   if (ptm.format == PtmFormat::kLrgb) {
-    std::vector<char> rgb(static_cast<std::size_t>(ptm.width) * 3);
-    for (int y = ptm.height - 1; y >= 0; --y) {
-      for (int x = 0; x < ptm.width; ++x) {
-        for (int c = 0; c < 3; ++c) {
-          const float v = ptm.colour[(static_cast<std::size_t>(y) * ptm.width + x) * 3 +
-                                     static_cast<std::size_t>(c)];
-          rgb[static_cast<std::size_t>(x) * 3 + static_cast<std::size_t>(c)] =
-              static_cast<char>(std::clamp(std::lround(255.0f * v), 0L, 255L));
-        }
-      }
-      out.write(rgb.data(), static_cast<std::streamsize>(rgb.size()));
-    }
+    WriteRowsBottomUp(out, ptm.height, width * 3, [&](int y, char* row) {
+      const float* colour = &ptm.colour[static_cast<std::size_t>(y) * width * 3];
+      for (std::size_t i = 0; i < width * 3; ++i)
+        row[i] = static_cast<char>(RoundToByte(255.0f * colour[i]));
+    });
   }
 }
 

@@ -4,6 +4,10 @@
 #include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 
 #include "core/errors.h"
@@ -121,6 +125,101 @@ TEST(Fit, PerTexelLightsMatchSharedLightsWhenTheyAgree) {
   for (std::size_t i = 0; i < shared.ptm.coefficients.size(); ++i) {
     ASSERT_NEAR(shared.ptm.coefficients[i], per_texel.ptm.coefficients[i], 1e-4);
   }
+}
+
+// The images of `k` with noise, rounded to 8 bits, in memory and as 8-bit and
+// 16-bit PNGs (the same values: 16-bit = 8-bit x 257).
+struct QuantisedCapture {
+  std::vector<ImageRgb> images;
+  std::vector<std::filesystem::path> png8, png16;
+};
+
+QuantisedCapture WriteQuantised(const KnownPtm& k, const std::filesystem::path& dir) {
+  QuantisedCapture q;
+  std::mt19937 rng(9);
+  std::normal_distribution<float> noise(0.0f, 0.03f);
+  for (std::size_t n = 0; n < k.images.size(); ++n) {
+    const ImageRgb& image = k.images[n];
+    cv::Mat bgr8(image.height, image.width, CV_8UC3);
+    ImageRgb quantised = image;
+    for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+      const float byte = std::round(std::clamp(image.pixels[i] + noise(rng), 0.0f, 1.0f) * 255);
+      quantised.pixels[i] = byte / 255.0f;
+      bgr8.data[i / 3 * 3 + 2 - i % 3] = static_cast<std::uint8_t>(byte);
+    }
+    cv::Mat bgr16;
+    bgr8.convertTo(bgr16, CV_16UC3, 257.0);
+    q.png8.push_back(dir / ("e" + std::to_string(n) + ".png"));
+    q.png16.push_back(dir / ("s" + std::to_string(n) + ".png"));
+    cv::imwrite(q.png8.back().string(), bgr8);
+    cv::imwrite(q.png16.back().string(), bgr16);
+    q.images.push_back(std::move(quantised));
+  }
+  return q;
+}
+
+// The residual RMS of texel t by its definition: over lights and channels.
+double ResidualByDefinition(const FitResult& r, const std::vector<ImageRgb>& images,
+                            const std::vector<Eigen::Vector3d>& lights, std::size_t t) {
+  double sum_sq = 0.0;
+  for (std::size_t k = 0; k < images.size(); ++k) {
+    const Eigen::Vector3f v = r.ptm.Evaluate(t, lights[k].x(), lights[k].y());
+    for (int c = 0; c < 3; ++c)
+      sum_sq += std::pow(v[c] - images[k].pixels[t * 3 + static_cast<std::size_t>(c)], 2);
+  }
+  return std::sqrt(sum_sq / (3.0 * static_cast<double>(images.size())));
+}
+
+TEST(Fit, FilesOfEveryDepthAndBandFitAsTheImagesInMemory) {
+  testing::TempDir tmp;
+  const KnownPtm k = MakeKnown(37, 13, 14, 6);  // bands of 5 rows: the last one short
+  const QuantisedCapture q = WriteQuantised(k, tmp.path());
+  for (const PtmFormat format : {PtmFormat::kLrgb, PtmFormat::kRgb}) {
+    for (const bool robust : {false, true}) {
+      FitOptions options;
+      options.format = format;
+      options.robust = robust;
+      options.band_rows = 5;
+      const FitResult memory = FitPtm(q.images, k.lights, options);
+      for (const auto* files : {&q.png8, &q.png16}) {
+        const FitResult streamed = FitPtmFromFiles(*files, k.lights, options);
+        SCOPED_TRACE(std::string(format == PtmFormat::kLrgb ? "LRGB" : "RGB") +
+                     (robust ? ", robust, " : ", ") + (files == &q.png8 ? "8-bit" : "16-bit"));
+        for (std::size_t i = 0; i < memory.ptm.coefficients.size(); ++i)
+          ASSERT_NEAR(streamed.ptm.coefficients[i], memory.ptm.coefficients[i], 1e-5);
+        for (std::size_t i = 0; i < memory.ptm.colour.size(); ++i)
+          ASSERT_NEAR(streamed.ptm.colour[i], memory.ptm.colour[i], 1e-5);
+        for (std::size_t t = 0; t < memory.residual_rms.size(); ++t)
+          ASSERT_NEAR(streamed.residual_rms[t], memory.residual_rms[t], 1e-5);
+      }
+      if (robust) continue;
+      // The one-pass residual (energy minus a^T A^T A a) is the residual's definition.
+      for (std::size_t t = 0; t < memory.residual_rms.size(); t += 7)
+        ASSERT_NEAR(memory.residual_rms[t], ResidualByDefinition(memory, q.images, k.lights, t),
+                    1e-5);
+      EXPECT_GT(memory.mean_residual_rms, 0.02);  // the noise is there to be measured
+    }
+  }
+}
+
+TEST(FitBadInput, ATruncatedImageAmongManyIsNamedWhicheverThreadDecodesIt) {
+  testing::TempDir tmp;
+  const KnownPtm k = MakeKnown(40, 64, 9, 7);
+  const QuantisedCapture q = WriteQuantised(k, tmp.path());
+  for (const std::size_t broken : {std::size_t{0}, std::size_t{5}}) {
+    const auto& file = q.png8[broken];
+    const auto size = std::filesystem::file_size(file);
+    const auto copy = tmp / "whole.png";
+    std::filesystem::copy_file(file, copy, std::filesystem::copy_options::overwrite_existing);
+    std::filesystem::resize_file(file, size / 3);
+    FitOptions options;
+    options.band_rows = 8;
+    const std::string message =
+        testing::InputErrorMessage([&] { FitPtmFromFiles(q.png8, k.lights, options); });
+    EXPECT_NE(message.find(file.filename().string()), std::string::npos) << message;
+    std::filesystem::rename(copy, file);
+  }
+  EXPECT_NO_THROW(FitPtmFromFiles(q.png8, k.lights, FitOptions{}));
 }
 
 TEST(FitBadInput, FewDegenerateAndLowLightsAreRefused) {

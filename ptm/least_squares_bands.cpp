@@ -1,0 +1,149 @@
+#include "ptm/least_squares_bands.h"
+
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+
+namespace texlume::ptm {
+
+LeastSquaresBands::LeastSquaresBands(const std::vector<Eigen::Vector3d>& lights)
+    : lights_(lights.size()) {
+  Eigen::Matrix<double, Eigen::Dynamic, 6> a(static_cast<Eigen::Index>(lights.size()), 6);
+  for (std::size_t k = 0; k < lights.size(); ++k) {
+    const auto b = PtmBasis(lights[k].x(), lights[k].y());
+    for (int i = 0; i < 6; ++i) a(static_cast<Eigen::Index>(k), i) = b[static_cast<std::size_t>(i)];
+  }
+  const Eigen::Matrix<double, 6, Eigen::Dynamic> inverse =
+      a.completeOrthogonalDecomposition().pseudoInverse();
+  pseudo_inverse_.resize(lights.size() * 6);
+  for (std::size_t k = 0; k < lights.size(); ++k)
+    for (int i = 0; i < 6; ++i)
+      pseudo_inverse_[k * 6 + static_cast<std::size_t>(i)] =
+          inverse(i, static_cast<Eigen::Index>(k));
+  gram_ = a.transpose() * a;
+}
+
+template <typename Sample>
+void LeastSquaresBands::ToPlanes(const std::vector<const Sample*>& pixels, std::size_t first,
+                                 int count, double* planes) const {
+  for (std::size_t k = 0; k < lights_; ++k) {
+    const Sample* in = pixels[k] + first * 3;
+    double* out = planes + k * 3 * kRun;
+    for (int x = 0; x < count; ++x)
+      for (int ch = 0; ch < 3; ++ch) out[ch * kRun + x] = static_cast<double>(in[x * 3 + ch]);
+    for (int ch = 0; ch < 3; ++ch) std::fill(out + ch * kRun + count, out + (ch + 1) * kRun, 0.0);
+  }
+}
+
+double LeastSquaresBands::Quadratic(const double* a) const {
+  double q = 0.0;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) q += a[i] * gram_(i, j) * a[j];
+  return q;
+}
+
+void LeastSquaresBands::FitLrgb(const double* planes, int x, int count, double unit,
+                                std::size_t texel, Ptm& ptm, std::vector<float>& residual) const {
+  // Pass 1: 3 x the luminance-weighted colour sum, and the energy.
+  Lanes chroma[3] = {Lanes::Zero(), Lanes::Zero(), Lanes::Zero()}, energy = Lanes::Zero();
+  for (std::size_t k = 0; k < lights_; ++k) {
+    const double* p = planes + k * 3 * kRun + x;
+    const Lanes r = Lanes::Map(p), g = Lanes::Map(p + kRun), b = Lanes::Map(p + 2 * kRun);
+    const Lanes sum = r + g + b;
+    chroma[0] += sum * r, chroma[1] += sum * g, chroma[2] += sum * b;
+    energy += r * r + g * g + b * b;
+  }
+  // Chromaticity: largest channel 1; the luminance L_k = rgb_k . c / |c|^2.
+  Lanes scaled[3];
+  Eigen::Vector3d colour[kLanes];
+  for (int l = 0; l < kLanes; ++l) {
+    Eigen::Vector3d c(chroma[0][l], chroma[1][l], chroma[2][l]);
+    c /= 3.0 * unit * unit;
+    c = c.maxCoeff() > 1e-9 ? Eigen::Vector3d(c / c.maxCoeff()) : Eigen::Vector3d::Ones();
+    colour[l] = c;
+    for (int ch = 0; ch < 3; ++ch) scaled[ch][l] = c[ch] / c.squaredNorm() / unit;
+  }
+  // Pass 2: a = A^+ L.
+  Lanes a[6] = {Lanes::Zero(), Lanes::Zero(), Lanes::Zero(),
+                Lanes::Zero(), Lanes::Zero(), Lanes::Zero()};
+  for (std::size_t k = 0; k < lights_; ++k) {
+    const double* p = planes + k * 3 * kRun + x;
+    const Lanes luminance = Lanes::Map(p) * scaled[0] + Lanes::Map(p + kRun) * scaled[1] +
+                            Lanes::Map(p + 2 * kRun) * scaled[2];
+    const double* inverse_k = &pseudo_inverse_[k * 6];
+    for (int i = 0; i < 6; ++i) a[i] += inverse_k[i] * luminance;
+  }
+  for (int l = 0; l < std::min(kLanes, count - x); ++l) {
+    const std::size_t t = texel + static_cast<std::size_t>(l);
+    double coefficients[6];
+    float* out = ptm.Coefficients(t);
+    for (int i = 0; i < 6; ++i) out[i] = static_cast<float>(coefficients[i] = a[i][l]);
+    for (int ch = 0; ch < 3; ++ch)
+      ptm.colour[t * 3 + static_cast<std::size_t>(ch)] = static_cast<float>(colour[l][ch]);
+    const double sum_sq = std::max(
+        0.0, energy[l] / (unit * unit) - colour[l].squaredNorm() * Quadratic(coefficients));
+    residual[t] = static_cast<float>(std::sqrt(sum_sq / (3.0 * static_cast<double>(lights_))));
+  }
+}
+
+void LeastSquaresBands::FitRgb(const double* planes, int x, int count, double unit,
+                               std::size_t texel, Ptm& ptm, std::vector<float>& residual) const {
+  const int texels = std::min(kLanes, count - x);
+  double sum_sq[kLanes] = {};
+  for (int ch = 0; ch < 3; ++ch) {
+    Lanes a[6] = {Lanes::Zero(), Lanes::Zero(), Lanes::Zero(),
+                  Lanes::Zero(), Lanes::Zero(), Lanes::Zero()};
+    Lanes energy = Lanes::Zero();
+    for (std::size_t k = 0; k < lights_; ++k) {
+      const Lanes v = Lanes::Map(planes + (k * 3 + static_cast<std::size_t>(ch)) * kRun + x);
+      const double* inverse_k = &pseudo_inverse_[k * 6];
+      for (int i = 0; i < 6; ++i) a[i] += inverse_k[i] * v;
+      energy += v * v;
+    }
+    for (int l = 0; l < texels; ++l) {
+      double coefficients[6];
+      float* out = ptm.Coefficients(texel + static_cast<std::size_t>(l), ch);
+      for (int i = 0; i < 6; ++i) out[i] = static_cast<float>(coefficients[i] = a[i][l] / unit);
+      sum_sq[l] += std::max(0.0, energy[l] / (unit * unit) - Quadratic(coefficients));
+    }
+  }
+  for (int l = 0; l < texels; ++l)
+    residual[texel + static_cast<std::size_t>(l)] =
+        static_cast<float>(std::sqrt(sum_sq[l] / (3.0 * static_cast<double>(lights_))));
+}
+
+template <typename Sample>
+void LeastSquaresBands::Fit(const std::vector<const Sample*>& pixels, double unit, int rows,
+                            int width, int first_row, Ptm& ptm,
+                            std::vector<float>& residual) const {
+  const long runs_per_row = (width + kRun - 1) / kRun;
+  const long runs = runs_per_row * rows;
+#pragma omp parallel
+  {
+    std::vector<double> planes(lights_ * 3 * kRun);  // per thread, reused for every run
+#pragma omp for schedule(dynamic, 8)
+    for (long r = 0; r < runs; ++r) {
+      const int row = static_cast<int>(r / runs_per_row);
+      const int x0 = static_cast<int>(r % runs_per_row) * kRun;
+      const int count = std::min(kRun, width - x0);
+      const std::size_t local = static_cast<std::size_t>(row) * width + x0;
+      const std::size_t texel = static_cast<std::size_t>(first_row) * width + local;
+      ToPlanes(pixels, local, count, planes.data());
+      for (int x = 0; x < count; x += kLanes) {
+        if (ptm.format == PtmFormat::kLrgb) {
+          FitLrgb(planes.data(), x, count, unit, texel + static_cast<std::size_t>(x), ptm,
+                  residual);
+        } else {
+          FitRgb(planes.data(), x, count, unit, texel + static_cast<std::size_t>(x), ptm, residual);
+        }
+      }
+    }
+  }
+}
+
+template void LeastSquaresBands::Fit<float>(const std::vector<const float*>&, double, int, int, int,
+                                            Ptm&, std::vector<float>&) const;
+template void LeastSquaresBands::Fit<std::uint8_t>(const std::vector<const std::uint8_t*>&, double,
+                                                   int, int, int, Ptm&, std::vector<float>&) const;
+
+}  // namespace texlume::ptm
