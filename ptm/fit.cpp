@@ -168,6 +168,18 @@ class RobustBandFitter {
   Eigen::Matrix<double, 6, Eigen::Dynamic> pseudo_inverse_;
 };
 
+// Each image as its R, G and B planes (BandLayout::kPlanar).
+std::vector<std::vector<float>> PlanesOf(const std::vector<ImageRgb>& images) {
+  std::vector<std::vector<float>> planes;
+  for (const auto& image : images) {
+    const std::size_t texels = image.pixels.size() / 3;
+    std::vector<float>& out = planes.emplace_back(image.pixels.size());
+    for (std::size_t t = 0; t < texels; ++t)
+      for (std::size_t ch = 0; ch < 3; ++ch) out[ch * texels + t] = image.pixels[t * 3 + ch];
+  }
+  return planes;
+}
+
 void Finish(FitResult& result, std::chrono::steady_clock::time_point start) {
   double sum = 0.0;
   for (float r : result.residual_rms) sum += r;
@@ -315,11 +327,13 @@ FitResult FitPtm(const std::vector<ImageRgb>& images, const std::vector<Eigen::V
   result.residual_rms.assign(result.ptm.NumTexels(), 0.0f);
   result.num_images = images.size();
   std::vector<const float*> pixels;
-  for (const auto& image : images) pixels.push_back(image.pixels.data());
   if (options.robust) {
+    for (const auto& image : images) pixels.push_back(image.pixels.data());
     RobustBandFitter(lights, options)
         .Fit(pixels, height, width, 0, result.ptm, result.residual_rms);
   } else {
+    const std::vector<std::vector<float>> planes = PlanesOf(images);
+    for (const auto& image : planes) pixels.push_back(image.data());
     LeastSquaresBands(lights).Fit(pixels, 1.0, height, width, 0, result.ptm, result.residual_rms);
   }
   Finish(result, start);
@@ -354,7 +368,7 @@ FitResult FitPtmFromFiles(const std::vector<std::filesystem::path>& files,
         [&](const std::vector<const std::uint8_t*>& pixels, int y0, int rows) {
           fitter.Fit(pixels, 255.0, rows, bands.width(), y0, result.ptm, result.residual_rms);
         },
-        progress, "fit");
+        progress, "fit", BandLayout::kPlanar);
   } else {
     const LeastSquaresBands fitter(lights);
     bands.ForEach<float>(
@@ -362,7 +376,7 @@ FitResult FitPtmFromFiles(const std::vector<std::filesystem::path>& files,
         [&](const std::vector<const float*>& pixels, int y0, int rows) {
           fitter.Fit(pixels, 1.0, rows, bands.width(), y0, result.ptm, result.residual_rms);
         },
-        progress, "fit");
+        progress, "fit", BandLayout::kPlanar);
   }
   Finish(result, start);
   return result;

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <exception>
+#include <opencv2/core.hpp>
 #include <string>
 #include <thread>
+#include <type_traits>
 
 #include "core/errors.h"
 
@@ -33,17 +35,45 @@ bool ImageBands::eight_bit() const {
                      [](const ImageReader& in) { return in.eight_bit(); });
 }
 
+namespace {
+
+// Image k's rows [y0, y0 + rows) as three planes: decoded interleaved into
+// `scratch`, then split.
+template <typename Sample>
+void ReadPlanes(ImageReader& input, int y0, int rows, std::vector<Sample>& scratch,
+                Sample* planes) {
+  const int type = std::is_same_v<Sample, float> ? CV_32FC3 : CV_8UC3;
+  const int plane_type = std::is_same_v<Sample, float> ? CV_32FC1 : CV_8UC1;
+  const int width = input.width();
+  input.ReadRows(y0, y0 + rows, 3, scratch.data());
+  const std::size_t plane = static_cast<std::size_t>(rows) * static_cast<std::size_t>(width);
+  cv::Mat split[3];
+  for (std::size_t ch = 0; ch < 3; ++ch)
+    split[ch] = cv::Mat(rows, width, plane_type, planes + ch * plane);
+  cv::split(cv::Mat(rows, width, type, scratch.data()), split);
+}
+
+}  // namespace
+
 // Images k = t, t + T, t + 2T, ... on thread t: each image's reader decodes its
 // rows in order, on one thread at a time.
 template <typename Sample>
-void ImageBands::Read(int y0, int band_rows, std::vector<std::vector<Sample>>& band) {
+void ImageBands::Read(int y0, int band_rows, BandLayout layout,
+                      std::vector<std::vector<Sample>>& band) {
   const int rows = std::min(band_rows, height_ - y0);
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(decode_threads_));
   auto decode = [&](int t) {
     try {
+      std::vector<Sample> scratch;
+      if (layout == BandLayout::kPlanar) scratch.resize(band.empty() ? 0 : band[0].size());
       for (std::size_t k = static_cast<std::size_t>(t); k < inputs_.size();
-           k += static_cast<std::size_t>(decode_threads_))
-        inputs_[k].ReadRows(y0, y0 + rows, 3, band[k].data());
+           k += static_cast<std::size_t>(decode_threads_)) {
+        if (layout == BandLayout::kPlanar) {
+          ReadPlanes(inputs_[k], y0, rows, scratch, band[k].data());
+        } else {
+          inputs_[k].ReadRows(y0, y0 + rows, 3, band[k].data());
+        }
+      }
     } catch (...) {
       errors[static_cast<std::size_t>(t)] = std::current_exception();
     }
@@ -60,12 +90,12 @@ template <typename Sample>
 void ImageBands::ForEach(
     int band_rows,
     const std::function<void(const std::vector<const Sample*>& pixels, int y0, int rows)>& process,
-    const ProgressCallback& progress, const char* stage) {
+    const ProgressCallback& progress, const char* stage, BandLayout layout) {
   const std::size_t band_samples = static_cast<std::size_t>(band_rows) * width_ * 3;
   // Two bands: the next one is decoded while the current one is processed.
   std::vector<std::vector<Sample>> bands[2];
   for (auto& set : bands) set.assign(inputs_.size(), std::vector<Sample>(band_samples));
-  if (height_ > 0) Read(0, band_rows, bands[0]);
+  if (height_ > 0) Read(0, band_rows, layout, bands[0]);
   for (int b = 0, y0 = 0; y0 < height_; ++b, y0 += band_rows) {
     const int rows = std::min(band_rows, height_ - y0);
     const int next = y0 + band_rows;
@@ -74,7 +104,7 @@ void ImageBands::ForEach(
     if (next < height_) {
       reader = std::thread([&, next, b] {
         try {
-          Read(next, band_rows, bands[(b + 1) % 2]);
+          Read(next, band_rows, layout, bands[(b + 1) % 2]);
         } catch (...) {
           read_error = std::current_exception();
         }
@@ -97,9 +127,9 @@ void ImageBands::ForEach(
 
 template void ImageBands::ForEach<float>(
     int, const std::function<void(const std::vector<const float*>&, int, int)>&,
-    const ProgressCallback&, const char*);
+    const ProgressCallback&, const char*, BandLayout);
 template void ImageBands::ForEach<std::uint8_t>(
     int, const std::function<void(const std::vector<const std::uint8_t*>&, int, int)>&,
-    const ProgressCallback&, const char*);
+    const ProgressCallback&, const char*, BandLayout);
 
 }  // namespace texlume::ptm

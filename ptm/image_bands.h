@@ -10,6 +10,10 @@
 
 namespace texlume::ptm {
 
+/// How a band's pixels are laid out: RGB interleaved, or an image's band as its R
+/// plane, then its G plane, then its B plane (rows x width each).
+enum class BandLayout { kInterleaved, kPlanar };
+
 /// An RTI capture's images read together a band of rows at a time (the one image
 /// reader, core/image_io.h), so that fitting needs memory for one band of every
 /// image, not for every image. The next band is decoded while the current one is
@@ -27,18 +31,19 @@ class ImageBands {
   bool eight_bit() const;
 
   /// Calls `process(pixels, y0, rows)` for each band of `band_rows` rows, top to
-  /// bottom: pixels[k] holds image k's rows [y0, y0 + rows) as interleaved RGB,
-  /// floats in [0, 1] or 8-bit values 0..255 (Sample float or std::uint8_t).
-  /// Reports progress as `stage` over the rows.
+  /// bottom: pixels[k] holds image k's rows [y0, y0 + rows) in `layout`, floats in
+  /// [0, 1] or 8-bit values 0..255 (Sample float or std::uint8_t). Planes are made
+  /// by the decoding threads. Reports progress as `stage` over the rows.
   template <typename Sample>
   void ForEach(int band_rows,
                const std::function<void(const std::vector<const Sample*>& pixels, int y0,
                                         int rows)>& process,
-               const ProgressCallback& progress, const char* stage);
+               const ProgressCallback& progress, const char* stage,
+               BandLayout layout = BandLayout::kInterleaved);
 
  private:
   template <typename Sample>
-  void Read(int y0, int band_rows, std::vector<std::vector<Sample>>& band);
+  void Read(int y0, int band_rows, BandLayout layout, std::vector<std::vector<Sample>>& band);
   std::vector<ImageReader> inputs_;
   int width_ = 0, height_ = 0;
   int decode_threads_ = 1;

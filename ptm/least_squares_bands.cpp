@@ -3,6 +3,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 namespace texlume::ptm {
 
@@ -20,18 +21,31 @@ LeastSquaresBands::LeastSquaresBands(const std::vector<Eigen::Vector3d>& lights)
     for (int i = 0; i < 6; ++i)
       pseudo_inverse_[k * 6 + static_cast<std::size_t>(i)] =
           inverse(i, static_cast<Eigen::Index>(k));
+  pseudo_inverse_float_.assign(pseudo_inverse_.begin(), pseudo_inverse_.end());
   gram_ = a.transpose() * a;
 }
 
-template <typename Sample>
-void LeastSquaresBands::ToPlanes(const std::vector<const Sample*>& pixels, std::size_t first,
-                                 int count, double* planes) const {
+namespace {
+template <typename Sum>
+const Sum* InverseOf(const std::vector<double>& in_double, const std::vector<float>& in_float) {
+  if constexpr (std::is_same_v<Sum, float>) {
+    return in_float.data();
+  } else {
+    return in_double.data();
+  }
+}
+}  // namespace
+
+template <typename Sample, typename Sum>
+void LeastSquaresBands::ToPlanes(const std::vector<const Sample*>& pixels, std::size_t plane,
+                                 std::size_t first, int count, Sum* planes) const {
   for (std::size_t k = 0; k < lights_; ++k) {
-    const Sample* in = pixels[k] + first * 3;
-    double* out = planes + k * 3 * kRun;
-    for (int x = 0; x < count; ++x)
-      for (int ch = 0; ch < 3; ++ch) out[ch * kRun + x] = static_cast<double>(in[x * 3 + ch]);
-    for (int ch = 0; ch < 3; ++ch) std::fill(out + ch * kRun + count, out + (ch + 1) * kRun, 0.0);
+    for (std::size_t ch = 0; ch < 3; ++ch) {
+      const Sample* in = pixels[k] + ch * plane + first;
+      Sum* out = planes + (k * 3 + ch) * kRun;
+      for (int x = 0; x < count; ++x) out[x] = static_cast<Sum>(in[x]);
+      std::fill(out + count, out + kRun, Sum{0});
+    }
   }
 }
 
@@ -42,38 +56,42 @@ double LeastSquaresBands::Quadratic(const double* a) const {
   return q;
 }
 
-void LeastSquaresBands::FitLrgb(const double* planes, int x, int count, double unit,
-                                std::size_t texel, Ptm& ptm, std::vector<float>& residual) const {
+template <typename Sum>
+void LeastSquaresBands::FitLrgb(const Sum* planes, int x, int count, double unit, std::size_t texel,
+                                Ptm& ptm, std::vector<float>& residual) const {
+  using L = Lanes<Sum>;
+  constexpr int kLanesOf = kLanes<Sum>;
   // Pass 1: 3 x the luminance-weighted colour sum, and the energy.
-  Lanes chroma[3] = {Lanes::Zero(), Lanes::Zero(), Lanes::Zero()}, energy = Lanes::Zero();
+  L chroma[3] = {L::Zero(), L::Zero(), L::Zero()};
+  L energy = L::Zero();
   for (std::size_t k = 0; k < lights_; ++k) {
-    const double* p = planes + k * 3 * kRun + x;
-    const Lanes r = Lanes::Map(p), g = Lanes::Map(p + kRun), b = Lanes::Map(p + 2 * kRun);
-    const Lanes sum = r + g + b;
+    const Sum* p = planes + k * 3 * kRun + x;
+    const L r = L::Map(p), g = L::Map(p + kRun), b = L::Map(p + 2 * kRun);
+    const L sum = r + g + b;
     chroma[0] += sum * r, chroma[1] += sum * g, chroma[2] += sum * b;
     energy += r * r + g * g + b * b;
   }
   // Chromaticity: largest channel 1; the luminance L_k = rgb_k . c / |c|^2.
-  Lanes scaled[3];
-  Eigen::Vector3d colour[kLanes];
-  for (int l = 0; l < kLanes; ++l) {
+  L scaled[3];
+  Eigen::Vector3d colour[kLanesOf];
+  for (int l = 0; l < kLanesOf; ++l) {
     Eigen::Vector3d c(chroma[0][l], chroma[1][l], chroma[2][l]);
     c /= 3.0 * unit * unit;
     c = c.maxCoeff() > 1e-9 ? Eigen::Vector3d(c / c.maxCoeff()) : Eigen::Vector3d::Ones();
     colour[l] = c;
-    for (int ch = 0; ch < 3; ++ch) scaled[ch][l] = c[ch] / c.squaredNorm() / unit;
+    for (int ch = 0; ch < 3; ++ch) scaled[ch][l] = static_cast<Sum>(c[ch] / c.squaredNorm() / unit);
   }
   // Pass 2: a = A^+ L.
-  Lanes a[6] = {Lanes::Zero(), Lanes::Zero(), Lanes::Zero(),
-                Lanes::Zero(), Lanes::Zero(), Lanes::Zero()};
+  L a[6] = {L::Zero(), L::Zero(), L::Zero(), L::Zero(), L::Zero(), L::Zero()};
+  const Sum* inverse = InverseOf<Sum>(pseudo_inverse_, pseudo_inverse_float_);
   for (std::size_t k = 0; k < lights_; ++k) {
-    const double* p = planes + k * 3 * kRun + x;
-    const Lanes luminance = Lanes::Map(p) * scaled[0] + Lanes::Map(p + kRun) * scaled[1] +
-                            Lanes::Map(p + 2 * kRun) * scaled[2];
-    const double* inverse_k = &pseudo_inverse_[k * 6];
+    const Sum* p = planes + k * 3 * kRun + x;
+    const L luminance =
+        L::Map(p) * scaled[0] + L::Map(p + kRun) * scaled[1] + L::Map(p + 2 * kRun) * scaled[2];
+    const Sum* inverse_k = inverse + k * 6;
     for (int i = 0; i < 6; ++i) a[i] += inverse_k[i] * luminance;
   }
-  for (int l = 0; l < std::min(kLanes, count - x); ++l) {
+  for (int l = 0; l < std::min(kLanesOf, count - x); ++l) {
     const std::size_t t = texel + static_cast<std::size_t>(l);
     double coefficients[6];
     float* out = ptm.Coefficients(t);
@@ -86,17 +104,20 @@ void LeastSquaresBands::FitLrgb(const double* planes, int x, int count, double u
   }
 }
 
-void LeastSquaresBands::FitRgb(const double* planes, int x, int count, double unit,
-                               std::size_t texel, Ptm& ptm, std::vector<float>& residual) const {
-  const int texels = std::min(kLanes, count - x);
-  double sum_sq[kLanes] = {};
+template <typename Sum>
+void LeastSquaresBands::FitRgb(const Sum* planes, int x, int count, double unit, std::size_t texel,
+                               Ptm& ptm, std::vector<float>& residual) const {
+  using L = Lanes<Sum>;
+  constexpr int kLanesOf = kLanes<Sum>;
+  const int texels = std::min(kLanesOf, count - x);
+  const Sum* inverse = InverseOf<Sum>(pseudo_inverse_, pseudo_inverse_float_);
+  double sum_sq[kLanesOf] = {};
   for (int ch = 0; ch < 3; ++ch) {
-    Lanes a[6] = {Lanes::Zero(), Lanes::Zero(), Lanes::Zero(),
-                  Lanes::Zero(), Lanes::Zero(), Lanes::Zero()};
-    Lanes energy = Lanes::Zero();
+    L a[6] = {L::Zero(), L::Zero(), L::Zero(), L::Zero(), L::Zero(), L::Zero()};
+    L energy = L::Zero();
     for (std::size_t k = 0; k < lights_; ++k) {
-      const Lanes v = Lanes::Map(planes + (k * 3 + static_cast<std::size_t>(ch)) * kRun + x);
-      const double* inverse_k = &pseudo_inverse_[k * 6];
+      const L v = L::Map(planes + (k * 3 + static_cast<std::size_t>(ch)) * kRun + x);
+      const Sum* inverse_k = inverse + k * 6;
       for (int i = 0; i < 6; ++i) a[i] += inverse_k[i] * v;
       energy += v * v;
     }
@@ -120,7 +141,8 @@ void LeastSquaresBands::Fit(const std::vector<const Sample*>& pixels, double uni
   const long runs = runs_per_row * rows;
 #pragma omp parallel
   {
-    std::vector<double> planes(lights_ * 3 * kRun);  // per thread, reused for every run
+    using Sum = SumOf<Sample>;
+    std::vector<Sum> planes(lights_ * 3 * kRun);  // per thread, reused for every run
 #pragma omp for schedule(dynamic, 8)
     for (long r = 0; r < runs; ++r) {
       const int row = static_cast<int>(r / runs_per_row);
@@ -128,8 +150,8 @@ void LeastSquaresBands::Fit(const std::vector<const Sample*>& pixels, double uni
       const int count = std::min(kRun, width - x0);
       const std::size_t local = static_cast<std::size_t>(row) * width + x0;
       const std::size_t texel = static_cast<std::size_t>(first_row) * width + local;
-      ToPlanes(pixels, local, count, planes.data());
-      for (int x = 0; x < count; x += kLanes) {
+      ToPlanes(pixels, static_cast<std::size_t>(rows) * width, local, count, planes.data());
+      for (int x = 0; x < count; x += kLanes<Sum>) {
         if (ptm.format == PtmFormat::kLrgb) {
           FitLrgb(planes.data(), x, count, unit, texel + static_cast<std::size_t>(x), ptm,
                   residual);

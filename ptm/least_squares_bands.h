@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "ptm/ptm.h"
@@ -25,31 +26,44 @@ class LeastSquaresBands {
 
   /// Fits texels [first_row * width, (first_row + rows) * width) of `ptm` (its
   /// format chosen) and their residual RMS in [0, 1] units. pixels[k]: image k's
-  /// `rows` x `width` interleaved RGB, `unit` per 1 (255 for 8-bit, 1 for floats).
+  /// `rows` x `width` band as planes (BandLayout::kPlanar: R, then G, then B), `unit`
+  /// per 1 (255 for 8-bit, 1 for floats).
   template <typename Sample>
   void Fit(const std::vector<const Sample*>& pixels, double unit, int rows, int width,
            int first_row, Ptm& ptm, std::vector<float>& residual) const;
 
  private:
-  static constexpr int kRun = 32;   ///< texels converted to planes at once
-  static constexpr int kLanes = 4;  ///< texels whose sums stay in registers
-  using Lanes = Eigen::Array<double, kLanes, 1>;
+  static constexpr int kRun = 32;  ///< texels converted to planes at once
+  /// Texels whose sums stay in registers: two SSE registers of Sum.
+  template <typename Sum>
+  static constexpr int kLanes = static_cast<int>(32 / sizeof(Sum));
+  template <typename Sum>
+  using Lanes = Eigen::Array<Sum, kLanes<Sum>, 1>;
+  /// The sums of 8-bit samples are floats: exact for the colour and energy sums up
+  /// to 2^24 (85 images; beyond, 6e-8 relative), and 1e-7 relative for the
+  /// coefficients, far below the samples' own step of 1/255. Float samples are
+  /// summed in double.
+  template <typename Sample>
+  using SumOf = std::conditional_t<std::is_same_v<Sample, std::uint8_t>, float, double>;
 
   /// The planes of a run: image k's channel ch at planes[(k * 3 + ch) * kRun + x],
-  /// zero past `count` texels.
-  template <typename Sample>
-  void ToPlanes(const std::vector<const Sample*>& pixels, std::size_t first, int count,
-                double* planes) const;
+  /// zero past `count` texels; the band's planes are `plane` samples apart.
+  template <typename Sample, typename Sum>
+  void ToPlanes(const std::vector<const Sample*>& pixels, std::size_t plane, std::size_t first,
+                int count, Sum* planes) const;
   /// Fits the kLanes texels from `x` of a run's planes; writes those before `count`.
-  void FitLrgb(const double* planes, int x, int count, double unit, std::size_t texel, Ptm& ptm,
+  template <typename Sum>
+  void FitLrgb(const Sum* planes, int x, int count, double unit, std::size_t texel, Ptm& ptm,
                std::vector<float>& residual) const;
-  void FitRgb(const double* planes, int x, int count, double unit, std::size_t texel, Ptm& ptm,
+  template <typename Sum>
+  void FitRgb(const Sum* planes, int x, int count, double unit, std::size_t texel, Ptm& ptm,
               std::vector<float>& residual) const;
   double Quadratic(const double* a) const;  ///< a^T (A^T A) a
 
   std::size_t lights_ = 0;
-  std::vector<double> pseudo_inverse_;  ///< A^+ by light: pseudo_inverse_[k * 6 + i]
-  Eigen::Matrix<double, 6, 6> gram_;    ///< A^T A
+  std::vector<double> pseudo_inverse_;       ///< A^+ by light: pseudo_inverse_[k * 6 + i]
+  std::vector<float> pseudo_inverse_float_;  ///< the same in floats
+  Eigen::Matrix<double, 6, 6> gram_;         ///< A^T A
 };
 
 }  // namespace texlume::ptm
