@@ -11,7 +11,8 @@
 namespace texlume {
 
 /// sRGB decoding and encoding of display values in [0, 1] (IEC 61966-2-1);
-/// inputs outside [0, 1] are clamped. Photos and PTMs hold display values;
+/// inputs outside [0, 1] are clamped, NaN is 0. Within 1e-7 of the curves
+/// (tabulated: core/image_io.cpp). Photos and PTMs hold display values;
 /// light mixtures are summed in the linear domain (DESIGN.md, "Frames, units").
 float SrgbToLinear(float v);
 float LinearToSrgb(float v);

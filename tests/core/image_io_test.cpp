@@ -3,6 +3,8 @@
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <vector>
@@ -98,6 +100,41 @@ TEST(ImageIo, MissingAndBrokenFilesAreInputErrorsNamingThem) {
   WriteBytesAtomically(broken, {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0});
   EXPECT_THROW(ReadPhotoRgb(broken), InputError);
   EXPECT_THROW(ImageReader{broken}, InputError);
+}
+
+}  // namespace
+}  // namespace texlume
+
+namespace texlume {
+namespace {
+
+// The sRGB curves by their definition (IEC 61966-2-1), in double.
+double DecodeByDefinition(double v) {
+  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+}
+double EncodeByDefinition(double v) {
+  return v <= 0.0031308 ? v * 12.92 : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+TEST(Srgb, TransfersFollowTheStandardCurvesWithinAFloatsRounding) {
+  double worst_decode = 0.0, worst_encode = 0.0;
+  for (int i = 0; i <= 1000000; ++i) {
+    const double v = i / 1000000.0;
+    worst_decode = std::max(worst_decode, std::abs(SrgbToLinear(static_cast<float>(v)) -
+                                                   DecodeByDefinition(static_cast<float>(v))));
+    worst_encode = std::max(worst_encode, std::abs(LinearToSrgb(static_cast<float>(v)) -
+                                                   EncodeByDefinition(static_cast<float>(v))));
+  }
+  EXPECT_LT(worst_decode, 1e-7);
+  EXPECT_LT(worst_encode, 1e-7);
+  // Ends, clamping, NaN and the round trip.
+  EXPECT_FLOAT_EQ(SrgbToLinear(1.0f), 1.0f);
+  EXPECT_FLOAT_EQ(LinearToSrgb(1.0f), 1.0f);
+  EXPECT_EQ(SrgbToLinear(-0.5f), 0.0f);
+  EXPECT_EQ(LinearToSrgb(2.0f), 1.0f);
+  EXPECT_EQ(SrgbToLinear(std::nanf("")), 0.0f);
+  EXPECT_EQ(LinearToSrgb(std::nanf("")), 0.0f);
+  for (float v = 0.0f; v <= 1.0f; v += 0.001f) EXPECT_NEAR(LinearToSrgb(SrgbToLinear(v)), v, 2e-6);
 }
 
 }  // namespace
