@@ -26,15 +26,6 @@ namespace {
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
 using MatrixX6 = Eigen::Matrix<double, Eigen::Dynamic, 6>;
 
-MatrixX6 LightMatrix(const std::vector<Eigen::Vector3d>& lights) {
-  MatrixX6 a(static_cast<Eigen::Index>(lights.size()), 6);
-  for (std::size_t k = 0; k < lights.size(); ++k) {
-    const auto b = PtmBasis(lights[k].x(), lights[k].y());
-    for (int i = 0; i < 6; ++i) a(static_cast<Eigen::Index>(k), i) = b[static_cast<std::size_t>(i)];
-  }
-  return a;
-}
-
 // Robust refinement of one polynomial from its samples (Cauchy loss), starting
 // from the least-squares coefficients in `a`.
 void RobustRefine(const MatrixX6& basis, const std::vector<double>& values,
@@ -70,7 +61,7 @@ void RobustRefine(const MatrixX6& basis, const std::vector<double>& values,
 class RobustBandFitter {
  public:
   RobustBandFitter(const std::vector<Eigen::Vector3d>& lights, const FitOptions& options)
-      : options_(options), basis_(LightMatrix(lights)) {
+      : options_(options), basis_(PtmLightMatrix(lights)) {
     pseudo_inverse_ = basis_.completeOrthogonalDecomposition().pseudoInverse();
   }
 
@@ -143,7 +134,7 @@ class RobustBandFitter {
         }
       }
     }
-    return std::sqrt(sum_sq / (3.0 * static_cast<double>(k_count)));
+    return ResidualRms(sum_sq, k_count);
   }
 
   // Least squares a = A^+ values (one 6 x N product), then the Cauchy loss.
@@ -167,6 +158,20 @@ class RobustBandFitter {
   MatrixX6 basis_;
   Eigen::Matrix<double, 6, Eigen::Dynamic> pseudo_inverse_;
 };
+
+// The least-squares fit of every band of `bands` into `result`, the samples read as
+// Sample (`unit` per 1) in planes.
+template <typename Sample>
+void FitLeastSquares(ImageBands& bands, const std::vector<Eigen::Vector3d>& lights, double unit,
+                     int band_rows, const ProgressCallback& progress, FitResult& result) {
+  const LeastSquaresBands fitter(lights);
+  bands.ForEach<Sample>(
+      band_rows,
+      [&](const std::vector<const Sample*>& pixels, int y0, int rows) {
+        fitter.Fit(pixels, unit, rows, bands.width(), y0, result.ptm, result.residual_rms);
+      },
+      progress, "fit", BandLayout::kPlanar);
+}
 
 // Each image as its R, G and B planes (BandLayout::kPlanar).
 std::vector<std::vector<float>> PlanesOf(const std::vector<ImageRgb>& images) {
@@ -207,7 +212,7 @@ void FitOptions::Check() const {
 void CheckLightSet(const std::vector<Eigen::Vector3d>& lights, const FitOptions& options,
                    const std::string& label) {
   options.Check();
-  CheckLightsForBasis(lights, LightMatrix(lights), static_cast<std::size_t>(options.min_lights),
+  CheckLightsForBasis(lights, PtmLightMatrix(lights), static_cast<std::size_t>(options.min_lights),
                       options.max_condition_number, "a PTM", label);
 }
 
@@ -362,21 +367,9 @@ FitResult FitPtmFromFiles(const std::vector<std::filesystem::path>& files,
         },
         progress, "fit");
   } else if (bands.eight_bit()) {  // the camera's own bytes: no conversion on the way
-    const LeastSquaresBands fitter(lights);
-    bands.ForEach<std::uint8_t>(
-        options.band_rows,
-        [&](const std::vector<const std::uint8_t*>& pixels, int y0, int rows) {
-          fitter.Fit(pixels, 255.0, rows, bands.width(), y0, result.ptm, result.residual_rms);
-        },
-        progress, "fit", BandLayout::kPlanar);
+    FitLeastSquares<std::uint8_t>(bands, lights, 255.0, options.band_rows, progress, result);
   } else {
-    const LeastSquaresBands fitter(lights);
-    bands.ForEach<float>(
-        options.band_rows,
-        [&](const std::vector<const float*>& pixels, int y0, int rows) {
-          fitter.Fit(pixels, 1.0, rows, bands.width(), y0, result.ptm, result.residual_rms);
-        },
-        progress, "fit", BandLayout::kPlanar);
+    FitLeastSquares<float>(bands, lights, 1.0, options.band_rows, progress, result);
   }
   Finish(result, start);
   return result;
@@ -407,7 +400,7 @@ FitResult FitPtmPerTexelLights(
         rgb.emplace_back(p[0], p[1], p[2]);
       }
       Matrix6 normal = Matrix6::Zero();
-      const MatrixX6 a = LightMatrix(lights);
+      const MatrixX6 a = PtmLightMatrix(lights);
       normal = a.transpose() * a;
       const Eigen::JacobiSVD<Matrix6> svd(normal);
       const bool solvable =

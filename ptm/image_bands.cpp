@@ -1,5 +1,7 @@
 #include "ptm/image_bands.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <exception>
 #include <opencv2/core.hpp>
@@ -25,8 +27,8 @@ ImageBands::ImageBands(const std::vector<std::filesystem::path>& files, int deco
     }
     inputs_.push_back(std::move(in));
   }
-  const int hardware = static_cast<int>(std::max(1U, std::thread::hardware_concurrency()));
-  decode_threads_ = std::clamp(decode_threads > 0 ? decode_threads : hardware, 1,
+  // As many as the fit's OpenMP team (OMP_NUM_THREADS, else one per hardware thread).
+  decode_threads_ = std::clamp(decode_threads > 0 ? decode_threads : omp_get_max_threads(), 1,
                                std::max(1, static_cast<int>(inputs_.size())));
 }
 
@@ -79,7 +81,12 @@ void ImageBands::Read(int y0, int band_rows, BandLayout layout,
     }
   };
   std::vector<std::thread> threads;
-  for (int t = 1; t < decode_threads_; ++t) threads.emplace_back(decode, t);
+  try {
+    for (int t = 1; t < decode_threads_; ++t) threads.emplace_back(decode, t);
+  } catch (...) {  // a thread that cannot start: join those that did
+    for (auto& thread : threads) thread.join();
+    throw;
+  }
   decode(0);
   for (auto& thread : threads) thread.join();
   for (const auto& error : errors)

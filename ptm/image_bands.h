@@ -21,7 +21,7 @@ enum class BandLayout { kInterleaved, kPlanar };
 class ImageBands {
  public:
   /// Opens every file; throws InputError naming a file whose size differs from the
-  /// first one's. decode_threads 0: one per hardware thread.
+  /// first one's. decode_threads 0: as many as OpenMP's threads.
   explicit ImageBands(const std::vector<std::filesystem::path>& files, int decode_threads = 0);
 
   int width() const { return width_; }

@@ -9,11 +9,7 @@ namespace texlume::ptm {
 
 LeastSquaresBands::LeastSquaresBands(const std::vector<Eigen::Vector3d>& lights)
     : lights_(lights.size()) {
-  Eigen::Matrix<double, Eigen::Dynamic, 6> a(static_cast<Eigen::Index>(lights.size()), 6);
-  for (std::size_t k = 0; k < lights.size(); ++k) {
-    const auto b = PtmBasis(lights[k].x(), lights[k].y());
-    for (int i = 0; i < 6; ++i) a(static_cast<Eigen::Index>(k), i) = b[static_cast<std::size_t>(i)];
-  }
+  const Eigen::Matrix<double, Eigen::Dynamic, 6> a = PtmLightMatrix(lights);
   const Eigen::Matrix<double, 6, Eigen::Dynamic> inverse =
       a.completeOrthogonalDecomposition().pseudoInverse();
   pseudo_inverse_.resize(lights.size() * 6);
@@ -100,7 +96,7 @@ void LeastSquaresBands::FitLrgb(const Sum* planes, int x, int count, double unit
       ptm.colour[t * 3 + static_cast<std::size_t>(ch)] = static_cast<float>(colour[l][ch]);
     const double sum_sq = std::max(
         0.0, energy[l] / (unit * unit) - colour[l].squaredNorm() * Quadratic(coefficients));
-    residual[t] = static_cast<float>(std::sqrt(sum_sq / (3.0 * static_cast<double>(lights_))));
+    residual[t] = ResidualRms(sum_sq, lights_);
   }
 }
 
@@ -129,8 +125,7 @@ void LeastSquaresBands::FitRgb(const Sum* planes, int x, int count, double unit,
     }
   }
   for (int l = 0; l < texels; ++l)
-    residual[texel + static_cast<std::size_t>(l)] =
-        static_cast<float>(std::sqrt(sum_sq[l] / (3.0 * static_cast<double>(lights_))));
+    residual[texel + static_cast<std::size_t>(l)] = ResidualRms(sum_sq[l], lights_);
 }
 
 template <typename Sample>

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <type_traits>
 #include <vector>
@@ -8,6 +9,12 @@
 #include "ptm/ptm.h"
 
 namespace texlume::ptm {
+
+/// A texel's residual RMS over its `images` samples' three channels, from the sum
+/// of their squared differences.
+inline float ResidualRms(double sum_sq, std::size_t images) {
+  return static_cast<float>(std::sqrt(sum_sq / (3.0 * static_cast<double>(images))));
+}
 
 /// The closed-form least-squares PTM fit of bands of images lit from the same
 /// directions (Malzbender et al. 2001: a = A^+ L per texel, A the light matrix),

@@ -25,6 +25,16 @@ std::array<double, 6> PtmBasis(double lu, double lv) {
   return {lu * lu, lv * lv, lu * lv, lu, lv, 1.0};
 }
 
+Eigen::Matrix<double, Eigen::Dynamic, 6> PtmLightMatrix(
+    const std::vector<Eigen::Vector3d>& lights) {
+  Eigen::Matrix<double, Eigen::Dynamic, 6> a(static_cast<Eigen::Index>(lights.size()), 6);
+  for (std::size_t k = 0; k < lights.size(); ++k) {
+    const auto b = PtmBasis(lights[k].x(), lights[k].y());
+    for (int i = 0; i < 6; ++i) a(static_cast<Eigen::Index>(k), i) = b[static_cast<std::size_t>(i)];
+  }
+  return a;
+}
+
 double EvaluatePolynomial(const float* a, double lu, double lv) {
   return a[0] * lu * lu + a[1] * lv * lv + a[2] * lu * lv + a[3] * lu + a[4] * lv + a[5];
 }

@@ -63,6 +63,9 @@ Ptm AsRgb(const Ptm& ptm);
 
 /// The six monomials of eq. 1 at (lu, lv): (lu^2, lv^2, lu lv, lu, lv, 1).
 std::array<double, 6> PtmBasis(double lu, double lv);
+/// The light matrix A of a fit to images under `lights` (unit, tangent frame):
+/// row k is PtmBasis of light k.
+Eigen::Matrix<double, Eigen::Dynamic, 6> PtmLightMatrix(const std::vector<Eigen::Vector3d>& lights);
 /// L(lu, lv) = a0 lu^2 + a1 lv^2 + a2 lu lv + a3 lu + a4 lv + a5 (paper 003 eq. 1).
 double EvaluatePolynomial(const float* a, double lu, double lv);
 

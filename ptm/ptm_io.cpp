@@ -50,87 +50,86 @@ std::uint32_t OrderedKey(float v) {
   return (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
 }
 
+// The float whose OrderedKey is `key`.
+float FromOrderedKey(std::uint32_t key) {
+  const std::uint32_t bits = (key & 0x80000000u) ? (key & 0x7fffffffu) : ~key;
+  float v;
+  std::memcpy(&v, &bits, sizeof v);
+  return v;
+}
+
 // The values 255 a_i of each coefficient index i over every texel and polynomial
 // (a: 6 floats per texel and polynomial), and of each the values of two ranks,
-// found exactly in two passes over the coefficients without a copy of them: a
-// histogram of the keys' top 16 bits finds each rank's bin, then only that bin's
-// values are sorted.
+// found exactly in two passes over the coefficients without a copy of them (a
+// radix select): a histogram of the keys' high 16 bits finds each rank's bin,
+// then a histogram of the low 16 bits of the keys in that bin finds the key.
 class CoefficientRanks {
  public:
-  static constexpr std::uint32_t kBins = 1 << 16;
+  static constexpr std::size_t kBins = std::size_t{1} << 16;
 
   CoefficientRanks(const std::vector<float>& a, std::array<std::size_t, 2> ranks)
       : a_(a), ranks_(ranks), count_(a.size() / 6) {}
 
   // The value of rank ranks[r] among index i's values, for every i and r.
   std::array<std::array<float, 2>, 6> Values() {
-    FindBins(CountBins());
-    return Select();
+    const std::vector<std::size_t> high = Count(false);
+    for (std::size_t i = 0; i < 6; ++i)
+      for (std::size_t r = 0; r < 2; ++r) high_[i][r] = Find(high, i * 2, ranks_[r], below_[i][r]);
+    const std::vector<std::size_t> low = Count(true);
+    std::array<std::array<float, 2>, 6> values;
+    for (std::size_t i = 0; i < 6; ++i) {
+      for (std::size_t r = 0; r < 2; ++r) {
+        std::size_t below = below_[i][r];
+        const std::uint32_t digit = Find(low, i * 2 + r, ranks_[r], below);
+        values[i][r] = FromOrderedKey(high_[i][r] << 16 | digit);
+      }
+    }
+    return values;
   }
 
  private:
-  float Value(std::size_t j, std::size_t i) const { return 255.0f * a_[j * 6 + i]; }
+  std::uint32_t Key(std::size_t j, std::size_t i) const {
+    return OrderedKey(255.0f * a_[j * 6 + i]);
+  }
 
-  std::vector<std::size_t> CountBins() const {  // [i * kBins + bin]
-    std::vector<std::size_t> bins(6 * kBins, 0);
+  // Histogram h = i * 2 + r of the keys' high digits (r = 0: one per index), or of
+  // the low digits of the keys whose high digit is high_[i][r].
+  std::vector<std::size_t> Count(bool low_digits) const {
+    std::vector<std::size_t> bins(12 * kBins, 0);
 #pragma omp parallel
     {
-      std::vector<std::uint32_t> local(6 * kBins, 0);
+      std::vector<std::uint32_t> local(12 * kBins, 0);  // < 2^32 values per thread
 #pragma omp for schedule(static) nowait
-      for (std::size_t j = 0; j < count_; ++j)
-        for (std::size_t i = 0; i < 6; ++i) ++local[i * kBins + (OrderedKey(Value(j, i)) >> 16)];
+      for (std::size_t j = 0; j < count_; ++j) {
+        for (std::size_t i = 0; i < 6; ++i) {
+          const std::uint32_t key = Key(j, i);
+          if (!low_digits) {
+            ++local[i * 2 * kBins + (key >> 16)];
+            continue;
+          }
+          for (std::size_t r = 0; r < 2; ++r)
+            if ((key >> 16) == high_[i][r]) ++local[(i * 2 + r) * kBins + (key & 0xffffu)];
+        }
+      }
 #pragma omp critical
       for (std::size_t b = 0; b < bins.size(); ++b) bins[b] += local[b];
     }
     return bins;
   }
 
-  void FindBins(const std::vector<std::size_t>& bins) {
-    for (std::size_t i = 0; i < 6; ++i) {
-      for (std::size_t r = 0; r < 2; ++r) {
-        std::size_t seen = 0;
-        std::uint32_t b = 0;
-        while (seen + bins[i * kBins + b] <= ranks_[r]) seen += bins[i * kBins + b++];
-        bin_[i][r] = b, below_[i][r] = seen;
-      }
-    }
-  }
-
-  std::array<std::array<float, 2>, 6> Select() const {
-    std::array<std::array<std::vector<float>, 2>, 6> in_bin;
-#pragma omp parallel
-    {
-      std::array<std::array<std::vector<float>, 2>, 6> local;
-#pragma omp for schedule(static) nowait
-      for (std::size_t j = 0; j < count_; ++j) {
-        for (std::size_t i = 0; i < 6; ++i) {
-          const float v = Value(j, i);
-          const std::uint32_t b = OrderedKey(v) >> 16;
-          for (std::size_t r = 0; r < 2; ++r)
-            if (b == bin_[i][r]) local[i][r].push_back(v);
-        }
-      }
-#pragma omp critical
-      for (std::size_t i = 0; i < 6; ++i)
-        for (std::size_t r = 0; r < 2; ++r)
-          in_bin[i][r].insert(in_bin[i][r].end(), local[i][r].begin(), local[i][r].end());
-    }
-    std::array<std::array<float, 2>, 6> values;
-    for (std::size_t i = 0; i < 6; ++i) {
-      for (std::size_t r = 0; r < 2; ++r) {
-        auto& v = in_bin[i][r];
-        const auto nth = v.begin() + static_cast<std::ptrdiff_t>(ranks_[r] - below_[i][r]);
-        std::nth_element(v.begin(), nth, v.end());
-        values[i][r] = *nth;
-      }
-    }
-    return values;
+  // The digit whose bin in histogram h holds rank `rank`; `below` (values before
+  // the histogram's first bin) becomes the values before that digit's bin.
+  static std::uint32_t Find(const std::vector<std::size_t>& bins, std::size_t h, std::size_t rank,
+                            std::size_t& below) {
+    std::uint32_t digit = 0;
+    while (below + bins[h * kBins + digit] <= rank) below += bins[h * kBins + digit++];
+    return digit;
   }
 
   const std::vector<float>& a_;
   std::array<std::size_t, 2> ranks_;
   std::size_t count_;
-  std::array<std::array<std::uint32_t, 2>, 6> bin_{};
+  std::array<std::array<std::uint32_t, 2>, 6> high_{};
   std::array<std::array<std::size_t, 2>, 6> below_{};
 };
 
