@@ -6,6 +6,7 @@
 #include "apps/commands.h"
 #include "apps/progress_bar.h"
 #include "core/errors.h"
+#include "core/memory_budget.h"
 #include "core/units.h"
 #include "pipeline/jobs.h"
 
@@ -14,8 +15,8 @@ namespace {
 
 // What the synth command reads besides the Options it binds directly.
 struct SynthWords {
-  std::string tangent_frame, prior_shrink, world_unit, engine = "triangle", orientation = "field",
-                                                       fill_unseen = "overlap";
+  std::string tangent_frame, prior_shrink, world_unit, photo_cache,
+      engine = "triangle", orientation = "field", fill_unseen = "overlap";
   std::vector<double> tangent_field;
   bool best_view_only = false, no_additive = false, no_channel = false, no_detail = false,
        no_report = false, no_light_response = false, no_white_balance = false,
@@ -52,6 +53,9 @@ void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords
   sub->add_option("--max-buffer-size", j.visibility.max_buffer_dimension,
                   "largest z-buffer side in pixels (0: full resolution)")
       ->capture_default_str();
+  sub->add_option("--photo-cache", w.photo_cache,
+                  "decoded photos held at once, e.g. 4G (default: half of --memory-limit; the "
+                  "photos are decoded on demand)");
 }
 
 void BindEngine(CLI::App* sub, synth::MeshSynthesisOptions& s, SynthWords& w) {
@@ -218,6 +222,7 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
   q.mesh_file = o.job.mesh_file;
   q.sample_file = o.btf.empty() ? o.job.sample_file : o.btf;
   if (q.sample_file.empty()) throw UsageError("--sample or --btf is required");
+  if (sub->count("--photo-cache") > 0) throw UsageError("--photo-cache is for --engine triangle");
   if (!o.btf.empty() && !q.BtfSample())
     throw InputError(o.btf.string(), "is not a folder (a BTF capture or factorisation)");
   q.btf_components = o.components;
@@ -282,6 +287,7 @@ void Resolve(const CLI::App* sub, const SynthWords& w, const quilt::QuiltOptions
   o.job.atlas.blend_strip = s.strip;
   o.job.write_report = !w.no_report;
   o.job.mm_per_world_unit = WorldUnitMm(w.world_unit);
+  if (!w.photo_cache.empty()) o.job.photo_cache_bytes = ParseMemorySize(w.photo_cache);
 }
 
 }  // namespace

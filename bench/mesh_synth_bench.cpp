@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
     synth::MeshPhoto p;
     p.image_id = id;
     p.name = image.name;
-    p.image = ReadPhotoRgb(work / "object/images" / image.name);
+    p.pixels = PhotoPixels(ReadPhotoRgb(work / "object/images" / image.name));
     p.lights = lights.at(image.name);
     photos.push_back(p);
   }

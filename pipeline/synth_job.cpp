@@ -58,15 +58,27 @@ synth::ColourSynthesisOptions ColourOptions(const synth::MeshSynthesisOptions& p
 
 // The photos the job holds at once (float RGB and a luminance plane: 16 bytes a
 // pixel), against the memory limit.
-void RequirePhotoMemory(const sfm::Reconstruction& reconstruction, const sfm::ObjectLights& lights,
-                        const fs::path& images_dir) {
-  double pixels = 0.0;
-  for (const auto& [id, image] : reconstruction.images) {
-    if (!lights.contains(image.name)) continue;
-    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
-    pixels += static_cast<double>(camera.width) * static_cast<double>(camera.height);
-  }
-  RequireMemory(16.0 * pixels, "holding the photos", images_dir.string());
+// The photos' cache (core/photo_cache.h): `--photo-cache`, or half the memory
+// limit; never less than the minimum working set, the photos one face is
+// constrained by (max_views of the largest), which the memory limit must hold.
+std::uint64_t PhotoCacheBudget(const SynthJobOptions& options, std::uint64_t largest_photo_bytes,
+                               std::uint64_t all_photos_bytes) {
+  const std::uint64_t minimum =
+      static_cast<std::uint64_t>(std::max(1, options.synthesis.max_views)) * largest_photo_bytes;
+  RequireMemory(static_cast<double>(minimum),
+                "the decoded photos one face is constrained by (" +
+                    std::to_string(options.synthesis.max_views) + " of " +
+                    MemorySizeText(static_cast<double>(largest_photo_bytes)) + ")",
+                options.images_dir.string());
+  if (options.photo_cache_bytes > 0 && options.photo_cache_bytes < minimum)
+    throw OptionError("--photo-cache " +
+                      MemorySizeText(static_cast<double>(options.photo_cache_bytes)) +
+                      " cannot hold the " + std::to_string(options.synthesis.max_views) +
+                      " photos one face is constrained by (" +
+                      MemorySizeText(static_cast<double>(minimum)) + "); give at least that");
+  const std::uint64_t budget =
+      options.photo_cache_bytes > 0 ? options.photo_cache_bytes : MemoryLimitBytes() / 2;
+  return std::min(all_photos_bytes, std::max(budget, minimum));
 }
 
 }  // namespace
@@ -144,8 +156,9 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
   mesh::TriangleMesh& mesh = inputs.mesh;
   mesh = std::move(loaded_mesh.mesh);
 
-  RequirePhotoMemory(reconstruction, lights, options.images_dir);
+  // The photos' headers now, their pixels on demand (PhotoCache).
   std::vector<synth::MeshPhoto>& photos = inputs.photos;
+  std::vector<std::pair<fs::path, cv::Size>> files;
   for (const auto& [id, image] : reconstruction.images) {
     const auto it = lights.find(image.name);
     if (it == lights.end()) continue;
@@ -154,21 +167,31 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
       inputs.warnings.push_back("skipping " + image.name + ": no file " + file.string());
       continue;
     }
-    synth::MeshPhoto photo;
-    photo.image_id = id;
-    photo.name = image.name;
-    photo.image = ReadPhotoRgb(file);
+    const ImageReader header(file);
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
-    if (photo.image.cols != static_cast<int>(camera.width) ||
-        photo.image.rows != static_cast<int>(camera.height)) {
-      throw InputError(file.string(), "is " + std::to_string(photo.image.cols) + "x" +
-                                          std::to_string(photo.image.rows) + " but its camera is " +
+    if (header.width() != static_cast<int>(camera.width) ||
+        header.height() != static_cast<int>(camera.height)) {
+      throw InputError(file.string(), "is " + std::to_string(header.width()) + "x" +
+                                          std::to_string(header.height()) + " but its camera is " +
                                           std::to_string(camera.width) + "x" +
                                           std::to_string(camera.height));
     }
+    synth::MeshPhoto photo;
+    photo.image_id = id;
+    photo.name = image.name;
     photo.lights = it->second;
     photos.push_back(std::move(photo));
+    files.emplace_back(file, cv::Size(header.width(), header.height()));
   }
+  std::uint64_t largest = 0, total = 0;
+  for (const auto& [file, size] : files) {
+    largest = std::max(largest, DecodedPhotoBytes(size));
+    total += DecodedPhotoBytes(size);
+  }
+  inputs.photo_cache = std::make_shared<PhotoCache>(PhotoCacheBudget(options, largest, total));
+  for (std::size_t n = 0; n < photos.size(); ++n)
+    photos[n].pixels =
+        PhotoPixels(inputs.photo_cache, inputs.photo_cache->Add(files[n].first, files[n].second));
   if (photos.empty()) {
     throw InputError(options.images_dir.string(),
                      "no usable photo: every image of the model lacks a light or a file");
@@ -320,7 +343,19 @@ nlohmann::json SynthCounts::ToJson() const {
           {"atlases", atlases},
           {"charts", charts},
           {"chart_flattening", chart_flattening},
-          {"occupancy", occupancy}};
+          {"occupancy", occupancy},
+          {"photo_cache", photo_cache ? PhotoCacheJson(*photo_cache) : nlohmann::json(nullptr)}};
+}
+
+nlohmann::json PhotoCacheJson(const PhotoCache& cache) {
+  const PhotoCache::Stats stats = cache.stats();
+  return {{"budget_bytes", cache.budget_bytes()},
+          {"all_photos_bytes", cache.TotalBytes()},
+          {"holds_all", cache.HoldsAll()},
+          {"decodes", stats.decodes},
+          {"hits", stats.hits},
+          {"peak_bytes", stats.peak_bytes},
+          {"timings_s", {{"decoding", stats.seconds_decoding}}}};
 }
 
 void SynthCounts::CountInputs(const SynthInputs& inputs) {
@@ -328,6 +363,7 @@ void SynthCounts::CountInputs(const SynthInputs& inputs) {
   photos_used = inputs.photos.size();
   subdivisions = inputs.subdivisions;
   faces = inputs.mesh.faces.size();
+  photo_cache = inputs.photo_cache;
 }
 
 nlohmann::json EngineSummaryJson(const synth::TriangleSynthesis& synthesis) {
@@ -367,14 +403,14 @@ void AddPhotoViews(const SynthInputs& inputs, const fs::path& images_dir,
   for (std::size_t i = 0; i < inputs.photos.size(); ++i) {
     const synth::MeshPhoto& p = inputs.photos[i];
     const sfm::Image& image = inputs.reconstruction.images.at(p.image_id);
-    report.photos.push_back({p.name, images_dir / p.name, p.lights, p.image});
+    report.photos.push_back({p.name, images_dir / p.name, p.lights, p.pixels.Held()});
     render::PictureView view;
     view.name = p.name;
     view.camera = inputs.reconstruction.cameras.at(image.camera_id);
     view.cam_from_world = image.cam_from_world;
     view.lights = p.lights;
     view.reference_image = images_dir / p.name;
-    view.reference = p.image;
+    view.reference = p.pixels.Held();
     view.reference_gain = i < photo_gains.size() ? photo_gains[i] : 1.0;
     scene.views.push_back(std::move(view));
   }

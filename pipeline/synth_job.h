@@ -10,6 +10,7 @@
 
 #include "atlas/atlas.h"
 #include "core/image_io.h"
+#include "core/photo_cache.h"
 #include "core/progress.h"
 #include "model/baselines.h"
 #include "model/model_io.h"
@@ -69,6 +70,12 @@ struct SynthJobOptions {
   /// How long one world unit is, in millimetres (`--world-unit`); 0 = not stated. The
   /// report then gives texel and pixel sizes in millimetres as well as world units.
   double mm_per_world_unit = 0.0;
+  /// Bytes of decoded photos held at once (`--photo-cache`); 0: half the memory
+  /// limit. Never less than the photos one face is constrained by (max_views of
+  /// the largest): a smaller value is refused. The photos are decoded on demand
+  /// (core/photo_cache.h) and, when they do not all fit, visited photo by photo
+  /// (synth/face_order.h).
+  std::uint64_t photo_cache_bytes = 0;
 
   /// Throws OptionError when a path is missing or a setting is out of range.
   void Check() const;
@@ -81,6 +88,10 @@ struct SynthJobOptions {
 /// What the job did (also written to manifest.json).
 struct SynthInputs;
 
+/// The manifest's figures of a photo cache: its budget, what every photo would
+/// take, decodes, hits, the most bytes held and the time spent decoding.
+nlohmann::json PhotoCacheJson(const PhotoCache& cache);
+
 /// What every synth job counts, with any sample (its manifest's summary).
 struct SynthCounts {
   std::size_t photos_used = 0, faces = 0, subdivisions = 0;
@@ -89,6 +100,8 @@ struct SynthCounts {
   std::string chart_flattening;  ///< the one used ("auto" resolves to "strips" or "rigid")
   double occupancy = 0.0;
   std::vector<std::string> warnings;  ///< skipped photos, repaired faces, subdivisions
+  /// The job's photo cache, whose figures the summary records ("photo_cache").
+  std::shared_ptr<const PhotoCache> photo_cache;
   /// The counts as the manifest's "summary" names them.
   nlohmann::json ToJson() const;
   /// Takes the counts of the inputs (photos, faces, subdivisions, warnings).
@@ -122,9 +135,10 @@ Sample ReadSample(const std::filesystem::path& path);
 /// The main job's inputs, read and checked (shared with the BTF job, btf/).
 struct SynthInputs {
   sfm::Reconstruction reconstruction;
-  std::filesystem::path model_folder;    ///< the COLMAP model folder read (sfm::FindModelFolder)
-  mesh::TriangleMesh mesh;               ///< subdivided as needed
-  std::vector<synth::MeshPhoto> photos;  ///< those with a light and a file
+  std::filesystem::path model_folder;       ///< the COLMAP model folder read (sfm::FindModelFolder)
+  mesh::TriangleMesh mesh;                  ///< subdivided as needed
+  std::vector<synth::MeshPhoto> photos;     ///< those with a light and a file
+  std::shared_ptr<PhotoCache> photo_cache;  ///< the photos' pixels, decoded on demand
   sfm::VisibilityResult visibility;
   std::vector<std::string> warnings;
   std::size_t subdivisions = 0;

@@ -110,6 +110,7 @@ int PhotoImageTerm::PhotoPlanes(const View& view, const std::vector<WorkImageSam
   for (cv::Mat& plane : planes) plane = cv::Mat::zeros(work_size, CV_32FC1);
   mask = cv::Mat::zeros(work_size, CV_32FC1);
   int count = 0;
+  const cv::Mat pixels = photo.pixels.Get();
   std::map<int, bool> seen;  // per face met
   for (const WorkImageSample& w : samples) {
     const int face = surface_.samples()[static_cast<std::size_t>(w.sample)].face;
@@ -118,7 +119,7 @@ int PhotoImageTerm::PhotoPlanes(const View& view, const std::vector<WorkImageSam
     if (w.synthesised || !it->second || mask.at<float>(w.y, w.x) > 0) continue;
     const auto px = photos_.reconstruction.Project(image, surface_.PointInWorld(w.sample));
     float rgb[3];
-    if (!px || !PhotoAt(photo.image, *px, rgb)) continue;
+    if (!px || !PhotoAt(pixels, *px, rgb)) continue;
     for (int c = 0; c < 3; ++c) {
       const float v = rgb[c];
       planes[static_cast<std::size_t>(c)].at<float>(w.y, w.x) =

@@ -10,6 +10,7 @@
 
 #include "core/errors.h"
 #include "mesh/ray_caster.h"
+#include "synth/face_order.h"
 
 namespace texlume::render {
 namespace {
@@ -198,13 +199,15 @@ std::vector<cv::Mat> BakePhotoTextures(const model::TexturedModel& model,
     filled.push_back(cv::Mat::zeros(atlas.height, atlas.width, CV_8UC1));
   }
   const mesh::TriangleMesh& mesh = model.mesh;
-  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+  for (const std::size_t f : synth::FacesByPhoto(synth::KeyPhotoOfFaces(visibility, photos),
+                                                 synth::PhotosHeldTogether(photos))) {
     const sfm::TriangleVisibility& tv = visibility.triangles[f];
     const auto it = tv.best_view_source == sfm::BestViewSource::kNone
                         ? photo_index.end()
                         : photo_index.find(tv.best_view);
     if (it == photo_index.end()) continue;
     const synth::MeshPhoto& photo = photos[it->second];
+    const cv::Mat pixels = photo.pixels.Get();
     const std::array<double, 3> gain = ChannelGains(photo_gains, white_balance, it->second);
     const sfm::Image& image = reconstruction.images.at(photo.image_id);
     const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
@@ -233,13 +236,12 @@ std::vector<cv::Mat> BakePhotoTextures(const model::TexturedModel& model,
                                             image.cam_from_world.translation);
         if (!px) continue;
         const Eigen::Vector2d o = ToOpenCv(*px);
-        if (o.x() < -0.5 || o.y() < -0.5 || o.x() > photo.image.cols - 0.5 ||
-            o.y() > photo.image.rows - 0.5)
+        if (o.x() < -0.5 || o.y() < -0.5 || o.x() > pixels.cols - 0.5 || o.y() > pixels.rows - 0.5)
           continue;
         float rgb[3];
         Bilinear(
-            photo.image.cols, photo.image.rows, o.x() + 0.5, o.y() + 0.5, 3,
-            [&](int xx, int yy, int ch) { return photo.image.at<cv::Vec3f>(yy, xx)[ch]; }, rgb);
+            pixels.cols, pixels.rows, o.x() + 0.5, o.y() + 0.5, 3,
+            [&](int xx, int yy, int ch) { return pixels.at<cv::Vec3f>(yy, xx)[ch]; }, rgb);
         cv::Vec3f& out = tex.at<cv::Vec3f>(y, x);
         for (int ch = 0; ch < 3; ++ch)
           out[ch] = LinearToSrgb(
@@ -290,7 +292,8 @@ Eigen::Vector3f MeanAlbedoFromPhotos(const mesh::TriangleMesh& mesh,
   const std::vector<double> areas = mesh::FaceAreas(mesh);
   Eigen::Vector3d colour_sum = Eigen::Vector3d::Zero();
   double shading_sum = 0.0;
-  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+  for (const std::size_t f : synth::FacesByPhoto(synth::KeyPhotoOfFaces(visibility, photos),
+                                                 synth::PhotosHeldTogether(photos))) {
     const sfm::TriangleVisibility& tv = visibility.triangles[f];
     if (tv.best_view_source != sfm::BestViewSource::kFullyVisible) continue;
     const auto it = photo_index.find(tv.best_view);
@@ -304,12 +307,13 @@ Eigen::Vector3f MeanAlbedoFromPhotos(const mesh::TriangleMesh& mesh,
                                         image.cam_from_world.translation);
     if (!px) continue;
     const int x = static_cast<int>(px->x()), y = static_cast<int>(px->y());
-    if (x < 0 || y < 0 || x >= photo.image.cols || y >= photo.image.rows) continue;
+    const cv::Size size = photo.pixels.size();
+    if (x < 0 || y < 0 || x >= size.width || y >= size.height) continue;
     double shading = 0.0;
     for (const sfm::ObjectLight& l : photo.lights)
       shading += l.intensity * std::max(0.0, normals[f].dot(l.DirectionFrom(centroid)));
     if (shading < 0.2) continue;
-    const cv::Vec3f rgb = photo.image.at<cv::Vec3f>(y, x);
+    const cv::Vec3f rgb = photo.pixels.Get().at<cv::Vec3f>(y, x);
     const std::array<double, 3> gain = ChannelGains(photo_gains, white_balance, it->second);
     for (int c = 0; c < 3; ++c)
       colour_sum[c] += areas[f] * SrgbToLinear(rgb[c]) / gain[static_cast<std::size_t>(c)];

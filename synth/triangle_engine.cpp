@@ -13,6 +13,7 @@
 #include "core/image_io.h"
 #include "core/memory_budget.h"
 #include "core/timing.h"
+#include "synth/face_order.h"
 #include "synth/photo_blur.h"
 #include "synth/tangent_field.h"
 #include "synth/template_match.h"
@@ -99,9 +100,14 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
   const std::size_t num_faces = mesh_.faces.size();
   PrepareStages(true, progress);
 
-  // Breadth first from the best-seen face (Algorithm 2, step 2).
+  // Breadth first from the best-seen face (Algorithm 2, step 2); photo by photo
+  // when the photos do not all fit in memory (synth/face_order.h).
+  const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(mesh_);
   const std::vector<int> order =
-      mesh::BreadthFirstFaceOrder(mesh_, mesh::FaceNeighbours(mesh_), BestSeenFace(visibility_));
+      PhotosHeldTogether(photos_)
+          ? mesh::BreadthFirstFaceOrder(mesh_, neighbours, BestSeenFace(visibility_))
+          : PhotoByPhotoBreadthFirstOrder(neighbours, KeyPhotoOfFaces(visibility_, photos_),
+                                          BestSeenFace(visibility_));
   done_.assign(num_faces, 0);
   std::mt19937_64 rng(options_.seed);
   std::size_t processed = 0;
@@ -132,6 +138,8 @@ void TriangleEngine::PrepareStages(bool patches_in_sample, const ProgressCallbac
   result_.texel_size = t;
   patches_in_sample_ = patches_in_sample;
   score_margin_ = sample_.Blendable() ? 0.5 * options_.strip * t : 0.0;
+  photo_visit_order_ =
+      FacesByPhoto(KeyPhotoOfFaces(visibility_, photos_), PhotosHeldTogether(photos_));
   SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, options_.tangent_frame,
                                  options_.field_direction_in_world));
   TurnFramesToPhotos();
@@ -191,16 +199,16 @@ bool TriangleEngine::Rectify(std::size_t face, const sfm::TriangleView& view, Re
   cv::Mat map_x, map_y;
   out.count =
       RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera, image.cam_from_world,
-                        photo.image.size(), score_margin_, map_x, map_y, out.mask);
+                        photo.pixels.size(), score_margin_, map_x, map_y, out.mask);
   if (out.count < options_.min_photo_pixels) return false;
   if (wide_mask && correction_ && correction_->WideMaskMargin() >= 0.0) {
     cv::Mat wide_x, wide_y;
     RectificationMaps(patch, t, r.rx, r.ry, cv::Size(tw, th), camera, image.cam_from_world,
-                      photo.image.size(), correction_->WideMaskMargin(), wide_x, wide_y,
+                      photo.pixels.size(), correction_->WideMaskMargin(), wide_x, wide_y,
                       out.wide_mask);
   }
   cv::Mat rectified;
-  cv::remap(photo.image, rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
+  cv::remap(photo.pixels.Get(), rectified, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   cv::split(rectified, out.planes);
   if (sample_.Domain() == PhotoDomain::kLinear)
     for (cv::Mat& plane : out.planes)
@@ -255,13 +263,15 @@ void TriangleEngine::TurnFramesToPhotos() {
         },
         red.rx, red.ry);
   };
-  const auto photo_tensor = [&](std::size_t f) {
-    Eigen::Matrix2d tensor = Eigen::Matrix2d::Zero();
-    for (const RectifiedView& rect : RectifiedViews(f, false)) {
-      const ReducedPlanes& r = sample_.Reduced(rect.level);
-      tensor += LuminanceStructureTensor(rect.planes, rect.mask, r.rx, r.ry);
+  // Every seen face's tensor, at the first ask, in the photos' visit order.
+  std::vector<Eigen::Matrix2d> photo_tensors;
+  const auto photo_tensor = [&](std::size_t face) {
+    if (photo_tensors.empty()) {
+      photo_tensors.assign(num_faces, Eigen::Matrix2d::Zero());
+      for (const std::size_t f : photo_visit_order_)
+        if (face_levels[f] >= 0) photo_tensors[f] = PhotoStructureTensor(f);
     }
-    return tensor;
+    return photo_tensors[face];
   };
   const FrameChoice choice =
       ChoosePhotoFrames(options_.tangent_frame, result_.patches, result_.unfoldings, face_levels,
@@ -272,10 +282,59 @@ void TriangleEngine::TurnFramesToPhotos() {
     SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, choice.field.tangents_in_world));
 }
 
+Eigen::Matrix2d TriangleEngine::PhotoStructureTensor(std::size_t face) const {
+  Eigen::Matrix2d tensor = Eigen::Matrix2d::Zero();
+  for (const RectifiedView& rect : RectifiedViews(face, false)) {
+    const ReducedPlanes& r = sample_.Reduced(rect.level);
+    tensor += LuminanceStructureTensor(rect.planes, rect.mask, r.rx, r.ry);
+  }
+  return tensor;
+}
+
+TriangleEngine::PhotometryCandidate TriangleEngine::ObserveForPhotometry(
+    std::size_t face, const sfm::TriangleView& view, double zenith_per_cell,
+    bool observe_if_not_steep, PhotoBlurEstimator* blur) const {
+  PhotometryCandidate c;
+  RectifiedView rect;
+  if (!Rectify(face, view, rect)) return c;
+  c.rectified = true;
+  c.steep = rect.steep;
+  if (blur && rect.steep && blur->Wants(rect.photo) && SpreadForBlur(face))
+    blur->Add(rect.photo, PhotoLuminance(rect), SampleWindowLuminance(face, rect), rect.mask);
+  if (rect.steep || observe_if_not_steep)
+    c.observation = Observe(face, rect, zenith_per_cell, ShadingTurns(face));
+  return c;
+}
+
+std::vector<std::vector<TriangleEngine::PhotometryCandidate>> TriangleEngine::ObservePhotoByPhoto(
+    double zenith_per_cell, PhotoBlurEstimator* blur, const ProgressCallback& progress) const {
+  // Each photo's fully visible faces, as (face, rank among the face's views).
+  std::vector<std::vector<std::pair<std::size_t, std::size_t>>> faces_of_photo(photos_.size());
+  std::vector<std::vector<PhotometryCandidate>> candidates(mesh_.faces.size());
+  for (std::size_t f = 0; f < mesh_.faces.size(); ++f) {
+    const std::vector<sfm::TriangleView>& views = visibility_.triangles[f].views;
+    candidates[f].resize(views.size());
+    for (std::size_t rank = 0; rank < views.size(); ++rank) {
+      const auto it = photo_index_.find(views[rank].image_id);
+      if (views[rank].fully_visible && it != photo_index_.end())
+        faces_of_photo[it->second].emplace_back(f, rank);
+    }
+  }
+  for (std::size_t p = 0; p < photos_.size(); ++p) {
+    if (progress) progress("photometry", p, photos_.size());
+    for (const auto& [f, rank] : faces_of_photo[p])
+      candidates[f][rank] = ObserveForPhotometry(f, visibility_.triangles[f].views[rank],
+                                                 zenith_per_cell, options_.light_response, blur);
+  }
+  return candidates;
+}
+
 void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
   // Every face fully visible in a photo (up to 8 steep views, whose lighting the
   // gains trust, and 8 others): the photo's linear sum over the face, and the
   // sample's mean relit under each light alone and at the zenith (synth/photometry.h).
+  // When the photos do not all fit in memory, every view is observed first photo by
+  // photo (each photo decoded once), then chosen face by face as below.
   std::vector<PhotometricObservation> observations;
   const std::size_t num_faces = mesh_.faces.size();
   std::optional<PhotoBlurEstimator> blur;
@@ -286,28 +345,35 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
           ? -1.0
           : sample_.RelitLinearSum(
                 FaceLighting{Eigen::Vector3d::UnitZ(), {{Eigen::Vector3d::UnitZ(), 1.0}}, {}}, 1);
+  PhotoBlurEstimator* blur_estimator = blur ? &*blur : nullptr;
+  std::vector<std::vector<PhotometryCandidate>> observed;
+  if (!PhotosHeldTogether(photos_))
+    observed = ObservePhotoByPhoto(zenith_per_cell, blur_estimator, progress);
   for (std::size_t f = 0; f < num_faces; ++f) {
-    if (progress && f % 256 == 0) progress("photometry", f, num_faces);
-    const ShadingTurnSet turns = ShadingTurns(f);
+    if (progress && observed.empty() && f % 256 == 0) progress("photometry", f, num_faces);
+    const std::vector<sfm::TriangleView>& views = visibility_.triangles[f].views;
     int steep = 0, other = 0;
-    for (const sfm::TriangleView& view : visibility_.triangles[f].views) {
-      if (!view.fully_visible || steep >= 8) continue;
-      RectifiedView rect;
-      if (!Rectify(f, view, rect)) continue;
-      if (!rect.steep && (other >= 8 || !options_.light_response)) continue;
-      if (blur && rect.steep && blur->Wants(rect.photo) && SpreadForBlur(f))
-        blur->Add(rect.photo, PhotoLuminance(rect), SampleWindowLuminance(f, rect), rect.mask);
-      PhotometricObservation o = Observe(f, rect, zenith_per_cell, turns);
+    for (std::size_t rank = 0; rank < views.size(); ++rank) {
+      if (!views[rank].fully_visible || steep >= 8) continue;
+      PhotometryCandidate computed;
+      const PhotometryCandidate& c =
+          observed.empty() ? (computed = ObserveForPhotometry(f, views[rank], zenith_per_cell,
+                                                              other < 8 && options_.light_response,
+                                                              blur_estimator))
+                           : observed[f][rank];
+      if (!c.rectified) continue;
+      if (!c.steep && (other >= 8 || !options_.light_response)) continue;
+      const PhotometricObservation& o = c.observation;
       // A steep view counts towards the 8 only when it is lit enough for the
       // gains (GainsUnder's test under the identity).
       const bool lit = o.Predicted({}) > 0.02 * 3 * o.cells && o.photo_linear > 1e-6;
-      const bool counts_as_steep = rect.steep && lit;
-      if (rect.steep && !lit && !options_.light_response) continue;
+      const bool counts_as_steep = c.steep && lit;
+      if (c.steep && !lit && !options_.light_response) continue;
       if (counts_as_steep)
         ++steep;
       else
         ++other;
-      observations.push_back(std::move(o));
+      observations.push_back(o);
     }
   }
   if (progress) progress("photometry", num_faces, num_faces);

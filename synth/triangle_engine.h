@@ -116,6 +116,7 @@ struct TriangleSynthesis {
 };
 
 class TriangleEngine;
+class PhotoBlurEstimator;
 
 /// Divides a photo's R, G and B planes (in `domain`) by its white balance
 /// (linear factors, TriangleSynthesis::white_balance).
@@ -187,6 +188,23 @@ class TriangleEngine {
   void SetUpPatches(PatchGeometry geometry);
   // Stage 1b: frames turned to the photos (synth/tangent_field.h).
   void TurnFramesToPhotos();
+  // The luminance structure tensor of the photos that see face `face` fully.
+  Eigen::Matrix2d PhotoStructureTensor(std::size_t face) const;
+  // One view of a face the photometry may observe: rectified (else nothing else is
+  // set), steep, and its observation (when steep or asked for).
+  struct PhotometryCandidate {
+    bool rectified = false, steep = false;
+    PhotometricObservation observation;
+  };
+  // Rectifies and observes one view; adds it to `blur` (may be null) when the
+  // estimator wants a steep view of the photo and the face is one it spreads over.
+  PhotometryCandidate ObserveForPhotometry(std::size_t face, const sfm::TriangleView& view,
+                                           double zenith_per_cell, bool observe_if_not_steep,
+                                           PhotoBlurEstimator* blur) const;
+  // Every fully visible view of every face, photo by photo; [face][rank among
+  // the face's views].
+  std::vector<std::vector<PhotometryCandidate>> ObservePhotoByPhoto(
+      double zenith_per_cell, PhotoBlurEstimator* blur, const ProgressCallback& progress) const;
   // Stage 2a: a gain per photo (exposure x light intensity, linear domain) and
   // the object's light response (synth/photometry.h).
   void EstimatePhotometry(const ProgressCallback& progress);
@@ -239,6 +257,8 @@ class TriangleEngine {
   /// photo-corrected patches), none for a sample that is cut.
   double score_margin_ = 0.0;
   bool patches_in_sample_ = true;
+  /// The faces in the order the passes over the photos visit them (FacesByPhoto).
+  std::vector<std::size_t> photo_visit_order_;
   TriangleSynthesis result_;
 };
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/image_io.h"
+#include "core/photo_cache.h"
 #include "mesh/mesh.h"
 #include "mesh/triangle_frame.h"
 #include "ptm/ptm.h"
@@ -27,7 +28,9 @@ namespace texlume::synth {
 struct MeshPhoto {
   sfm::ImageId image_id;
   std::string name;
-  cv::Mat image;  ///< CV_32FC3, RGB, display domain (sRGB-encoded) in [0, 1]
+  /// CV_32FC3, RGB, display domain (sRGB-encoded) in [0, 1]; held in memory or
+  /// decoded on demand through the job's PhotoCache (core/photo_cache.h).
+  PhotoPixels pixels;
   std::vector<sfm::ObjectLight> lights;
 };
 

@@ -211,6 +211,11 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
                     "--sample-texel-size 0.01 --out f --tangent-frame photos --tangent-field 0,0,1",
                     &out),
             2);
+  // A photo cache that is not a size (photos on demand, docs/cli.md).
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --photo-cache lots",
+                    &out),
+            2);
   EXPECT_EQ(Texlume("render --model " + (tmp / "nomodel").string() +
                         " --cameras c --lights l "
                         "--out " +
@@ -595,6 +600,9 @@ TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
   // lights file that is not there: an input error naming it, 1).
   EXPECT_EQ(Texlume("synth" + inputs + " --model a --out " + (tmp / "bad").string(), &out), 2);
   EXPECT_NE(out.find("--model, --images and --lights"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth" + inputs + " --photo-cache 1G --out " + (tmp / "bad").string(), &out),
+            2);
+  EXPECT_NE(out.find("--photo-cache is for --engine triangle"), std::string::npos) << out;
   EXPECT_EQ(Texlume("synth" + inputs + " --top-k 3 --out " + (tmp / "bad").string(), &out), 2);
   EXPECT_NE(out.find("--top-k is for --engine graphcut with photos"), std::string::npos) << out;
   EXPECT_EQ(Texlume("synth" + inputs + " --model " + scene + "/object/sparse --images " + scene +

@@ -650,6 +650,51 @@ TEST_F(MeshPipelineTest, OutputsAreTheSameOnOneThreadAndOnTwo) {
   }
 }
 
+// Photos on demand (issue 33): with a cache of the fewest photos a face needs (its
+// max_views), the job visits the faces photo by photo, never holds more than the
+// budget, decodes each photo a few times rather than once per face, and makes the
+// same photometry and a model as good on held-out views.
+TEST_F(MeshPipelineTest, PhotosOnDemandStayWithinTheirCacheAndKeepTheModel) {
+  pipeline::SynthJobOptions j = Job(tmp_->path() / "model_small_cache");
+  const pipeline::SynthInputs inputs = pipeline::LoadSynthInputs(j);
+  const std::uint64_t photo_bytes = DecodedPhotoBytes(inputs.photos[0].pixels.size());
+  j.photo_cache_bytes = static_cast<std::uint64_t>(j.synthesis.max_views) * photo_bytes;
+  const pipeline::SynthJobSummary s = pipeline::RunSynthJob(j);
+  const nlohmann::json record =
+      nlohmann::json::parse(testing::ReadText(tmp_->path() / "model_small_cache/manifest.json"));
+  const nlohmann::json& cache = record["summary"]["photo_cache"];
+  ASSERT_FALSE(cache["holds_all"].get<bool>());
+  EXPECT_EQ(cache["budget_bytes"].get<std::uint64_t>(), j.photo_cache_bytes);
+  EXPECT_LE(cache["peak_bytes"].get<std::uint64_t>(), j.photo_cache_bytes);
+  const std::size_t photos = inputs.photos.size(), faces = s.faces;
+  const auto decodes = cache["decodes"].get<std::size_t>();
+  std::printf("photos on demand: %zu photos, %zu faces, %zu decodes\n", photos, faces, decodes);
+  EXPECT_GT(photos, static_cast<std::size_t>(j.synthesis.max_views));
+  EXPECT_LT(decodes, faces / 2);
+  // The photometry observes the same views either way: the same gains.
+  const nlohmann::json fixture =
+      nlohmann::json::parse(testing::ReadText(tmp_->path() / "model/manifest.json"));
+  const auto gains = record["summary"]["photo_gains"].get<std::vector<double>>();
+  const auto fixture_gains = fixture["summary"]["photo_gains"].get<std::vector<double>>();
+  ASSERT_EQ(gains.size(), fixture_gains.size());
+  for (std::size_t p = 0; p < gains.size(); ++p) EXPECT_NEAR(gains[p], fixture_gains[p], 1e-9);
+  EXPECT_TRUE(fixture["summary"]["photo_cache"]["holds_all"].get<bool>());
+  EXPECT_EQ(fixture["summary"]["photo_cache"]["decodes"].get<std::size_t>(), photos);
+  EXPECT_EQ(s.from_photos, summary_->from_photos);
+  const pipeline::RenderJobSummary small =
+      Render(render::RenderMode::kPtm, "render_small_cache", "model_small_cache");
+  const pipeline::RenderJobSummary full = Render(render::RenderMode::kPtm, "render_full_cache");
+  std::printf("held-out PSNR / SSIM: all photos held %.3f / %.4f, on demand %.3f / %.4f\n",
+              full.mean_psnr, full.mean_ssim, small.mean_psnr, small.mean_ssim);
+  EXPECT_NEAR(small.mean_psnr, full.mean_psnr, 0.3);
+  EXPECT_NEAR(small.mean_ssim, full.mean_ssim, 0.02);
+  // A cache too small for one face's photos is refused before anything is read.
+  j.photo_cache_bytes = photo_bytes;
+  j.out_dir = tmp_->path() / "model_too_small";
+  EXPECT_THROW(pipeline::RunSynthJob(j), OptionError);
+  EXPECT_FALSE(fs::exists(j.out_dir));
+}
+
 // The browser viewer's model: every face corner in the vertex streams, charts as
 // the atlas built them, every channel within half a quantisation step, and the
 // PTM evaluated from the web channels as from the atlas.

@@ -92,7 +92,7 @@ PhotographedPlane Photograph(const ptm::Ptm& ptm, double truth_rad,
   const double c = std::cos(truth_rad), sn = std::sin(truth_rad);
   const Eigen::Vector3d light_in_sample(c * l.x() + sn * l.y(), -sn * l.x() + c * l.y(), l.z());
   photo.lights = {light};
-  photo.image = cv::Mat::zeros(100, 100, CV_32FC3);
+  cv::Mat pixels = cv::Mat::zeros(100, 100, CV_32FC3);
   const sfm::Rigid3d world_from_cam = image.cam_from_world.Inverse();
   for (int v = 0; v < 100; ++v)
     for (int u = 0; u < 100; ++u) {
@@ -104,8 +104,9 @@ PhotographedPlane Photograph(const ptm::Ptm& ptm, double truth_rad,
       RawAt(ptm, TruthAt(on_plane, truth_rad), raw);
       const Eigen::Vector3f rgb =
           synth::RelightMixture(raw, raw + 6, ptm.format, {{light_in_sample, 1.0}}, 1.0);
-      photo.image.at<cv::Vec3f>(v, u) = cv::Vec3f(rgb.x(), rgb.y(), rgb.z());
+      pixels.at<cv::Vec3f>(v, u) = cv::Vec3f(rgb.x(), rgb.y(), rgb.z());
     }
+  photo.pixels = PhotoPixels(pixels);
   s.photos.push_back(photo);
   s.visibility = sfm::ComputeVisibility(s.mesh, s.reconstruction);
   s.photometry.photo_gains = {1.0};
