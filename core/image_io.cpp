@@ -195,19 +195,32 @@ void ImageReader::ReadRows(int y0, int y1, int channels, std::uint8_t* out) {
   ReadRowsAs(y0, y1, channels, out);
 }
 
-cv::Mat ReadPhotoRgb(const fs::path& path) {
+cv::Mat ReadPhotoNative(const fs::path& path) {
   cv::Mat image = ReadNative(path);
   if (image.channels() == 1) {
     cv::Mat rgb;
     cv::merge(std::vector<cv::Mat>{image, image, image}, rgb);
-    image = rgb;
-  } else if (image.channels() == 2) {
+    return rgb;
+  }
+  if (image.channels() == 2) {
     cv::Mat grey;
     cv::extractChannel(image, grey, 0);
     cv::merge(std::vector<cv::Mat>{grey, grey, grey}, image);
   }
+  return image;
+}
+
+cv::Mat PhotoDisplayRgb(const cv::Mat& native) {
+  if (native.type() == CV_32FC3) return native;
   cv::Mat rgb;
-  image.convertTo(rgb, CV_32FC3, ScaleToUnit(image.depth()));
+  native.convertTo(rgb, CV_32FC3, ScaleToUnit(native.depth()));
+  return rgb;
+}
+
+cv::Mat ReadPhotoRgb(const fs::path& path) {
+  cv::Mat rgb;
+  const cv::Mat native = ReadPhotoNative(path);
+  native.convertTo(rgb, CV_32FC3, ScaleToUnit(native.depth()));
   return rgb;
 }
 

@@ -69,6 +69,12 @@ cv::Mat DecodeGreyImageBytes(std::string_view bytes, const char* format, int wid
 /// A photo as CV_32FC3 RGB display values in [0, 1] (ImageReader; grey
 /// repeated, alpha dropped).
 cv::Mat ReadPhotoRgb(const std::filesystem::path& path);
+/// The same photo in its stored sample type, 3 channels (CV_8UC3, CV_16UC3 or
+/// CV_32FC3): a quarter of the memory for an 8-bit file (the photo cache keeps it so).
+cv::Mat ReadPhotoNative(const std::filesystem::path& path);
+/// ReadPhotoNative's pixels (or a part of them) as ReadPhotoRgb gives them: the same
+/// values; a CV_32FC3 image is returned as it is, without a copy.
+cv::Mat PhotoDisplayRgb(const cv::Mat& native);
 
 /// An image as CV_32FC1 values in [0, 1]: a grey file's channel, or the luma of
 /// an RGB one (Rec. 601: 0.299 R + 0.587 G + 0.114 B). Masks and the

@@ -1,5 +1,7 @@
 #include "core/memory_budget.h"
 
+#include <sys/resource.h>
+
 #include <atomic>
 #include <cctype>
 #include <cmath>
@@ -27,6 +29,12 @@ std::uint64_t DefaultLimitBytes() {
 }
 
 }  // namespace
+
+std::uint64_t PeakResidentBytes() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024u;  // ru_maxrss is in KiB on Linux
+}
 
 std::uint64_t MemoryLimitBytes() {
   const std::uint64_t set = g_limit_bytes.load();

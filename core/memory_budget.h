@@ -17,6 +17,10 @@ void SetMemoryLimitBytes(std::uint64_t bytes);
 /// allowed). Throws OptionError for anything else, zero or more than 2^60 bytes.
 std::uint64_t ParseMemorySize(const std::string& text);
 
+/// The most resident memory this process has used so far, in bytes (getrusage's
+/// ru_maxrss): what a run's manifest records as its peak.
+std::uint64_t PeakResidentBytes();
+
 /// "1.50 GiB", "512 MiB", ...
 std::string MemorySizeText(double bytes);
 

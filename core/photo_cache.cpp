@@ -10,18 +10,20 @@
 
 namespace texlume {
 
-std::uint64_t DecodedPhotoBytes(cv::Size size) {
-  return 12u * static_cast<std::uint64_t>(std::max(0, size.width)) *
+std::uint64_t DecodedPhotoBytes(cv::Size size, int bytes_per_pixel) {
+  return static_cast<std::uint64_t>(std::max(0, bytes_per_pixel)) *
+         static_cast<std::uint64_t>(std::max(0, size.width)) *
          static_cast<std::uint64_t>(std::max(0, size.height));
 }
 
 PhotoCache::PhotoCache(std::uint64_t budget_bytes) : budget_bytes_(budget_bytes) {}
 
-std::size_t PhotoCache::Add(std::filesystem::path file, cv::Size size) {
+std::size_t PhotoCache::Add(std::filesystem::path file, cv::Size size, int bytes_per_pixel) {
   std::lock_guard lock(mutex_);
   Entry entry;
   entry.file = std::move(file);
   entry.size = size;
+  entry.bytes = DecodedPhotoBytes(size, bytes_per_pixel);
   entries_.push_back(std::move(entry));
   return entries_.size() - 1;
 }
@@ -30,7 +32,7 @@ namespace {
 
 // The photo in `file`, checked against the size its header gave.
 cv::Mat DecodePhoto(const std::filesystem::path& file, cv::Size size) {
-  cv::Mat image = ReadPhotoRgb(file);
+  cv::Mat image = ReadPhotoNative(file);
   if (image.size() != size)
     throw InputError(file.string(),
                      "decodes to " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
@@ -76,9 +78,10 @@ cv::Mat PhotoCache::Get(std::size_t key) {
 void PhotoCache::Hold(std::size_t key, cv::Mat image) {
   Entry& entry = entries_[key];
   entry.image = std::move(image);
+  entry.bytes = entry.image.total() * entry.image.elemSize();
   recent_.push_front(key);
   entry.recent = recent_.begin();
-  held_bytes_ += DecodedPhotoBytes(entry.size);
+  held_bytes_ += entry.bytes;
   ++stats_.decodes;
   LetGoBeyondBudget(key);
   stats_.peak_bytes = std::max(stats_.peak_bytes, held_bytes_);
@@ -91,7 +94,7 @@ void PhotoCache::LetGoBeyondBudget(std::size_t keep) {
     Entry& entry = entries_[oldest];
     recent_.pop_back();
     entry.image.release();
-    held_bytes_ -= DecodedPhotoBytes(entry.size);
+    held_bytes_ -= entry.bytes;
   }
 }
 
@@ -115,7 +118,7 @@ std::size_t PhotoCache::NumPhotos() const {
 std::uint64_t PhotoCache::TotalBytes() const {
   std::lock_guard lock(mutex_);
   std::uint64_t total = 0;
-  for (const Entry& entry : entries_) total += DecodedPhotoBytes(entry.size);
+  for (const Entry& entry : entries_) total += entry.bytes;
   return total;
 }
 

@@ -9,18 +9,21 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "core/image_io.h"
+
 namespace texlume {
 
-/// Bytes a decoded photo of `size` takes (CV_32FC3: 12 a pixel).
-std::uint64_t DecodedPhotoBytes(cv::Size size);
+/// Bytes a decoded photo of `size` takes at `bytes_per_pixel` (3 for an 8-bit file
+/// as ReadPhotoNative keeps it, 12 for float).
+std::uint64_t DecodedPhotoBytes(cv::Size size, int bytes_per_pixel);
 
 /// Decoded photos on demand within a budget of bytes (issue 33, "photos on
-/// demand"): a photo is decoded by ReadPhotoRgb when it is asked for and not
-/// held, and the least recently used photos are let go while the held ones
-/// exceed the budget. A photo handed out stays valid for as long as its holder
-/// keeps it (cv::Mat counts its references), so the cache may hold less than the
-/// photos in use by up to one photo per thread. Safe to use from several threads;
-/// a photo asked for by two threads at once is decoded once.
+/// demand"): a photo is decoded by ReadPhotoNative (its stored sample type: 3
+/// bytes a pixel for JPEG) when it is asked for and not held, and the least
+/// recently used photos are let go while the held ones exceed the budget. A photo handed out stays
+/// valid for as long as its holder keeps it (cv::Mat counts its references), so the cache may hold
+/// less than the photos in use by up to one photo per thread. Safe to use from several threads; a
+/// photo asked for by two threads at once is decoded once.
 class PhotoCache {
  public:
   struct Stats {
@@ -32,20 +35,22 @@ class PhotoCache {
 
   explicit PhotoCache(std::uint64_t budget_bytes);
 
-  /// Registers a photo file whose size (from its header) is `size`; its key.
-  /// Every photo is registered before the first Get.
-  std::size_t Add(std::filesystem::path file, cv::Size size);
+  /// Registers a photo file whose size (from its header) is `size` and that will
+  /// take about `bytes_per_pixel` decoded (the budget counts the real bytes once
+  /// it is); its key. Every photo is registered before the first Get.
+  std::size_t Add(std::filesystem::path file, cv::Size size, int bytes_per_pixel);
 
-  /// The photo `key` as CV_32FC3 display RGB in [0, 1], decoded when not held.
-  /// Throws InputError naming the file when it cannot be decoded or its decoded
-  /// size is not the registered one.
+  /// The photo `key` as ReadPhotoNative gives it, decoded when not held. Throws
+  /// InputError naming the file when it cannot be decoded or its decoded size is
+  /// not the registered one.
   cv::Mat Get(std::size_t key);
 
   const std::filesystem::path& File(std::size_t key) const;
   cv::Size Size(std::size_t key) const;
   std::size_t NumPhotos() const;
   std::uint64_t budget_bytes() const { return budget_bytes_; }
-  /// Bytes of every registered photo decoded (what holding them all would take).
+  /// Bytes of every registered photo decoded (what holding them all would take;
+  /// registered estimates for the photos not decoded yet).
   std::uint64_t TotalBytes() const;
   /// Whether the budget holds every registered photo at once.
   bool HoldsAll() const { return TotalBytes() <= budget_bytes_; }
@@ -55,7 +60,8 @@ class PhotoCache {
   struct Entry {
     std::filesystem::path file;
     cv::Size size;
-    cv::Mat image;  // empty while not held
+    std::uint64_t bytes = 0;  // estimated, then the decoded image's
+    cv::Mat image;            // empty while not held
     bool decoding = false;
     std::list<std::size_t>::iterator recent;  // in recent_ while held
   };
@@ -72,18 +78,26 @@ class PhotoCache {
 };
 
 /// A photo's pixels: held in memory (tests, photos made in memory) or decoded on
-/// demand through a PhotoCache shared by the photos of a job.
+/// demand through a PhotoCache shared by the photos of a job. Read them as
+/// display RGB (CV_32FC3 in [0, 1], ReadPhotoRgb's values), whole or a region.
 class PhotoPixels {
  public:
   PhotoPixels() = default;
-  /// Pixels already in memory (CV_32FC3 display RGB).
+  /// Pixels already in memory (CV_32FC3 display RGB, or as ReadPhotoNative gives).
   explicit PhotoPixels(cv::Mat held) : held_(std::move(held)) {}
   PhotoPixels(std::shared_ptr<PhotoCache> cache, std::size_t key)
       : cache_(std::move(cache)), key_(key) {}
 
   cv::Size size() const { return cache_ ? cache_->Size(key_) : held_.size(); }
-  /// The pixels (decoded when not held; see PhotoCache::Get).
-  cv::Mat Get() const { return cache_ ? cache_->Get(key_) : held_; }
+  /// The stored pixels (decoded when not held; see PhotoCache::Get).
+  cv::Mat Native() const { return cache_ ? cache_->Get(key_) : held_; }
+  /// The whole photo as display RGB.
+  cv::Mat Display() const { return PhotoDisplayRgb(Native()); }
+  /// The part of the photo inside `region` (cut to the photo) as display RGB.
+  cv::Mat Display(cv::Rect region) const {
+    const cv::Mat native = Native();
+    return PhotoDisplayRgb(native(region & cv::Rect(0, 0, native.cols, native.rows)));
+  }
   /// The pixels when they live in memory for good; empty when decoded on demand.
   const cv::Mat& Held() const { return held_; }
   /// The cache the pixels come from (null when held).

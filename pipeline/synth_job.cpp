@@ -158,7 +158,12 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
 
   // The photos' headers now, their pixels on demand (PhotoCache).
   std::vector<synth::MeshPhoto>& photos = inputs.photos;
-  std::vector<std::pair<fs::path, cv::Size>> files;
+  struct PhotoFile {
+    fs::path path;
+    cv::Size size;
+    int bytes_per_pixel = 12;  // decoded as stored: 3 for 8-bit files, at most 12
+  };
+  std::vector<PhotoFile> files;
   for (const auto& [id, image] : reconstruction.images) {
     const auto it = lights.find(image.name);
     if (it == lights.end()) continue;
@@ -181,17 +186,18 @@ SynthInputs LoadSynthInputs(const SynthJobOptions& options) {
     photo.name = image.name;
     photo.lights = it->second;
     photos.push_back(std::move(photo));
-    files.emplace_back(file, cv::Size(header.width(), header.height()));
+    files.push_back({file, cv::Size(header.width(), header.height()), header.eight_bit() ? 3 : 12});
   }
   std::uint64_t largest = 0, total = 0;
-  for (const auto& [file, size] : files) {
-    largest = std::max(largest, DecodedPhotoBytes(size));
-    total += DecodedPhotoBytes(size);
+  for (const PhotoFile& file : files) {
+    largest = std::max(largest, DecodedPhotoBytes(file.size, file.bytes_per_pixel));
+    total += DecodedPhotoBytes(file.size, file.bytes_per_pixel);
   }
   inputs.photo_cache = std::make_shared<PhotoCache>(PhotoCacheBudget(options, largest, total));
   for (std::size_t n = 0; n < photos.size(); ++n)
-    photos[n].pixels =
-        PhotoPixels(inputs.photo_cache, inputs.photo_cache->Add(files[n].first, files[n].second));
+    photos[n].pixels = PhotoPixels(
+        inputs.photo_cache,
+        inputs.photo_cache->Add(files[n].path, files[n].size, files[n].bytes_per_pixel));
   if (photos.empty()) {
     throw InputError(options.images_dir.string(),
                      "no usable photo: every image of the model lacks a light or a file");
@@ -579,6 +585,7 @@ class SynthJob {
         {"atlas", s.seconds_atlas},
         {"baselines", s.seconds_baselines},
         {"synthesis_per_triangle", s.seconds_synthesis / std::max<std::size_t>(1, s.faces)}};
+    record["resources"] = {{"peak_resident_bytes", PeakResidentBytes()}};
     return record;
   }
 

@@ -110,7 +110,7 @@ int PhotoImageTerm::PhotoPlanes(const View& view, const std::vector<WorkImageSam
   for (cv::Mat& plane : planes) plane = cv::Mat::zeros(work_size, CV_32FC1);
   mask = cv::Mat::zeros(work_size, CV_32FC1);
   int count = 0;
-  const cv::Mat pixels = photo.pixels.Get();
+  const cv::Mat pixels = photo.pixels.Display();
   std::map<int, bool> seen;  // per face met
   for (const WorkImageSample& w : samples) {
     const int face = surface_.samples()[static_cast<std::size_t>(w.sample)].face;

@@ -185,6 +185,55 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
   });
 }
 
+namespace {
+
+// An atlas texel of a face and where a photo sees it (OpenCV pixel centres).
+struct PhotoTexel {
+  int x = 0, y = 0;
+  Eigen::Vector2d at;
+};
+
+// The atlas texels of face `f` (within 2 % of its barycentric range) that a photo
+// of `photo_size` taken by `camera` at `cam_from_world` sees, in texel order.
+std::vector<PhotoTexel> FaceTexelsInPhoto(const model::TexturedModel& model, std::size_t f,
+                                          const sfm::Camera& camera,
+                                          const sfm::Rigid3d& cam_from_world, cv::Size photo_size,
+                                          cv::Size atlas_size) {
+  std::vector<PhotoTexel> texels;
+  const mesh::TriangleMesh& mesh = model.mesh;
+  const auto& c = model.corner_px[f];
+  Eigen::Vector2f lo = c[0], hi = c[0];
+  for (const auto& p : c) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const double det = (c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x();
+  if (std::abs(det) < 1e-12) return texels;
+  for (int y = std::max(0, static_cast<int>(std::floor(lo.y())));
+       y <= std::min(atlas_size.height - 1, static_cast<int>(std::ceil(hi.y()))); ++y) {
+    for (int x = std::max(0, static_cast<int>(std::floor(lo.x())));
+         x <= std::min(atlas_size.width - 1, static_cast<int>(std::ceil(hi.x()))); ++x) {
+      const Eigen::Vector2d q(x + 0.5, y + 0.5);
+      const Eigen::Vector2d d = q - c[0].cast<double>();
+      const double b1 = (d.x() * (c[2] - c[0]).y() - d.y() * (c[2] - c[0]).x()) / det;
+      const double b2 = ((c[1] - c[0]).x() * d.y() - (c[1] - c[0]).y() * d.x()) / det;
+      const double b0 = 1 - b1 - b2;
+      const double eps = -0.02;
+      if (b0 < eps || b1 < eps || b2 < eps) continue;
+      const Eigen::Vector3d world =
+          b0 * mesh.Corner(f, 0) + b1 * mesh.Corner(f, 1) + b2 * mesh.Corner(f, 2);
+      const auto px =
+          camera.ImageFromCam(cam_from_world.rotation * world + cam_from_world.translation);
+      if (!px) continue;
+      const Eigen::Vector2d o = ToOpenCv(*px);
+      if (o.x() < -0.5 || o.y() < -0.5 || o.x() > photo_size.width - 0.5 ||
+          o.y() > photo_size.height - 0.5)
+        continue;
+      texels.push_back({x, y, o});
+    }
+  }
+  return texels;
+}
+
+}  // namespace
+
 std::vector<cv::Mat> BakePhotoTextures(const model::TexturedModel& model,
                                        const sfm::Reconstruction& reconstruction,
                                        const sfm::VisibilityResult& visibility,
@@ -198,7 +247,6 @@ std::vector<cv::Mat> BakePhotoTextures(const model::TexturedModel& model,
     textures.push_back(cv::Mat(atlas.height, atlas.width, CV_32FC3, cv::Scalar::all(0)));
     filled.push_back(cv::Mat::zeros(atlas.height, atlas.width, CV_8UC1));
   }
-  const mesh::TriangleMesh& mesh = model.mesh;
   for (const std::size_t f : synth::FacesByPhoto(synth::KeyPhotoOfFaces(visibility, photos),
                                                  synth::PhotosHeldTogether(photos))) {
     const sfm::TriangleVisibility& tv = visibility.triangles[f];
@@ -207,47 +255,35 @@ std::vector<cv::Mat> BakePhotoTextures(const model::TexturedModel& model,
                         : photo_index.find(tv.best_view);
     if (it == photo_index.end()) continue;
     const synth::MeshPhoto& photo = photos[it->second];
-    const cv::Mat pixels = photo.pixels.Get();
-    const std::array<double, 3> gain = ChannelGains(photo_gains, white_balance, it->second);
     const sfm::Image& image = reconstruction.images.at(photo.image_id);
-    const sfm::Camera& camera = reconstruction.cameras.at(image.camera_id);
-    cv::Mat& tex = textures[static_cast<std::size_t>(model.face_atlas[f])];
-    cv::Mat& mask = filled[static_cast<std::size_t>(model.face_atlas[f])];
-    const auto& c = model.corner_px[f];
-    Eigen::Vector2f lo = c[0], hi = c[0];
-    for (const auto& p : c) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-    const double det =
-        (c[1] - c[0]).x() * (c[2] - c[0]).y() - (c[1] - c[0]).y() * (c[2] - c[0]).x();
-    if (std::abs(det) < 1e-12) continue;
-    for (int y = std::max(0, static_cast<int>(std::floor(lo.y())));
-         y <= std::min(tex.rows - 1, static_cast<int>(std::ceil(hi.y()))); ++y) {
-      for (int x = std::max(0, static_cast<int>(std::floor(lo.x())));
-           x <= std::min(tex.cols - 1, static_cast<int>(std::ceil(hi.x()))); ++x) {
-        const Eigen::Vector2d q(x + 0.5, y + 0.5);
-        const Eigen::Vector2d d = q - c[0].cast<double>();
-        const double b1 = (d.x() * (c[2] - c[0]).y() - d.y() * (c[2] - c[0]).x()) / det;
-        const double b2 = ((c[1] - c[0]).x() * d.y() - (c[1] - c[0]).y() * d.x()) / det;
-        const double b0 = 1 - b1 - b2;
-        const double eps = -0.02;
-        if (b0 < eps || b1 < eps || b2 < eps) continue;
-        const Eigen::Vector3d world =
-            b0 * mesh.Corner(f, 0) + b1 * mesh.Corner(f, 1) + b2 * mesh.Corner(f, 2);
-        const auto px = camera.ImageFromCam(image.cam_from_world.rotation * world +
-                                            image.cam_from_world.translation);
-        if (!px) continue;
-        const Eigen::Vector2d o = ToOpenCv(*px);
-        if (o.x() < -0.5 || o.y() < -0.5 || o.x() > pixels.cols - 0.5 || o.y() > pixels.rows - 0.5)
-          continue;
-        float rgb[3];
-        Bilinear(
-            pixels.cols, pixels.rows, o.x() + 0.5, o.y() + 0.5, 3,
-            [&](int xx, int yy, int ch) { return pixels.at<cv::Vec3f>(yy, xx)[ch]; }, rgb);
-        cv::Vec3f& out = tex.at<cv::Vec3f>(y, x);
-        for (int ch = 0; ch < 3; ++ch)
-          out[ch] = LinearToSrgb(
-              static_cast<float>(SrgbToLinear(rgb[ch]) / gain[static_cast<std::size_t>(ch)]));
-        mask.at<std::uint8_t>(y, x) = 255;
-      }
+    const std::size_t atlas = static_cast<std::size_t>(model.face_atlas[f]);
+    const std::vector<PhotoTexel> texels =
+        FaceTexelsInPhoto(model, f, reconstruction.cameras.at(image.camera_id),
+                          image.cam_from_world, photo.pixels.size(), textures[atlas].size());
+    if (texels.empty()) continue;
+    // The photo's region the bilinear taps reach.
+    Eigen::Vector2d lo = texels[0].at, hi = texels[0].at;
+    for (const PhotoTexel& texel : texels) lo = lo.cwiseMin(texel.at), hi = hi.cwiseMax(texel.at);
+    const cv::Size size = photo.pixels.size();
+    const cv::Point from(std::max(0, static_cast<int>(std::floor(lo.x())) - 1),
+                         std::max(0, static_cast<int>(std::floor(lo.y())) - 1));
+    const cv::Point to(std::min(size.width, static_cast<int>(std::floor(hi.x())) + 3),
+                       std::min(size.height, static_cast<int>(std::floor(hi.y())) + 3));
+    const cv::Mat region = photo.pixels.Display(cv::Rect(from, to));
+    const std::array<double, 3> gain = ChannelGains(photo_gains, white_balance, it->second);
+    for (const PhotoTexel& texel : texels) {
+      float rgb[3];
+      Bilinear(
+          size.width, size.height, texel.at.x() + 0.5, texel.at.y() + 0.5, 3,
+          [&](int xx, int yy, int ch) {
+            return region.at<cv::Vec3f>(yy - from.y, xx - from.x)[ch];
+          },
+          rgb);
+      cv::Vec3f& out = textures[atlas].at<cv::Vec3f>(texel.y, texel.x);
+      for (int ch = 0; ch < 3; ++ch)
+        out[ch] = LinearToSrgb(
+            static_cast<float>(SrgbToLinear(rgb[ch]) / gain[static_cast<std::size_t>(ch)]));
+      filled[atlas].at<std::uint8_t>(texel.y, texel.x) = 255;
     }
   }
   // Unfilled texels: the mean of the filled ones, after a few dilation rings.
@@ -313,7 +349,7 @@ Eigen::Vector3f MeanAlbedoFromPhotos(const mesh::TriangleMesh& mesh,
     for (const sfm::ObjectLight& l : photo.lights)
       shading += l.intensity * std::max(0.0, normals[f].dot(l.DirectionFrom(centroid)));
     if (shading < 0.2) continue;
-    const cv::Vec3f rgb = photo.pixels.Get().at<cv::Vec3f>(y, x);
+    const cv::Vec3f rgb = photo.pixels.Display(cv::Rect(x, y, 1, 1)).at<cv::Vec3f>(0, 0);
     const std::array<double, 3> gain = ChannelGains(photo_gains, white_balance, it->second);
     for (int c = 0; c < 3; ++c)
       colour_sum[c] += areas[f] * SrgbToLinear(rgb[c]) / gain[static_cast<std::size_t>(c)];

@@ -26,20 +26,20 @@ fs::path WritePhoto(const fs::path& dir, int n) {
 }
 
 const cv::Size kSize(16, 8);
-const std::uint64_t kPhotoBytes = 12 * 16 * 8;
+const std::uint64_t kPhotoBytes = 3 * 16 * 8;  // 8-bit RGB as stored
 
 TEST(PhotoCache, KeepsTheMostRecentlyUsedPhotosWithinItsBudget) {
   TempDir tmp;
   PhotoCache cache(2 * kPhotoBytes);  // two photos
   std::vector<std::size_t> keys;
-  for (int n = 1; n <= 3; ++n) keys.push_back(cache.Add(WritePhoto(tmp.path(), n), kSize));
+  for (int n = 1; n <= 3; ++n) keys.push_back(cache.Add(WritePhoto(tmp.path(), n), kSize, 3));
   EXPECT_EQ(cache.TotalBytes(), 3 * kPhotoBytes);
   EXPECT_FALSE(cache.HoldsAll());
   // Each photo's own pixels, in RGB order and [0, 1].
   for (int n = 1; n <= 3; ++n) {
-    const cv::Vec3f rgb = cache.Get(keys[static_cast<std::size_t>(n - 1)]).at<cv::Vec3f>(4, 7);
-    EXPECT_NEAR(rgb[0], n / 255.0, 1e-6);
-    EXPECT_NEAR(rgb[2], 3 * n / 255.0, 1e-6);
+    const cv::Mat native = cache.Get(keys[static_cast<std::size_t>(n - 1)]);
+    ASSERT_EQ(native.type(), CV_8UC3);
+    EXPECT_EQ(native.at<cv::Vec3b>(4, 7), cv::Vec3b(n, 2 * n, 3 * n));
   }
   EXPECT_EQ(cache.stats().decodes, 3u);
   // Photos 2 and 3 are held; 1 was let go.
@@ -59,11 +59,11 @@ TEST(PhotoCache, KeepsTheMostRecentlyUsedPhotosWithinItsBudget) {
 TEST(PhotoCache, APhotoHandedOutStaysValidAfterTheCacheLetsItGo) {
   TempDir tmp;
   PhotoCache cache(kPhotoBytes);
-  const std::size_t a = cache.Add(WritePhoto(tmp.path(), 10), kSize);
-  const std::size_t b = cache.Add(WritePhoto(tmp.path(), 20), kSize);
+  const std::size_t a = cache.Add(WritePhoto(tmp.path(), 10), kSize, 3);
+  const std::size_t b = cache.Add(WritePhoto(tmp.path(), 20), kSize, 3);
   const cv::Mat held = cache.Get(a);
   cache.Get(b);  // the cache lets `a` go
-  EXPECT_NEAR(held.at<cv::Vec3f>(0, 0)[0], 10 / 255.0, 1e-6);
+  EXPECT_EQ(held.at<cv::Vec3b>(0, 0)[0], 10);
   cache.Get(a);
   EXPECT_EQ(cache.stats().decodes, 3u);
 }
@@ -71,15 +71,15 @@ TEST(PhotoCache, APhotoHandedOutStaysValidAfterTheCacheLetsItGo) {
 TEST(PhotoCache, APhotoAskedForByManyThreadsAtOnceIsDecodedOnce) {
   TempDir tmp;
   PhotoCache cache(4 * kPhotoBytes);
-  const std::size_t key = cache.Add(WritePhoto(tmp.path(), 7), kSize);
+  const std::size_t key = cache.Add(WritePhoto(tmp.path(), 7), kSize, 3);
   std::vector<std::thread> threads;
   std::vector<float> red(8, 0.0f);
   for (std::size_t i = 0; i < red.size(); ++i)
-    threads.emplace_back([&, i] { red[i] = cache.Get(key).at<cv::Vec3f>(1, 1)[0]; });
+    threads.emplace_back([&, i] { red[i] = cache.Get(key).at<cv::Vec3b>(1, 1)[0]; });
   for (std::thread& t : threads) t.join();
   EXPECT_EQ(cache.stats().decodes, 1u);
   EXPECT_EQ(cache.stats().hits, 7u);
-  for (const float r : red) EXPECT_NEAR(r, 7 / 255.0, 1e-6);
+  for (const float r : red) EXPECT_EQ(r, 7.0f);
 }
 
 TEST(PhotoCache, AFileThatCannotBeDecodedOrChangedSizeIsNamed) {
@@ -87,8 +87,8 @@ TEST(PhotoCache, AFileThatCannotBeDecodedOrChangedSizeIsNamed) {
   PhotoCache cache(4 * kPhotoBytes);
   const fs::path broken = tmp.path() / "broken.png";
   std::ofstream(broken) << "not a png";
-  const std::size_t bad = cache.Add(broken, kSize);
-  const std::size_t resized = cache.Add(WritePhoto(tmp.path(), 1), cv::Size(32, 8));
+  const std::size_t bad = cache.Add(broken, kSize, 3);
+  const std::size_t resized = cache.Add(WritePhoto(tmp.path(), 1), cv::Size(32, 8), 3);
   for (const std::size_t key : {bad, resized}) {
     try {
       cache.Get(key);
@@ -107,9 +107,33 @@ TEST(PhotoPixels, HeldPixelsNeedNoCache) {
   const cv::Mat image(3, 5, CV_32FC3, cv::Scalar(0.25, 0.5, 0.75));
   const PhotoPixels pixels(image);
   EXPECT_EQ(pixels.size(), cv::Size(5, 3));
-  EXPECT_EQ(pixels.Get().data, image.data);
+  EXPECT_EQ(pixels.Display().data, image.data);
   EXPECT_EQ(pixels.Held().data, image.data);
   EXPECT_EQ(pixels.cache(), nullptr);
+}
+
+// A region of a cached photo reads as the same region of ReadPhotoRgb's photo, at
+// every depth a photo may be stored in, cut to the photo at its borders.
+TEST(PhotoPixels, RegionsOfACachedPhotoAreThePhotosDisplayValues) {
+  TempDir tmp;
+  cv::Mat bgr8(12, 20, CV_8UC3), grey16(12, 20, CV_16UC1);
+  cv::randu(bgr8, 0, 256);
+  cv::randu(grey16, 0, 65536);
+  const fs::path png8 = tmp.path() / "rgb8.png", png16 = tmp.path() / "grey16.png";
+  ASSERT_TRUE(cv::imwrite(png8.string(), bgr8));
+  ASSERT_TRUE(cv::imwrite(png16.string(), grey16));
+  auto cache = std::make_shared<PhotoCache>(std::uint64_t{1} << 20);
+  for (const fs::path& file : {png8, png16}) {
+    const PhotoPixels pixels(cache, cache->Add(file, cv::Size(20, 12), 12));
+    const cv::Mat whole = ReadPhotoRgb(file);
+    ASSERT_EQ(pixels.Display().type(), CV_32FC3);
+    EXPECT_EQ(cv::norm(pixels.Display(), whole, cv::NORM_INF), 0.0) << file;
+    const cv::Mat region = pixels.Display(cv::Rect(15, 8, 10, 10));  // cut to 5 x 4
+    ASSERT_EQ(region.size(), cv::Size(5, 4));
+    EXPECT_EQ(cv::norm(region, whole(cv::Rect(15, 8, 5, 4)), cv::NORM_INF), 0.0) << file;
+  }
+  EXPECT_EQ(cache->stats().decodes, 2u);
+  EXPECT_EQ(cache->stats().peak_bytes, 20u * 12 * 3 + 20u * 12 * 6);  // as stored
 }
 
 }  // namespace

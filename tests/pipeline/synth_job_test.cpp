@@ -609,6 +609,7 @@ std::string WithoutTimings(const fs::path& file) {
     std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& v) {
       if (v.is_object()) {
         v.erase("timings_s");
+        v.erase("resources");
         for (auto& [key, value] : v.items()) strip(value);
       } else if (v.is_array()) {
         for (auto& value : v) strip(value);
@@ -657,7 +658,7 @@ TEST_F(MeshPipelineTest, OutputsAreTheSameOnOneThreadAndOnTwo) {
 TEST_F(MeshPipelineTest, PhotosOnDemandStayWithinTheirCacheAndKeepTheModel) {
   pipeline::SynthJobOptions j = Job(tmp_->path() / "model_small_cache");
   const pipeline::SynthInputs inputs = pipeline::LoadSynthInputs(j);
-  const std::uint64_t photo_bytes = DecodedPhotoBytes(inputs.photos[0].pixels.size());
+  const std::uint64_t photo_bytes = inputs.photo_cache->TotalBytes() / inputs.photos.size();
   j.photo_cache_bytes = static_cast<std::uint64_t>(j.synthesis.max_views) * photo_bytes;
   const pipeline::SynthJobSummary s = pipeline::RunSynthJob(j);
   const nlohmann::json record =
@@ -666,6 +667,8 @@ TEST_F(MeshPipelineTest, PhotosOnDemandStayWithinTheirCacheAndKeepTheModel) {
   ASSERT_FALSE(cache["holds_all"].get<bool>());
   EXPECT_EQ(cache["budget_bytes"].get<std::uint64_t>(), j.photo_cache_bytes);
   EXPECT_LE(cache["peak_bytes"].get<std::uint64_t>(), j.photo_cache_bytes);
+  EXPECT_GT(record["resources"]["peak_resident_bytes"].get<std::uint64_t>(),
+            cache["peak_bytes"].get<std::uint64_t>());
   const std::size_t photos = inputs.photos.size(), faces = s.faces;
   const auto decodes = cache["decodes"].get<std::size_t>();
   std::printf("photos on demand: %zu photos, %zu faces, %zu decodes\n", photos, faces, decodes);

@@ -107,11 +107,12 @@ TEST(PhotosHeldTogether, OnlyACacheTooSmallForEveryPhotoSplitsThem) {
   photos[0].pixels = PhotoPixels(cv::Mat(2, 2, CV_32FC3));
   photos[1].pixels = PhotoPixels(cv::Mat(2, 2, CV_32FC3));
   EXPECT_TRUE(PhotosHeldTogether(photos));
-  for (const std::uint64_t budget : {2 * DecodedPhotoBytes({4, 4}), DecodedPhotoBytes({4, 4})}) {
+  for (const std::uint64_t budget :
+       {2 * DecodedPhotoBytes({4, 4}, 3), DecodedPhotoBytes({4, 4}, 3)}) {
     auto cache = std::make_shared<PhotoCache>(budget);
-    photos[0].pixels = PhotoPixels(cache, cache->Add("a.png", {4, 4}));
-    photos[1].pixels = PhotoPixels(cache, cache->Add("b.png", {4, 4}));
-    EXPECT_EQ(PhotosHeldTogether(photos), budget == 2 * DecodedPhotoBytes({4, 4}));
+    photos[0].pixels = PhotoPixels(cache, cache->Add("a.png", {4, 4}, 3));
+    photos[1].pixels = PhotoPixels(cache, cache->Add("b.png", {4, 4}, 3));
+    EXPECT_EQ(PhotosHeldTogether(photos), budget == 2 * DecodedPhotoBytes({4, 4}, 3));
   }
 }
 
