@@ -16,21 +16,45 @@ namespace {
 // tent (the same again).
 constexpr double kPixelFootprintSigma = 0.41;
 
-// The bilinear RGB value of a CV_32FC3 photo at a COLMAP pixel position
-// (top-left corner convention); false outside the photo.
-bool PhotoAt(const cv::Mat& photo, const Eigen::Vector2d& px, float rgb[3]) {
-  const double x = px.x() - 0.5, y = px.y() - 0.5;
-  if (!(x >= 0 && y >= 0 && x <= photo.cols - 1 && y <= photo.rows - 1)) return false;
-  const int x0 = std::min(static_cast<int>(x), photo.cols - 2);
-  const int y0 = std::min(static_cast<int>(y), photo.rows - 2);
-  const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
-  const cv::Vec3f* r0 = photo.ptr<cv::Vec3f>(y0);
-  const cv::Vec3f* r1 = photo.ptr<cv::Vec3f>(y0 + 1);
-  for (int c = 0; c < 3; ++c)
-    rgb[c] = (1 - fy) * ((1 - fx) * r0[x0][c] + fx * r0[x0 + 1][c]) +
-             fy * ((1 - fx) * r1[x0][c] + fx * r1[x0 + 1][c]);
-  return true;
-}
+// A photo's display RGB over the region its bilinear lookups reach, and the
+// lookups: at a COLMAP pixel position (top-left corner convention) of the whole
+// photo, false outside it.
+class PhotoRegion {
+ public:
+  // The region around `positions` (COLMAP pixels) of the photo.
+  PhotoRegion(const PhotoPixels& pixels, const std::vector<Eigen::Vector2d>& positions)
+      : size_(pixels.size()) {
+    if (positions.empty()) return;
+    Eigen::Vector2d lo = positions[0], hi = positions[0];
+    for (const Eigen::Vector2d& p : positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    origin_ = cv::Point(std::clamp(static_cast<int>(std::floor(lo.x())) - 2, 0, size_.width),
+                        std::clamp(static_cast<int>(std::floor(lo.y())) - 2, 0, size_.height));
+    const cv::Point end(std::clamp(static_cast<int>(std::floor(hi.x())) + 3, 0, size_.width),
+                        std::clamp(static_cast<int>(std::floor(hi.y())) + 3, 0, size_.height));
+    if (end.x > origin_.x && end.y > origin_.y)
+      display_ = pixels.Display(cv::Rect(origin_, end));
+  }
+
+  // The bilinear value at `px`, as read from the whole photo.
+  bool At(const Eigen::Vector2d& px, float rgb[3]) const {
+    const double x = px.x() - 0.5, y = px.y() - 0.5;
+    if (!(x >= 0 && y >= 0 && x <= size_.width - 1 && y <= size_.height - 1)) return false;
+    const int x0 = std::min(static_cast<int>(x), size_.width - 2);
+    const int y0 = std::min(static_cast<int>(y), size_.height - 2);
+    const float fx = static_cast<float>(x - x0), fy = static_cast<float>(y - y0);
+    const cv::Vec3f* r0 = display_.ptr<cv::Vec3f>(y0 - origin_.y) - origin_.x;
+    const cv::Vec3f* r1 = display_.ptr<cv::Vec3f>(y0 + 1 - origin_.y) - origin_.x;
+    for (int c = 0; c < 3; ++c)
+      rgb[c] = (1 - fy) * ((1 - fx) * r0[x0][c] + fx * r0[x0 + 1][c]) +
+               fy * ((1 - fx) * r1[x0][c] + fx * r1[x0 + 1][c]);
+    return true;
+  }
+
+ private:
+  cv::Size size_;
+  cv::Point origin_;
+  cv::Mat display_;
+};
 
 // A direction of the work frame turned by -rad about its normal.
 Eigen::Vector3d TurnedBack(const Eigen::Vector3d& d, double rad) {
@@ -109,17 +133,30 @@ int PhotoImageTerm::PhotoPlanes(const View& view, const std::vector<WorkImageSam
   planes.assign(3, cv::Mat());
   for (cv::Mat& plane : planes) plane = cv::Mat::zeros(work_size, CV_32FC1);
   mask = cv::Mat::zeros(work_size, CV_32FC1);
-  int count = 0;
-  const cv::Mat pixels = photo.pixels.Display();
+  // The work cells the photo may constrain, and where it sees them.
+  std::vector<const WorkImageSample*> cells;
+  std::vector<Eigen::Vector2d> positions;
+  cv::Mat taken = cv::Mat::zeros(work_size, CV_8UC1);
   std::map<int, bool> seen;  // per face met
   for (const WorkImageSample& w : samples) {
     const int face = surface_.samples()[static_cast<std::size_t>(w.sample)].face;
     auto it = seen.find(face);
     if (it == seen.end()) it = seen.emplace(face, SeesFully(view.photo, face)).first;
-    if (w.synthesised || !it->second || mask.at<float>(w.y, w.x) > 0) continue;
+    if (w.synthesised || !it->second || taken.at<std::uint8_t>(w.y, w.x)) continue;
     const auto px = photos_.reconstruction.Project(image, surface_.PointInWorld(w.sample));
+    const double x = px ? px->x() - 0.5 : -1.0, y = px ? px->y() - 0.5 : -1.0;
+    const cv::Size size = photo.pixels.size();
+    if (!(x >= 0 && y >= 0 && x <= size.width - 1 && y <= size.height - 1)) continue;
+    taken.at<std::uint8_t>(w.y, w.x) = 1;
+    cells.push_back(&w);
+    positions.push_back(*px);
+  }
+  const PhotoRegion region(photo.pixels, positions);
+  int count = 0;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const WorkImageSample& w = *cells[k];
     float rgb[3];
-    if (!px || !PhotoAt(pixels, *px, rgb)) continue;
+    if (!region.At(positions[k], rgb)) continue;
     for (int c = 0; c < 3; ++c) {
       const float v = rgb[c];
       planes[static_cast<std::size_t>(c)].at<float>(w.y, w.x) =
