@@ -73,7 +73,7 @@ void SceneOptions::Check() const {
   material.Check();
   if (mesh_resolution < 0 || mesh_resolution > 7)
     throw OptionError("mesh resolution must be in [0, 7]");
-  RequireInRange(num_images, 3, 500, "num_images");
+  RequireInRange(num_images, 3, 1000, "num_images");  // monument captures: 50-600
   RequireInRange(image_width, 64, 8192, "image_width");
   RequireInRange(image_height, 64, 8192, "image_height");
   RequireInRange(focal_px, 1, 1e6, "focal_px");

@@ -31,8 +31,7 @@ class PhotoRegion {
                         std::clamp(static_cast<int>(std::floor(lo.y())) - 2, 0, size_.height));
     const cv::Point end(std::clamp(static_cast<int>(std::floor(hi.x())) + 3, 0, size_.width),
                         std::clamp(static_cast<int>(std::floor(hi.y())) + 3, 0, size_.height));
-    if (end.x > origin_.x && end.y > origin_.y)
-      display_ = pixels.Display(cv::Rect(origin_, end));
+    if (end.x > origin_.x && end.y > origin_.y) display_ = pixels.Display(cv::Rect(origin_, end));
   }
 
   // The bilinear value at `px`, as read from the whole photo.

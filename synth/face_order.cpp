@@ -62,12 +62,12 @@ class PhotoFrontier {
     Queue(key_photo_[static_cast<std::size_t>(f)]).push_back(f);
   }
 
-  // The next face to place: the current photo's oldest, else the oldest of all
+  // The next face to place: the current photo's oldest, else the newest of all
   // (which makes its photo the current one); -1 when the frontier is empty.
   int Next() {
     int f = PopUnplaced(Queue(current_photo_));
     if (f < 0) {
-      f = PopUnplaced(by_age_);
+      f = PopNewestUnplaced(by_age_);
       if (f >= 0) current_photo_ = key_photo_[static_cast<std::size_t>(f)];
     }
     if (f >= 0) placed_[static_cast<std::size_t>(f)] = 1;
@@ -81,6 +81,14 @@ class PhotoFrontier {
     if (queue.empty()) return -1;
     const int f = queue.front();
     queue.pop_front();
+    return f;
+  }
+
+  int PopNewestUnplaced(std::deque<int>& queue) {
+    while (!queue.empty() && placed_[static_cast<std::size_t>(queue.back())]) queue.pop_back();
+    if (queue.empty()) return -1;
+    const int f = queue.back();
+    queue.pop_back();
     return f;
   }
 

@@ -31,8 +31,9 @@ std::vector<std::size_t> FacesByPhoto(const std::vector<int>& key_photo, bool he
 /// joins the frontier when a neighbour is placed, as in mesh::BreadthFirstFaceOrder,
 /// so every face but the first of each connected component has a neighbour placed
 /// before it; but the frontier faces whose key photo is the current one are placed
-/// first (oldest first), and only when none is left does the oldest frontier face
-/// choose the next photo. `neighbours` as mesh::FaceNeighbours gives them.
+/// first (oldest first), and only when none is left does the newest frontier face
+/// (beside the faces just placed, whose photos the cache still holds) choose the
+/// next photo. `neighbours` as mesh::FaceNeighbours gives them.
 std::vector<int> PhotoByPhotoBreadthFirstOrder(const std::vector<std::array<int, 3>>& neighbours,
                                                const std::vector<int>& key_photo, int seed_face);
 
