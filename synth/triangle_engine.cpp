@@ -46,27 +46,6 @@ std::array<double, 3> PhotoLinearSums(const RectifiedView& r, PhotoDomain domain
   return sums;
 }
 
-// cv::remap (bicubic, border replicated) of the photo's display RGB at the maps
-// (shifted in place), reading only the region the maps reach with the bicubic
-// taps' margin (the taps reach 1 pixel before and, once OpenCV rounds a position
-// to 1/32 pixel, 3 after): the same values as remapping the whole photo, without
-// converting it all.
-void RemapPhotoRegion(const PhotoPixels& pixels, cv::Mat& map_x, cv::Mat& map_y, cv::Mat& out) {
-  double x_lo, x_hi, y_lo, y_hi;
-  cv::minMaxLoc(map_x, &x_lo, &x_hi);
-  cv::minMaxLoc(map_y, &y_lo, &y_hi);
-  const cv::Size size = pixels.size();
-  const int x0 = std::clamp(static_cast<int>(std::floor(x_lo)) - 2, 0, size.width - 1);
-  const int y0 = std::clamp(static_cast<int>(std::floor(y_lo)) - 2, 0, size.height - 1);
-  const int x1 = std::clamp(static_cast<int>(std::floor(x_hi)) + 4, x0 + 1, size.width);
-  const int y1 = std::clamp(static_cast<int>(std::floor(y_hi)) + 4, y0 + 1, size.height);
-  const cv::Mat region = pixels.Display(cv::Rect(x0, y0, x1 - x0, y1 - y0));
-  // Whole-pixel shifts keep the maps' sub-pixel parts exact.
-  map_x -= x0;
-  map_y -= y0;
-  cv::remap(region, out, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
-}
-
 }  // namespace
 
 void TakeOutWhiteBalance(const std::array<double, 3>& white_balance, PhotoDomain domain,

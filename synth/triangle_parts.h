@@ -121,6 +121,13 @@ PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double texel_siz
 PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double texel_size, int strip,
                                 const std::vector<Eigen::Vector3d>& tangents_in_world);
 
+/// cv::remap (bicubic, border replicated) of a photo's display RGB at `map_x`,
+/// `map_y` (OpenCV pixel positions, as RectificationMaps makes them; shifted in
+/// place), reading only the region of the photo the maps reach with the bicubic
+/// taps' margin: the same values as remapping the whole photo, without converting
+/// it all from the photo cache's stored samples.
+void RemapPhotoRegion(const PhotoPixels& pixels, cv::Mat& map_x, cv::Mat& map_y, cv::Mat& out);
+
 /// Helpers of Algorithm 2 shared by the PTM and BTF synthesis.
 ///
 /// The photo density level of a face in a view: r = 2^(-level/4) photo pixels

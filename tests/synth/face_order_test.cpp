@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <opencv2/imgproc.hpp>
+#include <random>
 #include <vector>
 
 #include "datasets_synthetic/shapes.h"
@@ -114,6 +116,42 @@ TEST(PhotosHeldTogether, OnlyACacheTooSmallForEveryPhotoSplitsThem) {
     photos[1].pixels = PhotoPixels(cache, cache->Add("b.png", {4, 4}, 3));
     EXPECT_EQ(PhotosHeldTogether(photos), budget == 2 * DecodedPhotoBytes({4, 4}, 3));
   }
+}
+
+// Rectifying from the region the maps reach gives the values of remapping the whole
+// photo: maps inside, across and beyond the photo's borders, at sub-pixel positions
+// that OpenCV rounds up to the next pixel, and behind the camera (RectificationMaps'
+// -1e6).
+TEST(RemapPhotoRegion, GivesTheValuesOfRemappingTheWholePhoto) {
+  cv::Mat photo(48, 64, CV_32FC3);
+  cv::randu(photo, 0.0f, 1.0f);
+  std::mt19937 rng(3);
+  struct Maps {
+    float x0, y0, spread;
+  };
+  for (const Maps m : {Maps{20.0f, 15.0f, 6.0f}, Maps{-3.0f, 40.0f, 8.0f}, Maps{58.0f, -2.0f, 9.0f},
+                       Maps{62.99f, 46.99f, 0.02f}, Maps{30.0f, 20.0f, 100.0f}}) {
+    cv::Mat map_x(9, 11, CV_32FC1), map_y(9, 11, CV_32FC1);
+    std::uniform_real_distribution<float> d(0.0f, m.spread);
+    for (int j = 0; j < 9; ++j)
+      for (int i = 0; i < 11; ++i) {
+        map_x.at<float>(j, i) = m.x0 + d(rng);
+        map_y.at<float>(j, i) = m.y0 + d(rng);
+      }
+    map_x.at<float>(0, 0) = map_y.at<float>(0, 0) = -1e6f;
+    cv::Mat whole, region;
+    cv::remap(photo, whole, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
+    // A photo as the cache stores it: 8-bit, read back through its region.
+    RemapPhotoRegion(PhotoPixels(photo), map_x, map_y, region);
+    EXPECT_EQ(cv::norm(whole, region, cv::NORM_INF), 0.0) << m.x0 << ", " << m.y0;
+  }
+  cv::Mat photo8;
+  photo.convertTo(photo8, CV_8UC3, 255.0);
+  cv::Mat map_x(5, 5, CV_32FC1, cv::Scalar(10.4f)), map_y(5, 5, CV_32FC1, cv::Scalar(7.6f));
+  cv::Mat whole, region;
+  cv::remap(PhotoDisplayRgb(photo8), whole, map_x, map_y, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
+  RemapPhotoRegion(PhotoPixels(photo8), map_x, map_y, region);
+  EXPECT_EQ(cv::norm(whole, region, cv::NORM_INF), 0.0);
 }
 
 }  // namespace
