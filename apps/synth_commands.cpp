@@ -62,6 +62,15 @@ void BindEngine(CLI::App* sub, synth::MeshSynthesisOptions& s, SynthWords& w) {
   sub->add_option("--strip", s.strip, "W_e: texels of strip around each triangle [2, 32]")
       ->capture_default_str();
   sub->add_option("--top-k", s.top_k, "candidates kept by the image score")->capture_default_str();
+  sub->add_option("--search", s.search,
+                  "how the image score searches the sample: coarse-to-fine or exhaustive")
+      ->transform(Choice(std::map<std::string, synth::PlacementSearchKind>{
+          {"coarse-to-fine", synth::PlacementSearchKind::kCoarseToFine},
+          {"exhaustive", synth::PlacementSearchKind::kExhaustive}}))
+      ->default_str("coarse-to-fine");
+  sub->add_option("--search-candidates", s.search_candidates,
+                  "coarse-to-fine: placements kept at each coarser density (>= --top-k)")
+      ->capture_default_str();
   sub->add_flag("--best-view-only", w.best_view_only, "constrain by the best view alone");
   sub->add_option("--max-views", s.max_views, "most photos constraining a triangle")
       ->capture_default_str();
@@ -215,7 +224,8 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
   for (const char* name :
        {"--fill-unseen", "--seam-band", "--strip", "--max-subdivisions", "--correction-iterations",
         "--correction-noise", "--correction-sigma", "--correction-prior-shrink",
-        "--no-additive-correction", "--no-channel-correction", "--no-detail-transfer"})
+        "--no-additive-correction", "--no-channel-correction", "--no-detail-transfer", "--search",
+        "--search-candidates"})
     if (sub->count(name) > 0)
       throw UsageError(std::string(name) + " is not taken by --engine graphcut (docs/quilting.md)");
   TakePhotos(sub, w, o, q);

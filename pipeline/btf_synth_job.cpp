@@ -133,6 +133,8 @@ class BtfSynthJob {
                                {"strip", so_.strip},
                                {"seam_band", so_.seam_band},
                                {"top_k", so_.top_k},
+                               {"search", synth::PlacementSearchName(so_.search)},
+                               {"search_candidates", so_.search_candidates},
                                {"max_views", so_.max_views},
                                {"tangent_frame", synth::TangentFrameName(so_.tangent_frame)},
                                {"tolerance", so_.tolerance},

@@ -531,6 +531,8 @@ class SynthJob {
         {"world_unit_mm", WorldUnitJson(options_.mm_per_world_unit)},
         {"strip", so.strip},
         {"top_k", so.top_k},
+        {"search", synth::PlacementSearchName(so.search)},
+        {"search_candidates", so.search_candidates},
         {"all_views", so.all_views},
         {"max_views", so.max_views},
         {"tangent_frame", synth::TangentFrameName(so.tangent_frame)},

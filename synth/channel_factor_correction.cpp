@@ -6,25 +6,39 @@
 
 namespace texlume::synth {
 
+namespace {
+
+// The model seen through the photo's blur reads 3 sigma around the patch.
+int BlurMarginCells(const RectifiedView& view) {
+  return static_cast<int>(std::ceil(3.0 * view.blur_cells));
+}
+
+}  // namespace
+
+int ChannelFactorCorrection::RelitMarginCells(const RectifiedView& view) const {
+  return BlurMarginCells(view) + 2;
+}
+
 ChannelFactorCorrection::OnGrid ChannelFactorCorrection::ToGrid(const TrianglePatch& patch,
                                                                 const RectifiedView& view,
                                                                 const ReducedPlanes& red,
-                                                                const std::vector<cv::Mat>& relit,
+                                                                const RelitWindow& relit,
                                                                 cv::Size grid) const {
   OnGrid g;
   const cv::Size size = view.mask.size();
   // The placed patch relit under the view: its cell i is at reduced-sample
-  // position sample_x rx + i (pixel centres at integers).
-  const cv::Point2f centre(static_cast<float>(patch.sample_x * red.rx + (size.width - 1) * 0.5),
-                           static_cast<float>(patch.sample_y * red.ry + (size.height - 1) * 0.5));
+  // position sample_x rx + i (pixel centres at integers), in the window at origin.
+  const cv::Point2f centre(
+      static_cast<float>(patch.sample_x * red.rx + (size.width - 1) * 0.5 - relit.origin.x),
+      static_cast<float>(patch.sample_y * red.ry + (size.height - 1) * 0.5 - relit.origin.y));
   g.wide = view.wide_mask;
   g.inside = view.mask;
   for (std::size_t ch = 0; ch < 3; ++ch) {
     // The model as the photo sees it: through the photo's blur
     // (synth/photo_blur.h), over the relit sample around the patch too.
-    const int margin = static_cast<int>(std::ceil(3.0 * view.blur_cells));
+    const int margin = BlurMarginCells(view);
     cv::Mat wide;
-    cv::getRectSubPix(relit[ch], size + cv::Size(2 * margin, 2 * margin), centre, wide);
+    cv::getRectSubPix(relit.planes[ch], size + cv::Size(2 * margin, 2 * margin), centre, wide);
     if (view.blur_cells > 0.0) cv::GaussianBlur(wide, wide, cv::Size(), view.blur_cells);
     g.model[ch] = wide(cv::Rect(cv::Point(margin, margin), size)).clone();
     g.photo[ch] = view.planes[ch];
@@ -69,7 +83,7 @@ cv::Mat ChannelFactorCorrection::ChannelFactors(const cv::Mat& num, const cv::Ma
 
 void ChannelFactorCorrection::Correct(TriangleEngine& engine, std::size_t face,
                                       std::vector<RectifiedView>& views,
-                                      const std::vector<std::vector<cv::Mat>>& relit) {
+                                      const std::vector<RelitWindow>& relit) {
   const std::size_t num_faces = engine.result().patches.size();
   if (factors_.size() != num_faces) {
     factors_.resize(num_faces);

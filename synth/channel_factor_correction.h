@@ -35,7 +35,10 @@ class ChannelFactorCorrection : public PhotoCorrection {
 
   double WideMaskMargin() const override { return options_.wide_margin; }
   void Correct(TriangleEngine& engine, std::size_t face, std::vector<RectifiedView>& views,
-               const std::vector<std::vector<cv::Mat>>& relit) override;
+               const std::vector<RelitWindow>& relit) override;
+  /// The relit sample around the patch that the model seen through the photo's
+  /// blur reads (3 sigma), and a cell for the bilinear read.
+  int RelitMarginCells(const RectifiedView& view) const override;
 
   /// Per face: the factors (CV_32FC3, linear R, G, B) on a grid over its patch
   /// rectangle at density()[face] cells per texel (x, y); empty: none.
@@ -54,7 +57,7 @@ class ChannelFactorCorrection : public PhotoCorrection {
     cv::Mat wide;    // the observed cells
   };
   OnGrid ToGrid(const TrianglePatch& patch, const RectifiedView& view, const ReducedPlanes& reduced,
-                const std::vector<cv::Mat>& relit, cv::Size grid) const;
+                const RelitWindow& relit, cv::Size grid) const;
   // The factors of one channel from the summed products (num = sum m p,
   // den = sum m^2) over the observed cells, and the observed cells smoothed
   // by sigma (`weight`) and 4 sigma (`wide_weight`).

@@ -36,10 +36,11 @@ constexpr std::size_t kDetailMaxPoints = std::size_t{1} << 16;
 void CoarseWindow(const std::vector<cv::Mat>& coarse, double x, double y, double dx, double dy,
                   float* window) {
   for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
-    for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a)
+    for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a) {
+      const BilinearTaps at(coarse[0].size(), x + a * dx, y + b * dy);
       for (int m = 0; m < 6; ++m)
-        *window++ = static_cast<float>(
-            BilinearClamped(coarse[static_cast<std::size_t>(m)], x + a * dx, y + b * dy));
+        *window++ = static_cast<float>(at.Of(coarse[static_cast<std::size_t>(m)]));
+    }
 }
 
 }  // namespace
@@ -452,15 +453,15 @@ class CoefficientCorrection::DetailDictionary {
 void CoefficientCorrection::DetailDictionary::Transfer(TrianglePatch& patch, int level) const {
   const int gw = patch.correction[0].cols, gh = patch.correction[0].rows;
   std::vector<cv::Mat> corrected(6);
-  for (std::size_t m = 0; m < 6; ++m) {
-    corrected[m] = cv::Mat(gh, gw, CV_32FC1);
-    for (int j = 0; j < gh; ++j)
-      for (int i = 0; i < gw; ++i)
+  for (cv::Mat& m : corrected) m = cv::Mat(gh, gw, CV_32FC1);
+  for (int j = 0; j < gh; ++j)
+    for (int i = 0; i < gw; ++i) {
+      const BilinearTaps at(coarse_[0].size(), patch.sample_x + (i + 0.5) * dx_ - 0.5,
+                            patch.sample_y + (j + 0.5) * dy_ - 0.5);
+      for (std::size_t m = 0; m < 6; ++m)
         corrected[m].at<float>(j, i) =
-            static_cast<float>(BilinearClamped(coarse_[m], patch.sample_x + (i + 0.5) * dx_ - 0.5,
-                                               patch.sample_y + (j + 0.5) * dy_ - 0.5) +
-                               patch.correction[m].at<float>(j, i));
-  }
+            static_cast<float>(at.Of(coarse_[m]) + patch.correction[m].at<float>(j, i));
+    }
   cv::Mat queries(gh * gw, kDetailWindowLength, CV_32FC1);
   for (int j = 0; j < gh; ++j)
     for (int i = 0; i < gw; ++i) {
@@ -541,7 +542,7 @@ const CoefficientCorrection::CoefficientPrior& CoefficientCorrection::PriorAt(in
 
 void CoefficientCorrection::Correct(TriangleEngine& engine, std::size_t face,
                                     std::vector<RectifiedView>& views,
-                                    const std::vector<std::vector<cv::Mat>>& /*relit*/) {
+                                    const std::vector<RelitWindow>& /*relit*/) {
   // Every view on the best view's grid: a coarser photo, upsampled there,
   // constrains each cell at its place instead of one of its own pixels
   // constraining several cells alike.

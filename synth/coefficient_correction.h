@@ -37,7 +37,7 @@ class CoefficientCorrection : public PhotoCorrection {
   ~CoefficientCorrection() override;
 
   void Correct(TriangleEngine& engine, std::size_t face, std::vector<RectifiedView>& views,
-               const std::vector<std::vector<cv::Mat>>& relit) override;
+               const std::vector<RelitWindow>& relit) override;
   void Finish(TriangleEngine& engine, const ProgressCallback& progress) override;
 
   /// Per density level, the detail bands the transferred patches read

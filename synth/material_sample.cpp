@@ -81,9 +81,8 @@ void TransferredDetail(const TrianglePatch& patch, const std::vector<cv::Mat>& b
       std::pair{cv::Point(g.gx1, g.gy0), g.gfx * (1 - g.gfy)},
       std::pair{cv::Point(g.gx0, g.gy1), (1 - g.gfx) * g.gfy},
       std::pair{cv::Point(g.gx1, g.gy1), g.gfx * g.gfy}};
-  for (std::size_t c = 0; c < band.size(); ++c)
-    out[c] -=
-        static_cast<float>(BilinearClamped(band[c], patch.sample_x + uc, patch.sample_y + vc));
+  const BilinearTaps own(band[0].size(), patch.sample_x + uc, patch.sample_y + vc);
+  for (std::size_t c = 0; c < band.size(); ++c) out[c] -= static_cast<float>(own.Of(band[c]));
   // The band read at each cell's match, blended so that it keeps its contrast
   // (after Heitz and Neyret 2018's variance-preserving blend; the bands are
   // zero-mean): sum_k w_k b_k / sqrt(sum_jk w_j w_k rho_jk), the standard
@@ -109,11 +108,11 @@ void TransferredDetail(const TrianglePatch& patch, const std::vector<cv::Mat>& b
                            (2.0 * cell_texels_squared));
   if (n == 0 || !(variance > 0.0)) return;
   const double norm = 1.0 / std::sqrt(variance);
-  for (std::size_t k = 0; k < n; ++k)
+  for (std::size_t k = 0; k < n; ++k) {
+    const BilinearTaps at(band[0].size(), sources[k].first.x(), sources[k].first.y());
     for (std::size_t c = 0; c < band.size(); ++c)
-      out[c] +=
-          static_cast<float>(sources[k].second * norm *
-                             BilinearClamped(band[c], sources[k].first.x(), sources[k].first.y()));
+      out[c] += static_cast<float>(sources[k].second * norm * at.Of(band[c]));
+  }
 }
 
 // Catmull-Rom weights of the 4 taps around t in [0, 1).
@@ -165,16 +164,17 @@ bool MaterialSample::PatchFeatures(const TrianglePatch& patch, double t, const E
   return true;
 }
 
+BilinearTaps::BilinearTaps(cv::Size planes, double x, double y) {
+  x = std::clamp(x, 0.0, planes.width - 1.0);
+  y = std::clamp(y, 0.0, planes.height - 1.0);
+  x0_ = std::min(static_cast<int>(x), std::max(planes.width - 2, 0));
+  y0_ = std::min(static_cast<int>(y), std::max(planes.height - 2, 0));
+  x1_ = std::min(x0_ + 1, planes.width - 1), y1_ = std::min(y0_ + 1, planes.height - 1);
+  fx_ = x - x0_, fy_ = y - y0_;
+}
+
 double BilinearClamped(const cv::Mat& m, double x, double y) {
-  x = std::clamp(x, 0.0, m.cols - 1.0);
-  y = std::clamp(y, 0.0, m.rows - 1.0);
-  const int x0 = std::min(static_cast<int>(x), std::max(m.cols - 2, 0));
-  const int y0 = std::min(static_cast<int>(y), std::max(m.rows - 2, 0));
-  const int x1 = std::min(x0 + 1, m.cols - 1), y1 = std::min(y0 + 1, m.rows - 1);
-  const double fx = x - x0, fy = y - y0;
-  const float* r0 = m.ptr<float>(y0);
-  const float* r1 = m.ptr<float>(y1);
-  return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x1]);
+  return BilinearTaps(m.size(), x, y).Of(m);
 }
 
 bool SamplePtmPatch(const std::vector<cv::Mat>& values, ptm::PtmFormat format,

@@ -157,6 +157,24 @@ class PtmSample : public MaterialSample {
 /// clamped to the plane.
 double BilinearClamped(const cv::Mat& plane, double x, double y);
 
+/// BilinearClamped's taps and weights at one point of planes of one size, so that
+/// several planes are read there with one computation of them (the same values).
+class BilinearTaps {
+ public:
+  BilinearTaps(cv::Size planes, double x, double y);
+  /// BilinearClamped(plane, x, y) for a plane of the size given.
+  double Of(const cv::Mat& plane) const {
+    const float* r0 = plane.ptr<float>(y0_);
+    const float* r1 = plane.ptr<float>(y1_);
+    return (1 - fy_) * ((1 - fx_) * r0[x0_] + fx_ * r0[x1_]) +
+           fy_ * ((1 - fx_) * r1[x0_] + fx_ * r1[x1_]);
+  }
+
+ private:
+  int x0_ = 0, x1_ = 0, y0_ = 0, y1_ = 0;
+  double fx_ = 0.0, fy_ = 0.0;
+};
+
 /// The values of a PTM patch at a point of its face's frame (world units),
 /// bilinear within the patch rectangle, with its photo-consistency correction
 /// (additive change, per-channel factors) and detail transfer when it has them

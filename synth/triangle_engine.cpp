@@ -15,6 +15,7 @@
 #include "core/timing.h"
 #include "synth/face_order.h"
 #include "synth/photo_blur.h"
+#include "synth/placement_search.h"
 #include "synth/tangent_field.h"
 #include "synth/template_match.h"
 
@@ -71,12 +72,17 @@ void TriangleEngineOptions::Check() const {
     throw OptionError("sample texel size must be a positive number of world units");
   if (strip < 2 || strip > 32) throw OptionError("strip (W_e) must be in [2, 32] texels");
   if (top_k < 1) throw OptionError("top_k must be >= 1");
+  if (search_candidates < top_k) throw OptionError("search candidates must be >= top_k");
   if (max_views < 1) throw OptionError("max_views must be >= 1");
   if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
   if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
   if (max_texels < 1) throw OptionError("max_texels must be >= 1");
   if (!(field_direction_in_world.norm() > 0.0))
     throw OptionError("field direction must be nonzero");
+}
+
+const char* PlacementSearchName(PlacementSearchKind kind) {
+  return kind == PlacementSearchKind::kExhaustive ? "exhaustive" : "coarse-to-fine";
 }
 
 TriangleEngine::TriangleEngine(const mesh::TriangleMesh& mesh,
@@ -502,27 +508,21 @@ TriangleEngine::OverlapTargets TriangleEngine::CollectOverlapTargets(std::size_t
 }
 
 void TriangleEngine::ScoreAndPlace(TrianglePatch& patch, const std::vector<RectifiedView>& views,
-                                   const OverlapTargets& overlap,
-                                   std::vector<std::vector<cv::Mat>>& relit) {
+                                   const OverlapTargets& overlap, std::vector<RelitWindow>& relit) {
   // Eq. 3 of paper 003 per photo (RMS at the photo's density), summed over the
-  // photos, at every placement of the patch in the sample.
-  cv::Mat total = cv::Mat::zeros(sample_.Height() - patch.height + 1,
-                                 sample_.Width() - patch.width + 1, CV_32FC1);
-  for (const RectifiedView& r : views) {
-    const ReducedPlanes& red = sample_.Reduced(r.level);
-    const std::vector<cv::Mat>& model =
-        relit.emplace_back(sample_.Relight(red, r.lighting, result_.photo_gains[r.photo]));
-    AddImageScore(MaskedSsd(model, PlaneEnergy(model), r.planes, r.mask), r.count, red.rx, red.ry,
-                  total);
-  }
-  // Top-k distinct positions at the coarsest density used (neighbouring texel
-  // positions share one photo-density cell and score alike), then the one
-  // closest to the synthesised neighbours.
-  const int stride =
-      std::max(1, static_cast<int>(std::floor(1.0 / sample_.Reduced(views[0].level).rx)));
+  // photos, at the placements of the patch in the sample the search visits; of
+  // its top_k, the one closest to the synthesised neighbours.
+  const PlacementSearch search(sample_, views, result_.photo_gains,
+                               cv::Size(patch.width, patch.height));
   KeepClosestToNeighbours(
-      BestPlacements(total, stride, options_.top_k),
+      options_.search == PlacementSearchKind::kExhaustive
+          ? search.Exhaustive(options_.top_k)
+          : search.CoarseToFine(options_.top_k, options_.search_candidates),
       [&](int sx, int sy) { return overlap.Error(sample_, patch.width, sx, sy); }, patch);
+  if (!correction_ || correction_->RelitMarginCells(views.front()) < 0) return;
+  std::vector<int> margins;
+  for (const RectifiedView& r : views) margins.push_back(correction_->RelitMarginCells(r));
+  relit = search.RelitAround(cv::Point(patch.sample_x, patch.sample_y), margins);
 }
 
 void TriangleEngine::PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap,
@@ -552,7 +552,7 @@ void TriangleEngine::SynthesizeFace(std::size_t f, std::mt19937_64& rng) {
   std::vector<RectifiedView> views =
       RectifiedViews(f, correction_ && correction_->WideMaskMargin() >= 0.0);
   if (!views.empty()) {
-    std::vector<std::vector<cv::Mat>> relit;  // per view: the sample relit at its density
+    std::vector<RelitWindow> relit;  // per view: the sample relit around the placed patch
     ScoreAndPlace(patch, views, overlap, relit);
     patch.source = PatchSource::kPhotos;
     patch.views_used = static_cast<int>(views.size());

@@ -20,6 +20,15 @@
 
 namespace texlume::synth {
 
+/// How the image score searches the sample for a face's placement
+/// (synth/placement_search.h).
+enum class PlacementSearchKind {
+  kExhaustive,    ///< paper 003: every placement at the photos' density (FFT)
+  kCoarseToFine,  ///< every placement at a coarser density, then refined near the best
+};
+/// "exhaustive" or "coarse-to-fine", as the command line spells it.
+const char* PlacementSearchName(PlacementSearchKind kind);
+
 /// Settings every sample shares in the per-triangle engine (paper 003
 /// Algorithm 2). The PTM and BTF options add their photo-consistency passes.
 struct TriangleEngineOptions {
@@ -29,6 +38,10 @@ struct TriangleEngineOptions {
   int strip = 8;
   /// Candidates kept by the image score before the neighbour constraint. >= 1.
   int top_k = 12;
+  /// How the image score searches the sample (issue 33: coarse to fine by default).
+  PlacementSearchKind search = PlacementSearchKind::kCoarseToFine;
+  /// Coarse to fine: placements kept at each coarser density and refined. >= top_k.
+  int search_candidates = 48;
   /// Constrain with every photo in which the triangle is fully visible (scores
   /// summed, each under its own light), not only the best view (paper 003).
   bool all_views = true;
@@ -88,6 +101,14 @@ struct RectifiedView {
   double blur_cells = 0.0;
 };
 
+/// The sample relit under a view at the view's density over a window of the
+/// reduced sample (the cells around a placed patch): R, G, B planes (CV_32FC1,
+/// MaterialSample::Domain()) whose top-left cell is `origin` in the reduced sample.
+struct RelitWindow {
+  std::vector<cv::Mat> planes;
+  cv::Point origin;
+};
+
 /// What the engine produces: every face's placed patch in the sample (with
 /// what the photo-consistency pass added to it), the unfoldings across its
 /// edges, the photo gains, and the graph-cut labels for a sample that is cut.
@@ -133,11 +154,15 @@ class PhotoCorrection {
   virtual ~PhotoCorrection() = default;
   /// Margin (world units) of the wide mask the pass reads; < 0: none.
   virtual double WideMaskMargin() const { return -1.0; }
+  /// Cells of the relit sample the pass reads around a placed patch's grid under
+  /// `view`; < 0: it reads none.
+  virtual int RelitMarginCells(const RectifiedView& /*view*/) const { return -1; }
   /// Corrects face `face`'s placed patch. `views` are the score's (best view
   /// first), `relit[r]` the sample relit under view r at its density with its
-  /// photo's gain (what the score compared with the photo).
+  /// photo's gain (what the score compared with the photo) around the placed
+  /// patch (empty unless RelitMarginCells asks).
   virtual void Correct(TriangleEngine& engine, std::size_t face, std::vector<RectifiedView>& views,
-                       const std::vector<std::vector<cv::Mat>>& relit) = 0;
+                       const std::vector<RelitWindow>& relit) = 0;
   /// After the last face.
   virtual void Finish(TriangleEngine& /*engine*/, const ProgressCallback& /*progress*/) {}
 };
@@ -236,8 +261,9 @@ class TriangleEngine {
   };
   OverlapTargets CollectOverlapTargets(std::size_t face) const;
   // Score (eq. 3 summed over the views) and place (top_k, then the neighbours).
+  // `relit`: around the placed patch, when the correction reads it.
   void ScoreAndPlace(TrianglePatch& patch, const std::vector<RectifiedView>& views,
-                     const OverlapTargets& overlap, std::vector<std::vector<cv::Mat>>& relit);
+                     const OverlapTargets& overlap, std::vector<RelitWindow>& relit);
   // Unseen faces: the overlap constraint over every placement (FFT).
   void PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap,
                          std::mt19937_64& rng) const;

@@ -188,12 +188,13 @@ int BestSeenFace(const sfm::VisibilityResult& visibility) {
   return seed_face;
 }
 
-void AddImageScore(const cv::Mat& ssd, int count, double rx, double ry, cv::Mat& total) {
+void AddImageScore(const cv::Mat& ssd, double count, double rx, double ry, cv::Mat& total) {
+  const float cells = static_cast<float>(count);
   for (int sy = 0; sy < total.rows; ++sy) {
     const int py = std::min(static_cast<int>(std::lround(sy * ry)), ssd.rows - 1);
     for (int sx = 0; sx < total.cols; ++sx) {
       const int px = std::min(static_cast<int>(std::lround(sx * rx)), ssd.cols - 1);
-      total.at<float>(sy, sx) += std::sqrt(ssd.at<float>(py, px) / (3.0f * count));
+      total.at<float>(sy, sx) += std::sqrt(ssd.at<float>(py, px) / (3.0f * cells));
     }
   }
 }

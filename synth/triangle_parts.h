@@ -170,9 +170,9 @@ std::vector<double> SolvePhotoGains(const std::vector<GainObservation>& observat
 /// when there is none): where breadth-first synthesis starts.
 int BestSeenFace(const sfm::VisibilityResult& visibility);
 /// Adds eq. 3's RMS score of one photo (`ssd` from MaskedSsd at the photo's
-/// density (rx, ry), over `count` masked cells and 3 channels) to `total`, a map
-/// over sample placements in texels.
-void AddImageScore(const cv::Mat& ssd, int count, double rx, double ry, cv::Mat& total);
+/// density (rx, ry), over `count` masked cells (the mask's sum) and 3 channels) to
+/// `total`, a map over sample placements in texels.
+void AddImageScore(const cv::Mat& ssd, double count, double rx, double ry, cv::Mat& total);
 /// The k lowest placements of a score map, looking every `stride` texels, best first.
 std::vector<std::pair<float, cv::Point>> BestPlacements(const cv::Mat& score, int stride, int k);
 /// Of the image score's candidates (BestPlacements), the index of the one with the

@@ -211,6 +211,17 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
                     "--sample-texel-size 0.01 --out f --tangent-frame photos --tangent-field 0,0,1",
                     &out),
             2);
+  // A placement search that is not one of the two, or fewer candidates than top_k.
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --search sideways",
+                    &out),
+            2);
+  EXPECT_NE(out.find("--search"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --search-candidates 4",
+                    &out),
+            2);
+  EXPECT_NE(out.find("search candidates must be >= top_k"), std::string::npos) << out;
   // A photo cache that is not a size (photos on demand, docs/cli.md).
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
                     "--sample-texel-size 0.01 --out f --photo-cache lots",
@@ -641,6 +652,9 @@ TEST(Cli, SynthGraphcutQuiltsAMeshWithoutPhotosAndRefusesBadInput) {
       Texlume("synth" + inputs + " --fill-unseen graphcut --out " + (tmp / "bad").string(), &out),
       2);
   EXPECT_NE(out.find("--fill-unseen is not taken by --engine graphcut"), std::string::npos) << out;
+  EXPECT_EQ(
+      Texlume("synth" + inputs + " --search exhaustive --out " + (tmp / "bad").string(), &out), 2);
+  EXPECT_NE(out.find("--search is not taken by --engine graphcut"), std::string::npos) << out;
   // A sample smaller than the smallest work patch: an input error naming it (1).
   cv::imwrite((tmp / "tiny.png").string(), cv::Mat(12, 12, CV_8UC3, cv::Scalar(90, 120, 150)));
   EXPECT_EQ(Texlume("synth --engine graphcut --mesh " + scene +

@@ -1,0 +1,251 @@
+#include "synth/placement_search.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <unordered_set>
+
+#include "synth/template_match.h"
+#include "synth/triangle_parts.h"
+
+namespace texlume::synth {
+namespace {
+
+// Density levels are quarter octaves: four levels halve the density.
+constexpr int kLevelsPerHalving = 4;
+// Coarse to fine only when every placement is at least this many times those refined.
+constexpr double kRefineFraction = 4.0;
+
+// The best `k` of `scored`, best first.
+std::vector<ScoredPlacement> KeepBest(std::vector<ScoredPlacement> scored, int k) {
+  const std::size_t kept = std::min<std::size_t>(static_cast<std::size_t>(k), scored.size());
+  std::partial_sort(scored.begin(), scored.begin() + static_cast<std::ptrdiff_t>(kept),
+                    scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  scored.resize(kept);
+  return scored;
+}
+
+}  // namespace
+
+PlacementSearch::PlacementSearch(const MaterialSample& sample,
+                                 const std::vector<RectifiedView>& views,
+                                 const std::vector<double>& photo_gains, cv::Size patch_texels)
+    : sample_(sample), views_(views), photo_gains_(photo_gains), patch_(patch_texels) {
+  last_x_ = sample.Width() - patch_texels.width;
+  last_y_ = sample.Height() - patch_texels.height;
+}
+
+cv::Point PlacementSearch::ViewAtStep::Cell(cv::Point texel) const {
+  // As AddImageScore reads a placement's score: the nearest cell.
+  return {std::min(static_cast<int>(std::lround(texel.x * reduced->rx)), placements_x - 1),
+          std::min(static_cast<int>(std::lround(texel.y * reduced->ry)), placements_y - 1)};
+}
+
+std::vector<PlacementSearch::ViewAtStep> PlacementSearch::ViewsAtStep(int step) const {
+  std::vector<ViewAtStep> out;
+  out.reserve(views_.size());
+  for (const RectifiedView& r : views_) {
+    ViewAtStep& v = out.emplace_back();
+    v.view = &r;
+    v.reduced = &sample_.Reduced(r.level + kLevelsPerHalving * step);
+    if (step == 0) {
+      v.photo = r.planes;
+      v.mask = r.mask;
+      v.count = r.count;
+    } else {
+      // The photo at the coarser density: the masked mean of the cells each coarse
+      // cell covers, weighted by how much of it is seen.
+      const cv::Size grid(
+          std::max(1, static_cast<int>(std::lround(patch_.width * v.reduced->rx))),
+          std::max(1, static_cast<int>(std::lround(patch_.height * v.reduced->ry))));
+      cv::resize(r.mask, v.mask, grid, 0, 0, cv::INTER_AREA);
+      v.photo.resize(r.planes.size());
+      for (std::size_t c = 0; c < r.planes.size(); ++c) {
+        cv::Mat weighted;
+        cv::resize(r.planes[c].mul(r.mask), weighted, grid, 0, 0, cv::INTER_AREA);
+        cv::divide(weighted, v.mask, v.photo[c]);  // 0 where nothing is seen
+      }
+      v.count = cv::sum(v.mask)[0];
+    }
+    v.placements_x = v.reduced->planes[0].cols - v.mask.cols + 1;
+    v.placements_y = v.reduced->planes[0].rows - v.mask.rows + 1;
+  }
+  return out;
+}
+
+int PlacementSearch::CoarseSteps(int max_steps, int min_cells) const {
+  int steps = 0;
+  for (int step = 1; step <= max_steps; ++step) {
+    bool fits = true;
+    for (std::size_t n = 0; n < views_.size() && fits; ++n) {
+      const ReducedPlanes& r = sample_.Reduced(views_[n].level + kLevelsPerHalving * step);
+      const int gw = std::max(1, static_cast<int>(std::lround(patch_.width * r.rx)));
+      const int gh = std::max(1, static_cast<int>(std::lround(patch_.height * r.ry)));
+      fits = gw <= r.planes[0].cols && gh <= r.planes[0].rows &&
+             (n > 0 || (gw >= min_cells && gh >= min_cells));
+    }
+    if (!fits) break;
+    steps = step;
+  }
+  return steps;
+}
+
+int PlacementSearch::Stride(const std::vector<ViewAtStep>& views) {
+  return std::max(1, static_cast<int>(std::floor(1.0 / views.front().reduced->rx)));
+}
+
+std::vector<cv::Mat> PlacementSearch::RelitCells(const ViewAtStep& v, cv::Rect cells) const {
+  ReducedPlanes window{{}, v.reduced->rx, v.reduced->ry};
+  for (const cv::Mat& plane : v.reduced->planes) window.planes.push_back(plane(cells));
+  return sample_.Relight(window, v.view->lighting, photo_gains_[v.view->photo]);
+}
+
+std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<ViewAtStep>& views,
+                                                          int stride) const {
+  // Eq. 3 of every view at every placement of its density (FFT), read at the
+  // placements `stride` texels apart, in rows.
+  std::vector<ScoredPlacement> scored;
+  for (int sy = 0; sy <= last_y_; sy += stride)
+    for (int sx = 0; sx <= last_x_; sx += stride) scored.emplace_back(0.0f, cv::Point(sx, sy));
+  for (const ViewAtStep& v : views) {
+    const std::vector<cv::Mat> model =
+        sample_.Relight(*v.reduced, v.view->lighting, photo_gains_[v.view->photo]);
+    const cv::Mat ssd = MaskedSsd(model, PlaneEnergy(model), v.photo, v.mask);
+    const float cells = static_cast<float>(v.count);
+    for (auto& [score, texel] : scored) {
+      const cv::Point at = v.Cell(texel);
+      score += std::sqrt(ssd.at<float>(at.y, at.x) / (3.0f * cells));  // as AddImageScore
+    }
+  }
+  return scored;
+}
+
+class PlacementSearch::RelitTiles {
+ public:
+  RelitTiles(const PlacementSearch& search, const ViewAtStep& view) : search_(search), view_(view) {
+    const cv::Size size = view.reduced->planes[0].size();
+    for (cv::Mat& m : planes_) m.create(size, CV_32FC1);
+    tiles_x_ = (size.width + kTile - 1) / kTile;
+    done_.assign(static_cast<std::size_t>(tiles_x_ * ((size.height + kTile - 1) / kTile)), 0);
+  }
+  // Relights the tiles `cells` touches that are not relit yet.
+  void Cover(cv::Rect cells) {
+    const cv::Rect all(cv::Point(0, 0), planes_[0].size());
+    for (int ty = cells.y / kTile; ty <= (cells.br().y - 1) / kTile; ++ty)
+      for (int tx = cells.x / kTile; tx <= (cells.br().x - 1) / kTile; ++tx) {
+        char& done = done_[static_cast<std::size_t>(ty * tiles_x_ + tx)];
+        if (done) continue;
+        const cv::Rect tile = cv::Rect(tx * kTile, ty * kTile, kTile, kTile) & all;
+        const std::vector<cv::Mat> relit = search_.RelitCells(view_, tile);
+        for (std::size_t c = 0; c < planes_.size(); ++c) relit[c].copyTo(planes_[c](tile));
+        done = 1;
+      }
+  }
+  const std::array<cv::Mat, 3>& planes() const { return planes_; }
+
+ private:
+  static constexpr int kTile = 16;
+  const PlacementSearch& search_;
+  const ViewAtStep& view_;
+  std::array<cv::Mat, 3> planes_;
+  int tiles_x_ = 0;
+  std::vector<char> done_;
+};
+
+std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views,
+                                            const std::vector<cv::Point>& texels,
+                                            std::vector<RelitTiles>& relit) const {
+  std::vector<double> total(texels.size(), 0.0);
+  for (std::size_t r = 0; r < views.size(); ++r) {
+    const ViewAtStep& v = views[r];
+    for (std::size_t n = 0; n < texels.size(); ++n) {
+      const cv::Point at = v.Cell(texels[n]);
+      relit[r].Cover(cv::Rect(at, v.mask.size()));
+      double ssd = 0.0;
+      for (int j = 0; j < v.mask.rows; ++j) {
+        const float* m = v.mask.ptr<float>(j);
+        float row = 0.0f;  // a row's sum in floats (it vectorises), rows in doubles
+        for (std::size_t c = 0; c < v.photo.size(); ++c) {
+          const float* s = relit[r].planes()[c].ptr<float>(at.y + j) + at.x;
+          const float* p = v.photo[c].ptr<float>(j);
+          for (int i = 0; i < v.mask.cols; ++i) {
+            const float d = s[i] - p[i];
+            row += m[i] * d * d;
+          }
+        }
+        ssd += row;
+      }
+      // Eq. 3: the RMS difference at the photo's density (as AddImageScore).
+      total[n] += std::sqrt(std::max(ssd, 0.0) / (3.0 * v.count));
+    }
+  }
+  return {total.begin(), total.end()};
+}
+
+std::vector<ScoredPlacement> PlacementSearch::Exhaustive(int top_k) const {
+  const std::vector<ViewAtStep> views = ViewsAtStep(0);
+  // Top-k distinct positions at the best view's density (neighbouring texel
+  // positions share one photo-density cell and score alike).
+  return KeepBest(ScoreOnGrid(views, Stride(views)), top_k);
+}
+
+std::vector<ScoredPlacement> PlacementSearch::CoarseToFine(int top_k, int candidates, int max_steps,
+                                                           int min_cells) const {
+  const int steps = CoarseSteps(max_steps, min_cells);
+  if (steps == 0) return Exhaustive(top_k);
+  std::vector<ViewAtStep> views = ViewsAtStep(steps);
+  int coarse_stride = Stride(views);
+  // Refining scores about (2 coarse / fine + 1)^2 placements per candidate and step;
+  // when that is not well below every placement, the exhaustive search is cheaper.
+  const int fine_stride = Stride(ViewsAtStep(0));
+  const double per_candidate = std::pow(2.0 * coarse_stride / fine_stride + 1.0, 2.0);
+  const double everywhere = (last_x_ / fine_stride + 1.0) * (last_y_ / fine_stride + 1.0);
+  if (everywhere < kRefineFraction * std::max(candidates, top_k) * per_candidate * steps)
+    return Exhaustive(top_k);
+  std::vector<ScoredPlacement> kept =
+      KeepBest(ScoreOnGrid(views, coarse_stride), std::max(candidates, top_k));
+  for (int step = steps - 1; step >= 0; --step) {
+    views = ViewsAtStep(step);
+    const int stride = Stride(views);
+    std::vector<RelitTiles> relit;
+    relit.reserve(views.size());
+    for (const ViewAtStep& v : views) relit.emplace_back(*this, v);
+    // Every placement of this density's grid within a coarse cell of a candidate.
+    std::unordered_set<long long> seen;
+    std::vector<ScoredPlacement> scored;
+    for (const auto& [score, c] : kept) {
+      std::vector<cv::Point> near;
+      const auto first = [&](int v) {
+        return std::max(0, (v - coarse_stride + stride - 1) / stride);
+      };
+      for (int y = first(c.y) * stride; y <= std::min(last_y_, c.y + coarse_stride); y += stride)
+        for (int x = first(c.x) * stride; x <= std::min(last_x_, c.x + coarse_stride); x += stride)
+          if (seen.insert(static_cast<long long>(y) * (last_x_ + 1) + x).second)
+            near.emplace_back(x, y);
+      if (near.empty()) continue;
+      const std::vector<float> s = ScoreAt(views, near, relit);
+      for (std::size_t n = 0; n < near.size(); ++n) scored.emplace_back(s[n], near[n]);
+    }
+    kept = KeepBest(std::move(scored), step == 0 ? top_k : std::max(candidates, top_k));
+    coarse_stride = stride;
+  }
+  return kept;
+}
+
+std::vector<RelitWindow> PlacementSearch::RelitAround(cv::Point at,
+                                                      const std::vector<int>& margin_cells) const {
+  std::vector<RelitWindow> out;
+  const std::vector<ViewAtStep> views = ViewsAtStep(0);
+  for (std::size_t n = 0; n < views.size(); ++n) {
+    const ViewAtStep& v = views[n];
+    const int m = margin_cells[n];
+    const cv::Rect cells =
+        cv::Rect(v.Cell(at) - cv::Point(m, m), v.mask.size() + cv::Size(2 * m, 2 * m)) &
+        cv::Rect(0, 0, v.reduced->planes[0].cols, v.reduced->planes[0].rows);
+    out.push_back(RelitWindow{RelitCells(v, cells), cells.tl()});
+  }
+  return out;
+}
+
+}  // namespace texlume::synth

@@ -1,0 +1,146 @@
+#include "synth/placement_search.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "synth/colour_sample.h"
+
+namespace texlume::synth {
+namespace {
+
+// A colour texture with structure at every scale: blurred noise at three widths.
+cv::Mat StructuredColour(int size, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> n(0.0f, 1.0f);
+  cv::Mat sum = cv::Mat::zeros(size, size, CV_32FC3);
+  for (const double sigma : {0.7, 2.0, 5.0}) {
+    cv::Mat noise(size, size, CV_32FC3);
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) {
+        const float c2 = n(rng), c1 = n(rng), c0 = n(rng);
+        noise.at<cv::Vec3f>(y, x) = cv::Vec3f(c0, c1, c2);
+      }
+    cv::GaussianBlur(noise, noise, cv::Size(), sigma);
+    cv::Scalar mean, stddev;
+    cv::meanStdDev(noise, mean, stddev);
+    sum += noise * (0.08 / stddev[0]);
+  }
+  sum += cv::Scalar::all(0.5);
+  cv::Mat clamped;
+  cv::min(cv::max(sum, 0.02), 0.98, clamped);
+  return clamped;
+}
+
+constexpr int kPatch = 24;
+
+// A view at density `level` whose photo is the sample relit at the placement `at`
+// (sample texels), plus Gaussian noise of `noise` (linear).
+RectifiedView PlantedView(const ColourSample& sample, int level, cv::Point at,
+                          const FaceLighting& lighting, double gain, double noise, unsigned seed) {
+  RectifiedView v;
+  v.level = level;
+  v.lighting = lighting;
+  const ReducedPlanes& r = sample.Reduced(level);
+  const cv::Size grid(static_cast<int>(std::lround(kPatch * r.rx)),
+                      static_cast<int>(std::lround(kPatch * r.ry)));
+  const cv::Rect cells(cv::Point(static_cast<int>(std::lround(at.x * r.rx)),
+                                 static_cast<int>(std::lround(at.y * r.ry))),
+                       grid);
+  ReducedPlanes window{{}, r.rx, r.ry};
+  for (const cv::Mat& plane : r.planes) window.planes.push_back(plane(cells));
+  v.planes = sample.Relight(window, lighting, gain);
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> n(0.0f, static_cast<float>(noise));
+  for (cv::Mat& plane : v.planes) {
+    plane = plane.clone();
+    for (int y = 0; y < plane.rows; ++y)
+      for (int x = 0; x < plane.cols; ++x) plane.at<float>(y, x) += n(rng);
+  }
+  v.mask = cv::Mat::ones(grid, CV_32FC1);
+  v.count = grid.area();
+  return v;
+}
+
+struct Fixture {
+  ColourSample sample{StructuredColour(160, 7)};
+  std::vector<double> gains{1.0, 0.8};
+  cv::Point planted{73, 41};  // off every coarse grid
+  std::vector<RectifiedView> views;
+  Fixture(double noise) {
+    const FaceLighting zenith{Eigen::Vector3d::UnitZ(), {{Eigen::Vector3d::UnitZ(), 1.0}}, {}};
+    const FaceLighting slanted{
+        Eigen::Vector3d::UnitZ(), {{Eigen::Vector3d(0.6, 0.0, 0.8), 1.5}}, {}};
+    views.push_back(PlantedView(sample, 0, planted, zenith, gains[0], noise, 1));
+    views.push_back(PlantedView(sample, 4, planted, slanted, gains[1], noise, 2));
+    views.back().photo = 1;
+  }
+};
+
+// Both searches find the planted placement, and score it as the photos' noise.
+TEST(PlacementSearch, BothSearchesFindThePlantedPlacement) {
+  const Fixture f(0.01);
+  const PlacementSearch search(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch));
+  ASSERT_GE(search.CoarseSteps(3, 6), 1);
+  const std::vector<ScoredPlacement> exhaustive = search.Exhaustive(12);
+  const std::vector<ScoredPlacement> coarse_to_fine = search.CoarseToFine(12, 16);
+  ASSERT_EQ(exhaustive.size(), 12u);
+  ASSERT_EQ(coarse_to_fine.size(), 12u);
+  EXPECT_EQ(exhaustive[0].second, f.planted);
+  EXPECT_EQ(coarse_to_fine[0].second, f.planted);
+  // The noise of each photo (0.01, linear) in eq. 3's RMS, summed over 2 views.
+  EXPECT_NEAR(coarse_to_fine[0].first, 0.02, 0.004);
+  for (std::size_t n = 1; n < coarse_to_fine.size(); ++n)
+    EXPECT_LE(coarse_to_fine[n - 1].first, coarse_to_fine[n].first);
+}
+
+// The direct scores of the refinement equal the FFT scores of the exhaustive
+// search at the same placements.
+TEST(PlacementSearch, RefinedScoresEqualTheExhaustiveScores) {
+  const Fixture f(0.05);
+  const PlacementSearch search(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch));
+  std::map<std::pair<int, int>, float> everywhere;
+  for (const auto& [score, at] : search.Exhaustive(1 << 20)) everywhere[{at.x, at.y}] = score;
+  const std::vector<ScoredPlacement> refined = search.CoarseToFine(12, 16);
+  ASSERT_EQ(refined.size(), 12u);
+  for (const auto& [score, at] : refined) {
+    ASSERT_TRUE(everywhere.count({at.x, at.y})) << at;
+    EXPECT_NEAR(score, everywhere.at({at.x, at.y}), 1e-4 + 1e-4 * score) << at;
+  }
+  // No coarser density: the same as the exhaustive search.
+  EXPECT_EQ(search.CoarseSteps(3, 1000), 0);
+  const std::vector<ScoredPlacement> fallback = search.CoarseToFine(12, 16, 3, 1000);
+  const std::vector<ScoredPlacement> exhaustive = search.Exhaustive(12);
+  for (std::size_t n = 0; n < 12; ++n) EXPECT_EQ(fallback[n], exhaustive[n]);
+}
+
+// The relit windows are the whole relit sample's cells, clipped at its borders.
+TEST(PlacementSearch, RelitWindowsAreTheRelitSamplesCells) {
+  const Fixture f(0.0);
+  const PlacementSearch search(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch));
+  for (const cv::Point at : {cv::Point(72, 40), cv::Point(0, 0), cv::Point(136, 136)}) {
+    const std::vector<RelitWindow> relit = search.RelitAround(at, {3, 2});
+    ASSERT_EQ(relit.size(), 2u);
+    for (std::size_t v = 0; v < 2; ++v) {
+      const ReducedPlanes& r = f.sample.Reduced(f.views[v].level);
+      const std::vector<cv::Mat> whole =
+          f.sample.Relight(r, f.views[v].lighting, f.gains[f.views[v].photo]);
+      const cv::Rect window(relit[v].origin, relit[v].planes[0].size());
+      EXPECT_EQ(window, (window & cv::Rect(cv::Point(0, 0), whole[0].size())));
+      const int m = v == 0 ? 3 : 2;
+      const cv::Point cell(static_cast<int>(std::lround(at.x * r.rx)),
+                           static_cast<int>(std::lround(at.y * r.ry)));
+      EXPECT_EQ(window.x, std::max(0, cell.x - m));
+      EXPECT_EQ(window.br().x, std::min(whole[0].cols, cell.x + f.views[v].mask.cols + m));
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(cv::norm(relit[v].planes[static_cast<std::size_t>(c)],
+                           whole[static_cast<std::size_t>(c)](window), cv::NORM_INF),
+                  0.0);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace texlume::synth
