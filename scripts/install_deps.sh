@@ -10,6 +10,7 @@ PACKAGES=(
   libeigen3-dev libopenmesh-dev libopencv-dev libceres-dev libopenimageio-dev
   nlohmann-json3-dev libembree-dev
   libcli11-dev  # the command line (BSD)
+  libnanoflann-dev  # detail transfer's nearest windows (BSD, header-only)
   libcpp-httplib-dev  # the viewer's local HTTP server (MIT)
   zlib1g-dev  # CRC-32 checksums of the inputs in reports (zlib licence)
   openimageio-tools  # its CMake package config refers to the OIIO tools

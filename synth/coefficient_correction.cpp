@@ -6,11 +6,11 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <opencv2/flann.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/image_io.h"
 #include "ptm/coefficient_space.h"
+#include "synth/nearest_windows.h"
 #include "synth/photo_blur.h"
 
 namespace texlume::synth {
@@ -25,10 +25,6 @@ using Row6d = Eigen::Matrix<double, 1, 6>;
 constexpr int kDetailWindowRadius = 1;
 constexpr int kDetailWindowLength =
     (2 * kDetailWindowRadius + 1) * (2 * kDetailWindowRadius + 1) * 6;
-// Leaves visited per query (FLANN checks): 8 matches as well as 32 on the demo
-// (SSIM 0.538 either way) in 60 % of the time.
-constexpr int kDetailChecks = 8;
-constexpr int kDetailTrees = 4;
 // At most this many sample points per dictionary (2^16 windows take 14 MiB;
 // a 256 x 256 sample has about 62 000).
 constexpr std::size_t kDetailMaxPoints = std::size_t{1} << 16;
@@ -386,8 +382,7 @@ class CoefficientCorrection::PatchPass {
 class CoefficientCorrection::DetailDictionary {
  public:
   // Touches no shared state, so levels can be built in parallel.
-  DetailDictionary(const PtmSample& sample, int level, std::uint32_t seed,
-                   std::vector<cv::Mat>& band) {
+  DetailDictionary(const PtmSample& sample, int level, std::vector<cv::Mat>& band) {
     const ReducedPlanes& red = sample.Reduced(level);
     dx_ = 1.0 / red.rx, dy_ = 1.0 / red.ry;
     const cv::Size full(sample.Width(), sample.Height());
@@ -409,16 +404,16 @@ class CoefficientCorrection::DetailDictionary {
     band.resize(values.size());
     for (std::size_t c = 0; c < band.size(); ++c)
       band[c] = values[c] - (c < 6 ? coarse_[c] : coarse_raw[c]);
-    IndexWindows(full, level, seed);
+    IndexWindows(full);
   }
 
-  bool Usable() const { return index_ != nullptr; }
+  bool Usable() const { return nearest_ != nullptr; }
 
   // Matches for every cell of a corrected patch (its correction grid).
   void Transfer(TrianglePatch& patch, int level) const;
 
  private:
-  void IndexWindows(cv::Size full, int level, std::uint32_t seed) {
+  void IndexWindows(cv::Size full) {
     const int bx = static_cast<int>(std::ceil(kDetailWindowRadius * dx_)),
               by = static_cast<int>(std::ceil(kDetailWindowRadius * dy_));
     const int nx = full.width - 2 * bx, ny = full.height - 2 * by;
@@ -429,25 +424,17 @@ class CoefficientCorrection::DetailDictionary {
         std::ceil(std::sqrt(static_cast<double>(nx) * ny / static_cast<double>(kDetailMaxPoints))));
     for (int y = by; y < full.height - by; y += stride)
       for (int x = bx; x < full.width - bx; x += stride) points_.emplace_back(x, y);
-    windows_ = cv::Mat(static_cast<int>(points_.size()), kDetailWindowLength, CV_32FC1);
+    cv::Mat windows(static_cast<int>(points_.size()), kDetailWindowLength, CV_32FC1);
     for (std::size_t n = 0; n < points_.size(); ++n)
       CoarseWindow(coarse_, points_[n].x, points_[n].y, dx_, dy_,
-                   windows_.ptr<float>(static_cast<int>(n)));
-    // The randomised trees draw from this thread's cv::theRNG(): seeded per
-    // level, so that the matches do not depend on threads or earlier draws.
-    cv::RNG& rng_of_thread = cv::theRNG();
-    const std::uint64_t saved_state = rng_of_thread.state;
-    rng_of_thread.state = 0x7e41u + static_cast<std::uint64_t>(level) + seed * 1000003u;
-    index_ =
-        std::make_unique<cv::flann::Index>(windows_, cv::flann::KDTreeIndexParams(kDetailTrees));
-    rng_of_thread.state = saved_state;
+                   windows.ptr<float>(static_cast<int>(n)));
+    nearest_ = std::make_unique<NearestWindows>(std::move(windows), NearestWindows::Options{});
   }
 
   double dx_ = 1.0, dy_ = 1.0;     // texels per photo cell
   std::vector<cv::Mat> coarse_;    // 6 orthonormal luminance planes, full size
-  cv::Mat windows_;                // CV_32FC1, one kDetailWindowLength row per point
   std::vector<cv::Point> points_;  // window centres, texels
-  std::unique_ptr<cv::flann::Index> index_;
+  std::unique_ptr<NearestWindows> nearest_;
 };
 
 void CoefficientCorrection::DetailDictionary::Transfer(TrianglePatch& patch, int level) const {
@@ -472,16 +459,18 @@ void CoefficientCorrection::DetailDictionary::Transfer(TrianglePatch& patch, int
             *q++ =
                 corrected[m].at<float>(std::clamp(j + b, 0, gh - 1), std::clamp(i + a, 0, gw - 1));
     }
-  cv::Mat indices, distances;
-  index_->knnSearch(queries, indices, distances, 1, cv::flann::SearchParams(kDetailChecks));
+  std::vector<int> indices;
+  std::vector<float> distances;
+  nearest_->Nearest(queries, indices, distances);
   patch.detail_source = cv::Mat(gh, gw, CV_32FC2);
   cv::Mat best(gh, gw, CV_32FC1);
   for (int j = 0; j < gh; ++j)
     for (int i = 0; i < gw; ++i) {
-      const cv::Point p = points_[static_cast<std::size_t>(indices.at<int>(j * gw + i, 0))];
+      const std::size_t n = static_cast<std::size_t>(j * gw + i);
+      const cv::Point p = points_[static_cast<std::size_t>(indices[n])];
       patch.detail_source.at<cv::Vec2f>(j, i) =
           cv::Vec2f(static_cast<float>(p.x), static_cast<float>(p.y));
-      best.at<float>(j, i) = distances.at<float>(j * gw + i, 0);
+      best.at<float>(j, i) = distances[n];
     }
   // Coherent matches keep the detail whole where their bands are blended: a
   // neighbour cell's match moved by one cell wherever it is nearer.
@@ -581,7 +570,7 @@ void CoefficientCorrection::Finish(TriangleEngine& engine, const ProgressCallbac
   for (std::size_t n = 0; n < levels.size(); ++n) {
     const int level = levels[n];
     dictionaries_.at(level) =
-        std::make_unique<DetailDictionary>(sample_, level, options_.seed, detail_bands_.at(level));
+        std::make_unique<DetailDictionary>(sample_, level, detail_bands_.at(level));
   }
   // The corrected patches, independent of one another.
   std::vector<std::size_t> transferred;

@@ -1,0 +1,98 @@
+#include "synth/nearest_windows.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+namespace texlume::synth {
+namespace {
+
+// Windows as detail transfer makes them: 3 x 3 points 2 texels apart on 6
+// smooth planes (blurred noise), one window per texel inside.
+cv::Mat SmoothWindows(int size, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> n(0.0f, 1.0f);
+  std::vector<cv::Mat> planes(6);
+  for (cv::Mat& p : planes) {
+    p.create(size, size, CV_32FC1);
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x) p.at<float>(y, x) = n(rng);
+    cv::GaussianBlur(p, p, cv::Size(), 2.0);
+  }
+  cv::Mat windows;
+  for (int y = 2; y < size - 2; ++y)
+    for (int x = 2; x < size - 2; ++x) {
+      cv::Mat row(1, 54, CV_32FC1);
+      float* w = row.ptr<float>();
+      for (int b = -1; b <= 1; ++b)
+        for (int a = -1; a <= 1; ++a)
+          for (const cv::Mat& p : planes) *w++ = p.at<float>(y + 2 * b, x + 2 * a);
+      windows.push_back(row);
+    }
+  return windows;
+}
+
+float SquaredDistance(const cv::Mat& a, const cv::Mat& b) {
+  return static_cast<float>(cv::norm(a, b, cv::NORM_L2SQR));
+}
+
+TEST(NearestWindows, FewComponentsFindTheWindowsThemselves) {
+  const cv::Mat windows = SmoothWindows(120, 3);
+  const NearestWindows nearest(windows.clone(), NearestWindows::Options{});
+  EXPECT_GE(nearest.Components(), 1);
+  EXPECT_EQ(nearest.Components(), 8);
+  cv::Mat queries;
+  for (int r = 0; r < windows.rows; r += 37) queries.push_back(windows.row(r));
+  std::vector<int> index;
+  std::vector<float> distance;
+  nearest.Nearest(queries, index, distance);
+  for (int q = 0; q < queries.rows; ++q)
+    EXPECT_EQ(distance[static_cast<std::size_t>(q)], 0.0f) << q;
+}
+
+TEST(NearestWindows, NoisyQueriesFindNearlyTheExactNearestAtTheirFullDistance) {
+  const cv::Mat windows = SmoothWindows(120, 5);
+  const NearestWindows nearest(windows.clone(), NearestWindows::Options{});
+  std::mt19937 rng(9);
+  std::normal_distribution<float> noise(0.0f, 0.05f);
+  cv::Mat queries;
+  for (int r = 0; r < windows.rows; r += 53) {
+    cv::Mat q = windows.row(r).clone();
+    for (int i = 0; i < q.cols; ++i) q.at<float>(0, i) += noise(rng);
+    queries.push_back(q);
+  }
+  std::vector<int> index;
+  std::vector<float> distance;
+  nearest.Nearest(queries, index, distance);
+  int exact = 0;
+  double ratio_sum = 0.0;
+  for (int q = 0; q < queries.rows; ++q) {
+    float best = std::numeric_limits<float>::max();
+    for (int w = 0; w < windows.rows; ++w)
+      best = std::min(best, SquaredDistance(queries.row(q), windows.row(w)));
+    const std::size_t n = static_cast<std::size_t>(q);
+    // The distance returned is the full one to the window returned.
+    EXPECT_NEAR(distance[n], SquaredDistance(queries.row(q), windows.row(index[n])),
+                1e-4f * (1.0f + distance[n]));
+    EXPECT_GE(distance[n], best * (1.0f - 1e-5f));
+    exact += distance[n] <= best * (1.0f + 1e-5f);
+    ratio_sum += distance[n] / best;
+  }
+  EXPECT_GE(exact, queries.rows * 9 / 10) << exact << " of " << queries.rows;
+  EXPECT_LT(ratio_sum / queries.rows, 1.05);
+}
+
+TEST(NearestWindows, TheSameWindowsGiveTheSameMatches) {
+  const cv::Mat windows = SmoothWindows(80, 7);
+  const cv::Mat queries = SmoothWindows(20, 8);
+  std::vector<int> a, b;
+  std::vector<float> da, db;
+  NearestWindows(windows.clone(), NearestWindows::Options{}).Nearest(queries, a, da);
+  NearestWindows(windows.clone(), NearestWindows::Options{}).Nearest(queries, b, db);
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(da, db);
+}
+
+}  // namespace
+}  // namespace texlume::synth
