@@ -69,7 +69,7 @@ void BindEngine(CLI::App* sub, synth::MeshSynthesisOptions& s, SynthWords& w) {
           {"exhaustive", synth::PlacementSearchKind::kExhaustive}}))
       ->default_str("coarse-to-fine");
   sub->add_option("--search-candidates", s.search_candidates,
-                  "coarse-to-fine: placements kept at each coarser density (>= --top-k)")
+                  "coarse-to-fine: placements kept at each coarser density (at least --top-k)")
       ->capture_default_str();
   sub->add_flag("--best-view-only", w.best_view_only, "constrain by the best view alone");
   sub->add_option("--max-views", s.max_views, "most photos constraining a triangle")

@@ -28,58 +28,6 @@ Placement BestOf(const cv::Mat& ssd, int rotation, double overlap) {
   return best;
 }
 
-// The transform size for a copy of side n: the smallest 2^a, 3 * 2^a or
-// 5 * 2^a at least n. OpenCV's optimal sizes (any 2^a 3^b 5^c) are smaller but
-// can be slower: 375 = 3 * 5^3 (a 512^2 sample's copies) transforms 1.7 times
-// slower than 384.
-int FastDftSize(int n) {
-  int best = std::numeric_limits<int>::max();
-  for (const int odd : {1, 3, 5}) {
-    int m = odd;
-    while (m < n) m *= 2;
-    best = std::min(best, m);
-  }
-  return best;
-}
-
-cv::Mat Spectrum(const cv::Mat& plane, int dft_size) {
-  cv::Mat padded = cv::Mat::zeros(dft_size, dft_size, CV_32FC1), spectrum;
-  plane.copyTo(padded(cv::Rect(0, 0, plane.cols, plane.rows)));
-  cv::dft(padded, spectrum, 0, plane.rows);
-  return spectrum;
-}
-
-// sum_c sum M (T_c - I_c)^2 at every placement, expanded as in
-// synth::MaskedSsd: corr(E, M) - 2 sum_c corr(I_c, M T_c) + sum_c sum M T_c^2,
-// the correlations summed in the frequency domain (one inverse DFT). The copy
-// is padded to at least its side, so placements inside it never wrap. Only the
-// work image's rows are transformed forward (the rest is zero padding) and only
-// the placements' rows back.
-cv::Mat MaskedSsdBySpectra(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
-                           const cv::Mat& mask) {
-  const int n = copy.dft_size;
-  cv::Mat padded = cv::Mat::zeros(n, n, CV_32FC1), spectrum, term, sum, masked;
-  const cv::Rect work(0, 0, mask.cols, mask.rows);
-  mask.copyTo(padded(work));
-  cv::dft(padded, spectrum, 0, mask.rows);
-  cv::mulSpectrums(copy.energy_spectrum, spectrum, sum, 0, true);
-  double constant = 0;
-  for (std::size_t c = 0; c < work_planes.size(); ++c) {
-    cv::multiply(work_planes[c], mask, masked);
-    constant += masked.dot(work_planes[c]);
-    masked.copyTo(padded(work));
-    cv::dft(padded, spectrum, 0, mask.rows);
-    cv::mulSpectrums(copy.plane_spectra[c], spectrum, term, 0, true);
-    cv::scaleAdd(term, -2.0, sum, sum);
-  }
-  const cv::Size placements(copy.side() - mask.cols + 1, copy.side() - mask.rows + 1);
-  cv::Mat full;
-  cv::dft(sum, full, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT, placements.height);
-  cv::Mat ssd = full(cv::Rect(cv::Point(0, 0), placements)) + constant;
-  cv::max(ssd, 0.0, ssd);
-  return ssd;
-}
-
 void CheckWorkImage(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
                     const cv::Mat& work_mask) {
   if (work_planes.size() != copy.planes.size() || work_mask.type() != CV_32FC1)
@@ -142,10 +90,7 @@ RotatedCopy RotatedSample::Make(int rotation) const {
         copy.planes[static_cast<std::size_t>(c)].at<float>(y, x) = f[static_cast<std::size_t>(c)];
     }
   copy.energy = synth::PlaneEnergy(copy.planes);
-  copy.dft_size = FastDftSize(side_);
-  for (const cv::Mat& plane : copy.planes)
-    copy.plane_spectra.push_back(Spectrum(plane, copy.dft_size));
-  copy.energy_spectrum = Spectrum(copy.energy, copy.dft_size);
+  copy.spectra = synth::ImageSpectra(copy.planes, copy.energy);
   return copy;
 }
 
@@ -181,13 +126,13 @@ const RotatedCopy& RotatedSample::Copy(int rotation) {
 cv::Mat EntirePatchCosts(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
                          const cv::Mat& work_mask) {
   CheckWorkImage(copy, work_planes, work_mask);
-  return MaskedSsdBySpectra(copy, work_planes, work_mask) / std::max(cv::sum(work_mask)[0], 1.0);
+  return copy.spectra.MaskedSsd(work_planes, work_mask) / std::max(cv::sum(work_mask)[0], 1.0);
 }
 
 Placement MatchEntirePatch(const RotatedCopy& copy, const std::vector<cv::Mat>& work_planes,
                            const cv::Mat& work_mask) {
   CheckWorkImage(copy, work_planes, work_mask);
-  return BestOf(MaskedSsdBySpectra(copy, work_planes, work_mask), copy.rotation,
+  return BestOf(copy.spectra.MaskedSsd(work_planes, work_mask), copy.rotation,
                 cv::sum(work_mask)[0]);
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "synth/material_sample.h"
+#include "synth/template_match.h"
 
 // Entire-patch matching of graph-cut quilting on surfaces (paper 004 §III-B,
 // "Patch Matching", after Kwatra et al. 2003): the whole sample, turned to the
@@ -24,11 +25,9 @@ struct RotatedCopy {
   double angle_rad = 0;
   std::vector<cv::Mat> planes;  ///< CV_32FC1 feature planes, side x side
   cv::Mat energy;               ///< their summed squares
-  /// The planes' and the energy's DFTs (CCS packed, zero-padded to dft_size
-  /// square), made once per copy: a match then transforms only the work image.
-  std::vector<cv::Mat> plane_spectra;
-  cv::Mat energy_spectrum;
-  int dft_size = 0;
+  /// The planes' and the energy's DFTs, made once per copy: a match then
+  /// transforms only the work image.
+  synth::ImageSpectra spectra;
 
   int side() const { return planes.empty() ? 0 : planes[0].cols; }
 };

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <limits>
 #include <nanoflann.hpp>
+#include <stdexcept>
 
 namespace texlume::synth {
 namespace {
@@ -12,6 +13,13 @@ namespace {
 constexpr int kMaxComponentRows = 8192;
 // Points per leaf of the kd-tree.
 constexpr int kLeafSize = 16;
+
+// nanoflann's search settings with `eps` (renamed in 1.5).
+#if NANOFLANN_VERSION >= 0x150
+nanoflann::SearchParameters SearchEps(float eps) { return nanoflann::SearchParameters(eps); }
+#else
+nanoflann::SearchParams SearchEps(float eps) { return nanoflann::SearchParams(0, eps); }
+#endif
 
 // The mean (1 x length, CV_32F) and the `count` leading principal directions
 // (rows, CV_32F, by decreasing variance), from every step-th window.
@@ -47,12 +55,14 @@ struct NearestWindows::Tree {
 
 NearestWindows::NearestWindows(cv::Mat windows, Options options)
     : options_(options), windows_(std::move(windows)), tree_(std::make_unique<Tree>()) {
-  CV_Assert(windows_.type() == CV_32FC1 && windows_.rows >= 2);
+  if (windows_.type() != CV_32FC1 || windows_.rows < 2 || options_.components < 1 ||
+      options_.candidates < 1 || !(options_.eps >= 0.0f))
+    throw std::invalid_argument(
+        "NearestWindows: float windows (at least 2), components and candidates >= 1, eps >= 0");
   PrincipalComponents(windows_, options_.components, mean_, components_);
   tree_->projected = Project(windows_);
-  tree_->index = std::make_unique<Tree::Index>(
+  tree_->index = std::make_unique<Tree::Index>(  // builds the tree
       components_.rows, *tree_, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize));
-  tree_->index->buildIndex();
 }
 
 NearestWindows::~NearestWindows() = default;
@@ -77,8 +87,7 @@ void NearestWindows::Nearest(const cv::Mat& queries, std::vector<int>& index,
   for (int q = 0; q < queries.rows; ++q) {
     nanoflann::KNNResultSet<float, std::uint32_t> nearest(k);
     nearest.init(found.data(), reduced_distance.data());
-    tree_->index->findNeighbors(nearest, projected.ptr<float>(q),
-                                nanoflann::SearchParams(0, options_.eps));
+    tree_->index->findNeighbors(nearest, projected.ptr<float>(q), SearchEps(options_.eps));
     const float* query = queries.ptr<float>(q);
     const std::size_t n = static_cast<std::size_t>(q);
     for (std::size_t c = 0; c < nearest.size(); ++c) {

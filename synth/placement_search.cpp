@@ -64,7 +64,8 @@ std::vector<PlacementSearch::ViewAtStep> PlacementSearch::ViewsAtStep(int step) 
       for (std::size_t c = 0; c < r.planes.size(); ++c) {
         cv::Mat weighted;
         cv::resize(r.planes[c].mul(r.mask), weighted, grid, 0, 0, cv::INTER_AREA);
-        cv::divide(weighted, v.mask, v.photo[c]);  // 0 where nothing is seen
+        cv::divide(weighted, v.mask, v.photo[c]);
+        v.photo[c].setTo(0.0f, v.mask <= 0.0f);  // 0 / 0 is NaN: 0 where nothing is seen
       }
       v.count = cv::sum(v.mask)[0];
     }

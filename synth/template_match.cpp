@@ -1,5 +1,7 @@
 #include "synth/template_match.h"
 
+#include <algorithm>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
@@ -29,6 +31,64 @@ cv::Mat MaskedSsd(const std::vector<cv::Mat>& image_planes, const cv::Mat& image
   result += constant;
   cv::max(result, 0.0, result);
   return result;
+}
+
+int FastDftSize(int n) {
+  int best = std::numeric_limits<int>::max();
+  for (const int odd : {1, 3, 5}) {
+    int m = odd;
+    while (m < n) m *= 2;
+    best = std::min(best, m);
+  }
+  return best;
+}
+
+namespace {
+
+// The DFT of a plane zero-padded to `padded` (only its rows are transformed
+// forward: the rest is zero).
+cv::Mat Spectrum(const cv::Mat& plane, cv::Size padded) {
+  cv::Mat zeros = cv::Mat::zeros(padded, CV_32FC1), spectrum;
+  plane.copyTo(zeros(cv::Rect(0, 0, plane.cols, plane.rows)));
+  cv::dft(zeros, spectrum, 0, plane.rows);
+  return spectrum;
+}
+
+}  // namespace
+
+ImageSpectra::ImageSpectra(const std::vector<cv::Mat>& planes, const cv::Mat& energy)
+    : image_(energy.size()), padded_(FastDftSize(image_.width), FastDftSize(image_.height)) {
+  for (const cv::Mat& plane : planes) plane_spectra_.push_back(Spectrum(plane, padded_));
+  energy_spectrum_ = Spectrum(energy, padded_);
+}
+
+cv::Mat ImageSpectra::MaskedSsd(const std::vector<cv::Mat>& template_planes,
+                                const cv::Mat& mask) const {
+  // As synth::MaskedSsd: corr(E, M) - 2 sum_c corr(I_c, M T_c) + sum_c sum M T_c^2,
+  // the correlations summed in the frequency domain; only the placements' rows
+  // are transformed back.
+  if (template_planes.size() != plane_spectra_.size() || plane_spectra_.empty())
+    throw std::invalid_argument("ImageSpectra::MaskedSsd: one template plane per image plane");
+  cv::Mat padded = cv::Mat::zeros(padded_, CV_32FC1), spectrum, term, sum, masked;
+  const cv::Rect work(0, 0, mask.cols, mask.rows);
+  mask.copyTo(padded(work));
+  cv::dft(padded, spectrum, 0, mask.rows);
+  cv::mulSpectrums(energy_spectrum_, spectrum, sum, 0, true);
+  double constant = 0;
+  for (std::size_t c = 0; c < template_planes.size(); ++c) {
+    cv::multiply(template_planes[c], mask, masked);
+    constant += masked.dot(template_planes[c]);
+    masked.copyTo(padded(work));
+    cv::dft(padded, spectrum, 0, mask.rows);
+    cv::mulSpectrums(plane_spectra_[c], spectrum, term, 0, true);
+    cv::scaleAdd(term, -2.0, sum, sum);
+  }
+  const cv::Size placements(image_.width - mask.cols + 1, image_.height - mask.rows + 1);
+  cv::Mat full;
+  cv::dft(sum, full, cv::DFT_INVERSE | cv::DFT_SCALE | cv::DFT_REAL_OUTPUT, placements.height);
+  cv::Mat ssd = full(cv::Rect(cv::Point(0, 0), placements)) + constant;
+  cv::max(ssd, 0.0, ssd);
+  return ssd;
 }
 
 cv::Mat MaskedSsdBruteForce(const std::vector<cv::Mat>& image_planes,

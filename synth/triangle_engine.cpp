@@ -72,7 +72,7 @@ void TriangleEngineOptions::Check() const {
     throw OptionError("sample texel size must be a positive number of world units");
   if (strip < 2 || strip > 32) throw OptionError("strip (W_e) must be in [2, 32] texels");
   if (top_k < 1) throw OptionError("top_k must be >= 1");
-  if (search_candidates < top_k) throw OptionError("search candidates must be >= top_k");
+  if (search_candidates < 1) throw OptionError("search candidates must be >= 1");
   if (max_views < 1) throw OptionError("max_views must be >= 1");
   if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
   if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
@@ -526,7 +526,7 @@ void TriangleEngine::ScoreAndPlace(TrianglePatch& patch, const std::vector<Recti
 }
 
 void TriangleEngine::PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap,
-                                       std::mt19937_64& rng) const {
+                                       std::mt19937_64& rng) {
   const int w = patch.width, h = patch.height;
   const std::size_t n = static_cast<std::size_t>(sample_.NumFeatures());
   std::vector<cv::Mat> target_planes(n);
@@ -538,8 +538,8 @@ void TriangleEngine::PlaceByNeighbours(TrianglePatch& patch, const OverlapTarget
     for (std::size_t c = 0; c < n; ++c)
       target_planes[c].at<float>(j, i) = overlap.targets[m * n + c];
   }
-  const cv::Mat errors =
-      MaskedSsd(sample_.FeaturePlanes(), sample_.FeatureEnergy(), target_planes, mask);
+  if (!feature_spectra_) feature_spectra_.emplace(sample_.FeaturePlanes(), sample_.FeatureEnergy());
+  const cv::Mat errors = feature_spectra_->MaskedSsd(target_planes, mask);
   const cv::Point p = PickWithinTolerance(errors, options_.tolerance, rng);
   patch.sample_x = p.x;
   patch.sample_y = p.y;

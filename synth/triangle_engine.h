@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "sfm/visibility.h"
 #include "synth/material_sample.h"
 #include "synth/photometry.h"
+#include "synth/template_match.h"
 #include "synth/triangle_parts.h"
 
 namespace texlume::synth {
@@ -40,8 +42,9 @@ struct TriangleEngineOptions {
   int top_k = 12;
   /// How the image score searches the sample (issue 33: coarse to fine by default).
   PlacementSearchKind search = PlacementSearchKind::kCoarseToFine;
-  /// Coarse to fine: placements kept at each coarser density and refined. >= top_k.
-  int search_candidates = 48;
+  /// Coarse to fine: placements kept at each coarser density and refined (at
+  /// least top_k are). >= 1.
+  int search_candidates = 16;
   /// Constrain with every photo in which the triangle is fully visible (scores
   /// summed, each under its own light), not only the best view (paper 003).
   bool all_views = true;
@@ -265,8 +268,7 @@ class TriangleEngine {
   void ScoreAndPlace(TrianglePatch& patch, const std::vector<RectifiedView>& views,
                      const OverlapTargets& overlap, std::vector<RelitWindow>& relit);
   // Unseen faces: the overlap constraint over every placement (FFT).
-  void PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap,
-                         std::mt19937_64& rng) const;
+  void PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap, std::mt19937_64& rng);
 
   const mesh::TriangleMesh& mesh_;
   const sfm::Reconstruction& reconstruction_;
@@ -285,6 +287,8 @@ class TriangleEngine {
   bool patches_in_sample_ = true;
   /// The faces in the order the passes over the photos visit them (FacesByPhoto).
   std::vector<std::size_t> photo_visit_order_;
+  // The sample's feature planes transformed once, for the faces no photo sees.
+  std::optional<ImageSpectra> feature_spectra_;
   TriangleSynthesis result_;
 };
 

@@ -211,17 +211,17 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
                     "--sample-texel-size 0.01 --out f --tangent-frame photos --tangent-field 0,0,1",
                     &out),
             2);
-  // A placement search that is not one of the two, or fewer candidates than top_k.
+  // A placement search that is not one of the two, or no candidates.
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
                     "--sample-texel-size 0.01 --out f --search sideways",
                     &out),
             2);
   EXPECT_NE(out.find("--search"), std::string::npos) << out;
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
-                    "--sample-texel-size 0.01 --out f --search-candidates 4",
+                    "--sample-texel-size 0.01 --out f --search-candidates 0",
                     &out),
             2);
-  EXPECT_NE(out.find("search candidates must be >= top_k"), std::string::npos) << out;
+  EXPECT_NE(out.find("search candidates must be >= 1"), std::string::npos) << out;
   // A photo cache that is not a size (photos on demand, docs/cli.md).
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
                     "--sample-texel-size 0.01 --out f --photo-cache lots",
@@ -479,7 +479,9 @@ TEST(Cli, SynthWithABtfSampleRendersAsABtfAndRefusesBadInput) {
   const std::string model = (tmp / "model").string();
   std::string out;
   ASSERT_EQ(
-      Texlume("synth" + inputs + " --btf " + scene + "/material/btf --components 8 --out " + model,
+      Texlume("synth" + inputs + " --btf " + scene +
+                  "/material/btf --components 8 --search exhaustive --search-candidates 20 --out " +
+                  model,
               &out),
       0)
       << out;
@@ -488,6 +490,9 @@ TEST(Cli, SynthWithABtfSampleRendersAsABtfAndRefusesBadInput) {
       nlohmann::json::parse(testing::ReadText(tmp / "model/manifest.json"));
   EXPECT_EQ(manifest["btf"]["format"], "texlume-btf-model-1");
   EXPECT_EQ(manifest["settings"]["components"].get<int>(), 8);
+  // The placement search's settings reach the BTF job.
+  EXPECT_EQ(manifest["settings"]["search"], "exhaustive");
+  EXPECT_EQ(manifest["settings"]["search_candidates"].get<int>(), 20);
   const std::string held = scene + "/object/held_out";
   const std::string render = "render --model " + model + " --cameras " + held +
                              "/sparse --lights " + held + "/lights.json --truth " + held +

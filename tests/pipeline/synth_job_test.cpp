@@ -122,7 +122,7 @@ TEST_F(MeshPipelineTest, EveryTriangleGetsAPatchMostFromThePhotos) {
   // The photos' blur, one per photo (synth/photo_blur.h), within the candidates.
   EXPECT_TRUE(manifest["settings"]["photo_blur"].get<bool>());
   EXPECT_EQ(manifest["settings"]["search"], "coarse-to-fine");
-  EXPECT_EQ(manifest["settings"]["search_candidates"].get<int>(), 48);
+  EXPECT_EQ(manifest["settings"]["search_candidates"].get<int>(), 16);
   const nlohmann::json& blur = manifest["summary"]["photo_blur"];
   ASSERT_EQ(blur.size(), manifest["summary"]["photo_gains"].size());
   for (const auto& sigma : blur) {

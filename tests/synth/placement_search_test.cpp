@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -59,8 +60,14 @@ RectifiedView PlantedView(const ColourSample& sample, int level, cv::Point at,
     for (int y = 0; y < plane.rows; ++y)
       for (int x = 0; x < plane.cols; ++x) plane.at<float>(y, x) += n(rng);
   }
-  v.mask = cv::Mat::ones(grid, CV_32FC1);
-  v.count = grid.area();
+  // A triangle's mask, as a face's views have: the cells above the diagonal are
+  // outside it (their photo values are not the face's).
+  v.mask = cv::Mat::zeros(grid, CV_32FC1);
+  for (int y = 0; y < grid.height; ++y)
+    for (int x = 0; x < grid.width; ++x)
+      if (x * grid.height <= (y + 1) * grid.width) v.mask.at<float>(y, x) = 1.0f;
+  for (cv::Mat& plane : v.planes) plane.setTo(5.0f, v.mask == 0);
+  v.count = cv::sum(v.mask)[0];
   return v;
 }
 
@@ -94,6 +101,7 @@ TEST(PlacementSearch, BothSearchesFindThePlantedPlacement) {
   EXPECT_NEAR(coarse_to_fine[0].first, 0.02, 0.004);
   for (std::size_t n = 1; n < coarse_to_fine.size(); ++n)
     EXPECT_LE(coarse_to_fine[n - 1].first, coarse_to_fine[n].first);
+  for (const auto& [score, at] : coarse_to_fine) EXPECT_TRUE(std::isfinite(score)) << at;
 }
 
 // The direct scores of the refinement equal the FFT scores of the exhaustive
