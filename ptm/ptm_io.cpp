@@ -133,6 +133,103 @@ class CoefficientRanks {
   std::array<std::array<std::size_t, 2>, 6> below_{};
 };
 
+// CoefficientRanks' values in one pass over the coefficients, when a strided
+// sample brackets each rank: every step-th texel's keys give, per index and rank,
+// a key range holding the rank with a margin of 8 standard deviations of a sample
+// quantile's rank; the pass counts the keys below each range and collects those
+// inside it, among which the rank's key is selected. Exact like CoefficientRanks;
+// Values() returns false (and the caller falls back to it) when a rank falls
+// outside its range or a range holds too many keys (many equal values).
+class BracketedRanks {
+ public:
+  BracketedRanks(const std::vector<float>& a, std::array<std::size_t, 2> ranks)
+      : a_(a), ranks_(ranks), count_(a.size() / 6) {}
+
+  bool Values(std::array<std::array<float, 2>, 6>& values) {
+    const std::size_t step = std::max<std::size_t>(1, count_ / kSampleTarget);
+    for (std::size_t i = 0; i < 6; ++i) Bracket(i, step);
+    if (!CountAndCollect()) return false;
+    for (std::size_t i = 0; i < 6; ++i)
+      for (std::size_t r = 0; r < 2; ++r) {
+        std::vector<std::uint32_t>& inside = inside_[i][r];
+        if (ranks_[r] < below_[i][r] || ranks_[r] - below_[i][r] >= inside.size()) return false;
+        const auto nth = inside.begin() + static_cast<std::ptrdiff_t>(ranks_[r] - below_[i][r]);
+        std::nth_element(inside.begin(), nth, inside.end());
+        values[i][r] = FromOrderedKey(*nth);
+      }
+    return true;
+  }
+
+ private:
+  static constexpr std::size_t kSampleTarget = std::size_t{1} << 20;
+
+  std::uint32_t Key(std::size_t j, std::size_t i) const {
+    return OrderedKey(255.0f * a_[j * 6 + i]);
+  }
+
+  // Index i's key range around each rank, from every step-th texel's keys.
+  void Bracket(std::size_t i, std::size_t step) {
+    std::vector<std::uint32_t> sample;
+    for (std::size_t j = 0; j < count_; j += step) sample.push_back(Key(j, i));
+    const double m = static_cast<double>(sample.size());
+    for (std::size_t r = 0; r < 2; ++r) {
+      const double p = static_cast<double>(ranks_[r]) / static_cast<double>(count_);
+      const double at = p * m, margin = 8.0 * std::sqrt(m * p * (1.0 - p)) + 16.0;
+      const auto nth = [&](double rank, std::uint32_t beyond) {
+        if (rank < 0.0 || rank > m - 1.0) return beyond;
+        const auto it = sample.begin() + static_cast<std::ptrdiff_t>(rank);
+        std::nth_element(sample.begin(), it, sample.end());
+        return *it;
+      };
+      low_[i][r] = nth(std::floor(at - margin), 0u);
+      high_[i][r] = nth(std::ceil(at + margin), std::numeric_limits<std::uint32_t>::max());
+      // At most 4 times the keys a range of this width should hold, and 2^16.
+      limit_ = std::max<std::size_t>(
+          limit_, static_cast<std::size_t>(4.0 * 2.0 * margin * static_cast<double>(step)) +
+                      (std::size_t{1} << 16));
+    }
+  }
+
+  // Counts each index's keys below its ranges and collects those inside; false
+  // when a range holds more than limit_ keys.
+  bool CountAndCollect() {
+    bool overflow = false;
+#pragma omp parallel
+    {
+      std::array<std::array<std::size_t, 2>, 6> below{};
+      std::array<std::array<std::vector<std::uint32_t>, 2>, 6> inside;
+#pragma omp for schedule(static) nowait
+      for (std::size_t j = 0; j < count_; ++j)
+        for (std::size_t i = 0; i < 6; ++i) {
+          const std::uint32_t key = Key(j, i);
+          for (std::size_t r = 0; r < 2; ++r) {
+            if (key < low_[i][r]) {
+              ++below[i][r];
+            } else if (key <= high_[i][r] && inside[i][r].size() < limit_) {
+              inside[i][r].push_back(key);
+            }
+          }
+        }
+#pragma omp critical
+      for (std::size_t i = 0; i < 6; ++i)
+        for (std::size_t r = 0; r < 2; ++r) {
+          below_[i][r] += below[i][r];
+          overflow = overflow || inside[i][r].size() >= limit_;
+          inside_[i][r].insert(inside_[i][r].end(), inside[i][r].begin(), inside[i][r].end());
+        }
+    }
+    return !overflow;
+  }
+
+  const std::vector<float>& a_;
+  std::array<std::size_t, 2> ranks_;
+  std::size_t count_;
+  std::size_t limit_ = 0;
+  std::array<std::array<std::uint32_t, 2>, 6> low_{}, high_{};
+  std::array<std::array<std::size_t, 2>, 6> below_{};
+  std::array<std::array<std::vector<std::uint32_t>, 2>, 6> inside_;
+};
+
 // Quantisers per coefficient index, over every texel (and channel for RGB), in
 // 0-255 units: the range between the 0.1 % and 99.9 % quantiles, widened to hold 0,
 // in 255 steps.
@@ -140,8 +237,10 @@ std::array<Quantiser, 6> Quantisers(const Ptm& ptm) {
   std::array<Quantiser, 6> q;
   const std::size_t count = ptm.coefficients.size() / 6;
   if (count == 0) return q;
-  const auto values =
-      CoefficientRanks(ptm.coefficients, {count / 1000, count - 1 - count / 1000}).Values();
+  const std::array<std::size_t, 2> ranks{count / 1000, count - 1 - count / 1000};
+  std::array<std::array<float, 2>, 6> values;
+  if (!BracketedRanks(ptm.coefficients, ranks).Values(values))
+    values = CoefficientRanks(ptm.coefficients, ranks).Values();
   for (std::size_t i = 0; i < 6; ++i) {
     const float lo = std::min(0.0f, values[i][0]);
     const float hi = std::max(0.0f, values[i][1]);

@@ -129,6 +129,45 @@ TEST_P(PtmFileTest, EachCoefficientsRangeLeavesOutItsLowestAndHighestThousandth)
   }
 }
 
+// The header's ranges against the known answer by selection: [min(0, v_(n/1000)),
+// max(0, v_(n-1-n/1000))] of the values 255 a_i of every texel, n of them.
+void ExpectExactRanges(const Ptm& ptm) {
+  std::stringstream s;
+  WritePtm(ptm, s);
+  std::string line;
+  for (int l = 0; l < 4; ++l) std::getline(s, line);
+  double scale[6];
+  int bias[6];
+  for (double& v : scale) s >> v;
+  for (int& v : bias) s >> v;
+  for (int i = 0; i < 6; ++i) {
+    std::vector<float> values;
+    for (std::size_t t = 0; t < ptm.NumTexels(); ++t)
+      values.push_back(255.0f * ptm.Coefficients(t)[i]);
+    const std::size_t n = values.size();
+    std::nth_element(values.begin(), values.begin() + n / 1000, values.end());
+    const float lo = std::min(0.0f, values[n / 1000]);
+    std::nth_element(values.begin(), values.begin() + (n - 1 - n / 1000), values.end());
+    const float hi = std::max(0.0f, values[n - 1 - n / 1000]);
+    EXPECT_FLOAT_EQ(static_cast<float>(scale[i]), (hi - lo) / 255.0f) << "coefficient " << i;
+    EXPECT_EQ(bias[i], std::lround(-lo / ((hi - lo) / 255.0f))) << "coefficient " << i;
+  }
+}
+
+// On more than 2^21 values per coefficient the ranges are found from a strided
+// sample and one pass (ptm_io.cpp, BracketedRanks); with most of one coefficient's
+// values equal, by the two-pass radix select. Both exact.
+TEST(PtmFile, LargePtmRangesAreExactFromTheSampleAndTheFallback) {
+  Ptm ptm = RandomPtm(PtmFormat::kLrgb, 2200, 1000, 6);
+  std::mt19937 rng(8);
+  std::normal_distribution<float> spread(0.0f, 1.0f);
+  for (float& a : ptm.coefficients) a = a * spread(rng) * spread(rng);  // long tails
+  ExpectExactRanges(ptm);
+  for (std::size_t t = 0; t < ptm.NumTexels(); ++t)
+    if (t % 50 != 0) ptm.Coefficients(t)[4] = -0.25f;  // index 4: a range of ties
+  ExpectExactRanges(ptm);
+}
+
 INSTANTIATE_TEST_SUITE_P(Formats, PtmFileTest,
                          ::testing::Values(PtmFormat::kLrgb, PtmFormat::kRgb));
 
