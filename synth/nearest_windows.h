@@ -38,7 +38,6 @@ class NearestWindows {
                std::vector<float>& squared_distance) const;
 
   int Components() const { return components_.rows; }
-  int Size() const { return windows_.rows; }
 
  private:
   cv::Mat Project(const cv::Mat& rows) const;
