@@ -416,6 +416,10 @@ void BindSceneCapture(CLI::App* sub, datasets::SceneOptions& s) {
       ->capture_default_str();
   sub->add_option("--mesh-resolution", s.mesh_resolution, "coarse mesh resolution [0, 7]")
       ->capture_default_str();
+  sub->add_option("--mesh-faces", s.mesh_faces,
+                  "a coarse mesh of about this many faces instead (0: --mesh-resolution; a "
+                  "monument: 1000000)")
+      ->capture_default_str();
   sub->add_option("--btf-size", s.btf_size, "BTF capture side in texels")->capture_default_str();
   sub->add_option("--btf-views", s.btf_view_count, "BTF capture views")->capture_default_str();
   sub->add_option("--btf-lights", s.btf_light_count, "BTF capture lights")->capture_default_str();
@@ -479,6 +483,15 @@ void AddSceneCommand(CLI::App& app, CommandRunners& run) {
       ->default_str("pinhole");
   sub->add_option("--width", s->image_width, "photo width in pixels")->capture_default_str();
   sub->add_option("--height", s->image_height, "photo height in pixels")->capture_default_str();
+  sub->add_option("--camera-rings", s->camera_rings,
+                  "rings the photos lie on (1: one waving ring; more: a monument's capture)")
+      ->capture_default_str();
+  sub->add_option("--camera-distance", s->camera_distance,
+                  "cameras' distance from the object's centre, world units")
+      ->capture_default_str();
+  sub->add_option("--focal", s->focal_px,
+                  "focal length in pixels of a 640-pixel-wide photo (scaled with --width)")
+      ->capture_default_str();
   BindSceneCapture(sub, *s);
   BindSensor(sub, s->sensor);
   sub->add_flag("--no-btf", flags->first, "no BTF capture");

@@ -14,11 +14,64 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
+struct CameraAngles {
+  double azimuth = 0;    ///< radians
+  double elevation = 0;  ///< radians
+};
+
+// One ring: the elevation waves gently around it (neighbours stay close, as in
+// a real photo set, while the set covers a band of elevations). Several rings:
+// CameraRingElevations, the photos shared out evenly, each ring's azimuths half
+// a step from the ring below's.
+std::vector<CameraAngles> PhotoAngles(const ObjectSceneOptions& options) {
+  std::vector<CameraAngles> angles;
+  const int n = options.num_images;
+  if (options.camera_rings == 1) {
+    double mid = 22.0, amplitude = 12.0;
+    if (options.shape == SceneShape::kPlane) mid = 55.0, amplitude = 10.0;
+    if (options.shape == SceneShape::kTorus) mid = 38.0, amplitude = 12.0;
+    for (int i = 0; i < n; ++i) {
+      const double azimuth = 2 * kPi * i / n;
+      angles.push_back({azimuth, (mid + amplitude * std::sin(3.0 * azimuth)) * kPi / 180.0});
+    }
+    return angles;
+  }
+  const std::vector<double> elevations = CameraRingElevations(options.shape, options.camera_rings);
+  const int rings = options.camera_rings;
+  for (int ring = 0; ring < rings; ++ring) {
+    const int on_ring = n / rings + (ring < n % rings ? 1 : 0);
+    const double offset = ring % 2 == 0 ? 0.0 : 0.5;
+    for (int i = 0; i < on_ring; ++i) {
+      angles.push_back(
+          {2 * kPi * (i + offset) / on_ring, elevations[static_cast<std::size_t>(ring)]});
+    }
+  }
+  return angles;
+}
+
 }  // namespace
+
+std::vector<double> CameraRingElevations(SceneShape shape, int rings) {
+  double low = -40.0, high = 55.0;  // degrees
+  if (shape == SceneShape::kPlane) low = 35.0, high = 75.0;
+  if (shape == SceneShape::kTorus) low = 10.0, high = 70.0;
+  std::vector<double> elevations;
+  for (int ring = 0; ring < rings; ++ring) {
+    const double t = rings == 1 ? 0.5 : static_cast<double>(ring) / (rings - 1);
+    elevations.push_back((low + t * (high - low)) * kPi / 180.0);
+  }
+  return elevations;
+}
 
 void ObjectSceneOptions::Check() const {
   if (resolution < 0 || resolution > 7) throw OptionError("resolution must be in [0, 7]");
   if (num_images < 1 || num_images > 1000) throw OptionError("num_images must be in [1, 1000]");
+  if (target_faces < 0 || target_faces > kMaxTargetFaces) {
+    throw OptionError("target_faces must be in [0, " + std::to_string(kMaxTargetFaces) + "]");
+  }
+  if (camera_rings < 1 || camera_rings > 20 || camera_rings > num_images) {
+    throw OptionError("camera_rings must be in [1, 20] and at most num_images");
+  }
   if (image_width < 16 || image_width > 16384 || image_height < 16 || image_height > 16384) {
     throw OptionError("image size must be in [16, 16384]");
   }
@@ -55,7 +108,9 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
   options.Check();
   ObjectScene scene;
   const int res = options.resolution;
-  if (res == 0) {
+  if (options.target_faces > 0) {
+    scene.mesh = ShapeMeshWithFaces(options.shape, options.target_faces);
+  } else if (res == 0) {
     scene.mesh = CoarseMesh(options.shape);
   } else {
     switch (options.shape) {
@@ -88,19 +143,14 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
   }
   scene.reconstruction.cameras[camera.camera_id] = camera;
 
-  // A ring of cameras looking at the origin (the plane is seen from above only,
-  // the torus from higher up so its hole shows). Each photo gets 1 to
+  // Cameras looking at the origin (the plane is seen from above only, the torus
+  // from higher up so its hole shows). Each photo gets 1 to
   // max_lights_per_image directional lights from the camera's side of the object,
   // 20 to 70 degrees above the horizon, with intensities summing to about 1.
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  // Elevation waves gently around the ring (neighbours stay close, as in a real
-  // photo set, while the set covers a band of elevations).
-  double mid = 22.0, amplitude = 12.0;
-  if (options.shape == SceneShape::kPlane) mid = 55.0, amplitude = 10.0;
-  if (options.shape == SceneShape::kTorus) mid = 38.0, amplitude = 12.0;
+  const std::vector<CameraAngles> photo_angles = PhotoAngles(options);
   for (int i = 0; i < options.num_images; ++i) {
-    const double azimuth = 2 * kPi * i / options.num_images;
-    const double elevation = (mid + amplitude * std::sin(3.0 * azimuth)) * kPi / 180.0;
+    const auto [azimuth, elevation] = photo_angles[static_cast<std::size_t>(i)];
     const Eigen::Vector3d center =
         options.camera_distance * Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
                                                   std::cos(elevation) * std::sin(azimuth),

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <vector>
 
 #include "datasets_synthetic/shapes.h"
 #include "mesh/mesh.h"
@@ -18,8 +19,18 @@ struct ObjectSceneOptions {
   /// 1..7 an icosphere subdivision level (sphere) or segments / 8 around and
   /// along (cylinder, plane, torus).
   int resolution = 3;
-  /// Number of photos, placed on two rings around the object. Range [1, 1000].
+  /// > 0: a coarse mesh of about this many faces instead (ShapeMeshWithFaces), up
+  /// to kMaxTargetFaces: a monument-scale mesh.
+  std::int64_t target_faces = 0;
+  static constexpr std::int64_t kMaxTargetFaces = std::int64_t{1} << 23;
+  /// Number of photos around the object. Range [1, 1000].
   int num_images = 16;
+  /// 1: the photos on one ring whose elevation waves gently around the object.
+  /// 2 or more: on this many rings of even elevation steps (CameraRingElevations),
+  /// the photos shared out evenly, each ring's azimuths half a step from the
+  /// ring below: the layout of a monument's capture, where close photos on rings
+  /// at several heights cover the object between them. [1, 20], <= num_images.
+  int camera_rings = 1;
   int image_width = 640;    ///< pixels, [16, 16384]
   int image_height = 480;   ///< pixels, [16, 16384]
   double focal_px = 600.0;  ///< pixels, > 0
@@ -37,6 +48,12 @@ struct ObjectSceneOptions {
 
   void Check() const;
 };
+
+/// The elevations (radians) of `rings` >= 2 camera rings around a shape, in even
+/// steps: from below to above the equator for the sphere and cylinder (a camera
+/// looking at the origin then sees the lower, middle and upper parts), from above
+/// for the plane (seen from its front only) and the torus.
+std::vector<double> CameraRingElevations(SceneShape shape, int rings);
 
 /// A synthetic object: its coarse mesh, a COLMAP model of its photos (cameras,
 /// poses, sparse points with tracks) and one directional light per photo.

@@ -73,6 +73,10 @@ void SceneOptions::Check() const {
   material.Check();
   if (mesh_resolution < 0 || mesh_resolution > 7)
     throw OptionError("mesh resolution must be in [0, 7]");
+  RequireInRange(static_cast<double>(mesh_faces), 0,
+                 static_cast<double>(ObjectSceneOptions::kMaxTargetFaces), "mesh_faces");
+  RequireInRange(camera_rings, 1, 20, "camera_rings");
+  if (camera_rings > num_images) throw OptionError("camera_rings must be at most num_images");
   RequireInRange(num_images, 3, 1000, "num_images");  // monument captures: 50-600
   RequireInRange(image_width, 64, 8192, "image_width");
   RequireInRange(image_height, 64, 8192, "image_height");
@@ -466,6 +470,8 @@ class SceneGenerator {
     ObjectSceneOptions object_options;
     object_options.shape = options_.shape;
     object_options.resolution = options_.mesh_resolution;
+    object_options.target_faces = options_.mesh_faces;
+    object_options.camera_rings = options_.camera_rings;
     object_options.num_images = options_.num_images;
     object_options.image_width = options_.image_width;
     object_options.image_height = options_.image_height;
@@ -611,12 +617,16 @@ class SceneGenerator {
                           {"sheen", options_.material.sheen},
                           {"seed", options_.material.seed}};
     record["seed"] = options_.seed;
+    record["coarse_mesh"] = {{"resolution", options_.mesh_resolution},
+                             {"target_faces", options_.mesh_faces},
+                             {"faces", object_.mesh.faces.size()}};
     record["units"] = "world units of the COLMAP model (the shapes are about 2 units across)";
     record["camera"] = {{"model", sfm::CameraModelName(options_.camera_model)},
                         {"width", options_.image_width},
                         {"height", options_.image_height},
                         {"focal_px", options_.focal_px},
                         {"distance", options_.camera_distance},
+                        {"rings", options_.camera_rings},
                         {"held_out_scale", options_.held_out_scale}};
     record["held_out_light_elevations_deg"] = {options_.held_out_min_elevation_deg,
                                                options_.held_out_max_elevation_deg};

@@ -48,6 +48,13 @@ struct SceneOptions {
   /// on the sphere); 1..7 as ObjectSceneOptions::resolution (the sphere's
   /// icosphere level: 20 * 4^N triangles).
   int mesh_resolution = 0;
+  /// > 0: a coarse mesh of about this many faces instead (ShapeMeshWithFaces; up
+  /// to ObjectSceneOptions::kMaxTargetFaces): a monument-scale scene.
+  std::int64_t mesh_faces = 0;
+  /// Rings the photos lie on (ObjectSceneOptions::camera_rings): 1 is the gently
+  /// waving ring of the standard scenes; more, with a shorter camera distance and
+  /// a longer focal length, is a monument's capture of close photos. [1, 20].
+  int camera_rings = 1;
 
   // Material sample captures (orthographic, rectified to the material frame).
   int capture_size = 256;                ///< texels per side, [16, 4096]

@@ -1,6 +1,7 @@
 #include "datasets_synthetic/shapes.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -162,6 +163,35 @@ mesh::TriangleMesh CoarseMesh(SceneShape shape) {
   return {};
 }
 
+mesh::TriangleMesh ShapeMeshWithFaces(SceneShape shape, std::int64_t target_faces) {
+  const double n = static_cast<double>(std::max<std::int64_t>(target_faces, 1));
+  // Cells about square: segments around / along = circumference / length.
+  const auto segments = [](double value, int least) {
+    return std::max(least, static_cast<int>(std::lround(value)));
+  };
+  switch (shape) {
+    case SceneShape::kSphere: {
+      int level = 0;  // 20 * 4^level nearest n on a log scale
+      while (level < 10 && 20.0 * std::pow(4.0, level) * 2.0 < n) ++level;
+      return MakeIcosphere(level, kSphereRadius);
+    }
+    case SceneShape::kCylinder: {
+      // 2 * around * along (side) + about around^2 / pi (the caps' rings) faces.
+      const double aspect = 2 * kPi * kCylinderRadius / kCylinderHeight;
+      const int along = segments(std::sqrt(n / (2 * aspect + aspect * aspect / kPi)), 1);
+      return MakeColumn(segments(aspect * along, 3), along, kCylinderRadius, kCylinderHeight);
+    }
+    case SceneShape::kPlane:
+      return MakeGridPlane(segments(std::sqrt(n / 2), 1), kPlaneSize);
+    case SceneShape::kTorus: {
+      const double aspect = kTorusMajor / kTorusMinor;  // 2 * around * tube faces
+      const int tube = segments(std::sqrt(n / (2 * aspect)), 3);
+      return MakeTorus(segments(n / (2.0 * tube), 3), tube, kTorusMajor, kTorusMinor);
+    }
+  }
+  return {};
+}
+
 mesh::TriangleMesh MakeTorus(int around, int tube, double major, double minor) {
   mesh::TriangleMesh mesh;
   for (int j = 0; j < tube; ++j) {
@@ -299,6 +329,76 @@ mesh::TriangleMesh MakeCylinder(int around, int along, double radius, double hei
     mesh.faces.push_back({bottom, ring(i + 1, 0), ring(i, 0)});
     mesh.faces.push_back({top, ring(i, along), ring(i + 1, along)});
   }
+  return mesh;
+}
+
+namespace {
+
+// Vertices of a ring of `count` at `radius` and height z, from angle 0 counter-clockwise.
+std::vector<int> AddRing(mesh::TriangleMesh& mesh, int count, double radius, double z) {
+  std::vector<int> ring;
+  for (int i = 0; i < count; ++i) {
+    const double a = 2 * kPi * i / count;
+    ring.push_back(static_cast<int>(mesh.vertices.size()));
+    mesh.vertices.emplace_back(radius * std::cos(a), radius * std::sin(a), z);
+  }
+  return ring;
+}
+
+// The triangles between two concentric rings (both from angle 0, counter-clockwise),
+// advancing along whichever ring's next vertex comes first: facing +Z when `up`.
+void ZipRings(mesh::TriangleMesh& mesh, const std::vector<int>& inner,
+              const std::vector<int>& outer, bool up) {
+  const auto ni = inner.size(), no = outer.size();
+  const auto face = [&](int a, int b, int c) {
+    mesh.faces.push_back(up ? std::array<int, 3>{a, b, c} : std::array<int, 3>{a, c, b});
+  };
+  std::size_t i = 0, j = 0;
+  while (i < ni || j < no) {
+    const double next_inner = static_cast<double>(i + 1) / static_cast<double>(ni);
+    const double next_outer = static_cast<double>(j + 1) / static_cast<double>(no);
+    if (j < no && (i == ni || next_outer <= next_inner)) {
+      face(inner[i % ni], outer[j], outer[(j + 1) % no]);
+      ++j;
+    } else {
+      face(inner[i], outer[j % no], inner[(i + 1) % ni]);
+      ++i;
+    }
+  }
+}
+
+// A disk cap on `rim` (a ring of the side): concentric rings of about square
+// cells, fewer vertices towards the centre, closed by a small fan.
+void AddDiskCap(mesh::TriangleMesh& mesh, const std::vector<int>& rim, double radius, double z,
+                bool up) {
+  const int around = static_cast<int>(rim.size());
+  const int rings = std::max(1, static_cast<int>(std::lround(around / (2 * kPi))));
+  std::vector<int> outer = rim;
+  for (int r = rings - 1; r >= 1; --r) {
+    const int count = std::max(3, static_cast<int>(std::lround(around * r / double(rings))));
+    const std::vector<int> inner = AddRing(mesh, count, radius * r / rings, z);
+    ZipRings(mesh, inner, outer, up);
+    outer = inner;
+  }
+  const int centre = static_cast<int>(mesh.vertices.size());
+  mesh.vertices.emplace_back(0.0, 0.0, z);
+  for (std::size_t j = 0; j < outer.size(); ++j) {
+    const int a = outer[j], b = outer[(j + 1) % outer.size()];
+    mesh.faces.push_back(up ? std::array<int, 3>{centre, a, b} : std::array<int, 3>{centre, b, a});
+  }
+}
+
+}  // namespace
+
+mesh::TriangleMesh MakeColumn(int around, int along, double radius, double height) {
+  mesh::TriangleMesh mesh;
+  std::vector<std::vector<int>> rings;
+  for (int j = 0; j <= along; ++j)
+    rings.push_back(AddRing(mesh, around, radius, -height / 2 + height * j / along));
+  // Seen from outside, (lower, upper, upper next) turns clockwise: "down".
+  for (int j = 0; j < along; ++j) ZipRings(mesh, rings[j], rings[j + 1], false);
+  AddDiskCap(mesh, rings.front(), radius, -height / 2, false);
+  AddDiskCap(mesh, rings.back(), radius, height / 2, true);
   return mesh;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string_view>
@@ -46,10 +47,20 @@ std::vector<SurfacePatch> ShapePatches(SceneShape shape);
 /// The coarse, undisplaced, low-poly mesh of a shape (what a mesher would give).
 mesh::TriangleMesh CoarseMesh(SceneShape shape);
 
+/// The coarse mesh of a shape with about `target_faces` triangles (a monument-scale
+/// scene: issue 33), as regular as the shape allows: the cylinder, plane and torus
+/// as grids whose cells are about square (within 10 % of the target from a few
+/// hundred faces up), the sphere as the icosphere whose 20 * 4^N faces are nearest
+/// the target on a log scale (within a factor of 2). `target_faces` >= 1.
+mesh::TriangleMesh ShapeMeshWithFaces(SceneShape shape, std::int64_t target_faces);
+
 /// Mesh generators (outward normals), also used by tests.
 mesh::TriangleMesh MakeIcosphere(int subdivisions, double radius);
 mesh::TriangleMesh MakeCylinder(int segments_around, int segments_along, double radius,
                                 double height);
+/// A column as a monument's mesher would give it: the side as MakeCylinder's,
+/// each cap as concentric rings of about square cells (no long fan triangles).
+mesh::TriangleMesh MakeColumn(int around, int along, double radius, double height);
 mesh::TriangleMesh MakeGridPlane(int segments, double size);
 mesh::TriangleMesh MakeTorus(int segments_around, int segments_tube, double major_radius,
                              double minor_radius);

@@ -283,6 +283,14 @@ TEST(Cli, SceneRefusesUnknownKindsAndMaterials) {
   EXPECT_EQ(Texlume("scene --out " + tmp.path().string() + " --material marble", &out), 2);
   EXPECT_EQ(Texlume("scene --out " + tmp.path().string() + " --images 1", &out), 2);
   EXPECT_NE(out.find("num_images"), std::string::npos) << out;
+  // Monument-scale options: out of range, or more rings than photos.
+  EXPECT_EQ(Texlume("scene --out " + tmp.path().string() + " --mesh-faces -5", &out), 2);
+  EXPECT_NE(out.find("mesh_faces"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("scene --out " + tmp.path().string() + " --images 4 --camera-rings 5", &out),
+            2);
+  EXPECT_NE(out.find("camera_rings"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("scene --out " + tmp.path().string() + " --camera-distance 1", &out), 2);
+  EXPECT_FALSE(std::filesystem::exists(tmp / "scene.json"));
 }
 
 class FitCliTest : public ::testing::Test {
