@@ -54,30 +54,11 @@ ChartOutline Box(const std::vector<ChartFace>& chart, double angle,
   return o;
 }
 
-ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
-                     const std::vector<synth::TrianglePatch>& patches, double t, int gutter) {
-  std::vector<std::array<Eigen::Vector2d, 3>> corners;  // texels, chart frame
-  ChartOutline o = Box(chart, angle, patches, t, gutter, &corners);
-  const int w = o.Width(), h = o.Height();
-  cv::Mat mask = cv::Mat::zeros(h, w, CV_8UC1);
-  for (auto c : corners) {
-    for (auto& p : c) p = Eigen::Vector2d(p.x() - o.lo.x(), o.hi.y() - p.y());  // box, y down
-    Eigen::Vector2d clo = c[0], chi = clo;
-    for (const auto& p : c) clo = clo.cwiseMin(p), chi = chi.cwiseMax(p);
-    // Texels the bake writes for this face: centre within gutter + 0.5 of it
-    // (and a hair more, so rounding in the bake cannot write beyond the outline).
-    const double reach = gutter + 0.5 + 1e-6;
-    for (int y = std::max(0, static_cast<int>(clo.y()) - gutter - 1);
-         y <= std::min(h - 1, static_cast<int>(chi.y()) + gutter + 1); ++y) {
-      const auto [x_first, x_last] = TexelColumns(mesh::TriangleRowSpan(c, y + 0.5, reach), w);
-      // Centres on the row's chord of the triangle itself are within reach: no test.
-      const auto [chord_lo, chord_hi] = mesh::TriangleRowSpan(c, y + 0.5, 0.0);
-      for (int x = x_first; x <= x_last; ++x)
-        if ((x + 0.5 >= chord_lo && x + 0.5 <= chord_hi) ||
-            mesh::WithinReachOfTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5), reach))
-          mask.at<std::uint8_t>(y, x) = 1;
-    }
-  }
+namespace {
+
+// The outline's runs, first texel per row and area from its mask (box size, 1 inside).
+void RunsFromMask(const cv::Mat& mask, ChartOutline& o) {
+  const int w = mask.cols, h = mask.rows;
   o.row_first_x.assign(static_cast<std::size_t>(h), std::numeric_limits<int>::max());
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w;) {
@@ -97,6 +78,60 @@ ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
   std::stable_sort(
       o.runs.begin(), o.runs.end(),
       [](const ChartOutline::Run& a, const ChartOutline::Run& b) { return a.length > b.length; });
+}
+
+}  // namespace
+
+ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
+                     const std::vector<synth::TrianglePatch>& patches, double t, int gutter) {
+  std::vector<std::array<Eigen::Vector2d, 3>> corners;  // texels, chart frame
+  ChartOutline o = Box(chart, angle, patches, t, gutter, &corners);
+  const int w = o.Width(), h = o.Height();
+  cv::Mat mask = cv::Mat::zeros(h, w, CV_8UC1);
+  for (auto c : corners) {
+    for (auto& p : c) p = Eigen::Vector2d(p.x() - o.lo.x(), o.hi.y() - p.y());  // box, y down
+    Eigen::Vector2d clo = c[0], chi = clo;
+    for (const auto& p : c) clo = clo.cwiseMin(p), chi = chi.cwiseMax(p);
+    // Texels the bake writes for this face: centre within gutter + 0.5 of it
+    // (and a hair more, so rounding in the bake cannot write beyond the outline).
+    const double reach = gutter + 0.5 + 1e-6;
+    for (int y = std::max(0, static_cast<int>(clo.y()) - gutter - 1);
+         y <= std::min(h - 1, static_cast<int>(chi.y()) + gutter + 1); ++y) {
+      auto [x_first, x_last] = TexelColumns(mesh::TriangleRowSpan(c, y + 0.5, reach), w);
+      // The points within reach of a triangle are convex: on a row, one run of texels.
+      // Centres on the row's chord of the triangle itself are within reach: no test;
+      // outside it, the run's ends are found from the span's ends inwards.
+      const auto [chord_lo, chord_hi] = mesh::TriangleRowSpan(c, y + 0.5, 0.0);
+      const auto within = [&](int x) {
+        return (x + 0.5 >= chord_lo && x + 0.5 <= chord_hi) ||
+               mesh::WithinReachOfTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5), reach);
+      };
+      while (x_first <= x_last && !within(x_first)) ++x_first;
+      while (x_last > x_first && !within(x_last)) --x_last;
+      if (x_first <= x_last)
+        std::fill_n(mask.ptr<std::uint8_t>(y) + x_first, x_last - x_first + 1, std::uint8_t{1});
+    }
+  }
+  RunsFromMask(mask, o);
+  return o;
+}
+
+ChartOutline UnionOutline(const std::vector<ChartFace>& chart,
+                          const std::vector<const ChartOutline*>& face_outlines,
+                          const std::vector<synth::TrianglePatch>& patches, double t, int gutter) {
+  TEXLUME_CHECK(face_outlines.size() == chart.size(), "one outline per face of the chart");
+  ChartOutline o = Box(chart, face_outlines.empty() ? 0.0 : face_outlines[0]->angle, patches, t,
+                       gutter, nullptr);
+  cv::Mat mask = cv::Mat::zeros(o.Height(), o.Width(), CV_8UC1);
+  for (const ChartOutline* face : face_outlines) {
+    // Both boxes lie on the same integer texel grid: x from lo, rows down from hi.
+    const int dx = face->lo.x() - o.lo.x(), dy = o.hi.y() - face->hi.y();
+    for (const ChartOutline::Run& r : face->runs) {
+      std::uint8_t* row = mask.ptr<std::uint8_t>(r.row + dy) + r.x + dx;
+      std::fill(row, row + r.length, std::uint8_t{1});
+    }
+  }
+  RunsFromMask(mask, o);
   return o;
 }
 
@@ -216,6 +251,9 @@ class RowPacker {
   double GapPerRow(const ChartOutline& o, int x, int dy) const;
   // Whole chart c's outline at turn 0 or 1 (180 degrees), made when first needed.
   const ChartOutline& WholeOutline(std::size_t c, int turn);
+  // A piece's outline at a turn, from its faces' outlines (each made once per chart).
+  ChartOutline PieceOutline(std::vector<ChartFace>::iterator first,
+                            std::vector<ChartFace>::iterator last, int turn);
   // The position in `order_` of the chart to pack next.
   std::size_t PickChart();
   // Places all of chart c, cut into pieces along the rows.
@@ -252,6 +290,8 @@ class RowPacker {
   int atlas_ = 0, row_y_ = 0, row_height_ = 0;
   std::vector<int> right_edge_;  // per row of the current band row: first free x
   std::vector<ChartFace> rest_;  // faces of the chart being packed not yet placed
+  // The outlines of the chart's faces at turn 0 and 1, by face.
+  std::array<std::unordered_map<int, ChartOutline>, 2> face_outlines_;
 };
 
 RowPacking RowPacker::Run(const std::vector<std::vector<ChartFace>>& charts) {
@@ -318,6 +358,20 @@ double RowPacker::GapPerRow(const ChartOutline& o, int x, int dy) const {
   return rows > 0 ? gap / rows : 0.0;
 }
 
+ChartOutline RowPacker::PieceOutline(std::vector<ChartFace>::iterator first,
+                                     std::vector<ChartFace>::iterator last, int turn) {
+  const std::vector<ChartFace> piece(first, last);
+  std::vector<const ChartOutline*> faces;
+  for (const ChartFace& cf : piece) {
+    auto& cached = face_outlines_[static_cast<std::size_t>(turn)];
+    auto it = cached.find(cf.face);
+    if (it == cached.end())
+      it = cached.emplace(cf.face, Outline({cf}, turn * kPi, patches_, t_, gutter_)).first;
+    faces.push_back(&it->second);
+  }
+  return UnionOutline(piece, faces, patches_, t_, gutter_);
+}
+
 const ChartOutline& RowPacker::WholeOutline(std::size_t c, int turn) {
   auto& o = whole_[c][static_cast<std::size_t>(turn)];
   if (!o) o = Outline(queue_[c], turn * kPi, patches_, t_, gutter_);
@@ -356,6 +410,7 @@ void RowPacker::PackChart(std::size_t c) {
     throw OptionError("a strip chart of " + std::to_string(height_[c]) +
                       " texels' height does not fit an atlas of " + std::to_string(atlas_size_));
   rest_ = queue_[c];
+  for (auto& cached : face_outlines_) cached.clear();
   while (!rest_.empty()) {
     if (row_height_ == 0) NewRow(height_[c]);
     if (!PlacePiece(c)) {
@@ -377,8 +432,7 @@ Slide RowPacker::BestSlide(std::size_t count) {
   Slide best;
   for (int turn = 0; turn < 2; ++turn) {
     const auto [first, last] = EndOfRest(turn, count);
-    ChartOutline o =
-        Outline(std::vector<ChartFace>(first, last), turn * kPi, patches_, t_, gutter_);
+    ChartOutline o = PieceOutline(first, last, turn);
     // Shorter pieces may sit lower in the row, under others.
     for (int dy = 0; dy + o.Height() <= row_height_; ++dy) {
       const int x = SlideTo(o, dy);

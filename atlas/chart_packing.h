@@ -57,6 +57,13 @@ ChartOutline Box(const std::vector<ChartFace>& chart, double angle,
 ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
                      const std::vector<synth::TrianglePatch>& patches, double t, int gutter);
 
+/// The same outline as Outline(chart, angle) from its faces' own outlines
+/// (`face_outlines[i]` = Outline({chart[i]}, angle)): a packer that outlines many
+/// pieces of one chart rasterises each face once.
+ChartOutline UnionOutline(const std::vector<ChartFace>& chart,
+                          const std::vector<const ChartOutline*>& face_outlines,
+                          const std::vector<synth::TrianglePatch>& patches, double t, int gutter);
+
 /// The turn that brings a chart's smallest bounding box upright (radians): the
 /// smallest box has a side along an edge of the convex hull, so every hull
 /// edge's turn is tried. Packing tries turns from it, so long thin charts

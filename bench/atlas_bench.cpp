@@ -6,6 +6,9 @@
 //      (rigid, conformal, strips, boxes); ATLAS_BENCH_ONLY=dense|jittered|decimated
 // ATLAS_BENCH_DUMP=DIR writes each atlas's coverage (inside, gutter) as a PNG at
 // quarter size, or full size with ATLAS_BENCH_DUMP_FULL=1.
+// ATLAS_BENCH_MONUMENT=N lays out only bench/monument_bench.sh's column of about N
+// faces (texlume scene --kind cylinder --mesh-faces N) at its texel size, 0.001,
+// with the main job's default atlas settings (issue 33: layout at monument scale).
 // Prints per mesh and mode: occupancy (texels inside triangles / atlas texels),
 // charts, atlases, layout seconds, and the charts' texel stretch (area-weighted
 // mean and extremes of the per-face singular values of texels per texel size).
@@ -114,7 +117,26 @@ mesh::TriangleMesh FinerMesh(datasets::SceneShape shape, int doublings) {
 }
 }  // namespace
 
+// The monument column's layout with the job's default settings: seconds and atlases.
+int LayOutMonumentColumn(std::int64_t faces) {
+  const double texel_size = 0.001;
+  const mesh::TriangleMesh column =
+      datasets::ShapeMeshWithFaces(datasets::SceneShape::kCylinder, faces);
+  const synth::PatchGeometry geometry = synth::MakePatchGeometry(
+      column, texel_size, 8, synth::TangentFrame::kFirstEdge, Eigen::Vector3d::UnitZ());
+  const auto t0 = std::chrono::steady_clock::now();
+  const atlas::AtlasLayout layout =
+      atlas::LayoutAtlases(column, geometry.patches, geometry.unfoldings, texel_size, {});
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::printf("column %zu faces: layout %.2f s, %d charts, %zu atlases\n", column.faces.size(),
+              seconds, layout.num_charts, layout.atlas_sizes.size());
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (const char* monument = std::getenv("ATLAS_BENCH_MONUMENT"))
+    return LayOutMonumentColumn(std::atoll(monument));
   atlas::AtlasOptions charts;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--gutter")) charts.gutter = std::atoi(argv[i + 1]);
