@@ -71,6 +71,10 @@ void BindEngine(CLI::App* sub, synth::MeshSynthesisOptions& s, SynthWords& w) {
   sub->add_option("--search-candidates", s.search_candidates,
                   "coarse-to-fine: placements kept at each coarser density (at least --top-k)")
       ->capture_default_str();
+  sub->add_option("--photometry-faces", s.photometry_faces,
+                  "most faces the photo gains and light response observe (more: evenly spread "
+                  "among them)")
+      ->capture_default_str();
   sub->add_flag("--best-view-only", w.best_view_only, "constrain by the best view alone");
   sub->add_option("--max-views", s.max_views, "most photos constraining a triangle")
       ->capture_default_str();
@@ -225,7 +229,7 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
        {"--fill-unseen", "--seam-band", "--strip", "--max-subdivisions", "--correction-iterations",
         "--correction-noise", "--correction-sigma", "--correction-prior-shrink",
         "--no-additive-correction", "--no-channel-correction", "--no-detail-transfer", "--search",
-        "--search-candidates"})
+        "--search-candidates", "--photometry-faces"})
     if (sub->count(name) > 0)
       throw UsageError(std::string(name) + " is not taken by --engine graphcut (docs/quilting.md)");
   TakePhotos(sub, w, o, q);

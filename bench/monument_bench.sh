@@ -6,7 +6,7 @@
 # texel; then fit, synth (the main job, defaults) and render at the held-out views
 # against the truth. Each job runs in its own process, measured by its parent:
 # wall and CPU seconds and peak resident memory. The synth job's own stages are its
-# manifest's timings (wall seconds). The last lines give the synthesis CPU per
+# progress stages (wall seconds, from its log). The last lines give the synthesis CPU per
 # triangle and the held-out PSNR / SSIM.
 # Usage: bench/monument_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [FACES (100000)]
 # Environment: IMAGES (200), RINGS (5), WIDTH (320), HEIGHT (240), TEXEL (0.001), CAPTURE (256).
@@ -61,7 +61,7 @@ measure render "$texlume" render --model "$dir/model" --cameras "$held/sparse" \
   --out "$dir/render"
 
 python3 - "$dir" <<'PY'
-import json, os, sys
+import json, os, re, sys
 d = sys.argv[1]
 job = lambda name: json.load(open(os.path.join(d, name + ".json")))
 m = json.load(open(os.path.join(d, "model", "manifest.json")))
@@ -77,9 +77,11 @@ for name in ("scene", "fit", "synth", "render"):
     j = job(name)
     print(f"| {name} | {j['wall_s']:.1f} | {j['cpu_s']:.1f} | {j['peak_kib'] / 1024:.0f} |")
     if name == "synth":
-        for stage, seconds in m["timings_s"].items():
-            if isinstance(seconds, (int, float)):
-                print(f"| synth: {stage} | {seconds:.1f} | | |")
+        # Its stages as its progress reported them ("stage: n/n (100%), S s elapsed").
+        for line in open(os.path.join(d, "synth.log")):
+            hit = re.match(r"(.+): (\d+)/(\d+) \(100%\), ([\d.]+) s elapsed", line.strip())
+            if hit:
+                print(f"| synth: {hit.group(1)} | {float(hit.group(4)):.1f} | | |")
 print(f"\nsynth: {1000 * job('synth')['cpu_s'] / faces:.2f} CPU ms per triangle, peak "
       f"{m['resources']['peak_resident_bytes'] / 2**20:.0f} MiB (manifest)")
 print(f"held-out PSNR / SSIM: {r['mean_psnr_db']:.2f} / {r['mean_ssim']:.3f}")

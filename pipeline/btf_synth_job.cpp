@@ -135,6 +135,7 @@ class BtfSynthJob {
                                {"top_k", so_.top_k},
                                {"search", synth::PlacementSearchName(so_.search)},
                                {"search_candidates", so_.search_candidates},
+                               {"photometry_faces", so_.photometry_faces},
                                {"max_views", so_.max_views},
                                {"tangent_frame", synth::TangentFrameName(so_.tangent_frame)},
                                {"tolerance", so_.tolerance},

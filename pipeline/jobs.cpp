@@ -472,6 +472,7 @@ pipeline::BtfSynthJobOptions BtfJobFrom(const SynthCommandOptions& c) {
   b.synthesis.top_k = ptm.top_k;
   b.synthesis.search = ptm.search;
   b.synthesis.search_candidates = ptm.search_candidates;
+  b.synthesis.photometry_faces = ptm.photometry_faces;
   b.synthesis.max_views = ptm.all_views ? ptm.max_views : 1;
   b.synthesis.seed = ptm.seed;
   // The photo-consistency pass: --correction-iterations 0 turns it off, as for PTMs.

@@ -533,6 +533,7 @@ class SynthJob {
         {"top_k", so.top_k},
         {"search", synth::PlacementSearchName(so.search)},
         {"search_candidates", so.search_candidates},
+        {"photometry_faces", so.photometry_faces},
         {"all_views", so.all_views},
         {"max_views", so.max_views},
         {"tangent_frame", synth::TangentFrameName(so.tangent_frame)},

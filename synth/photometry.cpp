@@ -237,4 +237,26 @@ Photometry SolvePhotometry(std::vector<PhotometricObservation> observations, std
   return p;
 }
 
+std::vector<char> PhotometryFaces(const std::vector<std::vector<std::uint32_t>>& photos_of_face,
+                                  std::size_t num_photos, std::size_t limit,
+                                  std::size_t min_per_photo) {
+  const std::size_t num_faces = photos_of_face.size();
+  std::vector<char> observed(num_faces, 1);
+  if (num_faces <= limit) return observed;
+  const std::size_t stride = (num_faces + limit - 1) / limit;
+  std::vector<std::size_t> seen(num_photos, 0), kept(num_photos, 0);
+  for (std::size_t f = 0; f < num_faces; ++f) {
+    observed[f] = f % stride == 0 ? 1 : 0;
+    for (const std::uint32_t p : photos_of_face[f]) ++seen[p], kept[p] += observed[f];
+  }
+  // A photo left with too few: every step-th of its faces as well.
+  std::vector<std::size_t> step(num_photos, 0), index(num_photos, 0);
+  for (std::size_t p = 0; p < num_photos; ++p)
+    if (kept[p] < min_per_photo) step[p] = std::max<std::size_t>(1, seen[p] / min_per_photo);
+  for (std::size_t f = 0; f < num_faces; ++f)
+    for (const std::uint32_t p : photos_of_face[f])
+      if (step[p] > 0 && index[p]++ % step[p] == 0) observed[f] = 1;
+  return observed;
+}
+
 }  // namespace texlume::synth

@@ -76,6 +76,8 @@ void TriangleEngineOptions::Check() const {
   if (max_views < 1) throw OptionError("max_views must be >= 1");
   if (!(tolerance >= 0.0)) throw OptionError("tolerance must be >= 0");
   if (min_photo_pixels < 1) throw OptionError("min_photo_pixels must be >= 1");
+  if (photometry_faces < kPhotometryFacesPerPhoto)
+    throw OptionError("photometry_faces must be >= " + std::to_string(kPhotometryFacesPerPhoto));
   if (max_texels < 1) throw OptionError("max_texels must be >= 1");
   if (!(field_direction_in_world.norm() > 0.0))
     throw OptionError("field direction must be nonzero");
@@ -312,12 +314,27 @@ TriangleEngine::PhotometryCandidate TriangleEngine::ObserveForPhotometry(
   return c;
 }
 
+std::vector<char> TriangleEngine::PhotometryFaces() const {
+  std::vector<std::vector<std::uint32_t>> photos_of_face(mesh_.faces.size());
+  for (std::size_t f = 0; f < mesh_.faces.size(); ++f)
+    for (const sfm::TriangleView& view : visibility_.triangles[f].views) {
+      const auto it = photo_index_.find(view.image_id);
+      if (view.fully_visible && it != photo_index_.end())
+        photos_of_face[f].push_back(static_cast<std::uint32_t>(it->second));
+    }
+  return synth::PhotometryFaces(photos_of_face, photos_.size(),
+                                static_cast<std::size_t>(options_.photometry_faces),
+                                TriangleEngineOptions::kPhotometryFacesPerPhoto);
+}
+
 std::vector<std::vector<TriangleEngine::PhotometryCandidate>> TriangleEngine::ObservePhotoByPhoto(
-    double zenith_per_cell, PhotoBlurEstimator* blur, const ProgressCallback& progress) const {
+    const std::vector<char>& observed_faces, double zenith_per_cell, PhotoBlurEstimator* blur,
+    const ProgressCallback& progress) const {
   // Each photo's fully visible faces, as (face, rank among the face's views).
   std::vector<std::vector<std::pair<std::size_t, std::size_t>>> faces_of_photo(photos_.size());
   std::vector<std::vector<PhotometryCandidate>> candidates(mesh_.faces.size());
   for (std::size_t f = 0; f < mesh_.faces.size(); ++f) {
+    if (!observed_faces[f]) continue;
     const std::vector<sfm::TriangleView>& views = visibility_.triangles[f].views;
     candidates[f].resize(views.size());
     for (std::size_t rank = 0; rank < views.size(); ++rank) {
@@ -336,7 +353,8 @@ std::vector<std::vector<TriangleEngine::PhotometryCandidate>> TriangleEngine::Ob
 }
 
 void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
-  // Every face fully visible in a photo (up to 8 steep views, whose lighting the
+  // Every observed face (PhotometryFaces: all up to photometry_faces) fully
+  // visible in a photo (up to 8 steep views, whose lighting the
   // gains trust, and 8 others): the photo's linear sum over the face, and the
   // sample's mean relit under each light alone and at the zenith (synth/photometry.h).
   // When the photos do not all fit in memory, every view is observed first photo by
@@ -352,11 +370,13 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
           : sample_.RelitLinearSum(
                 FaceLighting{Eigen::Vector3d::UnitZ(), {{Eigen::Vector3d::UnitZ(), 1.0}}, {}}, 1);
   PhotoBlurEstimator* blur_estimator = blur ? &*blur : nullptr;
+  const std::vector<char> observed_faces = PhotometryFaces();
   std::vector<std::vector<PhotometryCandidate>> observed;
   if (!PhotosHeldTogether(photos_))
-    observed = ObservePhotoByPhoto(zenith_per_cell, blur_estimator, progress);
+    observed = ObservePhotoByPhoto(observed_faces, zenith_per_cell, blur_estimator, progress);
   for (std::size_t f = 0; f < num_faces; ++f) {
     if (progress && observed.empty() && f % 256 == 0) progress("photometry", f, num_faces);
+    if (!observed_faces[f]) continue;
     const std::vector<sfm::TriangleView>& views = visibility_.triangles[f].views;
     int steep = 0, other = 0;
     for (std::size_t rank = 0; rank < views.size(); ++rank) {

@@ -76,6 +76,13 @@ struct TriangleEngineOptions {
   /// (synth/photo_blur.h), so that the photo-consistency pass compares the
   /// photo with the model seen through that blur. Off: no blur.
   bool photo_blur = true;
+  /// Most faces whose views the photometry observes (issue 33): beyond it, every
+  /// k-th face, and for each photo left with fewer than kPhotometryFacesPerPhoto
+  /// of its fully visible faces, as many of them spread over its list. The
+  /// photometry solves a few unknowns per photo, so a monument's million faces
+  /// would add time, not precision. >= kPhotometryFacesPerPhoto.
+  int photometry_faces = 16384;
+  static constexpr int kPhotometryFacesPerPhoto = 64;
   std::uint32_t seed = 1;
 
   /// Throws OptionError naming the first invalid setting.
@@ -229,10 +236,14 @@ class TriangleEngine {
   PhotometryCandidate ObserveForPhotometry(std::size_t face, const sfm::TriangleView& view,
                                            double zenith_per_cell, bool observe_if_not_steep,
                                            PhotoBlurEstimator* blur) const;
-  // Every fully visible view of every face, photo by photo; [face][rank among
-  // the face's views].
+  // The faces the photometry observes (1), per face (TriangleEngineOptions::
+  // photometry_faces).
+  std::vector<char> PhotometryFaces() const;
+  // Every fully visible view of every observed face, photo by photo; [face][rank
+  // among the face's views].
   std::vector<std::vector<PhotometryCandidate>> ObservePhotoByPhoto(
-      double zenith_per_cell, PhotoBlurEstimator* blur, const ProgressCallback& progress) const;
+      const std::vector<char>& observed_faces, double zenith_per_cell, PhotoBlurEstimator* blur,
+      const ProgressCallback& progress) const;
   // Stage 2a: a gain per photo (exposure x light intensity, linear domain) and
   // the object's light response (synth/photometry.h).
   void EstimatePhotometry(const ProgressCallback& progress);

@@ -222,6 +222,11 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
                     &out),
             2);
   EXPECT_NE(out.find("search candidates must be >= 1"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --photometry-faces 10",
+                    &out),
+            2);
+  EXPECT_NE(out.find("photometry_faces must be >= 64"), std::string::npos) << out;
   // A photo cache that is not a size (photos on demand, docs/cli.md).
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
                     "--sample-texel-size 0.01 --out f --photo-cache lots",

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <random>
 
 namespace texlume::synth {
@@ -124,6 +126,46 @@ TEST(SolvePhotometry, WithoutResponseTheGainsCarryTheSamplesBrightness) {
   double mean_log = 0.0;
   for (double g : p.photo_gains) mean_log += std::log(g);
   EXPECT_LT(mean_log / KnownCapture::kPhotos, std::log(0.97));
+}
+
+TEST(PhotometryFaces, EveryKthFaceAndEnoughForEveryPhoto) {
+  // 1000 faces; photo 0 sees every face, photo 1 only faces 3, 13, 23, ... (100).
+  std::vector<std::vector<std::uint32_t>> photos_of_face(1000);
+  for (std::size_t f = 0; f < 1000; ++f) {
+    photos_of_face[f].push_back(0);
+    if (f % 10 == 3) photos_of_face[f].push_back(1);
+  }
+  const std::vector<char> all = PhotometryFaces(photos_of_face, 2, 1000, 20);
+  EXPECT_EQ(std::count(all.begin(), all.end(), 1), 1000);  // within the limit: all
+  const std::vector<char> observed = PhotometryFaces(photos_of_face, 2, 100, 20);
+  // Every 10th face (0, 10, 20, ...): none of photo 1's; then every 5th of its 100.
+  std::size_t count = 0, of_photo_1 = 0;
+  for (std::size_t f = 0; f < 1000; ++f) {
+    if (f % 10 == 0) {
+      EXPECT_TRUE(observed[f]) << f;
+    }
+    count += observed[f];
+    of_photo_1 += f % 10 == 3 && observed[f];
+  }
+  EXPECT_EQ(of_photo_1, 20u);
+  EXPECT_EQ(count, 120u);
+}
+
+TEST(PhotometryFaces, ASubsetOfTheFacesGivesTheSameGains) {
+  const KnownCapture capture;
+  std::vector<std::vector<std::uint32_t>> photos_of_face(KnownCapture::kFaces);
+  for (const PhotometricObservation& o : capture.observations)
+    photos_of_face[o.face].push_back(static_cast<std::uint32_t>(o.photo));
+  const std::vector<char> observed =
+      PhotometryFaces(photos_of_face, KnownCapture::kPhotos, KnownCapture::kFaces / 3, 8);
+  std::vector<PhotometricObservation> subset;
+  for (const PhotometricObservation& o : capture.observations)
+    if (observed[o.face]) subset.push_back(o);
+  ASSERT_LT(subset.size(), capture.observations.size() * 2 / 3);
+  const Photometry p =
+      SolvePhotometry(subset, KnownCapture::kFaces, KnownCapture::kPhotos, true, true);
+  for (std::size_t n = 0; n < KnownCapture::kPhotos; ++n)
+    EXPECT_NEAR(p.photo_gains[n] / capture.gain[n], 1.0, 0.01) << "photo " << n;
 }
 
 }  // namespace
