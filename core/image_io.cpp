@@ -15,60 +15,14 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/memory_budget.h"
+#include "core/srgb.h"
 
 namespace texlume {
 namespace fs = std::filesystem;
 
-namespace {
+float SrgbToLinear(float v) { return srgb::ToLinear(v); }
 
-// The sRGB curves' power segments, tabulated once and read by linear
-// interpolation: decoding over v in [0, 1], encoding over t = sqrt(v) (where
-// v^(1/2.4) = t^(1/1.2) bends gently), 4096 intervals each. Interpolation error
-// below 4e-8 (the curves' second derivatives are at most 3 and 4.2), a float's
-// rounding at 1; a call costs a square root and two loads instead of a power.
-class SrgbTables {
- public:
-  static constexpr int kIntervals = 4096;
-
-  SrgbTables() {
-    for (int i = 0; i <= kIntervals; ++i) {
-      const double x = static_cast<double>(i) / kIntervals;
-      decode_[static_cast<std::size_t>(i)] = static_cast<float>(std::pow((x + 0.055) / 1.055, 2.4));
-      encode_[static_cast<std::size_t>(i)] =
-          static_cast<float>(1.055 * std::pow(x, 2.0 / 2.4) - 0.055);
-    }
-  }
-  float Decode(float v) const { return Interpolate(decode_, v); }
-  float Encode(float v) const { return Interpolate(encode_, std::sqrt(v)); }
-
- private:
-  static float Interpolate(const std::array<float, kIntervals + 1>& table, float x) {
-    const float at = x * kIntervals;
-    const int i = std::min(static_cast<int>(at), kIntervals - 1);
-    const float f = at - static_cast<float>(i);
-    return table[static_cast<std::size_t>(i)] +
-           f * (table[static_cast<std::size_t>(i) + 1] - table[static_cast<std::size_t>(i)]);
-  }
-
-  std::array<float, kIntervals + 1> decode_, encode_;
-};
-
-const SrgbTables& Srgb() {
-  static const SrgbTables tables;
-  return tables;
-}
-
-}  // namespace
-
-float SrgbToLinear(float v) {
-  v = v > 0.0f ? std::min(v, 1.0f) : 0.0f;  // NaN: 0
-  return v <= 0.04045f ? v / 12.92f : Srgb().Decode(v);
-}
-
-float LinearToSrgb(float v) {
-  v = v > 0.0f ? std::min(v, 1.0f) : 0.0f;  // NaN: 0
-  return v <= 0.0031308f ? v * 12.92f : Srgb().Encode(v);
-}
+float LinearToSrgb(float v) { return srgb::FromLinear(v); }
 
 namespace {
 

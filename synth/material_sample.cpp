@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/image_io.h"
+#include "core/srgb.h"
 #include "ptm/coefficient_space.h"
 #include "synth/planar_synthesis.h"
 #include "synth/template_match.h"
@@ -279,7 +280,7 @@ double PtmSample::RelitLinearSum(const FaceLighting& lighting, int cells) const 
   for (int c = 0; c < 3; ++c)
     for (int j = 0; j < relit[0].rows; ++j)
       for (int i = 0; i < relit[0].cols; ++i)
-        sum += SrgbToLinear(relit[static_cast<std::size_t>(c)].at<float>(j, i));
+        sum += srgb::ToLinear(relit[static_cast<std::size_t>(c)].at<float>(j, i));
   return sum * (cells / static_cast<double>(relit[0].total()));
 }
 

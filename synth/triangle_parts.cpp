@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "core/srgb.h"
 #include "ptm/coefficient_space.h"
 
 namespace texlume::synth {
@@ -25,11 +26,11 @@ Eigen::Vector3f RelightEffective(const float* coefficients, const float* colour,
       const double v = format == ptm::PtmFormat::kLrgb
                            ? ptm::EvaluatePolynomial(coefficients, l.x(), l.y()) * colour[c]
                            : ptm::EvaluatePolynomial(coefficients + 6 * c, l.x(), l.y());
-      linear[c] += static_cast<float>(e.weight) * SrgbToLinear(static_cast<float>(v));
+      linear[c] += static_cast<float>(e.weight) * srgb::ToLinear(static_cast<float>(v));
     }
   }
   Eigen::Vector3f out;
-  for (int c = 0; c < 3; ++c) out[c] = LinearToSrgb(static_cast<float>(gain) * linear[c]);
+  for (int c = 0; c < 3; ++c) out[c] = srgb::FromLinear(static_cast<float>(gain) * linear[c]);
   return out;
 }
 

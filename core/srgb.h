@@ -1,0 +1,61 @@
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+
+namespace texlume::srgb {
+
+/// The sRGB curves' power segments, tabulated once and read by linear
+/// interpolation: decoding over v in [0, 1], encoding over t = sqrt(v) (where
+/// v^(1/2.4) = t^(1/1.2) bends gently), 4096 intervals each. Interpolation error
+/// below 4e-8 (the curves' second derivatives are at most 3 and 4.2), a float's
+/// rounding at 1; a call costs a square root and two loads instead of a power.
+/// Inline here so that the relighting loops (synth/) inline the conversions;
+/// core/image_io.h's SrgbToLinear and LinearToSrgb are these.
+class Tables {
+ public:
+  static constexpr int kIntervals = 4096;
+
+  Tables() {
+    for (int i = 0; i <= kIntervals; ++i) {
+      const double x = static_cast<double>(i) / kIntervals;
+      decode_[static_cast<std::size_t>(i)] = static_cast<float>(std::pow((x + 0.055) / 1.055, 2.4));
+      encode_[static_cast<std::size_t>(i)] =
+          static_cast<float>(1.055 * std::pow(x, 2.0 / 2.4) - 0.055);
+    }
+  }
+  float Decode(float v) const { return Interpolate(decode_, v); }
+  float Encode(float v) const { return Interpolate(encode_, std::sqrt(v)); }
+
+ private:
+  static float Interpolate(const std::array<float, kIntervals + 1>& table, float x) {
+    const float at = x * kIntervals;
+    const int i = std::min(static_cast<int>(at), kIntervals - 1);
+    const float f = at - static_cast<float>(i);
+    return table[static_cast<std::size_t>(i)] +
+           f * (table[static_cast<std::size_t>(i) + 1] - table[static_cast<std::size_t>(i)]);
+  }
+
+  std::array<float, kIntervals + 1> decode_, encode_;
+};
+
+inline const Tables& TheTables() {
+  static const Tables tables;
+  return tables;
+}
+
+/// sRGB display value in [0, 1] (clamped; NaN: 0) to linear.
+inline float ToLinear(float v) {
+  v = v > 0.0f ? std::min(v, 1.0f) : 0.0f;
+  return v <= 0.04045f ? v / 12.92f : TheTables().Decode(v);
+}
+
+/// Linear value in [0, 1] (clamped; NaN: 0) to sRGB display.
+inline float FromLinear(float v) {
+  v = v > 0.0f ? std::min(v, 1.0f) : 0.0f;
+  return v <= 0.0031308f ? v * 12.92f : TheTables().Encode(v);
+}
+
+}  // namespace texlume::srgb
