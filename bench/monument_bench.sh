@@ -9,7 +9,8 @@
 # progress stages (wall seconds, from its log). The last lines give the synthesis CPU per
 # triangle and the held-out PSNR / SSIM.
 # Usage: bench/monument_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [FACES (100000)]
-# Environment: IMAGES (200), RINGS (5), WIDTH (320), HEIGHT (240), TEXEL (0.001), CAPTURE (256).
+# Environment: IMAGES (200), RINGS (5), WIDTH (320), HEIGHT (240), TEXEL (0.001), CAPTURE (256);
+# SYNTH_ARGS: more options for texlume synth (e.g. --memory-limit 22G).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$(realpath "${1:-$root/build}")
@@ -55,7 +56,7 @@ rm -rf "$dir/sample.ptm" "$dir/model" "$dir/render"
 measure fit "$texlume" fit --images "$capture" --lights "$capture/lights.lp" --out "$dir/sample.ptm"
 measure synth "$texlume" synth --model "$object/sparse" --images "$object/images" \
   --lights "$object/lights.json" --mesh "$object/mesh.ply" --sample "$dir/sample.ptm" \
-  --sample-texel-size "$texel" --no-report --out "$dir/model"
+  --sample-texel-size "$texel" --no-report --out "$dir/model" ${SYNTH_ARGS:-}
 measure render "$texlume" render --model "$dir/model" --cameras "$held/sparse" \
   --lights "$held/lights.json" --truth "$held/images" --truth-masks "$held/masks" \
   --out "$dir/render"

@@ -109,14 +109,21 @@ std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<View
   std::vector<ScoredPlacement> scored;
   for (int sy = 0; sy <= last_y_; sy += stride)
     for (int sx = 0; sx <= last_x_; sx += stride) scored.emplace_back(0.0f, cv::Point(sx, sy));
-  for (const ViewAtStep& v : views) {
+  // The views' relit samples and SSD maps on both cores, summed in view order.
+  std::vector<cv::Mat> ssd(views.size());
+#pragma omp parallel for schedule(dynamic, 1) if (views.size() > 1)
+  for (std::size_t r = 0; r < views.size(); ++r) {
+    const ViewAtStep& v = views[r];
     const std::vector<cv::Mat> model =
         sample_.Relight(*v.reduced, v.view->lighting, photo_gains_[v.view->photo]);
-    const cv::Mat ssd = MaskedSsd(model, PlaneEnergy(model), v.photo, v.mask);
+    ssd[r] = MaskedSsd(model, PlaneEnergy(model), v.photo, v.mask);
+  }
+  for (std::size_t r = 0; r < views.size(); ++r) {
+    const ViewAtStep& v = views[r];
     const float cells = static_cast<float>(v.count);
     for (auto& [score, texel] : scored) {
       const cv::Point at = v.Cell(texel);
-      score += std::sqrt(ssd.at<float>(at.y, at.x) / (3.0f * cells));  // as AddImageScore
+      score += std::sqrt(ssd[r].at<float>(at.y, at.x) / (3.0f * cells));  // as AddImageScore
     }
   }
   return scored;
@@ -157,7 +164,9 @@ class PlacementSearch::RelitTiles {
 std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views,
                                             const std::vector<cv::Point>& texels,
                                             std::vector<RelitTiles>& relit) const {
-  std::vector<double> total(texels.size(), 0.0);
+  // Each view (its own relit tiles) on both cores; the scores summed in view order.
+  std::vector<std::vector<double>> per_view(views.size(), std::vector<double>(texels.size()));
+#pragma omp parallel for schedule(dynamic, 1) if (views.size() > 1)
   for (std::size_t r = 0; r < views.size(); ++r) {
     const ViewAtStep& v = views[r];
     for (std::size_t n = 0; n < texels.size(); ++n) {
@@ -178,9 +187,12 @@ std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views
         ssd += row;
       }
       // Eq. 3: the RMS difference at the photo's density (as AddImageScore).
-      total[n] += std::sqrt(std::max(ssd, 0.0) / (3.0 * v.count));
+      per_view[r][n] = std::sqrt(std::max(ssd, 0.0) / (3.0 * v.count));
     }
   }
+  std::vector<double> total(texels.size(), 0.0);
+  for (const std::vector<double>& scores : per_view)
+    for (std::size_t n = 0; n < texels.size(); ++n) total[n] += scores[n];
   return {total.begin(), total.end()};
 }
 
