@@ -168,9 +168,8 @@ void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
                                  "; use a larger texel size or a finer mesh");
   }
   // The patches' feature planes, the atlases baked from them and the bake's own
-  // buffers: 20 bytes a texel per feature plane (measured: 66-122 bytes a texel
-  // with a 6-plane PTM sample, docs/robustness.md "Memory").
-  RequireMemory(20.0 * static_cast<double>(geometry.total_texels) * sample_.NumFeatures(),
+  // buffers (docs/robustness.md "Memory").
+  RequireMemory(PatchMemoryBytes(geometry, sample_.NumFeatures()),
                 "the patches and atlases of " + std::to_string(geometry.total_texels) +
                     " texels at a texel size of " + std::to_string(t) +
                     " world units (a larger --sample-texel-size needs fewer)",

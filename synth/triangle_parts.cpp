@@ -238,6 +238,12 @@ void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& can
   patch.overlap_error = error;
 }
 
+double PatchMemoryBytes(const PatchGeometry& geometry, int feature_planes) {
+  const double patch = static_cast<double>(geometry.total_texels);
+  const double like_triangles = std::min(patch, 4.0 * geometry.surface_texels);
+  return feature_planes * (20.0 * like_triangles + 3.0 * (patch - like_triangles));
+}
+
 PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double t, int strip,
                                 TangentFrame tangent_frame,
                                 const Eigen::Vector3d& field_direction_in_world) {
@@ -293,6 +299,9 @@ PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double t, int st
     widest = std::max(widest, patch.width);
     tallest = std::max(tallest, patch.height);
     total_texels += static_cast<std::int64_t>(patch.width) * patch.height;
+    const Eigen::Vector2d e1 = patch.corners_in_frame[1] - patch.corners_in_frame[0];
+    const Eigen::Vector2d e2 = patch.corners_in_frame[2] - patch.corners_in_frame[0];
+    result.surface_texels += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x()) / (t * t);
   }
   // Unfoldings across every shared edge.
   const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(mesh);

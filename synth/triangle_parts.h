@@ -109,9 +109,19 @@ struct Unfolding {
 struct PatchGeometry {
   std::vector<TrianglePatch> patches;
   std::vector<std::array<Unfolding, 3>> unfoldings;
-  std::int64_t total_texels = 0;
-  int widest = 0, tallest = 0;  ///< largest patch sides, texels
+  std::int64_t total_texels = 0;  ///< of the patch rectangles (strips included)
+  double surface_texels = 0.0;    ///< of the triangles themselves: their area / texel size^2
+  int widest = 0, tallest = 0;    ///< largest patch sides, texels
 };
+
+/// What the patches and the atlases baked from them take, bytes (issue 33): 20
+/// bytes per feature plane a texel for the patch texels up to 4 times the
+/// triangles' own (the patches, the atlases, the bake: measured 66-122 bytes a
+/// texel with a 6-plane sample, where patches are 2-4 times the triangles), and 3
+/// bytes per plane for the rest, the strips of small triangles, which are held
+/// only as correction grids at the photos' density (measured: 17 bytes a texel
+/// with 6 planes, columns of 99280 and 300144 faces; docs/robustness.md).
+double PatchMemoryBytes(const PatchGeometry& geometry, int feature_planes);
 PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double texel_size, int strip,
                                 TangentFrame tangent_frame,
                                 const Eigen::Vector3d& field_direction_in_world);

@@ -210,5 +210,26 @@ TEST(ChoosePhotoFrames, AutoTurnsFramesOnlyForAnAnisotropicSample) {
   EXPECT_TRUE(asked.empty());
 }
 
+TEST(PatchMemoryBytes, SmallTrianglesStripsCostLessThanTheirTexels) {
+  // A 2 x 2 plane (4e4 texels of 0.01): 2 x 2 triangles (large: patches about
+  // 1.5 times the surface) and 2 x 50^2 (small: mostly strip).
+  for (const int segments : {1, 50}) {
+    const PatchGeometry g = FirstEdgeGeometry(datasets::MakeGridPlane(segments, 2.0));
+    EXPECT_NEAR(g.surface_texels, 4e4, 1e-6);
+    const double patch = static_cast<double>(g.total_texels);
+    const double expected =
+        patch <= 4 * g.surface_texels
+            ? 6 * 20.0 * patch
+            : 6 * (20.0 * 4 * g.surface_texels + 3.0 * (patch - 4 * g.surface_texels));
+    EXPECT_DOUBLE_EQ(PatchMemoryBytes(g, 6), expected);
+    if (segments == 1) {
+      EXPECT_LT(patch, 4 * g.surface_texels);
+    } else {
+      EXPECT_GT(patch, 8 * g.surface_texels);  // strips: 16 x 16 texels at least per 4-texel face
+      EXPECT_LT(PatchMemoryBytes(g, 6), 0.5 * 6 * 20.0 * patch);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace texlume::synth
