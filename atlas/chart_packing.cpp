@@ -101,9 +101,9 @@ ChartOutline Outline(const std::vector<ChartFace>& chart, double angle,
       // The points within reach of a triangle are convex: on a row, one run of texels.
       // Centres on the row's chord of the triangle itself are within reach: no test;
       // outside it, the run's ends are found from the span's ends inwards.
-      const auto [chord_lo, chord_hi] = mesh::TriangleRowSpan(c, y + 0.5, 0.0);
+      const std::pair<double, double> chord = mesh::TriangleRowSpan(c, y + 0.5, 0.0);
       const auto within = [&](int x) {
-        return (x + 0.5 >= chord_lo && x + 0.5 <= chord_hi) ||
+        return (x + 0.5 >= chord.first && x + 0.5 <= chord.second) ||
                mesh::WithinReachOfTriangle(c, Eigen::Vector2d(x + 0.5, y + 0.5), reach);
       };
       while (x_first <= x_last && !within(x_first)) ++x_first;

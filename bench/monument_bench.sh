@@ -20,7 +20,8 @@ faces=${3:-100000}
 images=${IMAGES:-200} rings=${RINGS:-5} width=${WIDTH:-320} height=${HEIGHT:-240}
 texel=${TEXEL:-0.001} capture_size=${CAPTURE:-256}
 mkdir -p "$work"
-dir="$work/column_${faces}_${images}"
+# One folder per scene: every setting the scene is made from is in its name.
+dir="$work/column_${faces}_${images}_${rings}_${width}x${height}_t${texel}_c${capture_size}"
 
 # measure NAME COMMAND...: runs COMMAND (its output to NAME.log), records its wall and
 # CPU seconds and peak resident KiB in NAME.json.

@@ -75,9 +75,9 @@ void SceneOptions::Check() const {
     throw OptionError("mesh resolution must be in [0, 7]");
   RequireInRange(static_cast<double>(mesh_faces), 0,
                  static_cast<double>(ObjectSceneOptions::kMaxTargetFaces), "mesh_faces");
+  RequireInRange(num_images, 3, 1000, "num_images");  // monument captures: 50-600
   RequireInRange(camera_rings, 1, 20, "camera_rings");
   if (camera_rings > num_images) throw OptionError("camera_rings must be at most num_images");
-  RequireInRange(num_images, 3, 1000, "num_images");  // monument captures: 50-600
   RequireInRange(image_width, 64, 8192, "image_width");
   RequireInRange(image_height, 64, 8192, "image_height");
   RequireInRange(focal_px, 1, 1e6, "focal_px");

@@ -49,9 +49,9 @@ mesh::TriangleMesh CoarseMesh(SceneShape shape);
 
 /// The coarse mesh of a shape with about `target_faces` triangles (a monument-scale
 /// scene: issue 33), as regular as the shape allows: the cylinder, plane and torus
-/// as grids whose cells are about square (within 10 % of the target from a few
-/// hundred faces up), the sphere as the icosphere whose 20 * 4^N faces are nearest
-/// the target on a log scale (within a factor of 2). `target_faces` >= 1.
+/// as grids whose cells are about square (the column's caps as rings: MakeColumn),
+/// within 10 % of the target from about 2000 faces up, the sphere as the icosphere whose 20 * 4^N
+/// faces are nearest the target on a log scale (within a factor of 2). `target_faces` >= 1.
 mesh::TriangleMesh ShapeMeshWithFaces(SceneShape shape, std::int64_t target_faces);
 
 /// Mesh generators (outward normals), also used by tests.

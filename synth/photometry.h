@@ -55,6 +55,15 @@ std::vector<std::array<double, 3>> SolveWhiteBalance(
     const std::vector<PhotometricObservation>& observations, std::size_t num_faces,
     std::size_t num_photos);
 
+/// The faces a photometry observes (1 per face; issue 33). `photos_of_face[f]`
+/// lists the photos (indices below num_photos) that see face f fully. All faces
+/// when there are at most `limit`; else every k-th face, k = ceil(faces / limit),
+/// and for each photo then seeing fewer than `min_per_photo` observed faces, every
+/// j-th of its faces as well, j = max(1, its faces / min_per_photo).
+std::vector<char> PhotometryFaces(const std::vector<std::vector<std::uint32_t>>& photos_of_face,
+                                  std::size_t num_photos, std::size_t limit,
+                                  std::size_t min_per_photo);
+
 /// Solves photo_linear = g_n a_f (sum_l r(theta_l) P_l + alpha Z) for the photo
 /// gains g_n, the faces' albedos a_f relative to the sample, the elevation
 /// factors r (ptm::LightResponse's knots) and the ambient alpha, alternating:
@@ -70,15 +79,6 @@ std::vector<std::array<double, 3>> SolveWhiteBalance(
 /// Without `estimate_response`, the gains alone as SolvePhotoGains gives them.
 /// With `estimate_white_balance`, first each photo's white balance
 /// (SolveWhiteBalance), taken out of the photo sums before the rest.
-/// The faces a photometry observes (1 per face; issue 33). `photos_of_face[f]`
-/// lists the photos (indices below num_photos) that see face f fully. All faces
-/// when there are at most `limit`; else every k-th face, k = ceil(faces / limit),
-/// and for each photo then seeing fewer than `min_per_photo` observed faces, every
-/// j-th of its faces as well, j = max(1, its faces / min_per_photo).
-std::vector<char> PhotometryFaces(const std::vector<std::vector<std::uint32_t>>& photos_of_face,
-                                  std::size_t num_photos, std::size_t limit,
-                                  std::size_t min_per_photo);
-
 Photometry SolvePhotometry(std::vector<PhotometricObservation> observations, std::size_t num_faces,
                            std::size_t num_photos, bool estimate_response,
                            bool estimate_white_balance);

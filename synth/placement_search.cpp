@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <opencv2/imgproc.hpp>
 #include <unordered_set>
 
@@ -24,6 +25,23 @@ std::vector<ScoredPlacement> KeepBest(std::vector<ScoredPlacement> scored, int k
                     scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   scored.resize(kept);
   return scored;
+}
+
+// Runs view(r) for every r in [0, count) on every core. An exception must not
+// leave an OpenMP loop: each view's is kept and the first view's rethrown after it.
+template <typename PerView>
+void ForEachView(std::size_t count, const PerView& view) {
+  std::vector<std::exception_ptr> errors(count);
+#pragma omp parallel for schedule(dynamic, 1) if (count > 1)
+  for (std::size_t r = 0; r < count; ++r) {
+    try {
+      view(r);
+    } catch (...) {
+      errors[r] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& error : errors)
+    if (error) std::rethrow_exception(error);
 }
 
 }  // namespace
@@ -111,13 +129,12 @@ std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<View
     for (int sx = 0; sx <= last_x_; sx += stride) scored.emplace_back(0.0f, cv::Point(sx, sy));
   // The views' relit samples and SSD maps on both cores, summed in view order.
   std::vector<cv::Mat> ssd(views.size());
-#pragma omp parallel for schedule(dynamic, 1) if (views.size() > 1)
-  for (std::size_t r = 0; r < views.size(); ++r) {
+  ForEachView(views.size(), [&](std::size_t r) {
     const ViewAtStep& v = views[r];
     const std::vector<cv::Mat> model =
         sample_.Relight(*v.reduced, v.view->lighting, photo_gains_[v.view->photo]);
     ssd[r] = MaskedSsd(model, PlaneEnergy(model), v.photo, v.mask);
-  }
+  });
   for (std::size_t r = 0; r < views.size(); ++r) {
     const ViewAtStep& v = views[r];
     const float cells = static_cast<float>(v.count);
@@ -166,8 +183,7 @@ std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views
                                             std::vector<RelitTiles>& relit) const {
   // Each view (its own relit tiles) on both cores; the scores summed in view order.
   std::vector<std::vector<double>> per_view(views.size(), std::vector<double>(texels.size()));
-#pragma omp parallel for schedule(dynamic, 1) if (views.size() > 1)
-  for (std::size_t r = 0; r < views.size(); ++r) {
+  ForEachView(views.size(), [&](std::size_t r) {
     const ViewAtStep& v = views[r];
     for (std::size_t n = 0; n < texels.size(); ++n) {
       const cv::Point at = v.Cell(texels[n]);
@@ -189,7 +205,7 @@ std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views
       // Eq. 3: the RMS difference at the photo's density (as AddImageScore).
       per_view[r][n] = std::sqrt(std::max(ssd, 0.0) / (3.0 * v.count));
     }
-  }
+  });
   std::vector<double> total(texels.size(), 0.0);
   for (const std::vector<double>& scores : per_view)
     for (std::size_t n = 0; n < texels.size(); ++n) total[n] += scores[n];

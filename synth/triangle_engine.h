@@ -76,9 +76,10 @@ struct TriangleEngineOptions {
   /// (synth/photo_blur.h), so that the photo-consistency pass compares the
   /// photo with the model seen through that blur. Off: no blur.
   bool photo_blur = true;
-  /// Most faces whose views the photometry observes (issue 33): beyond it, every
-  /// k-th face, and for each photo left with fewer than kPhotometryFacesPerPhoto
-  /// of its fully visible faces, as many of them spread over its list. The
+  /// Faces whose views the photometry observes (issue 33): all up to this many;
+  /// beyond, every k-th face, k = ceil(faces / this), and for each photo left with
+  /// fewer than kPhotometryFacesPerPhoto of its fully visible faces, that many of
+  /// them spread over its list (so a few more than this may be observed). The
   /// photometry solves a few unknowns per photo, so a monument's million faces
   /// would add time, not precision. >= kPhotometryFacesPerPhoto.
   int photometry_faces = 16384;

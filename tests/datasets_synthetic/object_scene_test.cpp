@@ -61,7 +61,7 @@ TEST(ObjectScene, ShapeMeshWithFacesComesNearTheTarget) {
                   0.1 * static_cast<double>(target))
           << SceneShapeName(shape);
       // Square cells on the plane: the diagonal is the longest edge. (The torus's
-      // cells narrow towards its hole; the cylinder's caps are fans.)
+      // cells narrow towards its hole; the column's cap rings are not squares.)
       double shortest = 1e9, longest = 0;
       for (std::size_t f = 0; f < mesh.faces.size(); f += 97) {
         for (int k = 0; k < 3; ++k) {
