@@ -6,6 +6,7 @@
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <stdexcept>
 
 #include "synth/colour_sample.h"
 
@@ -122,6 +123,31 @@ TEST(PlacementSearch, RefinedScoresEqualTheExhaustiveScores) {
   const std::vector<ScoredPlacement> fallback = search.CoarseToFine(12, 16, 3, 1000);
   const std::vector<ScoredPlacement> exhaustive = search.Exhaustive(12);
   for (std::size_t n = 0; n < 12; ++n) EXPECT_EQ(fallback[n], exhaustive[n]);
+}
+
+// A sample whose relighting fails under one photo's gain (as a failed allocation
+// would): the error leaves the search, whose views are scored on every core,
+// as an exception the job reports, not as the end of the process.
+class FailingUnderGain : public ColourSample {
+ public:
+  FailingUnderGain(const cv::Mat& display, double failing_gain)
+      : ColourSample(display), failing_gain_(failing_gain) {}
+  std::vector<cv::Mat> Relight(const ReducedPlanes& reduced, const FaceLighting& lighting,
+                               double gain) const override {
+    if (gain == failing_gain_) throw std::runtime_error("relighting failed");
+    return ColourSample::Relight(reduced, lighting, gain);
+  }
+
+ private:
+  double failing_gain_;
+};
+
+TEST(PlacementSearch, AnErrorInOneViewLeavesTheSearchAsAnException) {
+  const Fixture f(0.01);
+  const FailingUnderGain failing(StructuredColour(160, 7), f.gains[1]);
+  const PlacementSearch search(failing, f.views, f.gains, cv::Size(kPatch, kPatch));
+  EXPECT_THROW(search.Exhaustive(12), std::runtime_error);
+  EXPECT_THROW(search.CoarseToFine(12, 16), std::runtime_error);
 }
 
 // The relit windows are the whole relit sample's cells, clipped at its borders.
