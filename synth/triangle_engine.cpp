@@ -314,6 +314,9 @@ TriangleEngine::PhotometryCandidate TriangleEngine::ObserveForPhotometry(
 }
 
 std::vector<char> TriangleEngine::PhotometryFaces() const {
+  // Within the limit every face is observed: no per-face photo lists needed.
+  if (mesh_.faces.size() <= static_cast<std::size_t>(options_.photometry_faces))
+    return std::vector<char>(mesh_.faces.size(), 1);
   std::vector<std::vector<std::uint32_t>> photos_of_face(mesh_.faces.size());
   for (std::size_t f = 0; f < mesh_.faces.size(); ++f)
     for (const sfm::TriangleView& view : visibility_.triangles[f].views) {
