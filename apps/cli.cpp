@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cstdlib>
 #include <functional>
 #include <map>
 #include <string>
@@ -77,6 +78,33 @@ std::string HelpHint(const CLI::App* sub) {
 
 }  // namespace
 
+namespace {
+synth::RankCommunicator* g_ranks = nullptr;
+
+// Only `texlume synth` runs across ranks, and only in a build with MPI.
+void RefuseSeveralRanksUnlessSynth(const CLI::App& sub) {
+  if (!LaunchedAsSeveralRanks()) return;
+  if (!g_ranks)
+    throw UsageError(
+        "started as one of several MPI ranks, but this texlume was built without MPI "
+        "(scripts/install_deps.sh installs OpenMPI; then rebuild)");
+  if (sub.get_name() != "synth")
+    throw UsageError("only texlume synth runs across MPI ranks; run texlume " + sub.get_name() +
+                     " in one process (without mpirun)");
+}
+}  // namespace
+
+bool LaunchedAsSeveralRanks() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"}) {
+    const char* value = std::getenv(name);
+    if (value && std::atoi(value) > 1) return true;
+  }
+  return false;
+}
+
+void SetRanks(synth::RankCommunicator* ranks) { g_ranks = ranks; }
+synth::RankCommunicator* Ranks() { return g_ranks; }
+
 int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   RecordCommandLine(argc, argv);
   CLI::App app("texlume: relightable PTM models from photos and a material sample", "texlume");
@@ -119,6 +147,7 @@ int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostrea
       throw UsageError(extras);
     if (!sub) throw UsageError("give a command");
     SetMemoryLimitBytes(memory_limit.empty() ? 0 : ParseMemorySize(memory_limit));
+    RefuseSeveralRanksUnlessSynth(*sub);
     return run.at(sub)(out, err);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e, out, err);

@@ -2,6 +2,10 @@
 
 #include <ostream>
 
+namespace texlume::synth {
+class RankCommunicator;
+}
+
 namespace texlume::apps {
 
 /// Exit codes of the texlume program.
@@ -17,5 +21,13 @@ inline constexpr int kExitInternalError = 3;  ///< a broken internal invariant (
 /// runs; errors map to the exit codes above (the message names the file for
 /// bad input). Writes what a user reads to `out`, warnings and errors to `err`.
 int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostream& err);
+
+/// True when an MPI launcher started this process as one of several ranks
+/// (OpenMPI's OMPI_COMM_WORLD_SIZE or MPICH's PMI_SIZE above 1).
+bool LaunchedAsSeveralRanks();
+/// The ranks of a distributed run, which main() started (distributed/mpi_ranks.h);
+/// null in one process. Only `texlume synth` runs across ranks.
+void SetRanks(synth::RankCommunicator* ranks);
+synth::RankCommunicator* Ranks();
 
 }  // namespace texlume::apps

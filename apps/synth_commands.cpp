@@ -321,12 +321,22 @@ void AddSynthCommand(CLI::App& app, CommandRunners& run) {
   auto q = std::make_shared<pipeline::QuiltJobOptions>();
   BindQuilting(sub, *q, *w);
   run[sub] = [sub, o, w, q](std::ostream& out, std::ostream& err) {
-    ProgressBar bar;
+    synth::RankCommunicator* ranks = Ranks();
     if (w->engine == "graphcut") {
+      if (ranks && ranks->Size() > 1)
+        throw UsageError("--engine graphcut runs in one process; start it without mpirun");
+      ProgressBar bar;
       pipeline::RunQuiltCommandJob(QuiltJobFrom(sub, *w, *o, *q), out, err, bar.Callback());
       return 0;
     }
     Resolve(sub, *w, q->quilt, *o);
+    o->job.ranks = ranks;
+    if (ranks && ranks->Rank() != 0) {  // rank 0 shows the progress and writes the model
+      std::ostream quiet(nullptr);
+      pipeline::RunSynthCommandJob(*o, quiet, err, {});
+      return 0;
+    }
+    ProgressBar bar;
     pipeline::RunSynthCommandJob(*o, out, err, bar.Callback());
     return 0;
   };

@@ -46,6 +46,10 @@ class BtfSynthJob {
     AnnounceStep(progress_, "reading the BTF sample");
     LoadSample();
     Synthesize();
+    if (synthesis_.rank_share_only) {  // its faces went to rank 0, which writes the model
+      summary_.rank_share_only = true;
+      return summary_;
+    }
     LayOut();
     AnnounceStep(progress_, "writing the model folder");
     nlohmann::json record = Record();
@@ -78,8 +82,11 @@ class BtfSynthJob {
   }
 
   void Synthesize() {
+    const std::optional<synth::FaceRegions> regions = pipeline::RegionsOfJob(job_, inputs_);
     synthesis_ = synth::SynthesizeMeshBtf(inputs_.mesh, inputs_.reconstruction, inputs_.visibility,
-                                          inputs_.photos, sample_, so_, progress_);
+                                          inputs_.photos, sample_, so_, progress_,
+                                          regions ? &*regions : nullptr);
+    if (synthesis_.rank_share_only) return;
     summary_.seconds_synthesis = synthesis_.seconds_synthesis;
     summary_.seconds_seams = synthesis_.seconds_seams;
     summary_.from_photos = synthesis_.num_from_photos;
@@ -187,6 +194,7 @@ class BtfSynthJob {
         {"ptm_preview", s.seconds_preview},
         {"synthesis_per_triangle", (s.seconds_synthesis + s.seconds_seams) /
                                        static_cast<double>(std::max<std::size_t>(1, s.faces))}};
+    record["distributed"] = pipeline::RanksJson(synthesis_, std::nullopt);
     return record;
   }
 

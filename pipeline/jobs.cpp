@@ -496,6 +496,7 @@ void RunSynthCommandJob(const SynthCommandOptions& options, std::ostream& out, s
   if (!options.btf.empty()) {
     const pipeline::BtfSynthJobOptions b = BtfJobFrom(options);
     const pipeline::BtfSynthJobSummary s = pipeline::RunBtfSynthJob(b, progress);
+    if (s.rank_share_only) return;  // rank 0 reports the distributed run
     for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
     out << "Synthesised a BTF over " << s.faces << " triangles (" << s.from_photos
         << " from photos, " << s.from_neighbours << " from neighbours only, " << s.random
@@ -512,6 +513,7 @@ void RunSynthCommandJob(const SynthCommandOptions& options, std::ostream& out, s
   job.synthesis.correction_sigma =
       options.correction_sigma.value_or(job.synthesis.correction_sigma);
   const pipeline::SynthJobSummary s = pipeline::RunSynthJob(job, progress);
+  if (s.rank_share_only) return;  // rank 0 reports the distributed run
   for (const std::string& w : s.warnings) err << "warning: " << w << "\n";
   out << "Synthesised " << s.faces << " triangles (" << s.from_photos << " from photos, "
       << s.from_neighbours << " from neighbours only, " << s.random << " seeds) from "

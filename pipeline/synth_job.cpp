@@ -339,6 +339,39 @@ void SynthJobOptions::Check() const {
   if (fill_unseen == FillUnseen::kGraphcut) fill_quilt.Check();
 }
 
+std::optional<synth::FaceRegions> RegionsOfJob(const SynthJobOptions& options,
+                                               const SynthInputs& inputs) {
+  if (!options.ranks || options.ranks->Size() <= 1) return std::nullopt;
+  synth::FaceRegions regions;
+  regions.ranks = options.ranks;
+  regions.partition = synth::RegionsForRanks(mesh::FaceNeighbours(inputs.mesh), inputs.visibility,
+                                             options.ranks->Size(), options.synthesis.max_views,
+                                             options.synthesis.seed);
+  return regions;
+}
+
+nlohmann::json RanksJson(const synth::TriangleSynthesis& synthesis,
+                         const std::optional<synth::EdgeMismatch>& mismatch) {
+  if (synthesis.rank_records.empty()) return nullptr;
+  nlohmann::json ranks = nlohmann::json::array();
+  for (const synth::RankRecord& r : synthesis.rank_records)
+    ranks.push_back({{"rank", r.rank},
+                     {"faces", r.faces},
+                     {"faces_placed", r.faces_placed},
+                     {"seconds_region", r.seconds_region},
+                     {"bytes_sent", r.bytes_sent}});
+  nlohmann::json record = {{"ranks", synthesis.rank_records.size()},
+                           {"region_border_faces", synthesis.region_border_faces},
+                           {"region_cut_edges", synthesis.region_cut_edges},
+                           {"per_rank", ranks}};
+  if (mismatch)
+    record["edge_mismatch"] = {{"region_borders", mismatch->region_borders},
+                               {"elsewhere", mismatch->elsewhere},
+                               {"border_edges", mismatch->border_edges},
+                               {"other_edges", mismatch->other_edges}};
+  return record;
+}
+
 nlohmann::json SynthCounts::ToJson() const {
   return {{"photos_used", photos_used},
           {"faces", faces},
@@ -438,6 +471,7 @@ class SynthJob {
     AnnounceStep(progress_, "reading the inputs");
     Load();
     Synthesize();
+    if (synthesis_.rank_share_only) return RankShare();
     LayOut();
     AnnounceStep(progress_, "photo baselines");
     Baselines();
@@ -469,18 +503,30 @@ class SynthJob {
   void Synthesize() {
     const auto t = std::chrono::steady_clock::now();
     const SynthInputs& in = inputs_;
+    const std::optional<synth::FaceRegions> regions = RegionsOfJob(options_, in);
+    const synth::FaceRegions* regions_or_null = regions ? &*regions : nullptr;
     synthesis_ =
         sample_.colour.empty()
             ? synth::SynthesizeMeshPtm(in.mesh, in.reconstruction, in.visibility, in.photos,
-                                       sample_.ptm, options_.synthesis, progress_)
+                                       sample_.ptm, options_.synthesis, progress_, regions_or_null)
             : synth::SynthesizeMeshColour(in.mesh, in.reconstruction, in.visibility, in.photos,
                                           sample_.colour, ColourOptions(options_.synthesis),
-                                          progress_);
+                                          progress_, regions_or_null);
+    if (synthesis_.rank_share_only) return;
+    if (regions) edge_mismatch_ = synth::MeasureEdgeMismatch(synthesis_, synthesis_.region_of_face);
     summary_.seconds_synthesis = SecondsSince(t);
     summary_.from_photos = synthesis_.num_from_photos;
     summary_.from_neighbours = synthesis_.num_from_neighbours;
     summary_.random = synthesis_.num_random;
     if (options_.fill_unseen == FillUnseen::kGraphcut) FillUnseenFaces();
+  }
+
+  // A rank other than 0: its faces went to rank 0, which writes the model.
+  SynthJobSummary RankShare() {
+    summary_.rank_share_only = true;
+    for (const synth::TrianglePatch& p : synthesis_.patches)
+      summary_.rank_faces_placed += p.source == synth::PatchSource::kPhotos ? 1 : 0;
+    return summary_;
   }
 
   // The faces no photo placed, quilted by the graph-cut engine from the
@@ -589,6 +635,7 @@ class SynthJob {
         {"baselines", s.seconds_baselines},
         {"synthesis_per_triangle", s.seconds_synthesis / std::max<std::size_t>(1, s.faces)}};
     record["resources"] = {{"peak_resident_bytes", PeakResidentBytes()}};
+    record["distributed"] = RanksJson(synthesis_, edge_mismatch_);
     return record;
   }
 
@@ -653,6 +700,7 @@ class SynthJob {
   SynthInputs inputs_;
   Sample sample_;
   synth::MeshSynthesis synthesis_;
+  std::optional<synth::EdgeMismatch> edge_mismatch_;  // a distributed run's
   model::TexturedModel model_;
   std::vector<cv::Mat> baked_;
   Eigen::Vector3f flat_albedo_ = Eigen::Vector3f::Constant(0.5f);

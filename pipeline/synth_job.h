@@ -5,6 +5,7 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,11 @@ struct SynthJobOptions {
   /// (core/photo_cache.h) and, when they do not all fit, visited photo by photo
   /// (synth/face_order.h).
   std::uint64_t photo_cache_bytes = 0;
+  /// The ranks of a distributed run (`mpirun -np N texlume synth`, issue 33;
+  /// borrowed; not a setting): the faces are placed region by region, one per
+  /// rank (synth/face_regions.h), and rank 0 finishes and writes the model.
+  /// Null or one rank: one process.
+  synth::RankCommunicator* ranks = nullptr;
 
   /// Throws OptionError when a path is missing or a setting is out of range.
   void Check() const;
@@ -102,6 +108,10 @@ struct SynthCounts {
   std::vector<std::string> warnings;  ///< skipped photos, repaired faces, subdivisions
   /// The job's photo cache, whose figures the summary records ("photo_cache").
   std::shared_ptr<const PhotoCache> photo_cache;
+  /// A distributed run on a rank other than 0: this rank placed its region's
+  /// faces and sent them to rank 0, which writes the model; nothing else was done.
+  bool rank_share_only = false;
+  std::size_t rank_faces_placed = 0;  ///< with rank_share_only: the faces this rank placed
   /// The counts as the manifest's "summary" names them.
   nlohmann::json ToJson() const;
   /// Takes the counts of the inputs (photos, faces, subdivisions, warnings).
@@ -144,6 +154,16 @@ struct SynthInputs {
   std::size_t subdivisions = 0;
   double seconds_load = 0, seconds_visibility = 0;
 };
+
+/// A distributed run's regions of the job's (prepared) mesh, one per rank
+/// (synth::RegionsForRanks, seeded by the synthesis seed); none in one process.
+std::optional<synth::FaceRegions> RegionsOfJob(const SynthJobOptions& options,
+                                               const SynthInputs& inputs);
+/// The manifest's record of a distributed run (ranks, regions, what each rank
+/// did, and for a blended sample the edge mismatch on region borders against
+/// elsewhere); null in one process.
+nlohmann::json RanksJson(const synth::TriangleSynthesis& synthesis,
+                         const std::optional<synth::EdgeMismatch>& mismatch);
 
 /// Reads the COLMAP model, object lights, mesh and photos named in `options`
 /// (sample and out_dir are not touched). Throws InputError as RunSynthJob describes.

@@ -13,6 +13,8 @@ PACKAGES=(
   libnanoflann-dev  # detail transfer's nearest windows (BSD, header-only)
   libcpp-httplib-dev  # the viewer's local HTTP server (MIT)
   zlib1g-dev  # CRC-32 checksums of the inputs in reports (zlib licence)
+  libmetis-dev  # the face graph's partition into regions, one per rank (Apache-2.0)
+  libopenmpi-dev openmpi-bin  # synth across machines: mpirun -np N texlume synth (BSD)
   openimageio-tools  # its CMake package config refers to the OIIO tools
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev

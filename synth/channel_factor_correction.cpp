@@ -129,6 +129,33 @@ void ChannelFactorCorrection::Correct(TriangleEngine& engine, std::size_t face,
   density_[face] = Eigen::Vector2d(grid_level.rx, grid_level.ry);
 }
 
+void ChannelFactorCorrection::SaveFace(std::size_t face, ByteWriter& out) const {
+  const bool kept = face < factors_.size();
+  out.PutMat(kept ? factors_[face] : cv::Mat());
+  out.Put(kept ? density_[face].x() : 1.0), out.Put(kept ? density_[face].y() : 1.0);
+}
+
+void ChannelFactorCorrection::LoadFace(TriangleEngine& engine, std::size_t face, ByteReader& in) {
+  const std::size_t num_faces = engine.result().patches.size();
+  if (factors_.size() != num_faces) {
+    factors_.resize(num_faces);
+    density_.resize(num_faces, Eigen::Vector2d::Ones());
+  }
+  factors_[face] = in.GetMat();
+  density_[face].x() = in.Get<double>();
+  density_[face].y() = in.Get<double>();
+}
+
+void ChannelFactorCorrection::SaveSums(ByteWriter& out) const {
+  out.Put(residual_quilted_), out.Put(residual_corrected_), out.Put(residual_count_);
+}
+
+void ChannelFactorCorrection::AddSums(ByteReader& in) {
+  residual_quilted_ += in.Get<double>();
+  residual_corrected_ += in.Get<double>();
+  residual_count_ += in.Get<double>();
+}
+
 double ChannelFactorCorrection::RmsQuilted() const {
   return residual_count_ > 0 ? std::sqrt(residual_quilted_ / residual_count_) : 0.0;
 }

@@ -38,6 +38,11 @@ class ChannelFactorCorrection : public PhotoCorrection {
                const std::vector<RelitWindow>& relit) override;
   /// The relit sample around the patch that the model seen through the photo's
   /// blur reads (3 sigma), and a cell for the bilinear read.
+  /// A distributed run: the face's factors and their density; the residual sums.
+  void SaveFace(std::size_t face, ByteWriter& out) const override;
+  void LoadFace(TriangleEngine& engine, std::size_t face, ByteReader& in) override;
+  void SaveSums(ByteWriter& out) const override;
+  void AddSums(ByteReader& in) override;
   int RelitMarginCells(const RectifiedView& view) const override;
 
   /// Per face: the factors (CV_32FC3, linear R, G, B) on a grid over its patch

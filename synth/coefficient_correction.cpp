@@ -553,6 +553,16 @@ void CoefficientCorrection::Correct(TriangleEngine& engine, std::size_t face,
   correction_level_[face] = primary_level;
 }
 
+void CoefficientCorrection::SaveFace(std::size_t face, ByteWriter& out) const {
+  out.Put<std::int32_t>(correction_level_.empty() ? -1 : correction_level_[face]);
+}
+
+void CoefficientCorrection::LoadFace(TriangleEngine& engine, std::size_t face, ByteReader& in) {
+  const auto level = in.Get<std::int32_t>();
+  if (correction_level_.empty()) correction_level_.assign(engine.result().patches.size(), -1);
+  correction_level_[face] = level;
+}
+
 void CoefficientCorrection::Finish(TriangleEngine& engine, const ProgressCallback& progress) {
   if (!options_.detail_transfer) return;
   std::vector<TrianglePatch>& patches = engine.result().patches;

@@ -138,7 +138,7 @@ MeshSynthesis SynthesizeMeshColour(const mesh::TriangleMesh& mesh,
                                    const sfm::VisibilityResult& visibility,
                                    const std::vector<MeshPhoto>& photos, const cv::Mat& display_rgb,
                                    const ColourSynthesisOptions& options,
-                                   const ProgressCallback& progress) {
+                                   const ProgressCallback& progress, const FaceRegions* regions) {
   options.Check();
   const ColourSample sample(display_rgb);
   // The observed cells reach as far as the blend (W_e / 2), like the score's.
@@ -147,7 +147,9 @@ MeshSynthesis SynthesizeMeshColour(const mesh::TriangleMesh& mesh,
   TriangleEngine engine(mesh, reconstruction, visibility, photos, sample, options,
                         options.photo_correction ? &correction : nullptr);
   MeshSynthesis result;
+  if (regions) engine.DistributeOver(*regions);
   static_cast<TriangleSynthesis&>(result) = engine.Run(progress);
+  if (result.rank_share_only) return result;  // rank 0 finishes
   result.format = ptm::PtmFormat::kLrgb;
   result.sample_planes = ToOrthonormalPlanes(LambertianPtm(display_rgb));
   const std::vector<cv::Mat>& factors = correction.factors();

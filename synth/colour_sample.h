@@ -74,11 +74,14 @@ struct ColourSynthesisOptions : TriangleEngineOptions {
 /// baked into atlases and exported as PTM models are: each corrected face
 /// carries its factors (display domain, lin^(1/2.2)) as the per-channel gains
 /// of MeshSynthesis. Throws as SynthesizeMeshPtm.
+/// `regions`: a distributed run (TriangleEngine::DistributeOver); on ranks other than
+/// 0 the result is only this rank's share (rank_share_only).
 MeshSynthesis SynthesizeMeshColour(const mesh::TriangleMesh& mesh,
                                    const sfm::Reconstruction& reconstruction,
                                    const sfm::VisibilityResult& visibility,
                                    const std::vector<MeshPhoto>& photos, const cv::Mat& display_rgb,
                                    const ColourSynthesisOptions& options,
-                                   const ProgressCallback& progress = {});
+                                   const ProgressCallback& progress = {},
+                                   const FaceRegions* regions = nullptr);
 
 }  // namespace texlume::synth

@@ -78,7 +78,7 @@ BtfMeshSynthesis SynthesizeMeshBtf(const mesh::TriangleMesh& mesh,
                                    const std::vector<MeshPhoto>& photos,
                                    const btf::BtfFactorisation& btf,
                                    const BtfMeshSynthesisOptions& options,
-                                   const ProgressCallback& progress) {
+                                   const ProgressCallback& progress, const FaceRegions* regions) {
   options.Check();
   const BtfSample sample(btf);
   ChannelFactorCorrection correction({options.correction_noise, options.correction_sigma,
@@ -86,7 +86,9 @@ BtfMeshSynthesis SynthesizeMeshBtf(const mesh::TriangleMesh& mesh,
   TriangleEngine engine(mesh, reconstruction, visibility, photos, sample, options,
                         options.photo_correction ? &correction : nullptr);
   BtfMeshSynthesis result;
+  if (regions) engine.DistributeOver(*regions);
   static_cast<TriangleSynthesis&>(result) = engine.Run(progress);
+  if (result.rank_share_only) return result;  // rank 0 finishes
   result.sample_width = btf.width;
   result.sample_height = btf.height;
   result.colour_gain = correction.factors();

@@ -93,12 +93,12 @@ struct BtfMeshSynthesis : TriangleSynthesis {
 /// seam_band texels on both sides of every shared edge.
 /// Throws OptionError for bad options and InputError when a patch does not fit
 /// the sample or the patches exceed max_texels.
-BtfMeshSynthesis SynthesizeMeshBtf(const mesh::TriangleMesh& mesh,
-                                   const sfm::Reconstruction& reconstruction,
-                                   const sfm::VisibilityResult& visibility,
-                                   const std::vector<MeshPhoto>& photos,
-                                   const btf::BtfFactorisation& sample,
-                                   const BtfMeshSynthesisOptions& options,
-                                   const ProgressCallback& progress = {});
+/// `regions`: a distributed run (TriangleEngine::DistributeOver); on ranks other than
+/// 0 the result is only this rank's share (rank_share_only).
+BtfMeshSynthesis SynthesizeMeshBtf(
+    const mesh::TriangleMesh& mesh, const sfm::Reconstruction& reconstruction,
+    const sfm::VisibilityResult& visibility, const std::vector<MeshPhoto>& photos,
+    const btf::BtfFactorisation& sample, const BtfMeshSynthesisOptions& options,
+    const ProgressCallback& progress = {}, const FaceRegions* regions = nullptr);
 
 }  // namespace texlume::synth

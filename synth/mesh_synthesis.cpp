@@ -58,12 +58,66 @@ void MeshSynthesis::SampleBlended(int face, const Eigen::Vector2d& p, int strip,
   for (std::size_t c = 0; c < n; ++c) out[c] = static_cast<float>(own_weight * own[c] + sum[c]);
 }
 
+namespace {
+
+// Summed squared coefficient difference across edge k of face f, and the points.
+std::pair<double, int> EdgeDifference(const MeshSynthesis& synthesis, std::size_t f, int k) {
+  const Unfolding& u = synthesis.unfoldings[f][static_cast<std::size_t>(k)];
+  const TrianglePatch& patch = synthesis.patches[f];
+  const Eigen::Vector2d a = patch.corners_in_frame[static_cast<std::size_t>(k)];
+  const Eigen::Vector2d b = patch.corners_in_frame[static_cast<std::size_t>((k + 1) % 3)];
+  const int points = std::max(1, static_cast<int>((b - a).norm() / synthesis.texel_size));
+  const int planes = synthesis.CoefficientPlanes();
+  std::array<float, MeshSynthesis::kMaxPlanes> own{}, other{};
+  double sum = 0.0;
+  int counted = 0;
+  for (int i = 0; i < points; ++i) {
+    const Eigen::Vector2d p = a + (b - a) * ((i + 0.5) / points);
+    if (!synthesis.SamplePatch(static_cast<int>(f), p, own.data()) ||
+        !synthesis.SamplePatch(u.face, u.rotation * p + u.translation, other.data()))
+      continue;
+    for (int q = 0; q < planes / 6; ++q) {
+      Eigen::Matrix<double, 6, 1> c, o;
+      for (int j = 0; j < 6; ++j)
+        c[j] = other[static_cast<std::size_t>(q * 6 + j)],
+        o[j] = own[static_cast<std::size_t>(q * 6 + j)];
+      sum += (u.coefficients_to_this * c - o).squaredNorm();
+    }
+    ++counted;
+  }
+  return {sum, counted};
+}
+
+}  // namespace
+
+EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
+                                 const std::vector<int>& region_of_face) {
+  EdgeMismatch m;
+  double border_sum = 0.0, other_sum = 0.0;
+  std::size_t border_points = 0, other_points = 0;
+  for (std::size_t f = 0; f < synthesis.patches.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int g = synthesis.unfoldings[f][static_cast<std::size_t>(k)].face;
+      if (g < static_cast<int>(f)) continue;  // each shared edge once (and not boundaries)
+      const auto [sum, points] = EdgeDifference(synthesis, f, k);
+      const bool border = !region_of_face.empty() &&
+                          region_of_face[f] != region_of_face[static_cast<std::size_t>(g)];
+      (border ? border_sum : other_sum) += sum;
+      (border ? border_points : other_points) += static_cast<std::size_t>(points);
+      ++(border ? m.border_edges : m.other_edges);
+    }
+  const double planes = std::max(1, synthesis.CoefficientPlanes());
+  if (border_points) m.region_borders = border_sum / (border_points * planes);
+  if (other_points) m.elsewhere = other_sum / (other_points * planes);
+  return m;
+}
+
 MeshSynthesis SynthesizeMeshPtm(const mesh::TriangleMesh& mesh,
                                 const sfm::Reconstruction& reconstruction,
                                 const sfm::VisibilityResult& visibility,
                                 const std::vector<MeshPhoto>& photos, const ptm::Ptm& ptm,
                                 const MeshSynthesisOptions& options,
-                                const ProgressCallback& progress) {
+                                const ProgressCallback& progress, const FaceRegions* regions) {
   options.Check();
   const PtmSample sample(ptm);
   // The photo-consistency pass and detail transfer work on LRGB luminance.
@@ -73,7 +127,9 @@ MeshSynthesis SynthesizeMeshPtm(const mesh::TriangleMesh& mesh,
   TriangleEngine engine(mesh, reconstruction, visibility, photos, sample, options,
                         correction.get());
   MeshSynthesis result;
+  if (regions) engine.DistributeOver(*regions);
   static_cast<TriangleSynthesis&>(result) = engine.Run(progress);
+  if (result.rank_share_only) return result;  // rank 0 finishes
   result.format = ptm.format;
   result.sample_planes = sample.Values();
   if (correction) result.detail_bands = correction->TakeDetailBands();

@@ -92,11 +92,26 @@ struct MeshSynthesis : TriangleSynthesis {
 /// `photos` the usable photos (each image_id in the reconstruction). Throws
 /// OptionError for bad options and InputError when the patches would not fit the
 /// sample or would exceed max_texels (with the estimate).
+/// How well neighbouring patches agree across the mesh's shared edges, split
+/// between edges whose faces lie in different regions of a distributed run and
+/// the others: the mean squared difference of the blended coefficient planes
+/// (orthonormal space, the neighbour's turned by the unfolding) between the two
+/// faces' patches at points one texel apart along each edge.
+struct EdgeMismatch {
+  double region_borders = 0.0, elsewhere = 0.0;
+  std::size_t border_edges = 0, other_edges = 0;
+};
+EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
+                                 const std::vector<int>& region_of_face);
+
+/// `regions`: a distributed run (TriangleEngine::DistributeOver); on ranks other than
+/// 0 the result is only this rank's share (rank_share_only).
 MeshSynthesis SynthesizeMeshPtm(const mesh::TriangleMesh& mesh,
                                 const sfm::Reconstruction& reconstruction,
                                 const sfm::VisibilityResult& visibility,
                                 const std::vector<MeshPhoto>& photos, const ptm::Ptm& sample,
                                 const MeshSynthesisOptions& options,
-                                const ProgressCallback& progress = {});
+                                const ProgressCallback& progress = {},
+                                const FaceRegions* regions = nullptr);
 
 }  // namespace texlume::synth

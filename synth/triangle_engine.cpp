@@ -117,18 +117,29 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
           : PhotoByPhotoBreadthFirstOrder(neighbours, KeyPhotoOfFaces(visibility_, photos_),
                                           BestSeenFace(visibility_));
   done_.assign(num_faces, 0);
-  std::mt19937_64 rng(options_.seed);
-  std::size_t processed = 0;
-  for (const int face : order) {
-    SynthesizeFace(static_cast<std::size_t>(face), rng);
-    done_[static_cast<std::size_t>(face)] = 1;
-    ++processed;
-    if (progress && (processed % 64 == 0 || processed == num_faces))
-      progress("synthesis", processed, num_faces);
+  if (!regions_) {
+    PlaceFaces(order, options_.seed, 0, num_faces, progress);
+  } else if (!PlaceRegions(order, progress)) {
+    result_.seconds_synthesis = SecondsSince(start);
+    return std::move(result_);
   }
   if (correction_) correction_->Finish(*this, progress);
   result_.seconds_synthesis = SecondsSince(start);
   return std::move(result_);
+}
+
+void TriangleEngine::PlaceFaces(const std::vector<int>& faces, std::uint32_t seed,
+                                std::size_t done_before, std::size_t total,
+                                const ProgressCallback& progress) {
+  std::mt19937_64 rng(seed);
+  std::size_t processed = done_before;
+  for (const int face : faces) {
+    SynthesizeFace(static_cast<std::size_t>(face), rng);
+    done_[static_cast<std::size_t>(face)] = 1;
+    ++processed;
+    if (progress && (processed % 64 == 0 || processed == total))
+      progress("synthesis", processed, total);
+  }
 }
 
 const TriangleSynthesis& TriangleEngine::Prepare(const ProgressCallback& progress) {
@@ -151,7 +162,7 @@ void TriangleEngine::PrepareStages(bool patches_in_sample, const ProgressCallbac
   SetUpPatches(MakePatchGeometry(mesh_, t, options_.strip, options_.tangent_frame,
                                  options_.field_direction_in_world));
   TurnFramesToPhotos();
-  EstimatePhotometry(progress);
+  EstimateOrReceivePhotometry(progress);
 }
 
 void TriangleEngine::SetUpPatches(PatchGeometry geometry) {

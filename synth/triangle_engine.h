@@ -11,10 +11,12 @@
 #include <random>
 #include <vector>
 
+#include "core/byte_buffer.h"
 #include "core/progress.h"
 #include "mesh/mesh.h"
 #include "sfm/reconstruction.h"
 #include "sfm/visibility.h"
+#include "synth/face_regions.h"
 #include "synth/material_sample.h"
 #include "synth/photometry.h"
 #include "synth/template_match.h"
@@ -145,6 +147,15 @@ struct TriangleSynthesis {
   /// at the photos' median density; -1 when not measured.
   double sample_coherence = -1.0;
   double seconds_synthesis = 0.0;  ///< set-up, placement and the photo pass
+  /// A distributed run (TriangleEngine::DistributeOver) on a rank other than 0:
+  /// its faces went to rank 0, which holds the result; this one holds only the
+  /// set-up, the photometry and this rank's own faces.
+  bool rank_share_only = false;
+  /// A distributed run, at rank 0: what every rank did, by rank, and the faces
+  /// on region borders (placed by rank 0 last) and the edges between regions.
+  std::vector<RankRecord> rank_records;
+  std::vector<int> region_of_face;  ///< the partition (mesh::FacePartition)
+  std::size_t region_border_faces = 0, region_cut_edges = 0;
 };
 
 class TriangleEngine;
@@ -176,6 +187,13 @@ class PhotoCorrection {
                        const std::vector<RelitWindow>& relit) = 0;
   /// After the last face.
   virtual void Finish(TriangleEngine& /*engine*/, const ProgressCallback& /*progress*/) {}
+  /// A distributed run: what Correct kept for face `face` (beyond its patch),
+  /// written by the rank that corrected it and read at rank 0 in the same order.
+  virtual void SaveFace(std::size_t /*face*/, ByteWriter& /*out*/) const {}
+  virtual void LoadFace(TriangleEngine& /*engine*/, std::size_t /*face*/, ByteReader& /*in*/) {}
+  /// Sums over this rank's faces (statistics), added to rank 0's.
+  virtual void SaveSums(ByteWriter& /*out*/) const {}
+  virtual void AddSums(ByteReader& /*in*/) {}
 };
 
 /// Paper 003 Algorithm 2 for any MaterialSample: each face's frame and patch
@@ -193,6 +211,13 @@ class TriangleEngine {
                  const sfm::VisibilityResult& visibility, const std::vector<MeshPhoto>& photos,
                  const MaterialSample& sample, const TriangleEngineOptions& options,
                  PhotoCorrection* correction);
+
+  /// Makes Run distributed over `regions.ranks` (synth/face_regions.h): each
+  /// rank places its region's faces off the region border, rank 0 gathers them,
+  /// places the border faces and finishes. Set-up and frames run on every rank;
+  /// the photometry on rank 0, which sends it to the others. Call on every rank
+  /// with the same partition.
+  void DistributeOver(FaceRegions regions);
 
   /// Runs every stage. Throws OptionError for bad options and InputError when
   /// the patches would not fit the sample or would exceed max_texels.
@@ -262,8 +287,22 @@ class TriangleEngine {
   // The sample relit under a rectified view's lighting, as luminance, over a
   // window of the view's grid size (the photo blur's comparison).
   cv::Mat SampleWindowLuminance(std::size_t face, const RectifiedView& rect) const;
-  // Stage 2b: one face, breadth first.
+  // The photometry: estimated (at rank 0 of a distributed run), sent to the other ranks.
+  void EstimateOrReceivePhotometry(const ProgressCallback& progress);
+  // Stage 2b: `faces` in their order, each placed and corrected (SynthesizeFace);
+  // progress counts from `done_before` of `total`.
+  void PlaceFaces(const std::vector<int>& faces, std::uint32_t seed, std::size_t done_before,
+                  std::size_t total, const ProgressCallback& progress);
   void SynthesizeFace(std::size_t face, std::mt19937_64& rng);
+  // Stage 2b distributed: this rank's region off the border, gathered at rank 0,
+  // which places the border faces. False on the other ranks (nothing to finish).
+  bool PlaceRegions(const std::vector<int>& order, const ProgressCallback& progress);
+  // A rank's placed faces (patches, the correction's state) and record, and
+  // their reading at rank 0.
+  void WriteRegion(const std::vector<int>& faces, const RankRecord& record, ByteWriter& out) const;
+  void ReadRegion(const std::vector<char>& message);
+  // The placed-by counts from the patches' sources (after a distributed run).
+  void CountSources();
   // The views that constrain a face, rectified.
   std::vector<RectifiedView> RectifiedViews(std::size_t face, bool wide_mask) const;
 
@@ -299,6 +338,7 @@ class TriangleEngine {
   bool patches_in_sample_ = true;
   /// The faces in the order the passes over the photos visit them (FacesByPhoto).
   std::vector<std::size_t> photo_visit_order_;
+  std::optional<FaceRegions> regions_;  // a distributed run (DistributeOver)
   // The sample's feature planes transformed once, for the faces no photo sees.
   std::optional<ImageSpectra> feature_spectra_;
   TriangleSynthesis result_;

@@ -1,0 +1,58 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "mesh/face_partition.h"
+#include "sfm/visibility.h"
+
+namespace texlume::synth {
+
+/// How the ranks of one distributed synthesis talk (issue 33: `mpirun -np N
+/// texlume synth`; the MPI implementation is distributed/mpi_ranks.h). Every
+/// rank calls each method at the same point of the job, in the same order.
+class RankCommunicator {
+ public:
+  virtual ~RankCommunicator() = default;
+  virtual int Rank() const = 0;
+  virtual int Size() const = 0;
+  /// Rank 0's `bytes`, on every rank.
+  virtual void Broadcast(std::vector<char>& bytes) = 0;
+  /// Every rank's `bytes` at rank 0, indexed by rank; nothing on the others.
+  virtual std::vector<std::vector<char>> GatherToRoot(const std::vector<char>& bytes) = 0;
+};
+
+/// What one rank of a distributed synthesis did (the run's timings).
+struct RankRecord {
+  int rank = 0;
+  std::uint64_t faces = 0;         ///< faces of its region, border included
+  std::uint64_t faces_placed = 0;  ///< its region's faces off the border, which it placed
+  double seconds_region = 0.0;     ///< placing and correcting them
+  std::uint64_t bytes_sent = 0;    ///< what it sent rank 0
+};
+
+/// A distributed synthesis: the ranks and one region of faces per rank. Each
+/// rank places the faces of its region off the region's border, breadth first
+/// within the region; rank 0 gathers them and places the border faces, whose
+/// neighbours on both sides are then placed.
+struct FaceRegions {
+  RankCommunicator* ranks = nullptr;  ///< Size() == partition.num_regions
+  mesh::FacePartition partition;
+};
+
+/// The faces divided into `num_regions` regions (mesh::PartitionFaces), each
+/// face weighted by the work it costs: 1 + the views that constrain it (at
+/// most `max_views`).
+mesh::FacePartition RegionsForRanks(const std::vector<std::array<int, 3>>& neighbours,
+                                    const sfm::VisibilityResult& visibility, int num_regions,
+                                    int max_views, std::uint32_t seed);
+
+/// The faces with `member[f]`, breadth first over edge adjacency within them:
+/// each connected piece starts at its first face in `order`, and the pieces
+/// follow in that order too (so a piece's faces, but the first, each have a
+/// neighbour before them).
+std::vector<int> OrderWithin(const std::vector<int>& order, const std::vector<char>& member,
+                             const std::vector<std::array<int, 3>>& neighbours);
+
+}  // namespace texlume::synth

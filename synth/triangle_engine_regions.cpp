@@ -1,0 +1,149 @@
+// The distributed run of the per-triangle engine (issue 33, synth/face_regions.h):
+// photometry sent from rank 0, regions placed by their ranks, borders by rank 0.
+#include <chrono>
+
+#include "core/check.h"
+#include "core/timing.h"
+#include "synth/face_order.h"
+#include "synth/triangle_engine.h"
+
+namespace texlume::synth {
+
+void TriangleEngine::DistributeOver(FaceRegions regions) {
+  TEXLUME_CHECK(regions.ranks != nullptr, "a distributed run has ranks");
+  TEXLUME_CHECK(regions.partition.num_regions == regions.ranks->Size(), "one region per rank");
+  TEXLUME_CHECK(regions.partition.region_of_face.size() == mesh_.faces.size(),
+                "the partition is of the engine's mesh");
+  regions_ = std::move(regions);
+}
+
+void TriangleEngine::EstimateOrReceivePhotometry(const ProgressCallback& progress) {
+  if (!regions_) return EstimatePhotometry(progress);
+  RankCommunicator& ranks = *regions_->ranks;
+  ByteWriter out;
+  if (ranks.Rank() == 0) {
+    EstimatePhotometry(progress);
+    out.PutVector(result_.photo_gains);
+    out.Put(result_.light_response);
+    out.PutVector(result_.white_balance);
+    out.PutVector(result_.photo_blur);
+  }
+  ranks.Broadcast(out.bytes());
+  if (ranks.Rank() == 0) return;
+  ByteReader in(out.bytes());
+  result_.photo_gains = in.GetVector<double>();
+  result_.light_response = in.Get<ptm::LightResponse>();
+  result_.white_balance = in.GetVector<std::array<double, 3>>();
+  result_.photo_blur = in.GetVector<double>();
+  TEXLUME_CHECK(result_.photo_gains.size() == photos_.size(), "rank 0 has the same photos");
+}
+
+bool TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressCallback& progress) {
+  const mesh::FacePartition& partition = regions_->partition;
+  RankCommunicator& ranks = *regions_->ranks;
+  const int rank = ranks.Rank();
+  const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(mesh_);
+  std::vector<char> interior(mesh_.faces.size(), 0), border(mesh_.faces.size(), 0);
+  for (std::size_t f = 0; f < interior.size(); ++f) {
+    interior[f] = partition.region_of_face[f] == rank && !partition.on_border[f];
+    border[f] = partition.on_border[f];
+  }
+  // The region breadth first within itself (cache-warm photo-by-photo order
+  // kept when the photos do not all fit).
+  std::vector<int> region_faces;
+  if (PhotosHeldTogether(photos_)) {
+    region_faces = OrderWithin(order, interior, neighbours);
+  } else {
+    for (const int f : order)
+      if (interior[static_cast<std::size_t>(f)]) region_faces.push_back(f);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  PlaceFaces(region_faces, options_.seed + static_cast<std::uint32_t>(rank), 0, region_faces.size(),
+             progress);
+  RankRecord record;
+  record.rank = rank;
+  record.faces = partition.faces_in_region[static_cast<std::size_t>(rank)];
+  record.faces_placed = region_faces.size();
+  record.seconds_region = SecondsSince(start);
+  ByteWriter message;
+  WriteRegion(region_faces, record, message);
+  const std::vector<std::vector<char>> messages = ranks.GatherToRoot(message.bytes());
+  if (rank != 0) {
+    result_.rank_share_only = true;
+    return false;
+  }
+  record.bytes_sent = 0;  // rank 0's own faces stay where they are
+  result_.rank_records.push_back(record);
+  for (std::size_t r = 1; r < messages.size(); ++r) ReadRegion(messages[r]);
+  // The border faces, with their neighbours on both sides placed.
+  const std::vector<int> border_faces = OrderWithin(order, border, neighbours);
+  if (progress) progress("region borders", 0, border_faces.size());
+  PlaceFaces(border_faces, options_.seed + static_cast<std::uint32_t>(ranks.Size()), 0,
+             border_faces.size(),
+             progress
+                 ? ProgressCallback([&](std::string_view, std::size_t done, std::size_t total) {
+                     progress("region borders", done, total);
+                   })
+                 : ProgressCallback());
+  result_.region_border_faces = border_faces.size();
+  result_.region_cut_edges = partition.cut_edges;
+  result_.region_of_face = partition.region_of_face;
+  CountSources();
+  return true;
+}
+
+void TriangleEngine::WriteRegion(const std::vector<int>& faces, const RankRecord& record,
+                                 ByteWriter& out) const {
+  out.Put(record);
+  out.Put<std::uint64_t>(faces.size());
+  for (const int f : faces) {
+    const TrianglePatch& p = result_.patches[static_cast<std::size_t>(f)];
+    out.Put<std::int32_t>(f);
+    out.Put(p.sample_x), out.Put(p.sample_y), out.Put(p.source), out.Put(p.views_used);
+    out.Put(p.image_score), out.Put(p.prior_shrink), out.Put(p.overlap_error);
+    out.Put(p.correction_density.x()), out.Put(p.correction_density.y());
+    out.PutMats(p.correction);
+    out.PutMats(p.channel_gain);
+    if (correction_) correction_->SaveFace(static_cast<std::size_t>(f), out);
+  }
+  if (correction_) correction_->SaveSums(out);
+  // What this message costs, counted in the record at rank 0.
+  out.Put<std::uint64_t>(out.bytes().size() + sizeof(std::uint64_t));
+}
+
+void TriangleEngine::ReadRegion(const std::vector<char>& message) {
+  ByteReader in(message);
+  RankRecord record = in.Get<RankRecord>();
+  const auto count = in.Get<std::uint64_t>();
+  TEXLUME_CHECK(count <= mesh_.faces.size(), "a rank places faces of the mesh");
+  for (std::uint64_t n = 0; n < count; ++n) {
+    const auto f = in.Get<std::int32_t>();
+    TEXLUME_CHECK(f >= 0 && static_cast<std::size_t>(f) < mesh_.faces.size(), "a face index");
+    TrianglePatch& p = result_.patches[static_cast<std::size_t>(f)];
+    p.sample_x = in.Get<int>(), p.sample_y = in.Get<int>();
+    p.source = in.Get<PatchSource>(), p.views_used = in.Get<int>();
+    p.image_score = in.Get<double>(), p.prior_shrink = in.Get<double>();
+    p.overlap_error = in.Get<double>();
+    p.correction_density.x() = in.Get<double>();
+    p.correction_density.y() = in.Get<double>();
+    p.correction = in.GetMats();
+    p.channel_gain = in.GetMats();
+    if (correction_) correction_->LoadFace(*this, static_cast<std::size_t>(f), in);
+    done_[static_cast<std::size_t>(f)] = 1;
+  }
+  if (correction_) correction_->AddSums(in);
+  record.bytes_sent = in.Get<std::uint64_t>();
+  TEXLUME_CHECK(in.Remaining() == 0, "a rank's message is read whole");
+  result_.rank_records.push_back(record);
+}
+
+void TriangleEngine::CountSources() {
+  result_.num_from_photos = result_.num_from_neighbours = result_.num_random = 0;
+  for (const TrianglePatch& p : result_.patches) {
+    if (p.source == PatchSource::kPhotos) ++result_.num_from_photos;
+    if (p.source == PatchSource::kNeighbours) ++result_.num_from_neighbours;
+    if (p.source == PatchSource::kRandom) ++result_.num_random;
+  }
+}
+
+}  // namespace texlume::synth

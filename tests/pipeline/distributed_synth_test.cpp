@@ -1,0 +1,196 @@
+// The main job across ranks (issue 33): regions placed by their ranks, borders by
+// rank 0, in threads standing in for ranks and through mpirun.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <barrier>
+#include <exception>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "datasets_synthetic/scene.h"
+#include "mesh/mesh.h"
+#include "pipeline/synth_job.h"
+#include "ptm/ptm_io.h"
+#include "synth/mesh_synthesis.h"
+#include "tests/test_util.h"
+
+namespace texlume::pipeline {
+namespace {
+namespace fs = std::filesystem;
+
+// Ranks as threads of this process: each call waits for every rank.
+class ThreadRanks final : public synth::RankCommunicator {
+ public:
+  struct Shared {
+    explicit Shared(int size) : barrier(size), slots(static_cast<std::size_t>(size)) {}
+    std::barrier<> barrier;
+    std::vector<std::vector<char>> slots;
+  };
+  ThreadRanks(Shared& shared, int rank) : shared_(shared), rank_(rank) {}
+  int Rank() const override { return rank_; }
+  int Size() const override { return static_cast<int>(shared_.slots.size()); }
+  void Broadcast(std::vector<char>& bytes) override {
+    if (rank_ == 0) shared_.slots[0] = bytes;
+    shared_.barrier.arrive_and_wait();
+    if (rank_ != 0) bytes = shared_.slots[0];
+    shared_.barrier.arrive_and_wait();
+  }
+  std::vector<std::vector<char>> GatherToRoot(const std::vector<char>& bytes) override {
+    shared_.slots[static_cast<std::size_t>(rank_)] = bytes;
+    shared_.barrier.arrive_and_wait();
+    std::vector<std::vector<char>> all;
+    if (rank_ == 0) all = shared_.slots;
+    shared_.barrier.arrive_and_wait();
+    return all;
+  }
+
+ private:
+  Shared& shared_;
+  int rank_;
+};
+
+class DistributedSynthTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    tmp_ = new testing::TempDir;
+    datasets::SceneOptions o = datasets::SmallObjectSceneOptions(datasets::SceneShape::kSphere,
+                                                                 datasets::MaterialKind::kStone);
+    o.num_held_out_views = 1;
+    o.write_btf = false;
+    datasets::GenerateScene(o, tmp_->path() / "scene");
+    ptm::WritePtmExr(datasets::FitSceneSample(tmp_->path() / "scene"), tmp_->path() / "sample.exr");
+    one_ = new SynthJobSummary(RunSynthJob(Job("one")));
+  }
+  static void TearDownTestSuite() {
+    delete one_;
+    delete tmp_;
+  }
+  static SynthJobOptions Job(const std::string& out) {
+    SynthJobOptions j;
+    const fs::path object = tmp_->path() / "scene/object";
+    j.model_dir = object / "sparse";
+    j.images_dir = object / "images";
+    j.lights_file = object / "lights.json";
+    j.mesh_file = object / "mesh.ply";
+    j.sample_file = tmp_->path() / "sample.exr";
+    j.out_dir = tmp_->path() / out;
+    j.synthesis.sample_texel_size = 0.004;
+    j.atlas.atlas_size = 512;
+    j.write_report = false;
+    return j;
+  }
+  static std::string SynthCommand(const std::string& out) {
+    const fs::path object = tmp_->path() / "scene/object";
+    return std::string(TEXLUME_BINARY) + " synth --model " + (object / "sparse").string() +
+           " --images " + (object / "images").string() + " --lights " +
+           (object / "lights.json").string() + " --mesh " + (object / "mesh.ply").string() +
+           " --sample " + (tmp_->path() / "sample.exr").string() +
+           " --sample-texel-size 0.004 --atlas-size 512 --no-report --out " +
+           (tmp_->path() / out).string();
+  }
+  static std::string Mpirun(int ranks) {
+    // As root (CI), OpenMPI asks to be told; one thread per rank on a small machine.
+    return "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1 "
+           "timeout 600 " TEXLUME_MPIEXEC " --oversubscribe -np " +
+           std::to_string(ranks) + " ";
+  }
+  static nlohmann::json Manifest(const std::string& out) {
+    return nlohmann::json::parse(testing::ReadText(tmp_->path() / out / "manifest.json"));
+  }
+  static testing::TempDir* tmp_;
+  static SynthJobSummary* one_;
+};
+testing::TempDir* DistributedSynthTest::tmp_ = nullptr;
+SynthJobSummary* DistributedSynthTest::one_ = nullptr;
+
+// The job on `size` ranks in threads; rank 0's summary.
+SynthJobSummary RunOnThreadRanks(const SynthJobOptions& job, int size) {
+  ThreadRanks::Shared shared(size);
+  std::vector<ThreadRanks> ranks;
+  for (int r = 0; r < size; ++r) ranks.emplace_back(shared, r);
+  std::vector<SynthJobSummary> summaries(static_cast<std::size_t>(size));
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(size));
+  std::vector<std::thread> threads;
+  for (int r = 0; r < size; ++r)
+    threads.emplace_back([&, r] {
+      try {
+        SynthJobOptions own = job;
+        own.ranks = &ranks[static_cast<std::size_t>(r)];
+        summaries[static_cast<std::size_t>(r)] = RunSynthJob(own);
+      } catch (...) {
+        errors[static_cast<std::size_t>(r)] = std::current_exception();
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+  for (int r = 1; r < size; ++r)
+    EXPECT_TRUE(summaries[static_cast<std::size_t>(r)].rank_share_only);
+  return summaries[0];
+}
+
+TEST_F(DistributedSynthTest, ThreeRanksPlaceEveryFaceAndRankZeroWritesTheModel) {
+  const SynthJobSummary three = RunOnThreadRanks(Job("threads3"), 3);
+  EXPECT_FALSE(three.rank_share_only);
+  EXPECT_EQ(three.faces, one_->faces);
+  // Whether a face is placed from the photos does not depend on the order.
+  EXPECT_EQ(three.from_photos, one_->from_photos);
+  EXPECT_EQ(three.from_photos + three.from_neighbours + three.random, three.faces);
+  const nlohmann::json d = Manifest("threads3")["distributed"];
+  ASSERT_TRUE(d.is_object());
+  EXPECT_EQ(d["ranks"], 3);
+  std::size_t placed = d["region_border_faces"];
+  for (const auto& rank : d["per_rank"]) {
+    placed += rank["faces_placed"].get<std::size_t>();
+    EXPECT_GT(rank["faces_placed"].get<std::size_t>(), three.faces / 6);  // regions balanced
+    if (rank["rank"] != 0) {
+      EXPECT_GT(rank["bytes_sent"].get<std::size_t>(), 0u);
+    }
+  }
+  EXPECT_EQ(placed, three.faces);  // every face placed once, by one rank
+  // Borders placed with their neighbours on both sides agree with them no worse
+  // than other edges do (with a margin for a few dozen border edges).
+  EXPECT_GT(d["edge_mismatch"]["border_edges"].get<int>(), 10);
+  EXPECT_LT(d["edge_mismatch"]["region_borders"].get<double>(),
+            1.5 * d["edge_mismatch"]["elsewhere"].get<double>());
+  EXPECT_TRUE(Manifest("one")["distributed"].is_null());
+}
+
+TEST_F(DistributedSynthTest, MpirunWithTwoAndThreeRanksTakesTheSameCommandLine) {
+  std::string output;
+  for (const int ranks : {2, 3}) {
+    const std::string out = "mpi" + std::to_string(ranks);
+    ASSERT_EQ(testing::RunCommand(Mpirun(ranks) + SynthCommand(out), &output), 0) << output;
+    // One summary line, from rank 0.
+    std::size_t lines = 0;
+    for (std::size_t at = output.find("Synthesised"); at != std::string::npos;
+         at = output.find("Synthesised", at + 1))
+      ++lines;
+    EXPECT_EQ(lines, 1u) << output;
+    const nlohmann::json m = Manifest(out);
+    EXPECT_EQ(m["distributed"]["ranks"], ranks);
+    EXPECT_EQ(m["summary"]["from_photos"].get<std::size_t>(), one_->from_photos);
+    EXPECT_TRUE(fs::exists(tmp_->path() / out / "ptm_atlas_0.exr"));
+  }
+}
+
+TEST_F(DistributedSynthTest, MpirunRefusesOtherCommandsAndEndsEveryRankOnBadInput) {
+  std::string output;
+  EXPECT_EQ(testing::RunCommand(Mpirun(2) + TEXLUME_BINARY " inspect --model " +
+                                    (tmp_->path() / "scene/object/sparse").string(),
+                                &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("only texlume synth runs across MPI ranks"), std::string::npos) << output;
+  std::string command = SynthCommand("bad");
+  command.replace(command.find("mesh.ply"), 8, "missing.ply");
+  EXPECT_EQ(testing::RunCommand(Mpirun(2) + command, &output), 1) << output;
+  EXPECT_NE(output.find("missing.ply"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(tmp_->path() / "bad" / "manifest.json"));
+  command = SynthCommand("graphcut") + " --engine graphcut";
+  EXPECT_EQ(testing::RunCommand(Mpirun(2) + command, &output), 2) << output;
+}
+
+}  // namespace
+}  // namespace texlume::pipeline
