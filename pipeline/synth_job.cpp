@@ -358,11 +358,15 @@ nlohmann::json RanksJson(const synth::TriangleSynthesis& synthesis,
     ranks.push_back({{"rank", r.rank},
                      {"faces", r.faces},
                      {"faces_placed", r.faces_placed},
+                     {"seconds_prepare", r.seconds_prepare},
                      {"seconds_region", r.seconds_region},
+                     {"seconds_finish", r.seconds_finish},
                      {"bytes_sent", r.bytes_sent}});
   nlohmann::json record = {{"ranks", synthesis.rank_records.size()},
                            {"region_border_faces", synthesis.region_border_faces},
                            {"region_cut_edges", synthesis.region_cut_edges},
+                           {"seconds_gather", synthesis.seconds_gather},
+                           {"seconds_region_borders", synthesis.seconds_region_borders},
                            {"per_rank", ranks}};
   if (mismatch)
     record["edge_mismatch"] = {{"region_borders", mismatch->region_borders},

@@ -563,11 +563,12 @@ void CoefficientCorrection::LoadFace(TriangleEngine& engine, std::size_t face, B
   correction_level_[face] = level;
 }
 
-void CoefficientCorrection::Finish(TriangleEngine& engine, const ProgressCallback& progress) {
+void CoefficientCorrection::Finish(TriangleEngine& engine, const std::vector<std::size_t>& faces,
+                                   const ProgressCallback& progress) {
   if (!options_.detail_transfer) return;
   std::vector<TrianglePatch>& patches = engine.result().patches;
-  // The dictionaries of the levels used, in parallel (their reductions first:
-  // the sample's cache is not thread-safe).
+  // The dictionaries of the levels any face used (their detail bands serve every
+  // face), in parallel (their reductions first: the sample's cache is not thread-safe).
   std::vector<int> levels;
   for (const int level : correction_level_) {
     if (level < 0 || dictionaries_.count(level)) continue;
@@ -582,10 +583,11 @@ void CoefficientCorrection::Finish(TriangleEngine& engine, const ProgressCallbac
     dictionaries_.at(level) =
         std::make_unique<DetailDictionary>(sample_, level, detail_bands_.at(level));
   }
-  // The corrected patches, independent of one another.
+  // The corrected patches among `faces`, independent of one another.
   std::vector<std::size_t> transferred;
-  for (std::size_t f = 0; f < correction_level_.size(); ++f)
-    if (correction_level_[f] >= 0 && dictionaries_.at(correction_level_[f])->Usable())
+  for (const std::size_t f : faces)
+    if (f < correction_level_.size() && correction_level_[f] >= 0 &&
+        dictionaries_.at(correction_level_[f])->Usable())
       transferred.push_back(f);
   std::atomic<std::size_t> transfers_done{0};
 #pragma omp parallel for schedule(dynamic, 8)

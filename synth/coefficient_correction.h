@@ -38,7 +38,8 @@ class CoefficientCorrection : public PhotoCorrection {
 
   void Correct(TriangleEngine& engine, std::size_t face, std::vector<RectifiedView>& views,
                const std::vector<RelitWindow>& relit) override;
-  void Finish(TriangleEngine& engine, const ProgressCallback& progress) override;
+  void Finish(TriangleEngine& engine, const std::vector<std::size_t>& faces,
+              const ProgressCallback& progress) override;
   /// A distributed run: the face's correction level (its patch carries the rest).
   void SaveFace(std::size_t face, ByteWriter& out) const override;
   void LoadFace(TriangleEngine& engine, std::size_t face, ByteReader& in) override;

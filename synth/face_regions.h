@@ -28,7 +28,9 @@ struct RankRecord {
   int rank = 0;
   std::uint64_t faces = 0;         ///< faces of its region, border included
   std::uint64_t faces_placed = 0;  ///< its region's faces off the border, which it placed
+  double seconds_prepare = 0.0;    ///< set-up, frames and photometry (sent by rank 0)
   double seconds_region = 0.0;     ///< placing and correcting them
+  double seconds_finish = 0.0;     ///< their pass after placement (detail transfer)
   std::uint64_t bytes_sent = 0;    ///< what it sent rank 0
 };
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <string>
@@ -107,6 +108,7 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
   const std::size_t num_faces = mesh_.faces.size();
   PrepareStages(true, progress);
+  result_.seconds_prepare = SecondsSince(start);
 
   // Breadth first from the best-seen face (Algorithm 2, step 2); photo by photo
   // when the photos do not all fit in memory (synth/face_order.h).
@@ -119,13 +121,21 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
   done_.assign(num_faces, 0);
   if (!regions_) {
     PlaceFaces(order, options_.seed, 0, num_faces, progress);
-  } else if (!PlaceRegions(order, progress)) {
-    result_.seconds_synthesis = SecondsSince(start);
-    return std::move(result_);
+    std::vector<std::size_t> every_face(num_faces);
+    std::iota(every_face.begin(), every_face.end(), std::size_t{0});
+    FinishFaces(every_face, progress);
+  } else {
+    PlaceRegions(order, progress);  // rank 0 finishes; the others' result is their share
   }
-  if (correction_) correction_->Finish(*this, progress);
   result_.seconds_synthesis = SecondsSince(start);
   return std::move(result_);
+}
+
+void TriangleEngine::FinishFaces(const std::vector<std::size_t>& faces,
+                                 const ProgressCallback& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  if (correction_) correction_->Finish(*this, faces, progress);
+  result_.seconds_finish += SecondsSince(start);
 }
 
 void TriangleEngine::PlaceFaces(const std::vector<int>& faces, std::uint32_t seed,

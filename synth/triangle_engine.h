@@ -156,6 +156,13 @@ struct TriangleSynthesis {
   std::vector<RankRecord> rank_records;
   std::vector<int> region_of_face;  ///< the partition (mesh::FacePartition)
   std::size_t region_border_faces = 0, region_cut_edges = 0;
+  /// Rank 0 of a distributed run: waiting for and reading the other ranks'
+  /// faces, and placing and finishing the border faces.
+  double seconds_gather = 0.0, seconds_region_borders = 0.0;
+  /// The correction's pass after placement (detail transfer; a distributed
+  /// run's rank 0: over its own and the border faces).
+  double seconds_finish = 0.0;
+  double seconds_prepare = 0.0;  ///< set-up, frames and photometry
 };
 
 class TriangleEngine;
@@ -185,8 +192,11 @@ class PhotoCorrection {
   /// patch (empty unless RelitMarginCells asks).
   virtual void Correct(TriangleEngine& engine, std::size_t face, std::vector<RectifiedView>& views,
                        const std::vector<RelitWindow>& relit) = 0;
-  /// After the last face.
-  virtual void Finish(TriangleEngine& /*engine*/, const ProgressCallback& /*progress*/) {}
+  /// Once every face is placed, the pass over `faces` (PTM: detail transfer),
+  /// each face's depending on its own patch alone (a distributed run's ranks
+  /// finish their own faces).
+  virtual void Finish(TriangleEngine& /*engine*/, const std::vector<std::size_t>& /*faces*/,
+                      const ProgressCallback& /*progress*/) {}
   /// A distributed run: what Correct kept for face `face` (beyond its patch),
   /// written by the rank that corrected it and read at rank 0 in the same order.
   virtual void SaveFace(std::size_t /*face*/, ByteWriter& /*out*/) const {}
@@ -294,9 +304,12 @@ class TriangleEngine {
   void PlaceFaces(const std::vector<int>& faces, std::uint32_t seed, std::size_t done_before,
                   std::size_t total, const ProgressCallback& progress);
   void SynthesizeFace(std::size_t face, std::mt19937_64& rng);
-  // Stage 2b distributed: this rank's region off the border, gathered at rank 0,
-  // which places the border faces. False on the other ranks (nothing to finish).
-  bool PlaceRegions(const std::vector<int>& order, const ProgressCallback& progress);
+  // The correction's pass after placement (PhotoCorrection::Finish) over `faces`.
+  void FinishFaces(const std::vector<std::size_t>& faces, const ProgressCallback& progress);
+  // Stage 2b distributed: this rank's region off the border placed and finished,
+  // gathered at rank 0, which places and finishes the border faces; the other
+  // ranks' results are their share (rank_share_only).
+  void PlaceRegions(const std::vector<int>& order, const ProgressCallback& progress);
   // A rank's placed faces (patches, the correction's state) and record, and
   // their reading at rank 0.
   void WriteRegion(const std::vector<int>& faces, const RankRecord& record, ByteWriter& out) const;

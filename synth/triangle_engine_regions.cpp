@@ -1,6 +1,8 @@
 // The distributed run of the per-triangle engine (issue 33, synth/face_regions.h):
 // photometry sent from rank 0, regions placed by their ranks, borders by rank 0.
 #include <chrono>
+#include <tuple>
+#include <utility>
 
 #include "core/check.h"
 #include "core/timing.h"
@@ -38,7 +40,7 @@ void TriangleEngine::EstimateOrReceivePhotometry(const ProgressCallback& progres
   TEXLUME_CHECK(result_.photo_gains.size() == photos_.size(), "rank 0 has the same photos");
 }
 
-bool TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressCallback& progress) {
+void TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressCallback& progress) {
   const mesh::FacePartition& partition = regions_->partition;
   RankCommunicator& ranks = *regions_->ranks;
   const int rank = ranks.Rank();
@@ -60,23 +62,37 @@ bool TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressC
   const auto start = std::chrono::steady_clock::now();
   PlaceFaces(region_faces, options_.seed + static_cast<std::uint32_t>(rank), 0, region_faces.size(),
              progress);
+  const double placing = SecondsSince(start);
+  FinishFaces(std::vector<std::size_t>(region_faces.begin(), region_faces.end()), progress);
   RankRecord record;
   record.rank = rank;
   record.faces = partition.faces_in_region[static_cast<std::size_t>(rank)];
   record.faces_placed = region_faces.size();
-  record.seconds_region = SecondsSince(start);
+  record.seconds_prepare = result_.seconds_prepare;
+  record.seconds_region = placing;
+  record.seconds_finish = result_.seconds_finish;
+  const auto gather = std::chrono::steady_clock::now();
   ByteWriter message;
   WriteRegion(region_faces, record, message);
   const std::vector<std::vector<char>> messages = ranks.GatherToRoot(message.bytes());
   if (rank != 0) {
     result_.rank_share_only = true;
-    return false;
+    return;
   }
   record.bytes_sent = 0;  // rank 0's own faces stay where they are
   result_.rank_records.push_back(record);
   for (std::size_t r = 1; r < messages.size(); ++r) ReadRegion(messages[r]);
+  result_.seconds_gather = SecondsSince(gather);
+  const auto borders = std::chrono::steady_clock::now();
   // The border faces, with their neighbours on both sides placed.
   const std::vector<int> border_faces = OrderWithin(order, border, neighbours);
+  // In one process the detail transfer follows the last placement: the border
+  // faces are placed against their neighbours without it too.
+  std::vector<std::pair<cv::Mat, int>> detail(mesh_.faces.size());
+  for (std::size_t f = 0; f < detail.size(); ++f) {
+    TrianglePatch& p = result_.patches[f];
+    detail[f] = {std::exchange(p.detail_source, cv::Mat()), std::exchange(p.detail_level, -1)};
+  }
   if (progress) progress("region borders", 0, border_faces.size());
   PlaceFaces(border_faces, options_.seed + static_cast<std::uint32_t>(ranks.Size()), 0,
              border_faces.size(),
@@ -85,11 +101,15 @@ bool TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressC
                      progress("region borders", done, total);
                    })
                  : ProgressCallback());
+  for (std::size_t f = 0; f < detail.size(); ++f)
+    if (!border[f])
+      std::tie(result_.patches[f].detail_source, result_.patches[f].detail_level) = detail[f];
+  FinishFaces(std::vector<std::size_t>(border_faces.begin(), border_faces.end()), progress);
+  result_.seconds_region_borders = SecondsSince(borders);
   result_.region_border_faces = border_faces.size();
   result_.region_cut_edges = partition.cut_edges;
   result_.region_of_face = partition.region_of_face;
   CountSources();
-  return true;
 }
 
 void TriangleEngine::WriteRegion(const std::vector<int>& faces, const RankRecord& record,
@@ -104,6 +124,7 @@ void TriangleEngine::WriteRegion(const std::vector<int>& faces, const RankRecord
     out.Put(p.correction_density.x()), out.Put(p.correction_density.y());
     out.PutMats(p.correction);
     out.PutMats(p.channel_gain);
+    out.PutMat(p.detail_source), out.Put<std::int32_t>(p.detail_level);
     if (correction_) correction_->SaveFace(static_cast<std::size_t>(f), out);
   }
   if (correction_) correction_->SaveSums(out);
@@ -128,6 +149,8 @@ void TriangleEngine::ReadRegion(const std::vector<char>& message) {
     p.correction_density.y() = in.Get<double>();
     p.correction = in.GetMats();
     p.channel_gain = in.GetMats();
+    p.detail_source = in.GetMat();
+    p.detail_level = in.Get<std::int32_t>();
     if (correction_) correction_->LoadFace(*this, static_cast<std::size_t>(f), in);
     done_[static_cast<std::size_t>(f)] = 1;
   }

@@ -1,0 +1,143 @@
+#!/usr/bin/env bash
+# The main job across MPI ranks (issue 33): parallel efficiency here and a model of
+# 8-64 ranks. A column of about FACES triangles photographed by IMAGES photos on RINGS
+# rings of WIDTH x HEIGHT (as bench/monument_bench.sh), a CAPTURE^2 stone sample at TEXEL
+# world units per texel; then the same synth command three ways, each rendered at the
+# held-out views against the truth:
+#   one_1t     one process, one thread (OMP_NUM_THREADS=1): the baseline of the efficiency;
+#   ranks_Nt1  mpirun -np RANKS, one thread per rank;
+#   one_Nt     one process, RANKS threads (the same cores used by OpenMP alone).
+# Efficiency = wall(one_1t) / (RANKS x wall(ranks)), for the synthesis stage (the
+# manifests' timings) and the whole command. The model of N ranks takes the measured
+# per-face compute, border faces, bytes per face and serial stages (docs/synth.md,
+# "Across machines").
+# Usage: bench/mpi_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [FACES (20000)]
+# Environment: RANKS (2), IMAGES (100), RINGS (3), WIDTH (320), HEIGHT (240), TEXEL (0.001),
+# CAPTURE (256), BANDWIDTH (bytes/s between machines for the model, 1.25e9: 10 GbE),
+# PROJECT_FACES (the model's larger mesh, 1000000; its per-face stages scaled linearly from
+# this run, an upper bound for the stages with fixed costs).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=$(realpath "${1:-$root/build}")
+texlume="$build/apps/texlume"
+work=${2:-$(mktemp -d)}
+faces=${3:-20000}
+ranks=${RANKS:-2} images=${IMAGES:-100} rings=${RINGS:-3} width=${WIDTH:-320}
+height=${HEIGHT:-240} texel=${TEXEL:-0.001} capture_size=${CAPTURE:-256}
+bandwidth=${BANDWIDTH:-1.25e9}
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1  # CI machines run as root
+dir="$work/column_${faces}_${images}_${rings}_${width}x${height}_t${texel}_c${capture_size}"
+mkdir -p "$dir"
+
+# measure NAME COMMAND...: runs COMMAND (output to NAME.log); wall and CPU seconds and
+# the peak resident KiB of its largest process in NAME.json.
+measure() {
+  local name=$1
+  shift
+  echo "mpi_bench: $name" >&2
+  python3 - "$dir/$name" "$@" <<'PY'
+import json, resource, subprocess, sys, time
+out, cmd = sys.argv[1], sys.argv[2:]
+start = time.monotonic()
+with open(out + ".log", "w") as log:
+    code = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT).returncode
+usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+json.dump({"exit": code, "wall_s": time.monotonic() - start,
+           "cpu_s": usage.ru_utime + usage.ru_stime, "peak_kib": usage.ru_maxrss},
+          open(out + ".json", "w"))
+if code != 0:
+    sys.exit(f"mpi_bench: {' '.join(cmd[:3])} failed (exit {code}); see {out}.log")
+PY
+}
+
+if [ ! -f "$dir/scene/scene.json" ]; then
+  measure scene "$texlume" scene --out "$dir/scene" --kind cylinder --mesh-faces "$faces" \
+    --images "$images" --camera-rings "$rings" --camera-distance 2 --focal 1200 \
+    --width "$width" --height "$height" --texel-size "$texel" --capture-size "$capture_size" \
+    --no-btf --held-out-views 2
+fi
+object="$dir/scene/object" held="$dir/scene/object/held_out"
+capture="$dir/scene/material/capture"
+[ -f "$dir/sample.ptm" ] ||
+  measure fit "$texlume" fit --images "$capture" --lights "$capture/lights.lp" --out "$dir/sample.ptm"
+synth=("$texlume" synth --model "$object/sparse" --images "$object/images"
+  --lights "$object/lights.json" --mesh "$object/mesh.ply" --sample "$dir/sample.ptm"
+  --sample-texel-size "$texel" --no-report)
+run() {  # NAME THREADS [mpirun ARGS...]
+  local name=$1 threads=$2
+  shift 2
+  rm -rf "$dir/$name" "$dir/render_$name"
+  OMP_NUM_THREADS=$threads measure "$name" "$@" "${synth[@]}" --out "$dir/$name"
+  measure "render_$name" "$texlume" render --model "$dir/$name" --cameras "$held/sparse" \
+    --lights "$held/lights.json" --truth "$held/images" --truth-masks "$held/masks" \
+    --reduced-factor 4 --out "$dir/render_$name/out"
+}
+run one_1t 1
+run "ranks_${ranks}t1" 1 mpirun --oversubscribe -np "$ranks"
+run "one_${ranks}t" "$ranks"
+
+python3 - "$dir" "$ranks" "$bandwidth" "${PROJECT_FACES:-1000000}" <<'PY'
+import json, math, os, sys
+d, n, bandwidth, project = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
+job = lambda name: json.load(open(os.path.join(d, name + ".json")))
+manifest = lambda name: json.load(open(os.path.join(d, name, "manifest.json")))
+render = lambda name: json.load(open(os.path.join(d, "render_" + name, "out", "render.json")))["metrics"]
+names = ["one_1t", f"ranks_{n}t1", f"one_{n}t"]
+m1 = manifest(names[0])
+faces = m1["summary"]["faces"]
+print(f"Column of {faces} faces; synth three ways\n")
+print("| run | wall s | CPU s | synthesis s | peak MiB | PSNR / SSIM | reduced 4x4 |")
+print("|---|---|---|---|---|---|---|")
+for name in names:
+    j, m, r = job(name), manifest(name), render(name)
+    print(f"| {name} | {j['wall_s']:.1f} | {j['cpu_s']:.1f} | {m['timings_s']['synthesis']:.1f} | "
+          f"{j['peak_kib'] / 1024:.0f} | {r['mean_psnr_db']:.3f} / {r['mean_ssim']:.4f} | "
+          f"{r['mean_psnr_reduced_db']:.3f} / {r['mean_ssim_reduced']:.4f} |")
+mn = manifest(names[1])
+dist = mn["distributed"]
+wall1, walln = job(names[0])["wall_s"], job(names[1])["wall_s"]
+syn1, synn = m1["timings_s"]["synthesis"], mn["timings_s"]["synthesis"]
+print(f"\nefficiency at {n} ranks: synthesis {syn1 / (n * synn):.2f}, whole command "
+      f"{wall1 / (n * walln):.2f} (speed-up {syn1 / synn:.2f} / {wall1 / walln:.2f})")
+e = dist["edge_mismatch"]
+print(f"edge mismatch: region borders {e['region_borders']:.5f} ({e['border_edges']} edges), "
+      f"elsewhere {e['elsewhere']:.5f} ({e['other_edges']} edges)")
+for r in dist["per_rank"]:
+    print(f"rank {r['rank']}: {r['faces']} faces, placed {r['faces_placed']} in "
+          f"{r['seconds_region']:.1f} s, detail transfer {r['seconds_finish']:.1f} s (prepare "
+          f"{r['seconds_prepare']:.1f} s), sent {r['bytes_sent']} B")
+print(f"rank 0: gather {dist['seconds_gather']:.2f} s, {dist['region_border_faces']} border faces "
+      f"placed and finished in {dist['seconds_region_borders']:.1f} s")
+
+# The model (docs/synth.md "Across machines"), per face of the one-thread run:
+#   T(N) = redundant + prepare + compute / N x imbalance + gather + borders(N) + serial,
+# redundant = load + visibility (every rank), borders(N) = t_border x beta sqrt(N F).
+t = mn["timings_s"]
+placed = sum(r["faces_placed"] for r in dist["per_rank"])
+work = [r["seconds_region"] + r["seconds_finish"] for r in dist["per_rank"]]
+t_face = sum(work) / placed
+t_border = dist["seconds_region_borders"] / max(1, dist["region_border_faces"])
+beta = dist["region_border_faces"] / math.sqrt(n * faces)
+sent = [r for r in dist["per_rank"] if r["rank"] != 0]
+bytes_per_face = sum(r["bytes_sent"] for r in sent) / max(1, sum(r["faces_placed"] for r in sent))
+prepare = dist["per_rank"][0]["seconds_prepare"]
+imbalance = max(work) / (sum(work) / n)
+redundant_per_face = (t["load"] + t["visibility"]) / faces
+serial_per_face = (t["atlas"] + t["baselines"]) / faces
+print(f"\nmodel inputs: {1000 * t_face:.2f} ms per face, {1000 * t_border:.2f} ms per border face, "
+      f"beta {beta:.2f}, {bytes_per_face / 1024:.1f} KiB per face, imbalance {imbalance:.2f}, "
+      f"prepare {prepare:.1f} s, load+visibility {1000 * redundant_per_face:.3f} ms/face, "
+      f"atlas+baselines {1000 * serial_per_face:.3f} ms/face, {bandwidth:.3g} B/s")
+print("\n| faces | ranks | compute s | borders s | gather s | serial s | T s | speed-up | efficiency |")
+print("|---|---|---|---|---|---|---|---|---|")
+for f in (faces, project):
+    one = redundant_per_face * f + prepare + t_face * f + serial_per_face * f
+    for ranks in (1, 8, 16, 32, 64):
+        compute = t_face * f / ranks * (imbalance if ranks > 1 else 1.0)
+        borders = t_border * beta * math.sqrt(ranks * f) if ranks > 1 else 0.0
+        gather = bytes_per_face * f * (ranks - 1) / ranks / bandwidth if ranks > 1 else 0.0
+        serial = redundant_per_face * f + prepare + serial_per_face * f
+        total = compute + borders + gather + serial
+        print(f"| {f} | {ranks} | {compute:.0f} | {borders:.0f} | {gather:.1f} | {serial:.0f} | "
+              f"{total:.0f} | {one / total:.2f} | {one / (ranks * total):.2f} |")
+PY
