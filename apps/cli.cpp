@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <functional>
 #include <map>
@@ -94,12 +95,25 @@ void RefuseSeveralRanksUnlessSynth(const CLI::App& sub) {
 }
 }  // namespace
 
+namespace {
+int EnvironmentNumber(const char* name) {
+  const char* value = std::getenv(name);
+  return value ? std::atoi(value) : 0;
+}
+}  // namespace
+
 bool LaunchedAsSeveralRanks() {
-  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"}) {
-    const char* value = std::getenv(name);
-    if (value && std::atoi(value) > 1) return true;
-  }
-  return false;
+  // OpenMPI's mpirun, MPICH's Hydra (PMI), Slurm's srun (a PMI/PMIx rank in a step of tasks).
+  if (EnvironmentNumber("OMPI_COMM_WORLD_SIZE") > 1 || EnvironmentNumber("PMI_SIZE") > 1)
+    return true;
+  return (std::getenv("PMIX_RANK") || std::getenv("PMI_RANK")) &&
+         EnvironmentNumber("SLURM_STEP_NUM_TASKS") > 1;
+}
+
+int RanksOnThisMachine() {
+  for (const char* name : {"OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS"})
+    if (EnvironmentNumber(name) > 0) return EnvironmentNumber(name);
+  return 1;
 }
 
 void SetRanks(synth::RankCommunicator* ranks) { g_ranks = ranks; }
@@ -147,6 +161,9 @@ int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostrea
       throw UsageError(extras);
     if (!sub) throw UsageError("give a command");
     SetMemoryLimitBytes(memory_limit.empty() ? 0 : ParseMemorySize(memory_limit));
+    // Ranks on one machine share its memory: each takes its share of the default.
+    if (memory_limit.empty() && LaunchedAsSeveralRanks() && RanksOnThisMachine() > 1)
+      SetMemoryLimitBytes(MemoryLimitBytes() / static_cast<std::uint64_t>(RanksOnThisMachine()));
     RefuseSeveralRanksUnlessSynth(*sub);
     return run.at(sub)(out, err);
   } catch (const CLI::CallForHelp& e) {

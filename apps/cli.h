@@ -25,6 +25,9 @@ int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostrea
 /// True when an MPI launcher started this process as one of several ranks
 /// (OpenMPI's OMPI_COMM_WORLD_SIZE or MPICH's PMI_SIZE above 1).
 bool LaunchedAsSeveralRanks();
+/// The ranks an MPI launcher started on this machine (1 when it says nothing):
+/// each takes this share of the default --memory-limit.
+int RanksOnThisMachine();
 /// The ranks of a distributed run, which main() started (distributed/mpi_ranks.h);
 /// null in one process. Only `texlume synth` runs across ranks.
 void SetRanks(synth::RankCommunicator* ranks);

@@ -9,13 +9,12 @@
 #   one_Nt     one process, RANKS threads (the same cores used by OpenMP alone).
 # Efficiency = wall(one_1t) / (RANKS x wall(ranks)), for the synthesis stage (the
 # manifests' timings) and the whole command. The model of N ranks takes the measured
-# per-face compute, border faces, bytes per face and serial stages (docs/synth.md,
-# "Across machines").
+# region work, imbalance, border faces, bytes sent and serial stages of the RANKS run (its
+# row for RANKS ranks is checked against the measured wall time; docs/synth.md, "Across
+# machines").
 # Usage: bench/mpi_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [FACES (20000)]
 # Environment: RANKS (2), IMAGES (100), RINGS (3), WIDTH (320), HEIGHT (240), TEXEL (0.001),
-# CAPTURE (256), BANDWIDTH (bytes/s between machines for the model, 1.25e9: 10 GbE),
-# PROJECT_FACES (the model's larger mesh, 1000000; its per-face stages scaled linearly from
-# this run, an upper bound for the stages with fixed costs).
+# CAPTURE (256), BANDWIDTH (bytes/s between machines for the model, 1.25e9: 10 GbE).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$(realpath "${1:-$root/build}")
@@ -76,9 +75,9 @@ run one_1t 1
 run "ranks_${ranks}t1" 1 mpirun --oversubscribe -np "$ranks"
 run "one_${ranks}t" "$ranks"
 
-python3 - "$dir" "$ranks" "$bandwidth" "${PROJECT_FACES:-1000000}" <<'PY'
+python3 - "$dir" "$ranks" "$bandwidth" <<'PY'
 import json, math, os, sys
-d, n, bandwidth, project = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
+d, n, bandwidth = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
 job = lambda name: json.load(open(os.path.join(d, name + ".json")))
 manifest = lambda name: json.load(open(os.path.join(d, name, "manifest.json")))
 render = lambda name: json.load(open(os.path.join(d, "render_" + name, "out", "render.json")))["metrics"]
@@ -109,35 +108,41 @@ for r in dist["per_rank"]:
 print(f"rank 0: gather {dist['seconds_gather']:.2f} s, {dist['region_border_faces']} border faces "
       f"placed and finished in {dist['seconds_region_borders']:.1f} s")
 
-# The model (docs/synth.md "Across machines"), per face of the one-thread run:
-#   T(N) = redundant + prepare + compute / N x imbalance + gather + borders(N) + serial,
-# redundant = load + visibility (every rank), borders(N) = t_border x beta sqrt(N F).
+# The model (docs/synth.md "Across machines") of this job on N ranks of one thread, from the
+# measured parts of the RANKS run:
+#   T(N) = every rank's (load + visibility + set-up and photometry)
+#        + region work / N x imbalance          (placement and detail transfer, per face)
+#        + gather: the other ranks' bytes / bandwidth (rank 0 receives them one after another)
+#        + borders: t_border x beta sqrt(N F)    (border faces of N compact regions on a surface)
+#        + rank 0's serial stages (atlases, baselines, writing).
 t = mn["timings_s"]
-placed = sum(r["faces_placed"] for r in dist["per_rank"])
 work = [r["seconds_region"] + r["seconds_finish"] for r in dist["per_rank"]]
-t_face = sum(work) / placed
+placed = sum(r["faces_placed"] for r in dist["per_rank"])
+region_work = sum(work)
+imbalance = max(work) / (region_work / n)
 t_border = dist["seconds_region_borders"] / max(1, dist["region_border_faces"])
 beta = dist["region_border_faces"] / math.sqrt(n * faces)
 sent = [r for r in dist["per_rank"] if r["rank"] != 0]
-bytes_per_face = sum(r["bytes_sent"] for r in sent) / max(1, sum(r["faces_placed"] for r in sent))
+volume = sum(r["bytes_sent"] for r in sent) / max(1, sum(r["faces_placed"] for r in sent)) * placed
 prepare = dist["per_rank"][0]["seconds_prepare"]
-imbalance = max(work) / (sum(work) / n)
-redundant_per_face = (t["load"] + t["visibility"]) / faces
-serial_per_face = (t["atlas"] + t["baselines"]) / faces
-print(f"\nmodel inputs: {1000 * t_face:.2f} ms per face, {1000 * t_border:.2f} ms per border face, "
-      f"beta {beta:.2f}, {bytes_per_face / 1024:.1f} KiB per face, imbalance {imbalance:.2f}, "
-      f"prepare {prepare:.1f} s, load+visibility {1000 * redundant_per_face:.3f} ms/face, "
-      f"atlas+baselines {1000 * serial_per_face:.3f} ms/face, {bandwidth:.3g} B/s")
-print("\n| faces | ranks | compute s | borders s | gather s | serial s | T s | speed-up | efficiency |")
+every_rank = t["load"] + t["visibility"] + prepare
+# Rank 0's wall time less what the model counts apart (its gather wait is the imbalance).
+serial = (job(names[1])["wall_s"] - every_rank - work[0] - dist["seconds_gather"] -
+          dist["seconds_region_borders"])
+print(f"\nmodel inputs: region work {region_work:.1f} s ({1000 * region_work / placed:.2f} ms per "
+      f"face), imbalance {imbalance:.2f}, {1000 * t_border:.2f} ms per border face, beta {beta:.2f}, "
+      f"volume {volume / 2**20:.0f} MiB, every rank {every_rank:.1f} s, rank 0 serial {serial:.1f} s, "
+      f"{bandwidth:.3g} B/s")
+print("\n| ranks | region work s | gather s | borders s | every rank s | serial s | T s | "
+      "speed-up | efficiency |")
 print("|---|---|---|---|---|---|---|---|---|")
-for f in (faces, project):
-    one = redundant_per_face * f + prepare + t_face * f + serial_per_face * f
-    for ranks in (1, 8, 16, 32, 64):
-        compute = t_face * f / ranks * (imbalance if ranks > 1 else 1.0)
-        borders = t_border * beta * math.sqrt(ranks * f) if ranks > 1 else 0.0
-        gather = bytes_per_face * f * (ranks - 1) / ranks / bandwidth if ranks > 1 else 0.0
-        serial = redundant_per_face * f + prepare + serial_per_face * f
-        total = compute + borders + gather + serial
-        print(f"| {f} | {ranks} | {compute:.0f} | {borders:.0f} | {gather:.1f} | {serial:.0f} | "
-              f"{total:.0f} | {one / total:.2f} | {one / (ranks * total):.2f} |")
+one = every_rank + region_work + serial
+for ranks in (1, n, 8, 16, 32, 64):
+    compute = region_work / ranks * (imbalance if ranks > 1 else 1.0)
+    gather = volume * (ranks - 1) / ranks / bandwidth if ranks > 1 else 0.0
+    borders = t_border * beta * math.sqrt(ranks * faces) if ranks > 1 else 0.0
+    total = compute + gather + borders + every_rank + serial
+    label = f"{ranks} (measured {walln:.0f})" if ranks == n else str(ranks)
+    print(f"| {label} | {compute:.1f} | {gather:.2f} | {borders:.1f} | {every_rank:.1f} | "
+          f"{serial:.1f} | {total:.1f} | {one / total:.2f} | {one / (ranks * total):.2f} |")
 PY

@@ -19,15 +19,13 @@ class ByteWriter {
   template <typename T>
   void Put(const T& value) {
     static_assert(std::is_trivially_copyable_v<T>);
-    const auto* p = reinterpret_cast<const char*>(&value);
-    bytes_.insert(bytes_.end(), p, p + sizeof(T));
+    Append(&value, sizeof(T));
   }
   template <typename T>
   void PutVector(const std::vector<T>& values) {
     static_assert(std::is_trivially_copyable_v<T>);
     Put<std::uint64_t>(values.size());
-    const auto* p = reinterpret_cast<const char*>(values.data());
-    bytes_.insert(bytes_.end(), p, p + values.size() * sizeof(T));
+    Append(values.data(), values.size() * sizeof(T));
   }
   /// A matrix's type, size and elements (empty matrices included).
   void PutMat(const cv::Mat& mat) {
@@ -36,8 +34,7 @@ class ByteWriter {
     Put<std::int32_t>(mat.cols);
     if (mat.empty()) return;
     const cv::Mat dense = mat.isContinuous() ? mat : mat.clone();
-    const auto* p = reinterpret_cast<const char*>(dense.data);
-    bytes_.insert(bytes_.end(), p, p + dense.total() * dense.elemSize());
+    Append(dense.data, dense.total() * dense.elemSize());
   }
   void PutMats(const std::vector<cv::Mat>& mats) {
     Put<std::uint64_t>(mats.size());
@@ -46,6 +43,12 @@ class ByteWriter {
   std::vector<char>& bytes() { return bytes_; }
 
  private:
+  void Append(const void* data, std::size_t n) {
+    if (n == 0) return;
+    const std::size_t at = bytes_.size();
+    bytes_.resize(at + n);
+    std::memcpy(bytes_.data() + at, data, n);
+  }
   std::vector<char> bytes_;
 };
 
@@ -54,6 +57,7 @@ class ByteWriter {
 class ByteReader {
  public:
   explicit ByteReader(const std::vector<char>& bytes) : bytes_(bytes) {}
+  explicit ByteReader(std::vector<char>&&) = delete;  // the reader keeps a reference
 
   template <typename T>
   T Get() {
@@ -88,8 +92,8 @@ class ByteReader {
   std::vector<cv::Mat> GetMats() {
     const auto n = Get<std::uint64_t>();
     TEXLUME_CHECK(n <= Remaining() / 12, "a message's matrices fit it");
-    std::vector<cv::Mat> mats(static_cast<std::size_t>(n));
-    for (cv::Mat& mat : mats) mat = GetMat();
+    std::vector<cv::Mat> mats;
+    for (std::uint64_t i = 0; i < n; ++i) mats.push_back(GetMat());
     return mats;
   }
   std::size_t Remaining() const { return bytes_.size() - offset_; }

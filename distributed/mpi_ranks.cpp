@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdlib>
+#include <stdexcept>
 #include <string>
 
 #include "core/check.h"
@@ -40,7 +41,7 @@ class MpiRanks final : public synth::RankCommunicator {
     }
   }
 
-  std::vector<std::vector<char>> GatherToRoot(const std::vector<char>& bytes) override {
+  void GatherToRoot(const std::vector<char>& bytes, const Receive& receive) override {
     if (rank_ != 0) {
       std::uint64_t size = bytes.size();
       Check(MPI_Send(&size, 1, MPI_UINT64_T, 0, kSizeTag, MPI_COMM_WORLD), "MPI_Send");
@@ -48,22 +49,19 @@ class MpiRanks final : public synth::RankCommunicator {
         Check(MPI_Send(bytes.data() + at, static_cast<int>(std::min(kPieceBytes, size - at)),
                        MPI_CHAR, 0, kPieceTag, MPI_COMM_WORLD),
               "MPI_Send");
-      return {};
+      return;
     }
-    std::vector<std::vector<char>> messages(static_cast<std::size_t>(size_));
-    messages[0] = bytes;
     for (int from = 1; from < size_; ++from) {
       std::uint64_t size = 0;
       Check(MPI_Recv(&size, 1, MPI_UINT64_T, from, kSizeTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
             "MPI_Recv");
-      std::vector<char>& message = messages[static_cast<std::size_t>(from)];
-      message.resize(size);
+      std::vector<char> message(size);
       for (std::uint64_t at = 0; at < size; at += kPieceBytes)
         Check(MPI_Recv(message.data() + at, static_cast<int>(std::min(kPieceBytes, size - at)),
                        MPI_CHAR, from, kPieceTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
               "MPI_Recv");
+      receive(from, std::move(message));
     }
-    return messages;
   }
 
  private:
@@ -77,6 +75,11 @@ MpiSession::MpiSession(int& argc, char**& argv, bool start) {
   int provided = 0;
   // Only the main thread calls MPI (OpenMP threads compute between the calls).
   Check(MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+  if (provided < MPI_THREAD_FUNNELED) {
+    MPI_Finalize();
+    throw std::runtime_error(
+        "this MPI library does not allow threads beside MPI (MPI_THREAD_FUNNELED)");
+  }
   ranks_ = std::make_unique<MpiRanks>();
 }
 

@@ -82,7 +82,7 @@ class BtfSynthJob {
   }
 
   void Synthesize() {
-    const std::optional<synth::FaceRegions> regions = pipeline::RegionsOfJob(job_, inputs_);
+    const std::optional<synth::FaceRegions> regions = pipeline::RegionsOfJob(job_, inputs_, so_);
     synthesis_ = synth::SynthesizeMeshBtf(inputs_.mesh, inputs_.reconstruction, inputs_.visibility,
                                           inputs_.photos, sample_, so_, progress_,
                                           regions ? &*regions : nullptr);
@@ -194,7 +194,8 @@ class BtfSynthJob {
         {"ptm_preview", s.seconds_preview},
         {"synthesis_per_triangle", (s.seconds_synthesis + s.seconds_seams) /
                                        static_cast<double>(std::max<std::size_t>(1, s.faces))}};
-    record["distributed"] = pipeline::RanksJson(synthesis_, std::nullopt);
+    if (const nlohmann::json d = pipeline::RanksJson(synthesis_, std::nullopt); !d.is_null())
+      record["distributed"] = d;
     return record;
   }
 

@@ -340,13 +340,13 @@ void SynthJobOptions::Check() const {
 }
 
 std::optional<synth::FaceRegions> RegionsOfJob(const SynthJobOptions& options,
-                                               const SynthInputs& inputs) {
+                                               const SynthInputs& inputs,
+                                               const synth::TriangleEngineOptions& engine) {
   if (!options.ranks || options.ranks->Size() <= 1) return std::nullopt;
   synth::FaceRegions regions;
   regions.ranks = options.ranks;
-  regions.partition = synth::RegionsForRanks(mesh::FaceNeighbours(inputs.mesh), inputs.visibility,
-                                             options.ranks->Size(), options.synthesis.max_views,
-                                             options.synthesis.seed);
+  regions.partition =
+      synth::RegionsForRanks(mesh::FaceNeighbours(inputs.mesh), options.ranks->Size(), engine.seed);
   return regions;
 }
 
@@ -507,7 +507,8 @@ class SynthJob {
   void Synthesize() {
     const auto t = std::chrono::steady_clock::now();
     const SynthInputs& in = inputs_;
-    const std::optional<synth::FaceRegions> regions = RegionsOfJob(options_, in);
+    const std::optional<synth::FaceRegions> regions =
+        RegionsOfJob(options_, in, options_.synthesis);
     const synth::FaceRegions* regions_or_null = regions ? &*regions : nullptr;
     synthesis_ =
         sample_.colour.empty()
@@ -528,8 +529,6 @@ class SynthJob {
   // A rank other than 0: its faces went to rank 0, which writes the model.
   SynthJobSummary RankShare() {
     summary_.rank_share_only = true;
-    for (const synth::TrianglePatch& p : synthesis_.patches)
-      summary_.rank_faces_placed += p.source == synth::PatchSource::kPhotos ? 1 : 0;
     return summary_;
   }
 
@@ -639,7 +638,8 @@ class SynthJob {
         {"baselines", s.seconds_baselines},
         {"synthesis_per_triangle", s.seconds_synthesis / std::max<std::size_t>(1, s.faces)}};
     record["resources"] = {{"peak_resident_bytes", PeakResidentBytes()}};
-    record["distributed"] = RanksJson(synthesis_, edge_mismatch_);
+    if (const nlohmann::json d = RanksJson(synthesis_, edge_mismatch_); !d.is_null())
+      record["distributed"] = d;
     return record;
   }
 

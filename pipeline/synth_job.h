@@ -111,7 +111,6 @@ struct SynthCounts {
   /// A distributed run on a rank other than 0: this rank placed its region's
   /// faces and sent them to rank 0, which writes the model; nothing else was done.
   bool rank_share_only = false;
-  std::size_t rank_faces_placed = 0;  ///< with rank_share_only: the faces this rank placed
   /// The counts as the manifest's "summary" names them.
   nlohmann::json ToJson() const;
   /// Takes the counts of the inputs (photos, faces, subdivisions, warnings).
@@ -156,9 +155,10 @@ struct SynthInputs {
 };
 
 /// A distributed run's regions of the job's (prepared) mesh, one per rank
-/// (synth::RegionsForRanks, seeded by the synthesis seed); none in one process.
+/// (synth::RegionsForRanks with the engine's seed); none in one process.
 std::optional<synth::FaceRegions> RegionsOfJob(const SynthJobOptions& options,
-                                               const SynthInputs& inputs);
+                                               const SynthInputs& inputs,
+                                               const synth::TriangleEngineOptions& engine);
 /// The manifest's record of a distributed run (ranks, regions, what each rank
 /// did, and for a blended sample the edge mismatch on region borders against
 /// elsewhere); null in one process.

@@ -5,16 +5,8 @@
 namespace texlume::synth {
 
 mesh::FacePartition RegionsForRanks(const std::vector<std::array<int, 3>>& neighbours,
-                                    const sfm::VisibilityResult& visibility, int num_regions,
-                                    int max_views, std::uint32_t seed) {
-  std::vector<std::int32_t> weights(neighbours.size(), 1);
-  for (std::size_t f = 0; f < neighbours.size() && f < visibility.triangles.size(); ++f) {
-    int views = 0;
-    for (const sfm::TriangleView& view : visibility.triangles[f].views)
-      views += view.fully_visible ? 1 : 0;
-    weights[f] += std::min(views, max_views);
-  }
-  return mesh::PartitionFaces(neighbours, num_regions, weights, seed);
+                                    int num_regions, std::uint32_t seed) {
+  return mesh::PartitionFaces(neighbours, num_regions, {}, seed);
 }
 
 std::vector<int> OrderWithin(const std::vector<int>& order, const std::vector<char>& member,

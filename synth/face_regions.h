@@ -2,10 +2,10 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "mesh/face_partition.h"
-#include "sfm/visibility.h"
 
 namespace texlume::synth {
 
@@ -19,8 +19,10 @@ class RankCommunicator {
   virtual int Size() const = 0;
   /// Rank 0's `bytes`, on every rank.
   virtual void Broadcast(std::vector<char>& bytes) = 0;
-  /// Every rank's `bytes` at rank 0, indexed by rank; nothing on the others.
-  virtual std::vector<std::vector<char>> GatherToRoot(const std::vector<char>& bytes) = 0;
+  /// Every other rank's `bytes` handed to `receive` at rank 0, one message at a
+  /// time in rank order (so rank 0 holds one at once); the others send theirs.
+  using Receive = std::function<void(int rank, std::vector<char>&& bytes)>;
+  virtual void GatherToRoot(const std::vector<char>& bytes, const Receive& receive) = 0;
 };
 
 /// What one rank of a distributed synthesis did (the run's timings).
@@ -43,12 +45,13 @@ struct FaceRegions {
   mesh::FacePartition partition;
 };
 
-/// The faces divided into `num_regions` regions (mesh::PartitionFaces), each
-/// face weighted by the work it costs: 1 + the views that constrain it (at
-/// most `max_views`).
+/// The faces divided into `num_regions` regions of equal face counts
+/// (mesh::PartitionFaces). Every face weighs the same: measured by
+/// bench/mpi_bench.sh on a 20328-face column, a face's work (placement and detail
+/// transfer) hardly depends on its views; weighting faces by 1 + their views (up
+/// to 4) left the slower rank 9 % above the mean, equal weights 4 %.
 mesh::FacePartition RegionsForRanks(const std::vector<std::array<int, 3>>& neighbours,
-                                    const sfm::VisibilityResult& visibility, int num_regions,
-                                    int max_views, std::uint32_t seed);
+                                    int num_regions, std::uint32_t seed);
 
 /// The faces with `member[f]`, breadth first over edge adjacency within them:
 /// each connected piece starts at its first face in `order`, and the pieces

@@ -310,6 +310,9 @@ class TriangleEngine {
   // gathered at rank 0, which places and finishes the border faces; the other
   // ranks' results are their share (rank_share_only).
   void PlaceRegions(const std::vector<int>& order, const ProgressCallback& progress);
+  // Throws InputError on a rank whose faces, photos, patches or regions differ
+  // from rank 0's (every rank reads its own inputs).
+  void RequireSameInputsAsRankZero() const;
   // A rank's placed faces (patches, the correction's state) and record, and
   // their reading at rank 0.
   void WriteRegion(const std::vector<int>& faces, const RankRecord& record, ByteWriter& out) const;

@@ -1,10 +1,13 @@
 // The distributed run of the per-triangle engine (issue 33, synth/face_regions.h):
 // photometry sent from rank 0, regions placed by their ranks, borders by rank 0.
 #include <chrono>
+#include <string>
 #include <tuple>
+#include <type_traits>
 #include <utility>
 
 #include "core/check.h"
+#include "core/errors.h"
 #include "core/timing.h"
 #include "synth/face_order.h"
 #include "synth/triangle_engine.h"
@@ -40,10 +43,31 @@ void TriangleEngine::EstimateOrReceivePhotometry(const ProgressCallback& progres
   TEXLUME_CHECK(result_.photo_gains.size() == photos_.size(), "rank 0 has the same photos");
 }
 
+void TriangleEngine::RequireSameInputsAsRankZero() const {
+  // FNV-1a over what every rank must agree on: faces, photos, patch rectangles, regions.
+  std::uint64_t hash = 0xcbf29ce484222325ull;
+  const auto mix = [&hash](std::uint64_t value) { hash = (hash ^ value) * 0x100000001b3ull; };
+  mix(mesh_.faces.size());
+  for (const MeshPhoto& photo : photos_) mix(photo.image_id.value);
+  for (std::size_t f = 0; f < result_.patches.size(); ++f) {
+    mix(static_cast<std::uint64_t>(result_.patches[f].width));
+    mix(static_cast<std::uint64_t>(result_.patches[f].height));
+    mix(static_cast<std::uint64_t>(regions_->partition.region_of_face[f]));
+  }
+  ByteWriter rank_zero;
+  rank_zero.Put(hash);
+  regions_->ranks->Broadcast(rank_zero.bytes());
+  if (ByteReader(rank_zero.bytes()).Get<std::uint64_t>() != hash)
+    throw InputError("rank " + std::to_string(regions_->ranks->Rank()),
+                     "its mesh, photos, patches or regions differ from rank 0's; give every rank "
+                     "the same input files and settings");
+}
+
 void TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressCallback& progress) {
   const mesh::FacePartition& partition = regions_->partition;
   RankCommunicator& ranks = *regions_->ranks;
   const int rank = ranks.Rank();
+  RequireSameInputsAsRankZero();
   const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(mesh_);
   std::vector<char> interior(mesh_.faces.size(), 0), border(mesh_.faces.size(), 0);
   for (std::size_t f = 0; f < interior.size(); ++f) {
@@ -72,16 +96,19 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressC
   record.seconds_region = placing;
   record.seconds_finish = result_.seconds_finish;
   const auto gather = std::chrono::steady_clock::now();
-  ByteWriter message;
-  WriteRegion(region_faces, record, message);
-  const std::vector<std::vector<char>> messages = ranks.GatherToRoot(message.bytes());
   if (rank != 0) {
+    ByteWriter message;
+    WriteRegion(region_faces, record, message);
+    ranks.GatherToRoot(message.bytes(), {});
     result_.rank_share_only = true;
     return;
   }
   record.bytes_sent = 0;  // rank 0's own faces stay where they are
   result_.rank_records.push_back(record);
-  for (std::size_t r = 1; r < messages.size(); ++r) ReadRegion(messages[r]);
+  ranks.GatherToRoot({}, [this](int, std::vector<char>&& from_rank) {
+    ReadRegion(from_rank);
+    std::vector<char>().swap(from_rank);
+  });
   result_.seconds_gather = SecondsSince(gather);
   const auto borders = std::chrono::steady_clock::now();
   // The border faces, with their neighbours on both sides placed.
@@ -106,6 +133,8 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressC
       std::tie(result_.patches[f].detail_source, result_.patches[f].detail_level) = detail[f];
   FinishFaces(std::vector<std::size_t>(border_faces.begin(), border_faces.end()), progress);
   result_.seconds_region_borders = SecondsSince(borders);
+  for (std::size_t f = 0; f < done_.size(); ++f)
+    TEXLUME_CHECK(done_[f], "every face is placed by a rank or at the borders");
   result_.region_border_faces = border_faces.size();
   result_.region_cut_edges = partition.cut_edges;
   result_.region_of_face = partition.region_of_face;
@@ -119,7 +148,8 @@ void TriangleEngine::WriteRegion(const std::vector<int>& faces, const RankRecord
   for (const int f : faces) {
     const TrianglePatch& p = result_.patches[static_cast<std::size_t>(f)];
     out.Put<std::int32_t>(f);
-    out.Put(p.sample_x), out.Put(p.sample_y), out.Put(p.source), out.Put(p.views_used);
+    out.Put(p.sample_x), out.Put(p.sample_y);
+    out.Put(static_cast<std::underlying_type_t<PatchSource>>(p.source)), out.Put(p.views_used);
     out.Put(p.image_score), out.Put(p.prior_shrink), out.Put(p.overlap_error);
     out.Put(p.correction_density.x()), out.Put(p.correction_density.y());
     out.PutMats(p.correction);
@@ -140,9 +170,21 @@ void TriangleEngine::ReadRegion(const std::vector<char>& message) {
   for (std::uint64_t n = 0; n < count; ++n) {
     const auto f = in.Get<std::int32_t>();
     TEXLUME_CHECK(f >= 0 && static_cast<std::size_t>(f) < mesh_.faces.size(), "a face index");
+    const mesh::FacePartition& partition = regions_->partition;
+    TEXLUME_CHECK(partition.region_of_face[static_cast<std::size_t>(f)] == record.rank &&
+                      !partition.on_border[static_cast<std::size_t>(f)] &&
+                      !done_[static_cast<std::size_t>(f)],
+                  "a rank sends its own region's faces off the border, once");
     TrianglePatch& p = result_.patches[static_cast<std::size_t>(f)];
     p.sample_x = in.Get<int>(), p.sample_y = in.Get<int>();
-    p.source = in.Get<PatchSource>(), p.views_used = in.Get<int>();
+    const auto source = in.Get<std::underlying_type_t<PatchSource>>();
+    TEXLUME_CHECK(
+        source == static_cast<std::underlying_type_t<PatchSource>>(PatchSource::kPhotos) ||
+            source == static_cast<std::underlying_type_t<PatchSource>>(PatchSource::kNeighbours) ||
+            source == static_cast<std::underlying_type_t<PatchSource>>(PatchSource::kRandom),
+        "a patch's source");
+    p.source = static_cast<PatchSource>(source);
+    p.views_used = in.Get<int>();
     p.image_score = in.Get<double>(), p.prior_shrink = in.Get<double>();
     p.overlap_error = in.Get<double>();
     p.correction_density.x() = in.Get<double>();
