@@ -24,6 +24,7 @@ void TriangleEngine::DistributeOver(FaceRegions regions) {
 
 void TriangleEngine::EstimateOrReceivePhotometry(const ProgressCallback& progress) {
   if (!regions_) return EstimatePhotometry(progress);
+  RequireSameInputsAsRankZero();  // before anything a rank reads from rank 0
   RankCommunicator& ranks = *regions_->ranks;
   ByteWriter out;
   if (ranks.Rank() == 0) {
@@ -67,7 +68,6 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressC
   const mesh::FacePartition& partition = regions_->partition;
   RankCommunicator& ranks = *regions_->ranks;
   const int rank = ranks.Rank();
-  RequireSameInputsAsRankZero();
   const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(mesh_);
   std::vector<char> interior(mesh_.faces.size(), 0), border(mesh_.faces.size(), 0);
   for (std::size_t f = 0; f < interior.size(); ++f) {

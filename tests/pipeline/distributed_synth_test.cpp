@@ -5,6 +5,7 @@
 
 #include <barrier>
 #include <exception>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -104,8 +105,11 @@ class DistributedSynthTest : public ::testing::Test {
 testing::TempDir* DistributedSynthTest::tmp_ = nullptr;
 SynthJobSummary* DistributedSynthTest::one_ = nullptr;
 
-// The job on `size` ranks in threads; rank 0's summary.
-SynthJobSummary RunOnThreadRanks(const SynthJobOptions& job, int size) {
+// The job on `size` ranks in threads (`own` changes a rank's options); rank 0's
+// summary, or the first error.
+SynthJobSummary RunOnThreadRanks(const SynthJobOptions& job, int size,
+                                 const std::function<void(int, SynthJobOptions&)>& own_options = {},
+                                 std::vector<std::string>* messages = nullptr) {
   ThreadRanks::Shared shared(size);
   std::vector<ThreadRanks> ranks;
   for (int r = 0; r < size; ++r) ranks.emplace_back(shared, r);
@@ -117,6 +121,7 @@ SynthJobSummary RunOnThreadRanks(const SynthJobOptions& job, int size) {
       try {
         SynthJobOptions own = job;
         own.ranks = &ranks[static_cast<std::size_t>(r)];
+        if (own_options) own_options(r, own);
         summaries[static_cast<std::size_t>(r)] = RunSynthJob(own);
       } catch (...) {
         errors[static_cast<std::size_t>(r)] = std::current_exception();
@@ -124,6 +129,13 @@ SynthJobSummary RunOnThreadRanks(const SynthJobOptions& job, int size) {
       }
     });
   for (std::thread& t : threads) t.join();
+  if (messages)
+    for (const std::exception_ptr& e : errors) try {
+        if (e) std::rethrow_exception(e);
+        messages->push_back("");
+      } catch (const std::exception& error) {
+        messages->push_back(error.what());
+      }
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
   for (int r = 1; r < size; ++r)
@@ -156,6 +168,18 @@ TEST_F(DistributedSynthTest, ThreeRanksPlaceEveryFaceAndRankZeroWritesTheModel) 
   EXPECT_LT(d["edge_mismatch"]["region_borders"].get<double>(),
             1.5 * d["edge_mismatch"]["elsewhere"].get<double>());
   EXPECT_FALSE(Manifest("one").contains("distributed"));  // one process: as before
+}
+
+TEST_F(DistributedSynthTest, ARankWithOtherInputsStopsWithAnErrorNamingIt) {
+  std::vector<std::string> messages;
+  const auto other_texel_size = [](int rank, SynthJobOptions& own) {
+    if (rank == 1) own.synthesis.sample_texel_size = 0.005;  // other patch rectangles
+  };
+  EXPECT_ANY_THROW(RunOnThreadRanks(Job("differ"), 2, other_texel_size, &messages));
+  ASSERT_EQ(messages.size(), 2u);
+  EXPECT_NE(messages[1].find("rank 1"), std::string::npos) << messages[1];
+  EXPECT_NE(messages[1].find("differ from rank 0's"), std::string::npos) << messages[1];
+  EXPECT_FALSE(fs::exists(tmp_->path() / "differ" / "manifest.json"));
 }
 
 TEST_F(DistributedSynthTest, MpirunWithTwoAndThreeRanksTakesTheSameCommandLine) {
