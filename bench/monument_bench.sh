@@ -26,22 +26,8 @@ dir="$work/column_${faces}_${images}_${rings}_${width}x${height}_t${texel}_c${ca
 # measure NAME COMMAND...: runs COMMAND (its output to NAME.log), records its wall and
 # CPU seconds and peak resident KiB in NAME.json.
 measure() {
-  local name=$1
-  shift
-  echo "monument_bench: $name" >&2
-  python3 - "$dir/$name" "$@" <<'PY'
-import json, resource, subprocess, sys, time
-out, cmd = sys.argv[1], sys.argv[2:]
-start = time.monotonic()
-with open(out + ".log", "w") as log:
-    code = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT).returncode
-usage = resource.getrusage(resource.RUSAGE_CHILDREN)  # the one child's
-json.dump({"exit": code, "wall_s": time.monotonic() - start,
-           "cpu_s": usage.ru_utime + usage.ru_stime, "peak_kib": usage.ru_maxrss},
-          open(out + ".json", "w"))
-if code != 0:
-    sys.exit(f"monument_bench: {cmd[1]} failed (exit {code}); see {out}.log")
-PY
+  echo "monument_bench: $1" >&2
+  python3 "$root/bench/lib/measure.py" "$dir/$1" "${@:2}"
 }
 
 mkdir -p "$dir"

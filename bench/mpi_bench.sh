@@ -31,22 +31,8 @@ mkdir -p "$dir"
 # measure NAME COMMAND...: runs COMMAND (output to NAME.log); wall and CPU seconds and
 # the peak resident KiB of its largest process in NAME.json.
 measure() {
-  local name=$1
-  shift
-  echo "mpi_bench: $name" >&2
-  python3 - "$dir/$name" "$@" <<'PY'
-import json, resource, subprocess, sys, time
-out, cmd = sys.argv[1], sys.argv[2:]
-start = time.monotonic()
-with open(out + ".log", "w") as log:
-    code = subprocess.run(cmd, stdout=log, stderr=subprocess.STDOUT).returncode
-usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-json.dump({"exit": code, "wall_s": time.monotonic() - start,
-           "cpu_s": usage.ru_utime + usage.ru_stime, "peak_kib": usage.ru_maxrss},
-          open(out + ".json", "w"))
-if code != 0:
-    sys.exit(f"mpi_bench: {' '.join(cmd[:3])} failed (exit {code}); see {out}.log")
-PY
+  echo "mpi_bench: $1" >&2
+  python3 "$root/bench/lib/measure.py" "$dir/$1" "${@:2}"
 }
 
 if [ ! -f "$dir/scene/scene.json" ]; then

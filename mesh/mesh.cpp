@@ -10,6 +10,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <numeric>
 #include <queue>
 #include <stdexcept>
 #include <unordered_map>
@@ -470,26 +471,34 @@ std::vector<int> BreadthFirstFaceOrder(const TriangleMesh& mesh,
   if (seed_face < 0 || seed_face >= n) {
     throw std::out_of_range("seed face " + std::to_string(seed_face) + " is not a face index");
   }
-  std::vector<char> visited(static_cast<std::size_t>(n), 0);
+  // The seed's component, then the others from their lowest-index face.
+  std::vector<int> starts(static_cast<std::size_t>(n) + 1);
+  starts[0] = seed_face;
+  std::iota(starts.begin() + 1, starts.end(), 0);
+  return BreadthFirstFaceOrderWithin(starts, std::vector<char>(static_cast<std::size_t>(n), 1),
+                                     neighbours);
+}
+
+std::vector<int> BreadthFirstFaceOrderWithin(const std::vector<int>& starts,
+                                             const std::vector<char>& member,
+                                             const std::vector<std::array<int, 3>>& neighbours) {
+  std::vector<char> visited(member.size(), 0);
   std::vector<int> order;
-  order.reserve(static_cast<std::size_t>(n));
-  auto run = [&](int start) {
+  for (const int start : starts) {
+    const auto s = static_cast<std::size_t>(start);
+    if (!member[s] || visited[s]) continue;
     std::size_t head = order.size();
-    visited[static_cast<std::size_t>(start)] = 1;
+    visited[s] = 1;
     order.push_back(start);
     while (head < order.size()) {
-      const int f = order[head++];
-      for (int g : neighbours[static_cast<std::size_t>(f)]) {
-        if (g >= 0 && !visited[static_cast<std::size_t>(g)]) {
-          visited[static_cast<std::size_t>(g)] = 1;
-          order.push_back(g);
-        }
+      for (const int g : neighbours[static_cast<std::size_t>(order[head])]) {
+        if (g < 0 || !member[static_cast<std::size_t>(g)] || visited[static_cast<std::size_t>(g)])
+          continue;
+        visited[static_cast<std::size_t>(g)] = 1;
+        order.push_back(g);
       }
+      ++head;
     }
-  };
-  run(seed_face);
-  for (int f = 0; f < n; ++f) {
-    if (!visited[static_cast<std::size_t>(f)]) run(f);
   }
   return order;
 }

@@ -104,6 +104,14 @@ std::vector<int> BreadthFirstFaceOrder(const TriangleMesh& mesh,
                                        const std::vector<std::array<int, 3>>& neighbours,
                                        int seed_face);
 
+/// The faces with `member[f]`, breadth first over edge adjacency within them:
+/// each connected piece starts at its first face in `starts`, and the pieces
+/// follow in that order (so a piece's faces, but the first, each have a
+/// neighbour before them). Faces of no piece start in `starts` are left out.
+std::vector<int> BreadthFirstFaceOrderWithin(const std::vector<int>& starts,
+                                             const std::vector<char>& member,
+                                             const std::vector<std::array<int, 3>>& neighbours);
+
 /// Summary figures of a mesh.
 struct MeshStats {
   std::size_t vertices = 0;

@@ -53,11 +53,4 @@ struct FaceRegions {
 mesh::FacePartition RegionsForRanks(const std::vector<std::array<int, 3>>& neighbours,
                                     int num_regions, std::uint32_t seed);
 
-/// The faces with `member[f]`, breadth first over edge adjacency within them:
-/// each connected piece starts at its first face in `order`, and the pieces
-/// follow in that order too (so a piece's faces, but the first, each have a
-/// neighbour before them).
-std::vector<int> OrderWithin(const std::vector<int>& order, const std::vector<char>& member,
-                             const std::vector<std::array<int, 3>>& neighbours);
-
 }  // namespace texlume::synth

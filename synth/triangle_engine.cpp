@@ -125,7 +125,8 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
     std::iota(every_face.begin(), every_face.end(), std::size_t{0});
     FinishFaces(every_face, progress);
   } else {
-    PlaceRegions(order, progress);  // rank 0 finishes; the others' result is their share
+    PlaceRegions(order, neighbours,
+                 progress);  // rank 0 finishes; the others' result is their share
   }
   result_.seconds_synthesis = SecondsSince(start);
   return std::move(result_);

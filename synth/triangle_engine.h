@@ -309,7 +309,10 @@ class TriangleEngine {
   // Stage 2b distributed: this rank's region off the border placed and finished,
   // gathered at rank 0, which places and finishes the border faces; the other
   // ranks' results are their share (rank_share_only).
-  void PlaceRegions(const std::vector<int>& order, const ProgressCallback& progress);
+  // `neighbours`: mesh::FaceNeighbours.
+  void PlaceRegions(const std::vector<int>& order,
+                    const std::vector<std::array<int, 3>>& neighbours,
+                    const ProgressCallback& progress);
   // Throws InputError on a rank whose faces, photos, patches or regions differ
   // from rank 0's (every rank reads its own inputs).
   void RequireSameInputsAsRankZero() const;

@@ -64,11 +64,12 @@ void TriangleEngine::RequireSameInputsAsRankZero() const {
                      "the same input files and settings");
 }
 
-void TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressCallback& progress) {
+void TriangleEngine::PlaceRegions(const std::vector<int>& order,
+                                  const std::vector<std::array<int, 3>>& neighbours,
+                                  const ProgressCallback& progress) {
   const mesh::FacePartition& partition = regions_->partition;
   RankCommunicator& ranks = *regions_->ranks;
   const int rank = ranks.Rank();
-  const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(mesh_);
   std::vector<char> interior(mesh_.faces.size(), 0), border(mesh_.faces.size(), 0);
   for (std::size_t f = 0; f < interior.size(); ++f) {
     interior[f] = partition.region_of_face[f] == rank && !partition.on_border[f];
@@ -78,7 +79,7 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressC
   // kept when the photos do not all fit).
   std::vector<int> region_faces;
   if (PhotosHeldTogether(photos_)) {
-    region_faces = OrderWithin(order, interior, neighbours);
+    region_faces = mesh::BreadthFirstFaceOrderWithin(order, interior, neighbours);
   } else {
     for (const int f : order)
       if (interior[static_cast<std::size_t>(f)]) region_faces.push_back(f);
@@ -112,7 +113,8 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order, const ProgressC
   result_.seconds_gather = SecondsSince(gather);
   const auto borders = std::chrono::steady_clock::now();
   // The border faces, with their neighbours on both sides placed.
-  const std::vector<int> border_faces = OrderWithin(order, border, neighbours);
+  const std::vector<int> border_faces =
+      mesh::BreadthFirstFaceOrderWithin(order, border, neighbours);
   // In one process the detail transfer follows the last placement: the border
   // faces are placed against their neighbours without it too.
   std::vector<std::pair<cv::Mat, int>> detail(mesh_.faces.size());

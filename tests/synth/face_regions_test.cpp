@@ -9,7 +9,7 @@
 namespace texlume::synth {
 namespace {
 
-TEST(FaceRegions, OrderWithinVisitsARegionBreadthFirst) {
+TEST(FaceRegions, BreadthFirstFaceOrderWithinVisitsARegionBreadthFirst) {
   const mesh::TriangleMesh sphere = datasets::MakeIcosphere(3, 1.0);
   const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(sphere);
   const mesh::FacePartition p = mesh::PartitionFaces(neighbours, 3);
@@ -19,7 +19,7 @@ TEST(FaceRegions, OrderWithinVisitsARegionBreadthFirst) {
     std::size_t members = 0;
     for (std::size_t f = 0; f < member.size(); ++f)
       if (p.region_of_face[f] == region && !p.on_border[f]) member[f] = 1, ++members;
-    const std::vector<int> within = OrderWithin(order, member, neighbours);
+    const std::vector<int> within = mesh::BreadthFirstFaceOrderWithin(order, member, neighbours);
     ASSERT_EQ(within.size(), members);
     // Each face after a piece's first has a member neighbour before it; pieces
     // start in `order`'s order.
