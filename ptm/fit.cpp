@@ -170,17 +170,18 @@ void FitLeastSquares(ImageBands& bands, const std::vector<Eigen::Vector3d>& ligh
       [&](const std::vector<const Sample*>& pixels, int y0, int rows) {
         fitter.Fit(pixels, unit, rows, bands.width(), y0, result.ptm, result.residual_rms);
       },
-      progress, "fit", BandLayout::kPlanar);
+      progress, "fit", BandLayout::kRowPlanar);
 }
 
-// Each image as its R, G and B planes (BandLayout::kPlanar).
+// Each image's rows as their R, G and B values (BandLayout::kRowPlanar).
 std::vector<std::vector<float>> PlanesOf(const std::vector<ImageRgb>& images) {
   std::vector<std::vector<float>> planes;
   for (const auto& image : images) {
-    const std::size_t texels = image.pixels.size() / 3;
+    const auto width = static_cast<std::size_t>(image.width);
     std::vector<float>& out = planes.emplace_back(image.pixels.size());
-    for (std::size_t t = 0; t < texels; ++t)
-      for (std::size_t ch = 0; ch < 3; ++ch) out[ch * texels + t] = image.pixels[t * 3 + ch];
+    for (std::size_t t = 0; t < image.pixels.size() / 3; ++t)
+      for (std::size_t ch = 0; ch < 3; ++ch)
+        out[((t / width) * 3 + ch) * width + t % width] = image.pixels[t * 3 + ch];
   }
   return planes;
 }

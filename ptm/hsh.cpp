@@ -99,30 +99,32 @@ HshFitResult FitHshFromFiles(const std::vector<std::filesystem::path>& files,
   hsh.width = bands.width();
   hsh.height = bands.height();
   hsh.coefficients.assign(hsh.NumTexels() * 3 * static_cast<std::size_t>(terms), 0.0f);
-  double residual_sum = 0;
+  // Each row's residual sum, summed in row order at the end (rows run concurrently).
+  std::vector<double> row_residual(static_cast<std::size_t>(hsh.height), 0.0);
   const auto n = static_cast<Eigen::Index>(lights.size());
   bands.ForEach<float>(
       band_rows,
       [&](const std::vector<const float*>& pixels, int y0, int rows) {
-        const auto texels = static_cast<std::int64_t>(rows) * hsh.width;
-        double band_residual = 0;
-#pragma omp parallel for schedule(static) reduction(+ : band_residual)
-        for (std::int64_t i = 0; i < texels; ++i) {
-          const auto t = static_cast<std::size_t>(y0) * hsh.width + static_cast<std::size_t>(i);
-          Eigen::VectorXd y(n);
-          for (int c = 0; c < 3; ++c) {
-            for (Eigen::Index k = 0; k < n; ++k)
-              y(k) = pixels[static_cast<std::size_t>(k)]
-                           [static_cast<std::size_t>(i) * 3 + static_cast<std::size_t>(c)];
-            const Eigen::VectorXd coefficients = solve * y;
-            for (int j = 0; j < terms; ++j) hsh.At(t, c)[j] = static_cast<float>(coefficients(j));
-            band_residual +=
-                std::sqrt((a * coefficients - y).squaredNorm() / static_cast<double>(n));
+        Eigen::VectorXd y(n);
+        for (int row = 0; row < rows; ++row) {
+          double sum = 0;
+          for (int x = 0; x < hsh.width; ++x) {
+            const std::size_t i = static_cast<std::size_t>(row) * hsh.width + x;
+            const std::size_t t = static_cast<std::size_t>(y0) * hsh.width + i;
+            for (int c = 0; c < 3; ++c) {
+              for (Eigen::Index k = 0; k < n; ++k)
+                y(k) = pixels[static_cast<std::size_t>(k)][i * 3 + static_cast<std::size_t>(c)];
+              const Eigen::VectorXd coefficients = solve * y;
+              for (int j = 0; j < terms; ++j) hsh.At(t, c)[j] = static_cast<float>(coefficients(j));
+              sum += std::sqrt((a * coefficients - y).squaredNorm() / static_cast<double>(n));
+            }
           }
+          row_residual[static_cast<std::size_t>(y0 + row)] = sum;
         }
-        residual_sum += band_residual;
       },
       progress, "fit");
+  double residual_sum = 0;
+  for (const double sum : row_residual) residual_sum += sum;
   result.mean_residual_rms =
       residual_sum / std::max<double>(1.0, 3.0 * static_cast<double>(hsh.NumTexels()));
   result.seconds = SecondsSince(start);

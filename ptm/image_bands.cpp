@@ -4,16 +4,16 @@
 
 #include <algorithm>
 #include <exception>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <string>
-#include <thread>
 #include <type_traits>
 
 #include "core/errors.h"
 
 namespace texlume::ptm {
 
-ImageBands::ImageBands(const std::vector<std::filesystem::path>& files, int decode_threads) {
+ImageBands::ImageBands(const std::vector<std::filesystem::path>& files, int threads) {
   for (const auto& file : files) {
     ImageReader in(file);
     if (inputs_.empty()) {
@@ -27,9 +27,8 @@ ImageBands::ImageBands(const std::vector<std::filesystem::path>& files, int deco
     }
     inputs_.push_back(std::move(in));
   }
-  // As many as the fit's OpenMP team (OMP_NUM_THREADS, else one per hardware thread).
-  decode_threads_ = std::clamp(decode_threads > 0 ? decode_threads : omp_get_max_threads(), 1,
-                               std::max(1, static_cast<int>(inputs_.size())));
+  // As many as OpenMP's team (OMP_NUM_THREADS, else one per hardware thread).
+  threads_ = std::max(1, threads > 0 ? threads : omp_get_max_threads());
 }
 
 bool ImageBands::eight_bit() const {
@@ -39,97 +38,148 @@ bool ImageBands::eight_bit() const {
 
 namespace {
 
-// Image k's rows [y0, y0 + rows) as three planes: decoded interleaved into
-// `scratch`, then split.
+// Image `input`'s rows [y0, y0 + rows) as rows of R, G and B values
+// (BandLayout::kRowPlanar): decoded interleaved into `scratch`, then split row by row.
 template <typename Sample>
-void ReadPlanes(ImageReader& input, int y0, int rows, std::vector<Sample>& scratch,
-                Sample* planes) {
-  const int type = std::is_same_v<Sample, float> ? CV_32FC3 : CV_8UC3;
+void ReadRowPlanar(ImageReader& input, int y0, int rows, std::vector<Sample>& scratch,
+                   Sample* out) {
   const int plane_type = std::is_same_v<Sample, float> ? CV_32FC1 : CV_8UC1;
+  const int type = std::is_same_v<Sample, float> ? CV_32FC3 : CV_8UC3;
   const int width = input.width();
   input.ReadRows(y0, y0 + rows, 3, scratch.data());
-  const std::size_t plane = static_cast<std::size_t>(rows) * static_cast<std::size_t>(width);
-  cv::Mat split[3];
-  for (std::size_t ch = 0; ch < 3; ++ch)
-    split[ch] = cv::Mat(rows, width, plane_type, planes + ch * plane);
-  cv::split(cv::Mat(rows, width, type, scratch.data()), split);
+  for (int y = 0; y < rows; ++y) {
+    Sample* row = out + static_cast<std::size_t>(y) * 3 * static_cast<std::size_t>(width);
+    cv::Mat split[3];
+    for (std::size_t ch = 0; ch < 3; ++ch)
+      split[ch] = cv::Mat(1, width, plane_type, row + ch * static_cast<std::size_t>(width));
+    cv::split(
+        cv::Mat(1, width, type,
+                scratch.data() + static_cast<std::size_t>(y) * 3 * static_cast<std::size_t>(width)),
+        split);
+  }
 }
+
+// The first exception of any task; tasks stop starting work once there is one.
+class FirstError {
+ public:
+  template <typename Work>
+  void Run(const Work& work) {
+    if (Failed()) return;
+    try {
+      work();
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (!error_) error_ = std::current_exception();
+    }
+  }
+  bool Failed() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return static_cast<bool>(error_);
+  }
+  void Rethrow() {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::exception_ptr error_;
+};
+
+// ImageBands::ForEach's loop: two bands of every image, the next one read by one
+// task per image while tasks of a few rows each process the current one.
+template <typename Sample>
+class BandPipeline {
+ public:
+  using Process = std::function<void(const std::vector<const Sample*>&, int, int)>;
+
+  BandPipeline(std::vector<ImageReader>& inputs, int height, int band_rows, BandLayout layout)
+      : inputs_(inputs), height_(height), band_rows_(band_rows), layout_(layout) {
+    const int width = inputs.empty() ? 0 : inputs[0].width();
+    row_samples_ = static_cast<std::size_t>(width) * 3;
+    // Rows per process task: at least 4096 pixels, so that a task outweighs its cost.
+    task_rows_ = std::max(1, 4096 / std::max(1, width));
+    for (auto& set : bands_)
+      set.assign(inputs.size(),
+                 std::vector<Sample>(static_cast<std::size_t>(band_rows) * row_samples_));
+  }
+
+  // Runs on the single thread of an OpenMP team, whose threads run the tasks.
+  void Run(const Process& process, const ProgressCallback& progress, const char* stage) {
+    scratch_.resize(static_cast<std::size_t>(omp_get_num_threads()));
+    if (height_ > 0) SpawnReads(0, bands_[0]);
+#pragma omp taskwait
+    for (int b = 0, y0 = 0; y0 < height_ && !error_.Failed(); ++b, y0 += band_rows_) {
+      if (y0 + band_rows_ < height_) SpawnReads(y0 + band_rows_, bands_[(b + 1) % 2]);
+      SpawnProcess(process, bands_[b % 2], y0);
+#pragma omp taskwait
+      const int done = std::min(height_, y0 + band_rows_);
+      if (progress)
+        error_.Run([&] {
+          progress(stage, static_cast<std::size_t>(done), static_cast<std::size_t>(height_));
+        });
+    }
+  }
+
+  void Rethrow() { error_.Rethrow(); }
+
+ private:
+  // One task per image: its rows [y0, y0 + band_rows) into `band`.
+  void SpawnReads(int y0, std::vector<std::vector<Sample>>& band) {
+    const int rows = std::min(band_rows_, height_ - y0);
+    for (std::size_t k = 0; k < inputs_.size(); ++k) {
+#pragma omp task firstprivate(k, y0, rows) shared(band)
+      error_.Run([&] { Read(k, y0, rows, band[k].data()); });
+    }
+  }
+
+  void Read(std::size_t k, int y0, int rows, Sample* out) {
+    if (layout_ == BandLayout::kInterleaved) {
+      inputs_[k].ReadRows(y0, y0 + rows, 3, out);
+      return;
+    }
+    // The thread's own scratch (a task stays on its thread): kept for every band.
+    std::vector<Sample>& scratch = scratch_[static_cast<std::size_t>(omp_get_thread_num())];
+    scratch.resize(static_cast<std::size_t>(band_rows_) * row_samples_);
+    ReadRowPlanar(inputs_[k], y0, rows, scratch, out);
+  }
+
+  // Tasks of task_rows_ rows each over the band starting at row y0.
+  void SpawnProcess(const Process& process, const std::vector<std::vector<Sample>>& band, int y0) {
+    const int rows = std::min(band_rows_, height_ - y0);
+    for (int r0 = 0; r0 < rows; r0 += task_rows_) {
+      const int count = std::min(task_rows_, rows - r0);
+#pragma omp task firstprivate(r0, y0, count) shared(band, process)
+      error_.Run([&] {
+        std::vector<const Sample*> pixels;
+        for (const auto& image_band : band)
+          pixels.push_back(image_band.data() + static_cast<std::size_t>(r0) * row_samples_);
+        process(pixels, y0 + r0, count);
+      });
+    }
+  }
+
+  std::vector<ImageReader>& inputs_;
+  int height_, band_rows_;
+  BandLayout layout_;
+  std::size_t row_samples_ = 0;
+  int task_rows_ = 1;
+  std::vector<std::vector<Sample>> bands_[2];
+  std::vector<std::vector<Sample>> scratch_;  // one per thread of the team
+  FirstError error_;
+};
 
 }  // namespace
-
-// Images k = t, t + T, t + 2T, ... on thread t: each image's reader decodes its
-// rows in order, on one thread at a time.
-template <typename Sample>
-void ImageBands::Read(int y0, int band_rows, BandLayout layout,
-                      std::vector<std::vector<Sample>>& band) {
-  const int rows = std::min(band_rows, height_ - y0);
-  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(decode_threads_));
-  auto decode = [&](int t) {
-    try {
-      std::vector<Sample> scratch;
-      if (layout == BandLayout::kPlanar) scratch.resize(band.empty() ? 0 : band[0].size());
-      for (std::size_t k = static_cast<std::size_t>(t); k < inputs_.size();
-           k += static_cast<std::size_t>(decode_threads_)) {
-        if (layout == BandLayout::kPlanar) {
-          ReadPlanes(inputs_[k], y0, rows, scratch, band[k].data());
-        } else {
-          inputs_[k].ReadRows(y0, y0 + rows, 3, band[k].data());
-        }
-      }
-    } catch (...) {
-      errors[static_cast<std::size_t>(t)] = std::current_exception();
-    }
-  };
-  std::vector<std::thread> threads;
-  try {
-    for (int t = 1; t < decode_threads_; ++t) threads.emplace_back(decode, t);
-  } catch (...) {  // a thread that cannot start: join those that did
-    for (auto& thread : threads) thread.join();
-    throw;
-  }
-  decode(0);
-  for (auto& thread : threads) thread.join();
-  for (const auto& error : errors)
-    if (error) std::rethrow_exception(error);
-}
 
 template <typename Sample>
 void ImageBands::ForEach(
     int band_rows,
     const std::function<void(const std::vector<const Sample*>& pixels, int y0, int rows)>& process,
     const ProgressCallback& progress, const char* stage, BandLayout layout) {
-  const std::size_t band_samples = static_cast<std::size_t>(band_rows) * width_ * 3;
-  // Two bands: the next one is decoded while the current one is processed.
-  std::vector<std::vector<Sample>> bands[2];
-  for (auto& set : bands) set.assign(inputs_.size(), std::vector<Sample>(band_samples));
-  if (height_ > 0) Read(0, band_rows, layout, bands[0]);
-  for (int b = 0, y0 = 0; y0 < height_; ++b, y0 += band_rows) {
-    const int rows = std::min(band_rows, height_ - y0);
-    const int next = y0 + band_rows;
-    std::exception_ptr read_error;
-    std::thread reader;
-    if (next < height_) {
-      reader = std::thread([&, next, b] {
-        try {
-          Read(next, band_rows, layout, bands[(b + 1) % 2]);
-        } catch (...) {
-          read_error = std::current_exception();
-        }
-      });
-    }
-    std::vector<const Sample*> pixels;
-    for (const auto& image_band : bands[b % 2]) pixels.push_back(image_band.data());
-    try {
-      process(pixels, y0, rows);
-    } catch (...) {
-      if (reader.joinable()) reader.join();
-      throw;
-    }
-    if (reader.joinable()) reader.join();
-    if (read_error) std::rethrow_exception(read_error);
-    if (progress)
-      progress(stage, static_cast<std::size_t>(y0 + rows), static_cast<std::size_t>(height_));
-  }
+  BandPipeline<Sample> pipeline(inputs_, height_, band_rows, layout);
+#pragma omp parallel num_threads(threads_)
+#pragma omp single
+  pipeline.Run(process, progress, stage);
+  pipeline.Rethrow();
 }
 
 template void ImageBands::ForEach<float>(

@@ -10,19 +10,22 @@
 
 namespace texlume::ptm {
 
-/// How a band's pixels are laid out: RGB interleaved, or an image's band as its R
-/// plane, then its G plane, then its B plane (rows x width each).
-enum class BandLayout { kInterleaved, kPlanar };
+/// How a band's pixels are laid out: RGB interleaved, or each row as its R values,
+/// then its G values, then its B values (width each). Either way rows follow one
+/// another, so that rows [r, r + n) of a band are a band of n rows themselves.
+enum class BandLayout { kInterleaved, kRowPlanar };
 
 /// An RTI capture's images read together a band of rows at a time (the one image
 /// reader, core/image_io.h), so that fitting needs memory for one band of every
 /// image, not for every image. The next band is decoded while the current one is
-/// processed, its images shared among `decode_threads` threads.
+/// processed: one OpenMP team runs both as tasks (each image's rows of the next band,
+/// and a few rows of the current band at a time), so that neither waits for the
+/// other and the threads are never more than the cores.
 class ImageBands {
  public:
   /// Opens every file; throws InputError naming a file whose size differs from the
-  /// first one's. decode_threads 0: as many as OpenMP's threads.
-  explicit ImageBands(const std::vector<std::filesystem::path>& files, int decode_threads = 0);
+  /// first one's. threads 0: as many as OpenMP's threads.
+  explicit ImageBands(const std::vector<std::filesystem::path>& files, int threads = 0);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -30,10 +33,13 @@ class ImageBands {
   /// them without conversion.
   bool eight_bit() const;
 
-  /// Calls `process(pixels, y0, rows)` for each band of `band_rows` rows, top to
-  /// bottom: pixels[k] holds image k's rows [y0, y0 + rows) in `layout`, floats in
-  /// [0, 1] or 8-bit values 0..255 (Sample float or std::uint8_t). Planes are made
-  /// by the decoding threads. Reports progress as `stage` over the rows.
+  /// Calls `process(pixels, y0, rows)` for every row once, a few rows at a time:
+  /// pixels[k] holds image k's rows [y0, y0 + rows) in `layout`, floats in [0, 1] or
+  /// 8-bit values 0..255 (Sample float or std::uint8_t). Calls for rows of the same
+  /// band run on several threads at once, so `process` must be safe for that (it
+  /// writes only its own rows' results); the first exception thrown by a call or a
+  /// read ends the loop and is rethrown. Reports progress as `stage` over the rows,
+  /// band by band.
   template <typename Sample>
   void ForEach(int band_rows,
                const std::function<void(const std::vector<const Sample*>& pixels, int y0,
@@ -42,11 +48,9 @@ class ImageBands {
                BandLayout layout = BandLayout::kInterleaved);
 
  private:
-  template <typename Sample>
-  void Read(int y0, int band_rows, BandLayout layout, std::vector<std::vector<Sample>>& band);
   std::vector<ImageReader> inputs_;
   int width_ = 0, height_ = 0;
-  int decode_threads_ = 1;
+  int threads_ = 1;
 };
 
 }  // namespace texlume::ptm

@@ -33,11 +33,11 @@ const Sum* InverseOf(const std::vector<double>& in_double, const std::vector<flo
 }  // namespace
 
 template <typename Sample, typename Sum>
-void LeastSquaresBands::ToPlanes(const std::vector<const Sample*>& pixels, std::size_t plane,
-                                 std::size_t first, int count, Sum* planes) const {
+void LeastSquaresBands::ToPlanes(const std::vector<const Sample*>& pixels, std::size_t width,
+                                 std::size_t row, std::size_t x0, int count, Sum* planes) const {
   for (std::size_t k = 0; k < lights_; ++k) {
     for (std::size_t ch = 0; ch < 3; ++ch) {
-      const Sample* in = pixels[k] + ch * plane + first;
+      const Sample* in = pixels[k] + (row * 3 + ch) * width + x0;
       Sum* out = planes + (k * 3 + ch) * kRun;
       for (int x = 0; x < count; ++x) out[x] = static_cast<Sum>(in[x]);
       std::fill(out + count, out + kRun, Sum{0});
@@ -143,9 +143,10 @@ void LeastSquaresBands::Fit(const std::vector<const Sample*>& pixels, double uni
       const int row = static_cast<int>(r / runs_per_row);
       const int x0 = static_cast<int>(r % runs_per_row) * kRun;
       const int count = std::min(kRun, width - x0);
-      const std::size_t local = static_cast<std::size_t>(row) * width + x0;
-      const std::size_t texel = static_cast<std::size_t>(first_row) * width + local;
-      ToPlanes(pixels, static_cast<std::size_t>(rows) * width, local, count, planes.data());
+      const std::size_t texel =
+          (static_cast<std::size_t>(first_row) + static_cast<std::size_t>(row)) * width + x0;
+      ToPlanes(pixels, static_cast<std::size_t>(width), static_cast<std::size_t>(row),
+               static_cast<std::size_t>(x0), count, planes.data());
       for (int x = 0; x < count; x += kLanes<Sum>) {
         if (ptm.format == PtmFormat::kLrgb) {
           FitLrgb(planes.data(), x, count, unit, texel + static_cast<std::size_t>(x), ptm,

@@ -33,7 +33,8 @@ class LeastSquaresBands {
 
   /// Fits texels [first_row * width, (first_row + rows) * width) of `ptm` (its
   /// format chosen) and their residual RMS in [0, 1] units. pixels[k]: image k's
-  /// `rows` x `width` band as planes (BandLayout::kPlanar: R, then G, then B), `unit`
+  /// `rows` x `width` band, each row as its R, then G, then B values
+  /// (BandLayout::kRowPlanar), `unit`
   /// per 1 (255 for 8-bit, 1 for floats).
   template <typename Sample>
   void Fit(const std::vector<const Sample*>& pixels, double unit, int rows, int width,
@@ -53,11 +54,11 @@ class LeastSquaresBands {
   template <typename Sample>
   using SumOf = std::conditional_t<std::is_same_v<Sample, std::uint8_t>, float, double>;
 
-  /// The planes of a run: image k's channel ch at planes[(k * 3 + ch) * kRun + x],
-  /// zero past `count` texels; the band's planes are `plane` samples apart.
+  /// The planes of the run of `count` texels from x0 in the band's row `row`: image
+  /// k's channel ch at planes[(k * 3 + ch) * kRun + x], zero past `count` texels.
   template <typename Sample, typename Sum>
-  void ToPlanes(const std::vector<const Sample*>& pixels, std::size_t plane, std::size_t first,
-                int count, Sum* planes) const;
+  void ToPlanes(const std::vector<const Sample*>& pixels, std::size_t width, std::size_t row,
+                std::size_t x0, int count, Sum* planes) const;
   /// Fits the kLanes texels from `x` of a run's planes; writes those before `count`.
   template <typename Sum>
   void FitLrgb(const Sum* planes, int x, int count, double unit, std::size_t texel, Ptm& ptm,

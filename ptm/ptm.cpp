@@ -17,8 +17,11 @@ void Ptm::Resize(PtmFormat ptm_format, int ptm_width, int ptm_height) {
   format = ptm_format;
   width = ptm_width;
   height = ptm_height;
-  coefficients.assign(NumTexels() * static_cast<std::size_t>(NumPolynomials()) * 6, 0.0f);
-  colour.assign(format == PtmFormat::kLrgb ? NumTexels() * 3 : 0, 0.0f);
+  // Fresh buffers, value-initialised: zero without a pass over memory.
+  decltype(coefficients)().swap(coefficients);
+  decltype(colour)().swap(colour);
+  coefficients.resize(NumTexels() * static_cast<std::size_t>(NumPolynomials()) * 6);
+  colour.resize(format == PtmFormat::kLrgb ? NumTexels() * 3 : 0);
 }
 
 std::array<double, 6> PtmBasis(double lu, double lv) {

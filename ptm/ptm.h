@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/zeroed_allocator.h"
 #include "ptm/light_response.h"
 
 namespace texlume::ptm {
@@ -28,11 +29,12 @@ struct Ptm {
   int width = 0;
   int height = 0;
   /// Texel-major: for texel t, NumPolynomials() blocks of 6 coefficients a0..a5
-  /// (eq. 1); RGB orders the blocks R, G, B.
-  std::vector<float> coefficients;
+  /// (eq. 1); RGB orders the blocks R, G, B. Sized by Resize only (the allocator
+  /// leaves zeroing to the kernel, page by page as the planes are first written).
+  std::vector<float, ZeroedAllocator<float>> coefficients;
   /// LRGB only, texel-major R G B: colour = L * (R, G, B) (eq. 2). The colour is
   /// normalised so that its largest channel is 1.
-  std::vector<float> colour;
+  std::vector<float, ZeroedAllocator<float>> colour;
 
   /// 1 for LRGB, 3 for RGB.
   int NumPolynomials() const { return format == PtmFormat::kLrgb ? 1 : 3; }

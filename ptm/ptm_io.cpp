@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -28,18 +29,19 @@ constexpr double kMaxPtmScale = 1e6;  // the message below says 1e6
 constexpr std::int64_t kMaxPtmBias = 1000000;
 
 // x rounded half away from zero (as std::lround) and clamped to 0..255; NaN is 0.
-// Exact in double (a float plus 0.5 needs no rounding below 2^28), and branch-free
-// so that the encoding loops vectorise.
+// Exact in float: the fraction x - trunc(x) of a float in [0, 255] needs no
+// rounding (Sterbenz), and branch-free so that the encoding loops vectorise.
 inline std::uint8_t RoundToByte(float x) {
-  const double clamped = std::min(x > 0.0f ? static_cast<double>(x) : 0.0, 255.0);
-  return static_cast<std::uint8_t>(static_cast<int>(clamped + 0.5));
+  const float clamped = std::min(x > 0.0f ? x : 0.0f, 255.0f);
+  const int whole = static_cast<int>(clamped);
+  return static_cast<std::uint8_t>(whole + (clamped - static_cast<float>(whole) >= 0.5f ? 1 : 0));
 }
 
 // Quantisation of one coefficient index: coefficient = (byte - bias) * scale.
 struct Quantiser {
   float scale = 1.0f;
   int bias = 0;
-  std::uint8_t Encode(float v) const { return RoundToByte(v / scale + bias); }
+  std::uint8_t Encode(float v) const { return RoundToByte(v / scale + static_cast<float>(bias)); }
 };
 
 // A float's bits as an unsigned key in the float's order (IEEE 754: the sign bit
@@ -67,8 +69,8 @@ class CoefficientRanks {
  public:
   static constexpr std::size_t kBins = std::size_t{1} << 16;
 
-  CoefficientRanks(const std::vector<float>& a, std::array<std::size_t, 2> ranks)
-      : a_(a), ranks_(ranks), count_(a.size() / 6) {}
+  CoefficientRanks(const float* a, std::size_t values, std::array<std::size_t, 2> ranks)
+      : a_(a), ranks_(ranks), count_(values / 6) {}
 
   // The value of rank ranks[r] among index i's values, for every i and r.
   std::array<std::array<float, 2>, 6> Values() {
@@ -126,7 +128,7 @@ class CoefficientRanks {
     return digit;
   }
 
-  const std::vector<float>& a_;
+  const float* a_;  // 6 per texel and polynomial
   std::array<std::size_t, 2> ranks_;
   std::size_t count_;
   std::array<std::array<std::uint32_t, 2>, 6> high_{};
@@ -142,12 +144,14 @@ class CoefficientRanks {
 // outside its range or a range holds too many keys (many equal values).
 class BracketedRanks {
  public:
-  BracketedRanks(const std::vector<float>& a, std::array<std::size_t, 2> ranks)
-      : a_(a), ranks_(ranks), count_(a.size() / 6) {}
+  BracketedRanks(const float* a, std::size_t values, std::array<std::size_t, 2> ranks)
+      : a_(a), ranks_(ranks), count_(values / 6) {}
 
   bool Values(std::array<std::array<float, 2>, 6>& values) {
     const std::size_t step = std::max<std::size_t>(1, count_ / kSampleTarget);
+#pragma omp parallel for schedule(dynamic, 1)
     for (std::size_t i = 0; i < 6; ++i) Bracket(i, step);
+    limit_ = *std::max_element(limits_.begin(), limits_.end());
     if (!CountAndCollect()) return false;
     for (std::size_t i = 0; i < 6; ++i)
       for (std::size_t r = 0; r < 2; ++r) {
@@ -161,7 +165,7 @@ class BracketedRanks {
   }
 
  private:
-  static constexpr std::size_t kSampleTarget = std::size_t{1} << 20;
+  static constexpr std::size_t kSampleTarget = std::size_t{1} << 18;
 
   std::uint32_t Key(std::size_t j, std::size_t i) const {
     return OrderedKey(255.0f * a_[j * 6 + i]);
@@ -184,48 +188,97 @@ class BracketedRanks {
       low_[i][r] = nth(std::floor(at - margin), 0u);
       high_[i][r] = nth(std::ceil(at + margin), std::numeric_limits<std::uint32_t>::max());
       // At most 4 times the keys a range of this width should hold, and 2^16.
-      limit_ = std::max<std::size_t>(
-          limit_, static_cast<std::size_t>(4.0 * 2.0 * margin * static_cast<double>(step)) +
-                      (std::size_t{1} << 16));
+      limits_[i] = std::max<std::size_t>(
+          limits_[i], static_cast<std::size_t>(4.0 * 2.0 * margin * static_cast<double>(step)) +
+                          (std::size_t{1} << 16));
     }
   }
 
   // Counts each index's keys below its ranges and collects those inside; false
-  // when a range holds more than limit_ keys.
+  // when a range holds more than limit_ keys. The ranges are compared as floats
+  // (in the keys' order for finite values), two texels at a time in fixed-length
+  // loops that the compiler vectorises; a pair with a key inside a range, rare, is
+  // collected one key at a time.
   bool CountAndCollect() {
+    for (std::size_t e = 0; e < kPair; ++e)
+      for (std::size_t r = 0; r < 2; ++r) {
+        low_value_[r][e] = FromOrderedKey(low_[e % 6][r]);
+        high_value_[r][e] = FromOrderedKey(high_[e % 6][r]);
+      }
     bool overflow = false;
+    const std::size_t blocks = (count_ + kBlock - 1) / kBlock;
 #pragma omp parallel
     {
-      std::array<std::array<std::size_t, 2>, 6> below{};
-      std::array<std::array<std::vector<std::uint32_t>, 2>, 6> inside;
+      Counts counts;
 #pragma omp for schedule(static) nowait
-      for (std::size_t j = 0; j < count_; ++j)
-        for (std::size_t i = 0; i < 6; ++i) {
-          const std::uint32_t key = Key(j, i);
-          for (std::size_t r = 0; r < 2; ++r) {
-            if (key < low_[i][r]) {
-              ++below[i][r];
-            } else if (key <= high_[i][r] && inside[i][r].size() < limit_) {
-              inside[i][r].push_back(key);
-            }
-          }
-        }
+      for (std::size_t b = 0; b < blocks; ++b)
+        CountBlock(b * kBlock, std::min(count_, (b + 1) * kBlock), counts);
 #pragma omp critical
       for (std::size_t i = 0; i < 6; ++i)
         for (std::size_t r = 0; r < 2; ++r) {
-          below_[i][r] += below[i][r];
-          overflow = overflow || inside[i][r].size() >= limit_;
-          inside_[i][r].insert(inside_[i][r].end(), inside[i][r].begin(), inside[i][r].end());
+          below_[i][r] += counts.below[i][r];
+          overflow = overflow || counts.inside[i][r].size() >= limit_;
+          inside_[i][r].insert(inside_[i][r].end(), counts.inside[i][r].begin(),
+                               counts.inside[i][r].end());
         }
     }
     return !overflow;
   }
 
-  const std::vector<float>& a_;
+  struct Counts {
+    std::array<std::array<std::size_t, 2>, 6> below{};
+    std::array<std::array<std::vector<std::uint32_t>, 2>, 6> inside;
+  };
+
+  // Texels [begin, end): a pair at a time, the last odd one on its own.
+  void CountBlock(std::size_t begin, std::size_t end, Counts& counts) const {
+    std::int32_t below[2][kPair] = {};
+    std::size_t j = begin;
+    for (; j + 2 <= end; j += 2) {
+      float v[kPair];
+      for (std::size_t e = 0; e < kPair; ++e) v[e] = 255.0f * a_[j * 6 + e];
+      std::int32_t inside[kPair];
+      for (std::size_t e = 0; e < kPair; ++e) {
+        below[0][e] += v[e] < low_value_[0][e] ? 1 : 0;
+        below[1][e] += v[e] < low_value_[1][e] ? 1 : 0;
+        inside[e] = (v[e] >= low_value_[0][e] ? 1 : 0) & (v[e] <= high_value_[0][e] ? 1 : 0);
+        inside[e] |= (v[e] >= low_value_[1][e] ? 1 : 0) & (v[e] <= high_value_[1][e] ? 1 : 0);
+      }
+      std::int32_t any = 0;
+      for (std::size_t e = 0; e < kPair; ++e) any |= inside[e];
+      if (any) [[unlikely]]
+        for (std::size_t t = j; t < j + 2; ++t) Collect(t, counts, nullptr);
+    }
+    for (std::size_t r = 0; r < 2; ++r)
+      for (std::size_t e = 0; e < kPair; ++e)
+        counts.below[e % 6][r] += static_cast<std::size_t>(below[r][e]);
+    if (j < end) Collect(j, counts, &counts.below);
+  }
+
+  // Texel j's keys inside their ranges into `counts`, and those below into `below`
+  // when given.
+  void Collect(std::size_t j, Counts& counts,
+               std::array<std::array<std::size_t, 2>, 6>* below) const {
+    for (std::size_t i = 0; i < 6; ++i)
+      for (std::size_t r = 0; r < 2; ++r) {
+        const float v = 255.0f * a_[j * 6 + i];
+        if (below && v < low_value_[r][i]) ++(*below)[i][r];
+        std::vector<std::uint32_t>& inside = counts.inside[i][r];
+        if (v >= low_value_[r][i] && v <= high_value_[r][i] && inside.size() < limit_)
+          inside.push_back(OrderedKey(v));
+      }
+  }
+
+  static constexpr std::size_t kPair = 12;      // two texels' coefficients
+  static constexpr std::size_t kBlock = 65536;  // texels counted in 32-bit lanes at once
+
+  const float* a_;  // 6 per texel and polynomial
   std::array<std::size_t, 2> ranks_;
   std::size_t count_;
   std::size_t limit_ = 0;
+  std::array<std::size_t, 6> limits_{};  // limit_ of each index
   std::array<std::array<std::uint32_t, 2>, 6> low_{}, high_{};
+  float low_value_[2][kPair] = {}, high_value_[2][kPair] = {};  // the ranges as floats
   std::array<std::array<std::size_t, 2>, 6> below_{};
   std::array<std::array<std::vector<std::uint32_t>, 2>, 6> inside_;
 };
@@ -239,8 +292,9 @@ std::array<Quantiser, 6> Quantisers(const Ptm& ptm) {
   if (count == 0) return q;
   const std::array<std::size_t, 2> ranks{count / 1000, count - 1 - count / 1000};
   std::array<std::array<float, 2>, 6> values;
-  if (!BracketedRanks(ptm.coefficients, ranks).Values(values))
-    values = CoefficientRanks(ptm.coefficients, ranks).Values();
+  const float* a = ptm.coefficients.data();
+  if (!BracketedRanks(a, ptm.coefficients.size(), ranks).Values(values))
+    values = CoefficientRanks(a, ptm.coefficients.size(), ranks).Values();
   for (std::size_t i = 0; i < 6; ++i) {
     const float lo = std::min(0.0f, values[i][0]);
     const float hi = std::max(0.0f, values[i][1]);
@@ -549,27 +603,100 @@ Ptm PtmFromPlanes(const PtmHeader& h, const BytePlanes& planes) {
 
 namespace {
 
-// Writes rows height - 1 down to 0 (a .ptm's order), each `row_bytes` made by
-// encode_row(y, bytes); a block of rows is encoded in parallel at a time.
-template <typename EncodeRow>
-void WriteRowsBottomUp(std::ostream& out, int height, std::size_t row_bytes,
-                       const EncodeRow& encode_row) {
-  constexpr int kBlockRows = 64;
-  std::vector<char> block(row_bytes * kBlockRows);
-  for (int top = height - 1; top >= 0; top -= kBlockRows) {
-    const int rows = std::min(kBlockRows, top + 1);
-#pragma omp parallel for schedule(static)
-    for (int r = 0; r < rows; ++r)
-      encode_row(top - r, block.data() + static_cast<std::size_t>(r) * row_bytes);
-    out.write(block.data(),
-              static_cast<std::streamsize>(static_cast<std::size_t>(rows) * row_bytes));
+// Encodes groups of a polynomial's 6 coefficients (display values) as a .ptm's bytes,
+// four groups at a time in fixed-length loops that the compiler vectorises: the
+// same bytes as Quantiser::Encode.
+class GroupEncoder {
+ public:
+  explicit GroupEncoder(const std::array<Quantiser, 6>& q) {
+    for (std::size_t j = 0; j < kValues; ++j) {
+      scale_[j] = q[j % 6].scale;
+      bias_[j] = static_cast<float>(q[j % 6].bias);
+    }
   }
+
+  // The groups a[t * stride, t * stride + 6) for t < count, into out[t * 6 + i].
+  void Encode(const float* a, std::size_t stride, std::size_t count, std::uint8_t* out) const {
+    for (std::size_t t = 0; t < count; t += kGroups) {
+      const std::size_t n = std::min(kGroups, count - t);
+      float v[kValues];
+      for (std::size_t g = 0; g < kGroups; ++g)
+        std::memcpy(v + g * 6, a + (t + std::min(g, n - 1)) * stride, 6 * sizeof(float));
+      std::int32_t byte[kValues];
+      for (std::size_t j = 0; j < kValues; ++j) {  // RoundToByte, lane by lane
+        const float x = 255.0f * v[j] / scale_[j] + bias_[j];
+        const float clamped = std::min(x > 0.0f ? x : 0.0f, 255.0f);
+        const auto whole = static_cast<std::int32_t>(clamped);
+        byte[j] = whole + (clamped - static_cast<float>(whole) >= 0.5f ? 1 : 0);
+      }
+      std::uint8_t bytes[kValues];
+      for (std::size_t j = 0; j < kValues; ++j) bytes[j] = static_cast<std::uint8_t>(byte[j]);
+      std::memcpy(out + t * 6, bytes, n * 6);
+    }
+  }
+
+ private:
+  static constexpr std::size_t kGroups = 4, kValues = kGroups * 6;
+  float scale_[kValues], bias_[kValues];
+};
+
+// A .ptm's body after the header: `planes` planes one after another, each of rows
+// height - 1 down to 0 (a .ptm's order) of `row_bytes` made by encode_row(y, plane,
+// bytes) (which must not throw; the stream may). Blocks of rows are written by one task while tasks
+// of a row each encode the next block. `at_once` planes are encoded together, each
+// block written at its plane's place: with every plane at once (a file, which can
+// be written beyond its end), the texels are read in one pass.
+template <typename EncodeRow>
+void WritePlanesBottomUp(std::ostream& out, int height, std::size_t row_bytes, int planes,
+                         int at_once, const EncodeRow& encode_row) {
+  constexpr int kBlockRows = 64;
+  const std::streamoff body = out.tellp();
+  const auto plane_bytes = static_cast<std::streamoff>(row_bytes) * height;
+  const int blocks = (height + kBlockRows - 1) / kBlockRows;
+  const std::size_t block_bytes = row_bytes * kBlockRows;
+  std::vector<char> block[2];
+  for (auto& bytes : block) bytes.resize(block_bytes * static_cast<std::size_t>(at_once));
+  const auto rows_of = [&](int b) { return std::min(kBlockRows, height - b * kBlockRows); };
+  std::exception_ptr error;
+  for (int first = 0; first < planes && !error; first += at_once) {
+#pragma omp parallel
+#pragma omp single
+    for (int b = 0; b <= blocks; ++b) {
+      for (int p = 0; p < at_once && b < blocks; ++p) {
+        char* bytes = block[b % 2].data() + static_cast<std::size_t>(p) * block_bytes;
+        const int top = height - 1 - b * kBlockRows;
+        for (int r = 0; r < rows_of(b); ++r) {
+#pragma omp task firstprivate(r, top, bytes, p) shared(encode_row, first)
+          encode_row(top - r, first + p, bytes + static_cast<std::size_t>(r) * row_bytes);
+        }
+      }
+      if (b > 0) {
+        const char* bytes = block[(b - 1) % 2].data();
+        const auto offset = static_cast<std::streamoff>(block_bytes) * (b - 1);
+        const auto size =
+            static_cast<std::streamsize>(static_cast<std::size_t>(rows_of(b - 1)) * row_bytes);
+#pragma omp task firstprivate(bytes, offset, size) shared(out, first, error)
+        try {
+          for (int p = 0; p < at_once; ++p) {
+            out.seekp(body + plane_bytes * (first + p) + offset);
+            out.write(bytes + static_cast<std::size_t>(p) * block_bytes, size);
+          }
+        } catch (...) {  // a stream that throws: rethrown below, once the tasks are done
+          error = std::current_exception();
+        }
+      }
+#pragma omp taskwait
+      if (error) break;
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  out.seekp(body + plane_bytes * planes);
 }
 
-}  // namespace
-
-void WritePtm(const Ptm& ptm, std::ostream& out) {
+// The header, then the planes: `at_once` as in WritePlanesBottomUp.
+void WritePtm(const Ptm& ptm, std::ostream& out, int at_once) {
   const auto q = Quantisers(ptm);
+  const GroupEncoder encoder(q);
   out << "PTM_1.2\n"
       << (ptm.format == PtmFormat::kLrgb ? "PTM_FORMAT_LRGB" : "PTM_FORMAT_RGB") << "\n"
       << ptm.width << "\n"
@@ -580,17 +707,15 @@ void WritePtm(const Ptm& ptm, std::ostream& out) {
   for (int i = 0; i < 6; ++i) out << (i ? " " : "") << q[static_cast<std::size_t>(i)].bias;
   out << "\n";
   const auto width = static_cast<std::size_t>(ptm.width);
-  for (int p = 0; p < ptm.NumPolynomials(); ++p) {
-    WriteRowsBottomUp(out, ptm.height, width * 6, [&](int y, char* row) {
-      for (std::size_t x = 0; x < width; ++x) {
-        const float* a = ptm.Coefficients(static_cast<std::size_t>(y) * width + x, p);
-        for (std::size_t i = 0; i < 6; ++i)
-          row[x * 6 + i] = static_cast<char>(q[i].Encode(255.0f * a[i]));
-      }
-    });
-  }
+  const int polynomials = ptm.NumPolynomials();
+  WritePlanesBottomUp(out, ptm.height, width * 6, polynomials, std::min(at_once, polynomials),
+                      [&](int y, int p, char* row) {
+                        encoder.Encode(ptm.Coefficients(static_cast<std::size_t>(y) * width, p),
+                                       static_cast<std::size_t>(polynomials) * 6, width,
+                                       reinterpret_cast<std::uint8_t*>(row));
+                      });
   if (ptm.format == PtmFormat::kLrgb) {
-    WriteRowsBottomUp(out, ptm.height, width * 3, [&](int y, char* row) {
+    WritePlanesBottomUp(out, ptm.height, width * 3, 1, 1, [&](int y, int, char* row) {
       const float* colour = &ptm.colour[static_cast<std::size_t>(y) * width * 3];
       for (std::size_t i = 0; i < width * 3; ++i)
         row[i] = static_cast<char>(RoundToByte(255.0f * colour[i]));
@@ -598,9 +723,13 @@ void WritePtm(const Ptm& ptm, std::ostream& out) {
   }
 }
 
+}  // namespace
+
+void WritePtm(const Ptm& ptm, std::ostream& out) { WritePtm(ptm, out, 1); }
+
 void WritePtmFile(const Ptm& ptm, const std::filesystem::path& path) {
   WriteFileAtomically(
-      path, [&](std::ostream& out) { WritePtm(ptm, out); }, true);
+      path, [&](std::ostream& out) { WritePtm(ptm, out, 3); }, true);
 }
 
 Ptm ReadPtm(std::istream& in, const std::string& label) {

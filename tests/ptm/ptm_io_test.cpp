@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
@@ -135,7 +136,7 @@ TEST_P(PtmFileTest, EachCoefficientsRangeLeavesOutItsLowestAndHighestThousandth)
   ExpectExactRanges(ptm);
 }
 
-// On more than 2^21 values per coefficient the ranges are found from a strided
+// On more than 2^19 values per coefficient the ranges are found from a strided
 // sample and one pass (ptm_io.cpp, BracketedRanks); with most of one coefficient's
 // values equal, by the two-pass radix select. Both exact.
 TEST(PtmFile, LargePtmRangesAreExactFromTheSampleAndTheFallback) {
@@ -147,6 +148,22 @@ TEST(PtmFile, LargePtmRangesAreExactFromTheSampleAndTheFallback) {
   for (std::size_t t = 0; t < ptm.NumTexels(); ++t)
     if (t % 50 != 0) ptm.Coefficients(t)[4] = -0.25f;  // index 4: a range of ties
   ExpectExactRanges(ptm);
+}
+
+// A file is written by blocks of 64 rows, every polynomial's plane at its place in
+// one pass over the texels; a stream plane after plane: the same bytes.
+TEST_P(PtmFileTest, AFileHoldsTheBytesAStreamDoes) {
+  testing::TempDir tmp;
+  for (const int height : {1, 64, 150}) {
+    const Ptm ptm = RandomPtm(GetParam(), 37, height, 9);
+    std::stringstream s;
+    WritePtm(ptm, s);
+    WritePtmFile(ptm, tmp / "file.ptm");
+    std::ifstream in(tmp / "file.ptm", std::ios::binary);
+    const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_EQ(file.size(), s.str().size()) << "height " << height;
+    EXPECT_TRUE(file == s.str()) << "height " << height;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Formats, PtmFileTest,
