@@ -19,6 +19,7 @@
 #include <omp.h>
 #include <sys/resource.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -112,7 +113,7 @@ double DecodeOnly(const std::vector<fs::path>& files, int band_rows) {
 double DecodeBands(const std::vector<fs::path>& files, int band_rows) {
   const auto t0 = std::chrono::steady_clock::now();
   ptm::ImageBands bands(files);
-  double checksum = 0;
+  std::atomic<long> checksum{0};  // the calls run on several threads at once
   bands.ForEach<std::uint8_t>(
       band_rows,
       [&](const std::vector<const std::uint8_t*>& pixels, int, int) { checksum += pixels[0][0]; },

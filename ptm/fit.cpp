@@ -1,6 +1,7 @@
 #include "ptm/fit.h"
 
 #include <ceres/ceres.h>
+#include <omp.h>
 
 #include <Eigen/SVD>
 #include <algorithm>
@@ -68,7 +69,8 @@ class RobustBandFitter {
   void Fit(const std::vector<const float*>& pixels, int rows, int width, int first_row, Ptm& ptm,
            std::vector<float>& residual) const {
     const long texels = static_cast<long>(rows) * width;
-#pragma omp parallel
+    // On every thread, unless called from ImageBands' tasks (already on every thread).
+#pragma omp parallel if (!omp_in_parallel())
     {
       // Per-thread buffers, reused for every texel (no allocation in the loop).
       Texel texel_buffers(pixels.size());

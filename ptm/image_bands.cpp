@@ -92,20 +92,26 @@ class BandPipeline {
  public:
   using Process = std::function<void(const std::vector<const Sample*>&, int, int)>;
 
-  BandPipeline(std::vector<ImageReader>& inputs, int height, int band_rows, BandLayout layout)
-      : inputs_(inputs), height_(height), band_rows_(band_rows), layout_(layout) {
+  // `threads`: the most threads the team running the tasks may have.
+  BandPipeline(std::vector<ImageReader>& inputs, int height, int band_rows, BandLayout layout,
+               int threads)
+      : inputs_(inputs),
+        height_(height),
+        band_rows_(band_rows),
+        layout_(layout),
+        scratch_(static_cast<std::size_t>(threads)) {
     const int width = inputs.empty() ? 0 : inputs[0].width();
     row_samples_ = static_cast<std::size_t>(width) * 3;
     // Rows per process task: at least 4096 pixels, so that a task outweighs its cost.
-    task_rows_ = std::max(1, 4096 / std::max(1, width));
+    task_rows_ = std::max(1, (4096 + width - 1) / std::max(1, width));
     for (auto& set : bands_)
       set.assign(inputs.size(),
                  std::vector<Sample>(static_cast<std::size_t>(band_rows) * row_samples_));
   }
 
-  // Runs on the single thread of an OpenMP team, whose threads run the tasks.
+  // Runs on the calling thread, the primary thread of an OpenMP team whose threads
+  // run the tasks (so that `progress` is called from the calling thread).
   void Run(const Process& process, const ProgressCallback& progress, const char* stage) {
-    scratch_.resize(static_cast<std::size_t>(omp_get_num_threads()));
     if (height_ > 0) SpawnReads(0, bands_[0]);
 #pragma omp taskwait
     for (int b = 0, y0 = 0; y0 < height_ && !error_.Failed(); ++b, y0 += band_rows_) {
@@ -163,8 +169,8 @@ class BandPipeline {
   BandLayout layout_;
   std::size_t row_samples_ = 0;
   int task_rows_ = 1;
-  std::vector<std::vector<Sample>> bands_[2];
   std::vector<std::vector<Sample>> scratch_;  // one per thread of the team
+  std::vector<std::vector<Sample>> bands_[2];
   FirstError error_;
 };
 
@@ -175,10 +181,10 @@ void ImageBands::ForEach(
     int band_rows,
     const std::function<void(const std::vector<const Sample*>& pixels, int y0, int rows)>& process,
     const ProgressCallback& progress, const char* stage, BandLayout layout) {
-  BandPipeline<Sample> pipeline(inputs_, height_, band_rows, layout);
+  BandPipeline<Sample> pipeline(inputs_, height_, band_rows, layout, threads_);
 #pragma omp parallel num_threads(threads_)
-#pragma omp single
-  pipeline.Run(process, progress, stage);
+#pragma omp masked
+  pipeline.Run(process, progress, stage);  // the others run tasks at the region's barrier
   pipeline.Rethrow();
 }
 

@@ -1,5 +1,7 @@
 #include "ptm/least_squares_bands.h"
 
+#include <omp.h>
+
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
@@ -134,7 +136,8 @@ void LeastSquaresBands::Fit(const std::vector<const Sample*>& pixels, double uni
                             std::vector<float>& residual) const {
   const long runs_per_row = (width + kRun - 1) / kRun;
   const long runs = runs_per_row * rows;
-#pragma omp parallel
+  // On every thread, unless called from ImageBands' tasks (already on every thread).
+#pragma omp parallel if (!omp_in_parallel())
   {
     using Sum = SumOf<Sample>;
     std::vector<Sum> planes(lights_ * 3 * kRun);  // per thread, reused for every run

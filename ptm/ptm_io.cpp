@@ -49,7 +49,9 @@ struct Quantiser {
 std::uint32_t OrderedKey(float v) {
   std::uint32_t bits;
   std::memcpy(&bits, &v, sizeof bits);
-  return (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
+  // Every bit flipped for a negative value, the sign bit for a positive one (C++20:
+  // >> of a signed value is arithmetic); branch-free so that key loops vectorise.
+  return bits ^ (static_cast<std::uint32_t>(static_cast<std::int32_t>(bits) >> 31) | 0x80000000u);
 }
 
 // The float whose OrderedKey is `key`.
@@ -149,8 +151,10 @@ class BracketedRanks {
 
   bool Values(std::array<std::array<float, 2>, 6>& values) {
     const std::size_t step = std::max<std::size_t>(1, count_ / kSampleTarget);
+    std::array<std::vector<std::uint32_t>, 6> samples;
+    for (auto& sample : samples) sample.reserve((count_ + step - 1) / step);
 #pragma omp parallel for schedule(dynamic, 1)
-    for (std::size_t i = 0; i < 6; ++i) Bracket(i, step);
+    for (std::size_t i = 0; i < 6; ++i) Bracket(i, step, samples[i]);
     limit_ = *std::max_element(limits_.begin(), limits_.end());
     if (!CountAndCollect()) return false;
     for (std::size_t i = 0; i < 6; ++i)
@@ -171,9 +175,9 @@ class BracketedRanks {
     return OrderedKey(255.0f * a_[j * 6 + i]);
   }
 
-  // Index i's key range around each rank, from every step-th texel's keys.
-  void Bracket(std::size_t i, std::size_t step) {
-    std::vector<std::uint32_t> sample;
+  // Index i's key range around each rank, from every step-th texel's keys, in
+  // `sample` (its memory reserved by the caller: no allocation on the threads).
+  void Bracket(std::size_t i, std::size_t step, std::vector<std::uint32_t>& sample) {
     for (std::size_t j = 0; j < count_; j += step) sample.push_back(Key(j, i));
     const double m = static_cast<double>(sample.size());
     for (std::size_t r = 0; r < 2; ++r) {
@@ -195,24 +199,30 @@ class BracketedRanks {
   }
 
   // Counts each index's keys below its ranges and collects those inside; false
-  // when a range holds more than limit_ keys. The ranges are compared as floats
-  // (in the keys' order for finite values), two texels at a time in fixed-length
-  // loops that the compiler vectorises; a pair with a key inside a range, rare, is
-  // collected one key at a time.
+  // when a range holds more than limit_ keys. Two texels at a time, in fixed-length
+  // loops over their keys that the compiler vectorises; a pair with a key inside a
+  // range, rare, is collected one key at a time.
   bool CountAndCollect() {
     for (std::size_t e = 0; e < kPair; ++e)
       for (std::size_t r = 0; r < 2; ++r) {
-        low_value_[r][e] = FromOrderedKey(low_[e % 6][r]);
-        high_value_[r][e] = FromOrderedKey(high_[e % 6][r]);
+        low_of_lane_[r][e] = low_[e % 6][r];
+        width_of_lane_[r][e] = high_[e % 6][r] - low_[e % 6][r];
       }
     bool overflow = false;
+    std::exception_ptr error;  // from a thread's allocation: rethrown, not terminate()
     const std::size_t blocks = (count_ + kBlock - 1) / kBlock;
 #pragma omp parallel
     {
       Counts counts;
 #pragma omp for schedule(static) nowait
-      for (std::size_t b = 0; b < blocks; ++b)
-        CountBlock(b * kBlock, std::min(count_, (b + 1) * kBlock), counts);
+      for (std::size_t b = 0; b < blocks; ++b) {
+        try {
+          CountBlock(b * kBlock, std::min(count_, (b + 1) * kBlock), counts);
+        } catch (...) {
+#pragma omp critical
+          error = std::current_exception();
+        }
+      }
 #pragma omp critical
       for (std::size_t i = 0; i < 6; ++i)
         for (std::size_t r = 0; r < 2; ++r) {
@@ -222,6 +232,7 @@ class BracketedRanks {
                                counts.inside[i][r].end());
         }
     }
+    if (error) std::rethrow_exception(error);
     return !overflow;
   }
 
@@ -230,28 +241,28 @@ class BracketedRanks {
     std::array<std::array<std::vector<std::uint32_t>, 2>, 6> inside;
   };
 
-  // Texels [begin, end): a pair at a time, the last odd one on its own.
+  // Texels [begin, end): a pair at a time, the last odd one on its own. A key is
+  // inside its range when key - low <= high - low (unsigned: a key below wraps).
   void CountBlock(std::size_t begin, std::size_t end, Counts& counts) const {
-    std::int32_t below[2][kPair] = {};
+    std::uint32_t below[2][kPair] = {};
     std::size_t j = begin;
     for (; j + 2 <= end; j += 2) {
-      float v[kPair];
-      for (std::size_t e = 0; e < kPair; ++e) v[e] = 255.0f * a_[j * 6 + e];
-      std::int32_t inside[kPair];
+      std::uint32_t key[kPair];
+      for (std::size_t e = 0; e < kPair; ++e) key[e] = OrderedKey(255.0f * a_[j * 6 + e]);
+      std::uint32_t inside[kPair];
       for (std::size_t e = 0; e < kPair; ++e) {
-        below[0][e] += v[e] < low_value_[0][e] ? 1 : 0;
-        below[1][e] += v[e] < low_value_[1][e] ? 1 : 0;
-        inside[e] = (v[e] >= low_value_[0][e] ? 1 : 0) & (v[e] <= high_value_[0][e] ? 1 : 0);
-        inside[e] |= (v[e] >= low_value_[1][e] ? 1 : 0) & (v[e] <= high_value_[1][e] ? 1 : 0);
+        below[0][e] += key[e] < low_of_lane_[0][e] ? 1u : 0u;
+        below[1][e] += key[e] < low_of_lane_[1][e] ? 1u : 0u;
+        inside[e] = (key[e] - low_of_lane_[0][e] <= width_of_lane_[0][e] ? 1u : 0u) |
+                    (key[e] - low_of_lane_[1][e] <= width_of_lane_[1][e] ? 1u : 0u);
       }
-      std::int32_t any = 0;
+      std::uint32_t any = 0;
       for (std::size_t e = 0; e < kPair; ++e) any |= inside[e];
       if (any) [[unlikely]]
         for (std::size_t t = j; t < j + 2; ++t) Collect(t, counts, nullptr);
     }
     for (std::size_t r = 0; r < 2; ++r)
-      for (std::size_t e = 0; e < kPair; ++e)
-        counts.below[e % 6][r] += static_cast<std::size_t>(below[r][e]);
+      for (std::size_t e = 0; e < kPair; ++e) counts.below[e % 6][r] += below[r][e];
     if (j < end) Collect(j, counts, &counts.below);
   }
 
@@ -261,11 +272,11 @@ class BracketedRanks {
                std::array<std::array<std::size_t, 2>, 6>* below) const {
     for (std::size_t i = 0; i < 6; ++i)
       for (std::size_t r = 0; r < 2; ++r) {
-        const float v = 255.0f * a_[j * 6 + i];
-        if (below && v < low_value_[r][i]) ++(*below)[i][r];
+        const std::uint32_t key = Key(j, i);
+        if (below && key < low_[i][r]) ++(*below)[i][r];
         std::vector<std::uint32_t>& inside = counts.inside[i][r];
-        if (v >= low_value_[r][i] && v <= high_value_[r][i] && inside.size() < limit_)
-          inside.push_back(OrderedKey(v));
+        if (key >= low_[i][r] && key <= high_[i][r] && inside.size() < limit_)
+          inside.push_back(key);
       }
   }
 
@@ -278,7 +289,8 @@ class BracketedRanks {
   std::size_t limit_ = 0;
   std::array<std::size_t, 6> limits_{};  // limit_ of each index
   std::array<std::array<std::uint32_t, 2>, 6> low_{}, high_{};
-  float low_value_[2][kPair] = {}, high_value_[2][kPair] = {};  // the ranges as floats
+  // Each lane's range of a pair of texels: its low key and its width.
+  std::uint32_t low_of_lane_[2][kPair] = {}, width_of_lane_[2][kPair] = {};
   std::array<std::array<std::size_t, 2>, 6> below_{};
   std::array<std::array<std::vector<std::uint32_t>, 2>, 6> inside_;
 };
@@ -642,15 +654,18 @@ class GroupEncoder {
 
 // A .ptm's body after the header: `planes` planes one after another, each of rows
 // height - 1 down to 0 (a .ptm's order) of `row_bytes` made by encode_row(y, plane,
-// bytes) (which must not throw; the stream may). Blocks of rows are written by one task while tasks
-// of a row each encode the next block. `at_once` planes are encoded together, each
-// block written at its plane's place: with every plane at once (a file, which can
-// be written beyond its end), the texels are read in one pass.
+// bytes), which must not throw (the stream may). Blocks of rows are written by one
+// task while tasks of a row each encode the next block. With at_once 1 the planes
+// are written one after another, in order (any stream). With at_once > 1 (a file,
+// which can be sought and written beyond its end) that many planes are encoded
+// together, reading the texels once, and each block is written at its plane's place.
 template <typename EncodeRow>
 void WritePlanesBottomUp(std::ostream& out, int height, std::size_t row_bytes, int planes,
                          int at_once, const EncodeRow& encode_row) {
   constexpr int kBlockRows = 64;
   const std::streamoff body = out.tellp();
+  if (body < 0) at_once = 1;  // a stream that cannot tell its place: one plane after another
+  const bool positioned = at_once > 1;
   const auto plane_bytes = static_cast<std::streamoff>(row_bytes) * height;
   const int blocks = (height + kBlockRows - 1) / kBlockRows;
   const std::size_t block_bytes = row_bytes * kBlockRows;
@@ -678,7 +693,7 @@ void WritePlanesBottomUp(std::ostream& out, int height, std::size_t row_bytes, i
 #pragma omp task firstprivate(bytes, offset, size) shared(out, first, error)
         try {
           for (int p = 0; p < at_once; ++p) {
-            out.seekp(body + plane_bytes * (first + p) + offset);
+            if (positioned) out.seekp(body + plane_bytes * (first + p) + offset);
             out.write(bytes + static_cast<std::size_t>(p) * block_bytes, size);
           }
         } catch (...) {  // a stream that throws: rethrown below, once the tasks are done
@@ -690,7 +705,7 @@ void WritePlanesBottomUp(std::ostream& out, int height, std::size_t row_bytes, i
     }
   }
   if (error) std::rethrow_exception(error);
-  out.seekp(body + plane_bytes * planes);
+  if (positioned) out.seekp(body + plane_bytes * planes);
 }
 
 // The header, then the planes: `at_once` as in WritePlanesBottomUp.

@@ -8,6 +8,7 @@
 #include <random>
 #include <stdexcept>
 #include <string_view>
+#include <thread>
 
 #include "tests/test_util.h"
 
@@ -42,7 +43,8 @@ TEST(ImageBands, EveryRowIsProcessedOnceWithTheImagesPixelsInEitherLayout) {
   for (const BandLayout layout : {BandLayout::kInterleaved, BandLayout::kRowPlanar}) {
     ImageBands bands(c.files, 2);
     std::vector<std::atomic<int>> visits(23);
-    std::atomic<int> wrong{0}, progress_calls{0};
+    std::atomic<int> wrong{0}, progress_calls{0}, progress_elsewhere{0};
+    const std::thread::id caller = std::this_thread::get_id();
     bands.ForEach<std::uint8_t>(
         5,
         [&](const std::vector<const std::uint8_t*>& pixels, int y0, int rows) {
@@ -59,6 +61,7 @@ TEST(ImageBands, EveryRowIsProcessedOnceWithTheImagesPixelsInEitherLayout) {
           }
         },
         [&](std::string_view, std::size_t done, std::size_t total) {
+          if (std::this_thread::get_id() != caller) ++progress_elsewhere;
           EXPECT_EQ(total, 23u);
           EXPECT_EQ(done,
                     std::min<std::size_t>(23, 5 * static_cast<std::size_t>(++progress_calls)));
@@ -67,6 +70,7 @@ TEST(ImageBands, EveryRowIsProcessedOnceWithTheImagesPixelsInEitherLayout) {
     for (int y = 0; y < 23; ++y) EXPECT_EQ(visits[static_cast<std::size_t>(y)], 1) << "row " << y;
     EXPECT_EQ(wrong, 0);
     EXPECT_EQ(progress_calls, 5);
+    EXPECT_EQ(progress_elsewhere, 0);  // progress comes from the calling thread only
   }
 }
 

@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <sstream>
+#include <streambuf>
 
 #include "core/errors.h"
 #include "tests/test_util.h"
@@ -150,19 +151,41 @@ TEST(PtmFile, LargePtmRangesAreExactFromTheSampleAndTheFallback) {
   ExpectExactRanges(ptm);
 }
 
+// A stream that can only be appended to, as a pipe: it cannot tell or seek its place.
+class AppendOnlyBuffer : public std::streambuf {
+ public:
+  std::string bytes;
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (c != traits_type::eof()) bytes.push_back(static_cast<char>(c));
+    return traits_type::not_eof(c);
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    bytes.append(s, static_cast<std::size_t>(n));
+    return n;
+  }
+};
+
 // A file is written by blocks of 64 rows, every polynomial's plane at its place in
-// one pass over the texels; a stream plane after plane: the same bytes.
+// one pass over the texels; a stream plane after plane: the same bytes, also on a
+// stream that cannot seek.
 TEST_P(PtmFileTest, AFileHoldsTheBytesAStreamDoes) {
   testing::TempDir tmp;
   for (const int height : {1, 64, 150}) {
     const Ptm ptm = RandomPtm(GetParam(), 37, height, 9);
     std::stringstream s;
     WritePtm(ptm, s);
+    AppendOnlyBuffer pipe;
+    std::ostream piped(&pipe);
+    WritePtm(ptm, piped);
     WritePtmFile(ptm, tmp / "file.ptm");
     std::ifstream in(tmp / "file.ptm", std::ios::binary);
     const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     ASSERT_EQ(file.size(), s.str().size()) << "height " << height;
     EXPECT_TRUE(file == s.str()) << "height " << height;
+    EXPECT_TRUE(piped.good());
+    EXPECT_TRUE(pipe.bytes == s.str()) << "height " << height;
   }
 }
 
