@@ -138,7 +138,7 @@ TEST_P(PtmFileTest, EachCoefficientsRangeLeavesOutItsLowestAndHighestThousandth)
 }
 
 // On more than 2^19 values per coefficient the ranges are found from a strided
-// sample and one pass (ptm_io.cpp, BracketedRanks); with most of one coefficient's
+// sample and one pass (ptm_quantise.cpp, BracketedRanks); with most of one coefficient's
 // values equal, by the two-pass radix select. Both exact.
 TEST(PtmFile, LargePtmRangesAreExactFromTheSampleAndTheFallback) {
   Ptm ptm = RandomPtm(PtmFormat::kLrgb, 2200, 1000, 6);
