@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "atlas/charts.h"
+#include "atlas/packing_bin.h"
 #include "core/check.h"
 #include "core/errors.h"
 #include "ptm/coefficient_space.h"
@@ -174,44 +175,85 @@ double UprightBoxAngle(const std::vector<ChartFace>& chart,
   return best_angle;
 }
 
-/// Bottom-left packing of outlines (texel-exact, so charts fill each other's
-/// concavities and holes): charts go in `order`, each into the first atlas
-/// where it fits, at the rotation and position `rule` prefers.
-/// `placed` is called after each chart.
+namespace {
+
+// An atlas of PackOutlines. Charts come largest first, so an atlas that has refused
+// kBinRefusalsToClose charts in a row is passed over until they are half as large as
+// the last it refused; then it is tried again, for its holes.
+struct OutlineBin {
+  explicit OutlineBin(int size) : bin(size) {}
+  bool PassedOver(double area) {
+    if (closed_at_area > 0.0 && area > 0.5 * closed_at_area) return true;
+    closed_at_area = 0.0;
+    return false;
+  }
+  void Refused(double area) {
+    if (++refused_in_a_row == kBinRefusalsToClose) closed_at_area = area, refused_in_a_row = 0;
+  }
+  PackingBin bin;
+  int refused_in_a_row = 0;
+  double closed_at_area = 0.0;  // 0: open
+};
+
+// The chart's drop in `bin` at the turn `rule` prefers (`cores`: each turn's largest
+// square); rotation -1: no turn fits.
+OutlineDrop BestDrop(const std::vector<ChartOutline>& turns,
+                     const std::vector<OutlineSquare>& cores, const PackingBin& bin, int bin_size,
+                     DropRule rule) {
+  std::vector<std::pair<int, int>> fit(turns.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::size_t r = 0; r < turns.size(); ++r)
+    fit[r] = bin.FirstFit(turns[r], cores[r], bin_size);
+  const auto key = [&](std::size_t r) {
+    const int y = fit[r].second;
+    return std::make_tuple(rule == DropRule::kLowestBottom ? y + turns[r].Height() : y,
+                           fit[r].first, y);
+  };
+  int best = -1;
+  for (std::size_t r = 0; r < turns.size(); ++r)
+    if (fit[r].first >= 0 && (best < 0 || key(r) < key(static_cast<std::size_t>(best))))
+      best = static_cast<int>(r);
+  if (best < 0) return {0, -1, -1, -1};
+  const auto [x, y] = fit[static_cast<std::size_t>(best)];
+  return {0, best, x, y};
+}
+
+}  // namespace
+
 OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlines,
                             const std::vector<std::size_t>& order, int bin_size, DropRule rule,
                             const std::function<void()>& placed) {
   OutlinePacking packing;
   packing.drops.resize(outlines.size());
-  std::vector<PackingBin> bins;
+  std::vector<std::vector<OutlineSquare>> cores(outlines.size());
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::size_t c = 0; c < outlines.size(); ++c)
+    for (const ChartOutline& o : outlines[c]) cores[c].push_back(LargestSquare(o));
+  std::vector<OutlineBin> bins;
   for (const std::size_t c : order) {
-    for (std::size_t bin = 0;; ++bin) {
-      if (bin == bins.size()) bins.emplace_back(bin_size);
-      const std::size_t num_rotations = outlines[c].size();
-      std::vector<std::pair<int, int>> fit(num_rotations);
-#pragma omp parallel for schedule(dynamic, 1)
-      for (std::size_t r = 0; r < num_rotations; ++r)
-        fit[r] = bins[bin].FirstFit(outlines[c][r], bin_size);
-      int best = -1;
-      auto key = [&](std::size_t r) {
-        const int y = fit[r].second;
-        return std::make_tuple(rule == DropRule::kLowestBottom ? y + outlines[c][r].Height() : y,
-                               fit[r].first, y);
-      };
-      for (std::size_t r = 0; r < num_rotations; ++r)
-        if (fit[r].first >= 0 && (best < 0 || key(r) < key(static_cast<std::size_t>(best))))
-          best = static_cast<int>(r);
-      if (best < 0) continue;
-      const auto [x, y] = fit[static_cast<std::size_t>(best)];
-      bins[bin].Take(outlines[c][static_cast<std::size_t>(best)], x, y);
-      packing.drops[c] = {static_cast<int>(bin), best, x, y};
+    const double area = outlines[c].empty() ? 0.0 : outlines[c][0].area;
+    for (std::size_t b = 0;; ++b) {
+      if (b == bins.size()) bins.emplace_back(bin_size);
+      if (bins[b].PassedOver(area)) {
+        ++packing.bins_passed_over;
+        continue;
+      }
+      OutlineDrop drop = BestDrop(outlines[c], cores[c], bins[b].bin, bin_size, rule);
+      if (drop.rotation < 0) {
+        bins[b].Refused(area);
+        continue;
+      }
+      bins[b].refused_in_a_row = 0;
+      bins[b].bin.Take(outlines[c][static_cast<std::size_t>(drop.rotation)], drop.x, drop.y);
+      drop.bin = static_cast<int>(b);
+      packing.drops[c] = drop;
       break;
     }
     if (placed) placed();
   }
-  for (std::size_t bin = 0; bin < bins.size(); ++bin)
+  for (std::size_t b = 0; b < bins.size(); ++b)
     packing.texels += static_cast<std::int64_t>(bin_size) *
-                      (bin + 1 < bins.size() ? bin_size : bins[bin].used_rows);
+                      (b + 1 < bins.size() ? bin_size : bins[b].bin.UsedRows());
   return packing;
 }
 

@@ -25,6 +25,10 @@ inline constexpr int kPackingRotations = 16;
 /// quarter turns only.
 inline constexpr int kThinChartAspect = 4;
 
+/// An atlas that has refused this many charts in a row is passed over by
+/// PackOutlines until the charts are half as large (the largest come first).
+inline constexpr int kBinRefusalsToClose = 256;
+
 /// Strip charts compared for the best fit at each place in a row.
 inline constexpr int kBestFitCandidates = 64;
 
@@ -71,82 +75,6 @@ ChartOutline UnionOutline(const std::vector<ChartFace>& chart,
 double UprightBoxAngle(const std::vector<ChartFace>& chart,
                        const std::vector<synth::TrianglePatch>& patches);
 
-/// One atlas being packed: per texel, the length of the free (> 0) or used
-/// (< 0) run of texels that starts there, to its right.
-struct PackingBin {
-  int size = 0;
-  std::vector<std::int16_t> run;  // size x size, row-major (|run| <= 16384)
-  std::vector<int> longest_free;  // per row: its longest free run
-  int used_rows = 0;
-  explicit PackingBin(int bin_size)
-      : size(bin_size),
-        run(static_cast<std::size_t>(bin_size) * bin_size),
-        longest_free(static_cast<std::size_t>(bin_size), 0) {
-    for (int y = 0; y < size; ++y) UpdateRow(y, nullptr);
-  }
-  int At(int x, int y) const {
-    return run[static_cast<std::size_t>(y) * static_cast<std::size_t>(size) +
-               static_cast<std::size_t>(x)];
-  }
-  /// Rebuilds row y's runs; `used` marks texels to take (nullptr: all free).
-  void UpdateRow(int y, const std::vector<char>* used) {
-    std::int16_t* r = &run[static_cast<std::size_t>(y) * static_cast<std::size_t>(size)];
-    for (int x = size - 1; x >= 0; --x) {
-      const bool taken = used ? (*used)[static_cast<std::size_t>(x)] != 0 : false;
-      const int next = x + 1 < size ? r[x + 1] : 0;
-      r[x] =
-          static_cast<std::int16_t>(taken ? (next < 0 ? next - 1 : -1) : (next > 0 ? next + 1 : 1));
-    }
-    int longest = 0;
-    for (int x = 0; x < size; ++x) longest = std::max(longest, static_cast<int>(r[x]));
-    longest_free[static_cast<std::size_t>(y)] = longest;
-  }
-  /// 0 when the outline fits with its box's top-left at (x, y); otherwise how
-  /// far right the next position that can fit on the blocking row is.
-  int Skip(const ChartOutline& o, int x, int y) const {
-    for (const ChartOutline::Run& r : o.runs) {
-      const int v = At(x + r.x, y + r.row);
-      if (v >= r.length) continue;
-      if (v < 0) return -v;                   // blocked at the run's start: pass the used run
-      if (x + r.x + v >= size) return size;   // free to the edge but too short
-      return v - At(x + r.x + v, y + r.row);  // pass the free run and the used one after it
-    }
-    return 0;
-  }
-  /// The first position, by rows then columns, where the outline fits, with the
-  /// outline's row `y + Height()` not above `max_bottom`; (-1, -1): none.
-  std::pair<int, int> FirstFit(const ChartOutline& o, int max_bottom) const {
-    for (int y = 0; y + o.Height() <= std::min(size, max_bottom); ++y) {
-      // Rows where the longest run has no room are passed at once.
-      if (!o.runs.empty() &&
-          longest_free[static_cast<std::size_t>(y + o.runs[0].row)] < o.runs[0].length)
-        continue;
-      for (int x = 0; x + o.Width() <= size;) {
-        const int skip = Skip(o, x, y);
-        if (skip == 0) return {x, y};
-        x += skip;
-      }
-    }
-    return {-1, -1};
-  }
-  void Take(const ChartOutline& o, int x0, int y0) {
-    std::vector<std::vector<char>> rows(static_cast<std::size_t>(o.Height()));
-    for (const ChartOutline::Run& r : o.runs) {
-      auto& row = rows[static_cast<std::size_t>(r.row)];
-      if (row.empty()) {
-        row.resize(static_cast<std::size_t>(size));
-        const std::int16_t* cur =
-            &run[static_cast<std::size_t>(y0 + r.row) * static_cast<std::size_t>(size)];
-        for (int x = 0; x < size; ++x) row[static_cast<std::size_t>(x)] = cur[x] < 0;
-      }
-      std::fill(row.begin() + x0 + r.x, row.begin() + x0 + r.x + r.length, 1);
-    }
-    for (std::size_t i = 0; i < rows.size(); ++i)
-      if (!rows[i].empty()) UpdateRow(y0 + static_cast<int>(i), &rows[i]);
-    used_rows = std::max(used_rows, y0 + o.Height());
-  }
-};
-
 /// Where PackOutlines drops a chart: with its outline at `rotation`, the
 /// outline box's top-left at texel (x, y) of atlas `bin` (y down).
 struct OutlineDrop {
@@ -154,8 +82,9 @@ struct OutlineDrop {
 };
 
 struct OutlinePacking {
-  std::vector<OutlineDrop> drops;  ///< per chart
-  std::int64_t texels = 0;         ///< atlas texels used (the last atlas cropped)
+  std::vector<OutlineDrop> drops;     ///< per chart
+  std::int64_t texels = 0;            ///< atlas texels used (the last atlas cropped)
+  std::int64_t bins_passed_over = 0;  ///< atlases a chart skipped (kBinRefusalsToClose)
 };
 
 /// Which position (and rotation) a chart takes.
@@ -166,7 +95,8 @@ enum class DropRule {
 
 /// Bottom-left packing of outlines (texel-exact, so charts fill each other's
 /// concavities and holes): charts go in `order`, each into the first atlas
-/// where it fits, at the rotation and position `rule` prefers.
+/// where it fits, at the rotation and position `rule` prefers; an atlas that
+/// refused kBinRefusalsToClose charts in a row waits for charts half as large.
 /// `placed` is called after each chart.
 OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlines,
                             const std::vector<std::size_t>& order, int bin_size, DropRule rule,

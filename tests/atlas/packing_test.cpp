@@ -5,6 +5,7 @@
 
 #include "atlas/atlas.h"
 #include "atlas/chart_packing.h"
+#include "atlas/packing_bin.h"
 #include "core/errors.h"
 #include "mesh/triangle_frame.h"
 
@@ -114,6 +115,85 @@ TEST(ChartOutline, HoldsExactlyTheTexelsWithinReachAndIsTheUnionOfItsFaces) {
       EXPECT_EQ(cv::countNonZero(OutlineMask(united) != OutlineMask(whole)), 0);
     }
   }
+}
+
+// Brute force: the first position, by rows then columns, where no texel of the
+// outline meets a used texel of `used`, its bottom not below `max_bottom`.
+std::pair<int, int> FirstFreePosition(const cv::Mat& used, const cv::Mat& outline, int max_bottom) {
+  for (int y = 0; y + outline.rows <= std::min(used.rows, max_bottom); ++y)
+    for (int x = 0; x + outline.cols <= used.cols; ++x)
+      if (cv::countNonZero(used(cv::Rect(x, y, outline.cols, outline.rows)) & outline) == 0)
+        return {x, y};
+  return {-1, -1};
+}
+
+TEST(PackingBin, FirstFitIsTheFirstFreePositionInAFragmentedBin) {
+  // Outlines of 1-3 random triangles at random turns dropped one after another into
+  // one bin until it is full: holes of every size, rows with many free runs.
+  const int size = 96, gutter = 1;
+  chart_packing::PackingBin bin(size);
+  cv::Mat used = cv::Mat::zeros(size, size, CV_8UC1);
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> faces(1, 3), bottom(20, size);
+  std::uniform_real_distribution<double> turn(0.0, 6.28);
+  int dropped = 0, refused = 0;
+  for (unsigned i = 0; i < 250; ++i) {
+    const RandomStrip strip = MakeRandomStrip(faces(rng), 100 + i);
+    const auto o = chart_packing::Outline(strip.chart, turn(rng), strip.patches, 1.0, gutter);
+    const cv::Mat mask = OutlineMask(o);
+    const int max_bottom = i % 3 == 0 ? bottom(rng) : size;
+    const std::pair<int, int> fit = bin.FirstFit(o, chart_packing::LargestSquare(o), max_bottom);
+    ASSERT_EQ(fit, FirstFreePosition(used, mask, max_bottom)) << "outline " << i;
+    if (fit.first < 0) {
+      ++refused;
+      continue;
+    }
+    bin.Take(o, fit.first, fit.second);
+    cv::Mat roi = used(cv::Rect(fit.first, fit.second, o.Width(), o.Height()));
+    roi |= mask;
+    ++dropped;
+    EXPECT_GE(bin.UsedRows(), fit.second + o.Height());
+  }
+  EXPECT_GT(dropped, 40);   // the bin filled up...
+  EXPECT_GT(refused, 100);  // ...and then refused outlines it had no room for
+}
+
+TEST(PackOutlines, AtlasesPassedOverStillTakeSmallChartsInTheirHoles) {
+  // Many charts of 3 triangles, then single triangles half as large or less, largest
+  // first: the first atlases refuse the large charts long enough to be passed over,
+  // and must take small ones again.
+  const int size = 64, gutter = 1;
+  std::vector<std::vector<chart_packing::ChartOutline>> outlines;
+  const unsigned large = 3 * chart_packing::kBinRefusalsToClose;
+  for (unsigned i = 0; i < large + chart_packing::kBinRefusalsToClose; ++i) {
+    const RandomStrip strip = MakeRandomStrip(i < large ? 3 : 1, i);
+    std::vector<chart_packing::ChartOutline> turns;
+    for (const double angle : {0.0, 1.5708})
+      turns.push_back(chart_packing::Outline(strip.chart, angle, strip.patches, 1.0, gutter));
+    outlines.push_back(std::move(turns));
+  }
+  std::vector<std::size_t> order(outlines.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return outlines[a][0].area > outlines[b][0].area;
+  });
+  const chart_packing::OutlinePacking packing = chart_packing::PackOutlines(
+      outlines, order, size, chart_packing::DropRule::kLowestBottom, nullptr);
+  std::vector<cv::Mat> used;
+  bool small_in_first_atlas = false;
+  for (const std::size_t c : order) {
+    const chart_packing::OutlineDrop& d = packing.drops[c];
+    while (static_cast<int>(used.size()) <= d.bin) used.push_back(cv::Mat::zeros(size, size, 0));
+    const auto& o = outlines[c][static_cast<std::size_t>(d.rotation)];
+    ASSERT_TRUE(d.x >= 0 && d.y >= 0 && d.x + o.Width() <= size && d.y + o.Height() <= size);
+    cv::Mat roi = used[static_cast<std::size_t>(d.bin)](cv::Rect(d.x, d.y, o.Width(), o.Height()));
+    ASSERT_EQ(cv::countNonZero(roi & OutlineMask(o)), 0) << "chart " << c << " overlaps";
+    roi |= OutlineMask(o);
+    small_in_first_atlas |= c >= large && d.bin == 0;
+  }
+  EXPECT_GT(used.size(), 8u);
+  EXPECT_GT(packing.bins_passed_over, 0);
+  EXPECT_TRUE(small_in_first_atlas);
 }
 
 }  // namespace
