@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "core/errors.h"
+#include "core/first_exception.h"
 
 namespace texlume::ptm {
 
@@ -58,32 +59,6 @@ void ReadRowPlanar(ImageReader& input, int y0, int rows, std::vector<Sample>& sc
         split);
   }
 }
-
-// The first exception of any task; tasks stop starting work once there is one.
-class FirstError {
- public:
-  template <typename Work>
-  void Run(const Work& work) {
-    if (Failed()) return;
-    try {
-      work();
-    } catch (...) {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      if (!error_) error_ = std::current_exception();
-    }
-  }
-  bool Failed() {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    return static_cast<bool>(error_);
-  }
-  void Rethrow() {
-    if (error_) std::rethrow_exception(error_);
-  }
-
- private:
-  std::mutex mutex_;
-  std::exception_ptr error_;
-};
 
 // ImageBands::ForEach's loop: two bands of every image, the next one read by one
 // task per image while tasks of a few rows each process the current one.
@@ -171,7 +146,7 @@ class BandPipeline {
   int task_rows_ = 1;
   std::vector<std::vector<Sample>> scratch_;  // one per thread of the team
   std::vector<std::vector<Sample>> bands_[2];
-  FirstError error_;
+  FirstException error_;
 };
 
 }  // namespace

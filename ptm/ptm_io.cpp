@@ -15,6 +15,7 @@
 
 #include "core/errors.h"
 #include "core/file_util.h"
+#include "core/first_exception.h"
 #include "core/image_io.h"
 #include "core/memory_budget.h"
 #include "ptm/exr_io.h"
@@ -344,8 +345,8 @@ void WritePlanesBottomUp(std::ostream& out, int height, std::size_t row_bytes, i
   std::vector<char> block[2];
   for (auto& bytes : block) bytes.resize(block_bytes * static_cast<std::size_t>(at_once));
   const auto rows_of = [&](int b) { return std::min(kBlockRows, height - b * kBlockRows); };
-  std::exception_ptr error;
-  for (int first = 0; first < planes && !error; first += at_once) {
+  FirstException error;
+  for (int first = 0; first < planes && !error.Failed(); first += at_once) {
 #pragma omp parallel
 #pragma omp single
     for (int b = 0; b <= blocks; ++b) {
@@ -363,20 +364,18 @@ void WritePlanesBottomUp(std::ostream& out, int height, std::size_t row_bytes, i
         const auto size =
             static_cast<std::streamsize>(static_cast<std::size_t>(rows_of(b - 1)) * row_bytes);
 #pragma omp task firstprivate(bytes, offset, size) shared(out, first, error)
-        try {
+        error.Run([&] {  // a stream that throws: rethrown below, once the tasks are done
           for (int p = 0; p < at_once; ++p) {
             if (positioned) out.seekp(body + plane_bytes * (first + p) + offset);
             out.write(bytes + static_cast<std::size_t>(p) * block_bytes, size);
           }
-        } catch (...) {  // a stream that throws: rethrown below, once the tasks are done
-          error = std::current_exception();
-        }
+        });
       }
 #pragma omp taskwait
-      if (error) break;
+      if (error.Failed()) break;
     }
   }
-  if (error) std::rethrow_exception(error);
+  error.Rethrow();
   if (positioned) out.seekp(body + plane_bytes * planes);
 }
 

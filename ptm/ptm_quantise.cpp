@@ -8,6 +8,8 @@
 #include <limits>
 #include <vector>
 
+#include "core/first_exception.h"
+
 namespace texlume::ptm {
 namespace {
 
@@ -176,19 +178,14 @@ class BracketedRanks {
         width_of_lane_[r][e] = high_[e % 6][r] - low_[e % 6][r];
       }
     bool overflow = false;
-    std::exception_ptr error;  // from a thread's allocation: rethrown, not terminate()
+    FirstException error;  // from a thread's allocation: rethrown, not terminate()
     const std::size_t blocks = (count_ + kBlock - 1) / kBlock;
 #pragma omp parallel
     {
       Counts counts;
 #pragma omp for schedule(static) nowait
       for (std::size_t b = 0; b < blocks; ++b) {
-        try {
-          CountBlock(b * kBlock, std::min(count_, (b + 1) * kBlock), counts);
-        } catch (...) {
-#pragma omp critical
-          error = std::current_exception();
-        }
+        error.Run([&] { CountBlock(b * kBlock, std::min(count_, (b + 1) * kBlock), counts); });
       }
 #pragma omp critical
       for (std::size_t i = 0; i < 6; ++i)
@@ -199,7 +196,7 @@ class BracketedRanks {
                                counts.inside[i][r].end());
         }
     }
-    if (error) std::rethrow_exception(error);
+    error.Rethrow();
     return !overflow;
   }
 
