@@ -72,19 +72,28 @@ OutlineSquare LargestSquare(const ChartOutline& o) {
 }
 
 PackingBin::PackingBin(int bin_size) : size_(bin_size), runs_(bin_size), squares_(bin_size) {
-  for (int y = 0; y < size_; ++y) UpdateRuns(y, nullptr);
+  for (int y = 0; y < size_; ++y) {
+    std::int16_t* r = runs_.Row(y);
+    for (int x = 0; x < size_; ++x) r[x] = static_cast<std::int16_t>(size_ - x);
+    runs_.Changed(y, 0, size_);
+  }
   UpdateSquares(0, size_, 0, size_);
 }
 
-void PackingBin::UpdateRuns(int y, const std::vector<char>* used) {
+void PackingBin::TakeRun(int y, int x_first, int x_end) {
+  // Runs right of the taken texels stay; leftwards from the last taken texel each
+  // run follows from the one to its right, until one comes out as it was.
   std::int16_t* r = runs_.Row(y);
-  for (int x = size_ - 1; x >= 0; --x) {
-    const bool taken = used ? (*used)[static_cast<std::size_t>(x)] != 0 : false;
+  int x = x_end - 1;
+  for (; x >= 0; --x) {
+    const bool used = x >= x_first || r[x] < 0;
     const int next = x + 1 < size_ ? r[x + 1] : 0;
-    r[x] =
-        static_cast<std::int16_t>(taken ? (next < 0 ? next - 1 : -1) : (next > 0 ? next + 1 : 1));
+    const auto run =
+        static_cast<std::int16_t>(used ? (next < 0 ? next - 1 : -1) : (next > 0 ? next + 1 : 1));
+    if (x < x_first && run == r[x]) break;
+    r[x] = run;
   }
-  runs_.Changed(y, 0, size_);
+  runs_.Changed(y, x + 1, x_end);
 }
 
 void PackingBin::UpdateSquares(int x_lo, int x_hi, int y_lo, int y_hi) {
@@ -136,18 +145,7 @@ std::pair<int, int> PackingBin::FirstFit(const ChartOutline& o, const OutlineSqu
 }
 
 void PackingBin::Take(const ChartOutline& o, int x0, int y0) {
-  std::vector<std::vector<char>> rows(static_cast<std::size_t>(o.Height()));
-  for (const ChartOutline::Run& r : o.runs) {
-    auto& row = rows[static_cast<std::size_t>(r.row)];
-    if (row.empty()) {
-      row.resize(static_cast<std::size_t>(size_));
-      const std::int16_t* cur = runs_.Row(y0 + r.row);
-      for (int x = 0; x < size_; ++x) row[static_cast<std::size_t>(x)] = cur[x] < 0;
-    }
-    std::fill(row.begin() + x0 + r.x, row.begin() + x0 + r.x + r.length, 1);
-  }
-  for (std::size_t i = 0; i < rows.size(); ++i)
-    if (!rows[i].empty()) UpdateRuns(y0 + static_cast<int>(i), &rows[i]);
+  for (const ChartOutline::Run& r : o.runs) TakeRun(y0 + r.row, x0 + r.x, x0 + r.x + r.length);
   // Squares up to kMaxSquare up and left of the taken texels may have shrunk.
   UpdateSquares(std::max(0, x0 - kMaxSquare + 1), std::min(size_, x0 + o.Width()),
                 std::max(0, y0 - kMaxSquare + 1), std::min(size_, y0 + o.Height()));

@@ -70,8 +70,9 @@ class PackingBin {
   int UsedRows() const { return used_rows_; }
 
  private:
-  /// Rebuilds row y's runs; `used` marks the texels to take (nullptr: all free).
-  void UpdateRuns(int y, const std::vector<char>* used);
+  /// Marks texels [x_first, x_end) of row y used (they were free) and updates the
+  /// runs that change: those taken and the ones left of them up to the first that stays.
+  void TakeRun(int y, int x_first, int x_end);
   /// Recomputes the free squares whose top-left lies in [x_lo, x_hi) x [y_lo, y_hi).
   void UpdateSquares(int x_lo, int x_hi, int y_lo, int y_hi);
   /// The next column from x on (size_: none) where, the outline's top at row y,

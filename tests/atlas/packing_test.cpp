@@ -127,35 +127,77 @@ std::pair<int, int> FirstFreePosition(const cv::Mat& used, const cv::Mat& outlin
   return {-1, -1};
 }
 
-TEST(PackingBin, FirstFitIsTheFirstFreePositionInAFragmentedBin) {
-  // Outlines of 1-3 random triangles at random turns dropped one after another into
-  // one bin until it is full: holes of every size, rows with many free runs.
-  const int size = 96, gutter = 1;
+// Drops the outlines one after another into a bin of `size`, some with a bottom limit,
+// each where FirstFit puts it, after checking that against the brute force.
+struct Drops {
+  int dropped = 0, refused = 0;
+};
+Drops DropAndCompare(int size, const std::vector<chart_packing::ChartOutline>& outlines) {
   chart_packing::PackingBin bin(size);
   cv::Mat used = cv::Mat::zeros(size, size, CV_8UC1);
   std::mt19937 rng(7);
-  std::uniform_int_distribution<int> faces(1, 3), bottom(20, size);
-  std::uniform_real_distribution<double> turn(0.0, 6.28);
-  int dropped = 0, refused = 0;
-  for (unsigned i = 0; i < 250; ++i) {
-    const RandomStrip strip = MakeRandomStrip(faces(rng), 100 + i);
-    const auto o = chart_packing::Outline(strip.chart, turn(rng), strip.patches, 1.0, gutter);
+  std::uniform_int_distribution<int> bottom(size / 5, size);
+  Drops drops;
+  for (std::size_t i = 0; i < outlines.size(); ++i) {
+    const chart_packing::ChartOutline& o = outlines[i];
     const cv::Mat mask = OutlineMask(o);
     const int max_bottom = i % 3 == 0 ? bottom(rng) : size;
     const std::pair<int, int> fit = bin.FirstFit(o, chart_packing::LargestSquare(o), max_bottom);
-    ASSERT_EQ(fit, FirstFreePosition(used, mask, max_bottom)) << "outline " << i;
+    EXPECT_EQ(fit, FirstFreePosition(used, mask, max_bottom)) << "outline " << i;
+    if (fit != FirstFreePosition(used, mask, max_bottom)) return drops;
     if (fit.first < 0) {
-      ++refused;
+      ++drops.refused;
       continue;
     }
     bin.Take(o, fit.first, fit.second);
     cv::Mat roi = used(cv::Rect(fit.first, fit.second, o.Width(), o.Height()));
     roi |= mask;
-    ++dropped;
+    ++drops.dropped;
     EXPECT_GE(bin.UsedRows(), fit.second + o.Height());
   }
-  EXPECT_GT(dropped, 40);   // the bin filled up...
-  EXPECT_GT(refused, 100);  // ...and then refused outlines it had no room for
+  return drops;
+}
+
+// Outlines of 1-3 random triangles at random turns.
+std::vector<chart_packing::ChartOutline> RandomOutlines(int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> faces(1, 3);
+  std::uniform_real_distribution<double> turn(0.0, 6.28);
+  std::vector<chart_packing::ChartOutline> outlines;
+  for (int i = 0; i < count; ++i) {
+    const RandomStrip strip = MakeRandomStrip(faces(rng), seed + static_cast<unsigned>(i));
+    outlines.push_back(chart_packing::Outline(strip.chart, turn(rng), strip.patches, 1.0, 1));
+  }
+  return outlines;
+}
+
+TEST(PackingBin, FirstFitIsTheFirstFreePositionInAFragmentedBin) {
+  // Small outlines until the bin is full: holes of every size, rows with many free
+  // runs. 100 texels: the last block of each row's tree is partial.
+  const Drops drops = DropAndCompare(100, RandomOutlines(250, 100));
+  EXPECT_GT(drops.dropped, 40);   // the bin filled up...
+  EXPECT_GT(drops.refused, 100);  // ...and then refused outlines it had no room for
+}
+
+TEST(PackingBin, FirstFitHoldsForOutlinesWithSquaresBeyondTheCap) {
+  // Right triangles of 100 texels a side (inside squares of about 50 + gutter) and
+  // of 150 (about 75, more than PackingBin::kMaxSquare) among small outlines.
+  std::vector<chart_packing::ChartOutline> outlines = RandomOutlines(40, 500);
+  for (const double legs : {150.0, 100.0, 150.0}) {
+    synth::TrianglePatch patch;
+    patch.corners_in_frame = {Eigen::Vector2d(0, 0), Eigen::Vector2d(legs, 0),
+                              Eigen::Vector2d(0, legs)};
+    ChartFace cf;
+    cf.face = 0;
+    cf.linear = Eigen::Matrix2d::Identity();
+    cf.translation = Eigen::Vector2d::Zero();
+    outlines.push_back(chart_packing::Outline({cf}, 0.3 * legs, {patch}, 1.0, 1));
+  }
+  EXPECT_GT(chart_packing::LargestSquare(outlines.back()).side,
+            chart_packing::PackingBin::kMaxSquare);
+  for (const auto& o : RandomOutlines(60, 900)) outlines.push_back(o);
+  const Drops drops = DropAndCompare(230, outlines);
+  EXPECT_GT(drops.dropped, 40);
 }
 
 TEST(PackOutlines, AtlasesPassedOverStillTakeSmallChartsInTheirHoles) {
