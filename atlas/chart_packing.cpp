@@ -240,6 +240,8 @@ OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlin
       }
       OutlineDrop drop = BestDrop(outlines[c], cores[c], bins[b].bin, bin_size, rule);
       if (drop.rotation < 0) {
+        // An empty atlas that refuses it: no atlas ever takes it (CheckOutlinesFit).
+        TEXLUME_CHECK(bins[b].bin.UsedRows() > 0, "every chart fits an empty atlas");
         bins[b].Refused(area);
         continue;
       }

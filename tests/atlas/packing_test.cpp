@@ -234,6 +234,10 @@ TEST(PackOutlines, AtlasesPassedOverStillTakeSmallChartsInTheirHoles) {
     small_in_first_atlas |= c >= large && d.bin == 0;
   }
   EXPECT_GT(used.size(), 8u);
+  // A chart no empty atlas takes is an error, not an endless run of new atlases.
+  EXPECT_THROW(chart_packing::PackOutlines({outlines[0]}, {0}, outlines[0][0].Width() - 1,
+                                           chart_packing::DropRule::kLowestBottom, nullptr),
+               InternalError);
   EXPECT_GT(packing.bins_passed_over, 0);
   EXPECT_TRUE(small_in_first_atlas);
 }
