@@ -350,6 +350,7 @@ void AtlasLayouter::PackByOutlines() {
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return area[a] > area[b]; });
   CheckOutlinesFit(outlines);
+  const std::vector<std::vector<OutlineSquare>> cores = LargestSquares(outlines);
   // Both drop rules; the layout with fewer atlas texels wins.
   OutlinePacking best_packing;
   std::size_t placed = 0;
@@ -360,7 +361,8 @@ void AtlasLayouter::PackByOutlines() {
       progress_("packing outlines", placed, to_place);
   };
   for (const DropRule rule : {DropRule::kLowestBottom, DropRule::kLowestPosition}) {
-    OutlinePacking packing = PackOutlines(outlines, order, options_.atlas_size, rule, count_placed);
+    OutlinePacking packing =
+        PackOutlines(outlines, cores, order, options_.atlas_size, rule, count_placed);
     if (best_packing.drops.empty() || packing.texels < best_packing.texels)
       best_packing = std::move(packing);
   }

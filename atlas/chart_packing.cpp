@@ -175,6 +175,36 @@ double UprightBoxAngle(const std::vector<ChartFace>& chart,
   return best_angle;
 }
 
+OutlineSquare LargestSquare(const ChartOutline& o) {
+  const int w = o.Width(), h = o.Height();
+  std::vector<char> inside(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0);
+  for (const ChartOutline::Run& r : o.runs)
+    std::fill_n(inside.begin() + static_cast<std::ptrdiff_t>(r.row) * w + r.x, r.length, 1);
+  // side(x, y) = 1 + min(side right, below, right-below) inside, from the bottom-right;
+  // ties go to the earlier position (rows up, then columns left).
+  std::vector<int> below(static_cast<std::size_t>(w) + 1, 0), here(below.size(), 0);
+  OutlineSquare best;
+  for (int y = h - 1; y >= 0; --y) {
+    const char* row = &inside[static_cast<std::size_t>(y) * static_cast<std::size_t>(w)];
+    for (int x = w - 1; x >= 0; --x) {
+      const auto i = static_cast<std::size_t>(x);
+      here[i] = row[x] ? 1 + std::min({here[i + 1], below[i], below[i + 1]}) : 0;
+      if (here[i] > 0 && here[i] >= best.side) best = {y, x, here[i]};
+    }
+    std::swap(here, below);
+  }
+  return best;
+}
+
+std::vector<std::vector<OutlineSquare>> LargestSquares(
+    const std::vector<std::vector<ChartOutline>>& outlines) {
+  std::vector<std::vector<OutlineSquare>> cores(outlines.size());
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::size_t c = 0; c < outlines.size(); ++c)
+    for (const ChartOutline& o : outlines[c]) cores[c].push_back(LargestSquare(o));
+  return cores;
+}
+
 namespace {
 
 // An atlas of PackOutlines. Charts come largest first, so an atlas that has refused
@@ -189,6 +219,10 @@ struct OutlineBin {
   }
   void Refused(double area) {
     if (++refused_in_a_row == kBinRefusalsToClose) closed_at_area = area, refused_in_a_row = 0;
+  }
+  void Took(const ChartOutline& o, const OutlineDrop& drop) {
+    bin.Take(o, drop.x, drop.y);
+    refused_in_a_row = 0;
   }
   PackingBin bin;
   int refused_in_a_row = 0;
@@ -221,14 +255,11 @@ OutlineDrop BestDrop(const std::vector<ChartOutline>& turns,
 }  // namespace
 
 OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlines,
+                            const std::vector<std::vector<OutlineSquare>>& cores,
                             const std::vector<std::size_t>& order, int bin_size, DropRule rule,
                             const std::function<void()>& placed) {
   OutlinePacking packing;
   packing.drops.resize(outlines.size());
-  std::vector<std::vector<OutlineSquare>> cores(outlines.size());
-#pragma omp parallel for schedule(dynamic, 16)
-  for (std::size_t c = 0; c < outlines.size(); ++c)
-    for (const ChartOutline& o : outlines[c]) cores[c].push_back(LargestSquare(o));
   std::vector<OutlineBin> bins;
   for (const std::size_t c : order) {
     const double area = outlines[c].empty() ? 0.0 : outlines[c][0].area;
@@ -245,8 +276,7 @@ OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlin
         bins[b].Refused(area);
         continue;
       }
-      bins[b].refused_in_a_row = 0;
-      bins[b].bin.Take(outlines[c][static_cast<std::size_t>(drop.rotation)], drop.x, drop.y);
+      bins[b].Took(outlines[c][static_cast<std::size_t>(drop.rotation)], drop);
       drop.bin = static_cast<int>(b);
       packing.drops[c] = drop;
       break;

@@ -75,6 +75,17 @@ ChartOutline UnionOutline(const std::vector<ChartFace>& chart,
 double UprightBoxAngle(const std::vector<ChartFace>& chart,
                        const std::vector<synth::TrianglePatch>& patches);
 
+/// The largest square of texels inside an outline: its top-left (x, row) in the
+/// outline's box and its side (0 for an empty outline). Packing tests it first:
+/// a fragmented atlas has few free squares as large.
+struct OutlineSquare {
+  int row = 0, x = 0, side = 0;
+};
+OutlineSquare LargestSquare(const ChartOutline& o);
+/// LargestSquare of every turn of every chart.
+std::vector<std::vector<OutlineSquare>> LargestSquares(
+    const std::vector<std::vector<ChartOutline>>& outlines);
+
 /// Where PackOutlines drops a chart: with its outline at `rotation`, the
 /// outline box's top-left at texel (x, y) of atlas `bin` (y down).
 struct OutlineDrop {
@@ -97,8 +108,10 @@ enum class DropRule {
 /// concavities and holes): charts go in `order`, each into the first atlas
 /// where it fits, at the rotation and position `rule` prefers; an atlas that
 /// refused kBinRefusalsToClose charts in a row waits for charts half as large.
-/// `placed` is called after each chart.
+/// `cores`: LargestSquares(outlines), made once for every layout of the same
+/// outlines. `placed` is called after each chart.
 OutlinePacking PackOutlines(const std::vector<std::vector<ChartOutline>>& outlines,
+                            const std::vector<std::vector<OutlineSquare>>& cores,
                             const std::vector<std::size_t>& order, int bin_size, DropRule rule,
                             const std::function<void()>& placed);
 

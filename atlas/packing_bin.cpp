@@ -50,27 +50,6 @@ int RowMaxGrid<Value>::FirstAtLeast(int y, int from, int value) const {
 template class RowMaxGrid<std::int16_t>;
 template class RowMaxGrid<std::int8_t>;
 
-OutlineSquare LargestSquare(const ChartOutline& o) {
-  const int w = o.Width(), h = o.Height();
-  std::vector<char> inside(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0);
-  for (const ChartOutline::Run& r : o.runs)
-    std::fill_n(inside.begin() + static_cast<std::ptrdiff_t>(r.row) * w + r.x, r.length, 1);
-  // side(x, y) = 1 + min(side right, below, right-below) inside, from the bottom-right;
-  // ties go to the earlier position (rows up, then columns left).
-  std::vector<int> below(static_cast<std::size_t>(w) + 1, 0), here(below.size(), 0);
-  OutlineSquare best;
-  for (int y = h - 1; y >= 0; --y) {
-    const char* row = &inside[static_cast<std::size_t>(y) * static_cast<std::size_t>(w)];
-    for (int x = w - 1; x >= 0; --x) {
-      const auto i = static_cast<std::size_t>(x);
-      here[i] = row[x] ? 1 + std::min({here[i + 1], below[i], below[i + 1]}) : 0;
-      if (here[i] > 0 && here[i] >= best.side) best = {y, x, here[i]};
-    }
-    std::swap(here, below);
-  }
-  return best;
-}
-
 PackingBin::PackingBin(int bin_size) : size_(bin_size), runs_(bin_size), squares_(bin_size) {
   for (int y = 0; y < size_; ++y) {
     std::int16_t* r = runs_.Row(y);

@@ -40,14 +40,6 @@ class RowMaxGrid {
   std::vector<Value> tree_;    // per row 2 * blocks_: [1] the root, [blocks_ + b] block b
 };
 
-/// The largest square of texels inside an outline: its top-left (x, row) in the
-/// outline's box and its side (0 for an empty outline). Packing tests it first:
-/// a fragmented atlas has few free squares as large.
-struct OutlineSquare {
-  int row = 0, x = 0, side = 0;
-};
-OutlineSquare LargestSquare(const ChartOutline& o);
-
 /// One atlas being packed by outlines (PackOutlines). Per texel, the length of
 /// the free (> 0) or used (< 0) run of texels that starts there, to its right,
 /// and the side of the largest free square whose top-left it is (up to

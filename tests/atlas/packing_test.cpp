@@ -143,8 +143,9 @@ Drops DropAndCompare(int size, const std::vector<chart_packing::ChartOutline>& o
     const cv::Mat mask = OutlineMask(o);
     const int max_bottom = i % 3 == 0 ? bottom(rng) : size;
     const std::pair<int, int> fit = bin.FirstFit(o, chart_packing::LargestSquare(o), max_bottom);
-    EXPECT_EQ(fit, FirstFreePosition(used, mask, max_bottom)) << "outline " << i;
-    if (fit != FirstFreePosition(used, mask, max_bottom)) return drops;
+    const std::pair<int, int> expected = FirstFreePosition(used, mask, max_bottom);
+    EXPECT_EQ(fit, expected) << "outline " << i;
+    if (fit != expected) return drops;
     if (fit.first < 0) {
       ++drops.refused;
       continue;
@@ -219,8 +220,9 @@ TEST(PackOutlines, AtlasesPassedOverStillTakeSmallChartsInTheirHoles) {
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return outlines[a][0].area > outlines[b][0].area;
   });
-  const chart_packing::OutlinePacking packing = chart_packing::PackOutlines(
-      outlines, order, size, chart_packing::DropRule::kLowestBottom, nullptr);
+  const chart_packing::OutlinePacking packing =
+      chart_packing::PackOutlines(outlines, chart_packing::LargestSquares(outlines), order, size,
+                                  chart_packing::DropRule::kLowestBottom, nullptr);
   std::vector<cv::Mat> used;
   bool small_in_first_atlas = false;
   for (const std::size_t c : order) {
@@ -235,8 +237,9 @@ TEST(PackOutlines, AtlasesPassedOverStillTakeSmallChartsInTheirHoles) {
   }
   EXPECT_GT(used.size(), 8u);
   // A chart no empty atlas takes is an error, not an endless run of new atlases.
-  EXPECT_THROW(chart_packing::PackOutlines({outlines[0]}, {0}, outlines[0][0].Width() - 1,
-                                           chart_packing::DropRule::kLowestBottom, nullptr),
+  EXPECT_THROW(chart_packing::PackOutlines(
+                   {outlines[0]}, chart_packing::LargestSquares({outlines[0]}), {0},
+                   outlines[0][0].Width() - 1, chart_packing::DropRule::kLowestBottom, nullptr),
                InternalError);
   EXPECT_GT(packing.bins_passed_over, 0);
   EXPECT_TRUE(small_in_first_atlas);
