@@ -3,8 +3,6 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <exception>
-#include <mutex>
 #include <opencv2/core.hpp>
 #include <string>
 #include <type_traits>
