@@ -85,8 +85,10 @@ syn1, synn = m1["timings_s"]["synthesis"], mn["timings_s"]["synthesis"]
 print(f"\nefficiency at {n} ranks: synthesis {syn1 / (n * synn):.2f}, whole command "
       f"{wall1 / (n * walln):.2f} (speed-up {syn1 / synn:.2f} / {wall1 / walln:.2f})")
 e = dist["edge_mismatch"]
-print(f"edge mismatch: region borders {e['region_borders']:.5f} ({e['border_edges']} edges), "
-      f"elsewhere {e['elsewhere']:.5f} ({e['other_edges']} edges)")
+for name in ("region_borders", "next_to_borders", "elsewhere"):
+    t = e[name]
+    print(f"edge mismatch, {name.replace('_', ' ')}: {t['mean']:.5f} +- {t['standard_error']:.5f} "
+          f"({t['edges']} edges)")
 for r in dist["per_rank"]:
     print(f"rank {r['rank']}: {r['faces']} faces, placed {r['faces_placed']} in "
           f"{r['seconds_region']:.1f} s, detail transfer {r['seconds_finish']:.1f} s (prepare "

@@ -368,11 +368,15 @@ nlohmann::json RanksJson(const synth::TriangleSynthesis& synthesis,
                            {"seconds_gather", synthesis.seconds_gather},
                            {"seconds_region_borders", synthesis.seconds_region_borders},
                            {"per_rank", ranks}};
-  if (mismatch)
-    record["edge_mismatch"] = {{"region_borders", mismatch->region_borders},
-                               {"elsewhere", mismatch->elsewhere},
-                               {"border_edges", mismatch->border_edges},
-                               {"other_edges", mismatch->other_edges}};
+  if (mismatch) {
+    const auto tally = [](const synth::EdgeTally& t) {
+      return nlohmann::json{
+          {"mean", t.Mean()}, {"standard_error", t.StandardError()}, {"edges", t.Edges()}};
+    };
+    record["edge_mismatch"] = {{"region_borders", tally(mismatch->region_borders)},
+                               {"next_to_borders", tally(mismatch->next_to_borders)},
+                               {"elsewhere", tally(mismatch->elsewhere)}};
+  }
   return record;
 }
 

@@ -90,25 +90,48 @@ std::pair<double, int> EdgeDifference(const MeshSynthesis& synthesis, std::size_
 
 }  // namespace
 
+void EdgeTally::Add(double sum, int points) {
+  ++edges_;
+  if (points <= 0) return;
+  sum_ += sum;
+  points_ += static_cast<std::size_t>(points);
+  edge_means_.push_back(sum / points);
+}
+
+double EdgeTally::Mean() const { return points_ ? sum_ / static_cast<double>(points_) : 0.0; }
+
+double EdgeTally::StandardError() const {
+  const std::size_t n = edge_means_.size();
+  if (n < 2) return 0.0;
+  double mean = 0.0, squares = 0.0;
+  for (double e : edge_means_) mean += e / static_cast<double>(n);
+  for (double e : edge_means_) squares += (e - mean) * (e - mean);
+  return std::sqrt(squares / static_cast<double>(n - 1) / static_cast<double>(n));
+}
+
 EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
                                  const std::vector<int>& region_of_face) {
+  const std::size_t num_faces = synthesis.patches.size();
+  const auto region = [&](std::size_t f) { return region_of_face.empty() ? 0 : region_of_face[f]; };
+  std::vector<char> on_border(num_faces, 0);
+  for (std::size_t f = 0; f < num_faces; ++f)
+    for (const Unfolding& u : synthesis.unfoldings[f])
+      if (u.face >= 0 && region(f) != region(static_cast<std::size_t>(u.face))) on_border[f] = 1;
   EdgeMismatch m;
-  double border_sum = 0.0, other_sum = 0.0;
-  std::size_t border_points = 0, other_points = 0;
-  for (std::size_t f = 0; f < synthesis.patches.size(); ++f)
+  const double planes = std::max(1, synthesis.CoefficientPlanes());
+  for (std::size_t f = 0; f < num_faces; ++f)
     for (int k = 0; k < 3; ++k) {
       const int g = synthesis.unfoldings[f][static_cast<std::size_t>(k)].face;
       if (g < static_cast<int>(f)) continue;  // each shared edge once (and not boundaries)
       const auto [sum, points] = EdgeDifference(synthesis, f, k);
-      const bool border = !region_of_face.empty() &&
-                          region_of_face[f] != region_of_face[static_cast<std::size_t>(g)];
-      (border ? border_sum : other_sum) += sum;
-      (border ? border_points : other_points) += static_cast<std::size_t>(points);
-      ++(border ? m.border_edges : m.other_edges);
+      const std::size_t other = static_cast<std::size_t>(g);
+      if (region(f) != region(other)) {
+        m.region_borders.Add(sum / planes, points);
+        continue;
+      }
+      m.elsewhere.Add(sum / planes, points);
+      if (on_border[f] != on_border[other]) m.next_to_borders.Add(sum / planes, points);
     }
-  const double planes = std::max(1, synthesis.CoefficientPlanes());
-  if (border_points) m.region_borders = border_sum / (border_points * planes);
-  if (other_points) m.elsewhere = other_sum / (other_points * planes);
   return m;
 }
 

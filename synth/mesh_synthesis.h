@@ -92,14 +92,33 @@ struct MeshSynthesis : TriangleSynthesis {
 /// `photos` the usable photos (each image_id in the reconstruction). Throws
 /// OptionError for bad options and InputError when the patches would not fit the
 /// sample or would exceed max_texels (with the estimate).
+/// Per-edge values of one class of edges: their mean weighted by the points
+/// measured on each edge, and the standard error of that mean (the edges'
+/// spread over the square root of their count), so that classes of few edges
+/// can be told apart from noise.
+class EdgeTally {
+ public:
+  /// An edge whose `points` points summed `sum` (already per plane).
+  void Add(double sum, int points);
+  std::size_t Edges() const { return edges_; }
+  double Mean() const;           ///< sum over points; 0 without points
+  double StandardError() const;  ///< of Mean(); 0 below two edges
+
+ private:
+  std::size_t edges_ = 0, points_ = 0;
+  double sum_ = 0.0;
+  std::vector<double> edge_means_;
+};
+
 /// How well neighbouring patches agree across the mesh's shared edges, split
 /// between edges whose faces lie in different regions of a distributed run and
 /// the others: the mean squared difference of the blended coefficient planes
 /// (orthonormal space, the neighbour's turned by the unfolding) between the two
-/// faces' patches at points one texel apart along each edge.
+/// faces' patches at points one texel apart along each edge. `next_to_borders`
+/// is the part of `elsewhere` between a face on a region border and a face of
+/// its own region off it (both placed, one by the border pass).
 struct EdgeMismatch {
-  double region_borders = 0.0, elsewhere = 0.0;
-  std::size_t border_edges = 0, other_edges = 0;
+  EdgeTally region_borders, next_to_borders, elsewhere;
 };
 EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
                                  const std::vector<int>& region_of_face);

@@ -164,9 +164,12 @@ TEST_F(DistributedSynthTest, ThreeRanksPlaceEveryFaceAndRankZeroWritesTheModel) 
   EXPECT_EQ(placed, three.faces);  // every face placed once, by one rank
   // Borders placed with their neighbours on both sides agree with them no worse
   // than other edges do (with a margin for a few dozen border edges).
-  EXPECT_GT(d["edge_mismatch"]["border_edges"].get<int>(), 10);
-  EXPECT_LT(d["edge_mismatch"]["region_borders"].get<double>(),
-            1.5 * d["edge_mismatch"]["elsewhere"].get<double>());
+  const nlohmann::json& e = d["edge_mismatch"];
+  EXPECT_GT(e["region_borders"]["edges"].get<int>(), 10);
+  EXPECT_LT(e["region_borders"]["mean"].get<double>(), 1.5 * e["elsewhere"]["mean"].get<double>());
+  EXPECT_GT(e["region_borders"]["standard_error"].get<double>(), 0.0);
+  EXPECT_GT(e["next_to_borders"]["edges"].get<int>(), e["region_borders"]["edges"].get<int>());
+  EXPECT_LT(e["next_to_borders"]["edges"].get<int>(), e["elsewhere"]["edges"].get<int>());
   EXPECT_FALSE(Manifest("one").contains("distributed"));  // one process: as before
 }
 
