@@ -87,11 +87,6 @@ struct MeshSynthesis : TriangleSynthesis {
                      float* planes_out) const;
 };
 
-/// Per-triangle image-constrained PTM synthesis on a mesh (paper 003 Algorithm 2).
-/// `visibility` from sfm::ComputeVisibility for this mesh and reconstruction;
-/// `photos` the usable photos (each image_id in the reconstruction). Throws
-/// OptionError for bad options and InputError when the patches would not fit the
-/// sample or would exceed max_texels (with the estimate).
 /// Per-edge values of one class of edges: their mean weighted by the points
 /// measured on each edge, and the standard error of that mean (the edges'
 /// spread over the square root of their count), so that classes of few edges
@@ -123,6 +118,11 @@ struct EdgeMismatch {
 EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
                                  const std::vector<int>& region_of_face);
 
+/// Per-triangle image-constrained PTM synthesis on a mesh (paper 003 Algorithm 2).
+/// `visibility` from sfm::ComputeVisibility for this mesh and reconstruction;
+/// `photos` the usable photos (each image_id in the reconstruction). Throws
+/// OptionError for bad options and InputError when the patches would not fit the
+/// sample or would exceed max_texels (with the estimate).
 /// `regions`: a distributed run (TriangleEngine::DistributeOver); on ranks other than
 /// 0 the result is only this rank's share (rank_share_only).
 MeshSynthesis SynthesizeMeshPtm(const mesh::TriangleMesh& mesh,
