@@ -12,10 +12,13 @@ namespace {
 TEST(EdgeTally, MeanIsWeightedByPointsAndStandardErrorByEdges) {
   EdgeTally t;
   EXPECT_EQ(t.Mean(), 0.0);
-  t.Add(2.0, 2);  // an edge whose points average 1
-  EXPECT_EQ(t.StandardError(), 0.0);  // one edge: no spread to measure
-  t.Add(9.0, 3);  // 3
-  t.Add(0.0, 0);  // an edge with no point measured: counted, not averaged
+  // An edge whose 2 points average 1: one edge has no spread to measure.
+  t.Add(2.0, 2);
+  EXPECT_EQ(t.StandardError(), 0.0);
+  // An edge whose points average 3, and one with no point measured (counted,
+  // not averaged).
+  t.Add(9.0, 3);
+  t.Add(0.0, 0);
   EXPECT_EQ(t.Edges(), 3u);
   EXPECT_DOUBLE_EQ(t.Mean(), 11.0 / 5.0);
   // Edge means 1 and 3: sample variance 2, over 2 edges.
