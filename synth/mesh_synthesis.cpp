@@ -95,18 +95,16 @@ void EdgeTally::Add(double sum, int points) {
   if (points <= 0) return;
   sum_ += sum;
   points_ += static_cast<std::size_t>(points);
-  edge_means_.push_back(sum / points);
+  const double edge_mean = sum / points, before = edge_mean - edge_mean_;
+  edge_mean_ += before / static_cast<double>(++measured_edges_);
+  edge_squares_ += before * (edge_mean - edge_mean_);
 }
 
 double EdgeTally::Mean() const { return points_ ? sum_ / static_cast<double>(points_) : 0.0; }
 
 double EdgeTally::StandardError() const {
-  const std::size_t n = edge_means_.size();
-  if (n < 2) return 0.0;
-  double mean = 0.0, squares = 0.0;
-  for (double e : edge_means_) mean += e / static_cast<double>(n);
-  for (double e : edge_means_) squares += (e - mean) * (e - mean);
-  return std::sqrt(squares / static_cast<double>(n - 1) / static_cast<double>(n));
+  const double n = static_cast<double>(measured_edges_);
+  return measured_edges_ < 2 ? 0.0 : std::sqrt(edge_squares_ / (n - 1.0) / n);
 }
 
 EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,

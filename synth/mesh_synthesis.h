@@ -100,9 +100,10 @@ class EdgeTally {
   double StandardError() const;  ///< of Mean(); 0 below two edges
 
  private:
-  std::size_t edges_ = 0, points_ = 0;
+  std::size_t edges_ = 0, points_ = 0, measured_edges_ = 0;
   double sum_ = 0.0;
-  std::vector<double> edge_means_;
+  // Running mean and summed squared deviations of the edges' own means (Welford).
+  double edge_mean_ = 0.0, edge_squares_ = 0.0;
 };
 
 /// How well neighbouring patches agree across the mesh's shared edges, split
