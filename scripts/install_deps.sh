@@ -6,6 +6,7 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   build-essential cmake ninja-build pkg-config git clang-format
+  lld  # links the programs and tests in a fifth of GNU ld's time (Apache-2.0 with LLVM exception)
   # libraries (see DESIGN.md, "Modules")
   libeigen3-dev libopenmesh-dev libopencv-dev libceres-dev libopenimageio-dev
   nlohmann-json3-dev libembree-dev
