@@ -479,28 +479,53 @@ std::vector<int> BreadthFirstFaceOrder(const TriangleMesh& mesh,
                                      neighbours);
 }
 
-std::vector<int> BreadthFirstFaceOrderWithin(const std::vector<int>& starts,
-                                             const std::vector<char>& member,
-                                             const std::vector<std::array<int, 3>>& neighbours) {
+namespace {
+
+// Breadth first within `member` from the faces already in `order` (visited),
+// appending to it.
+void ContinueBreadthFirst(const std::vector<char>& member,
+                          const std::vector<std::array<int, 3>>& neighbours,
+                          std::vector<char>& visited, std::vector<int>& order, std::size_t head) {
+  for (; head < order.size(); ++head) {
+    for (const int g : neighbours[static_cast<std::size_t>(order[head])]) {
+      if (g < 0 || !member[static_cast<std::size_t>(g)] || visited[static_cast<std::size_t>(g)])
+        continue;
+      visited[static_cast<std::size_t>(g)] = 1;
+      order.push_back(g);
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<int> BreadthFirstFaceOrderFrom(const std::vector<int>& sources,
+                                           const std::vector<int>& starts,
+                                           const std::vector<char>& member,
+                                           const std::vector<std::array<int, 3>>& neighbours) {
   std::vector<char> visited(member.size(), 0);
   std::vector<int> order;
+  for (const int source : sources) {
+    const auto s = static_cast<std::size_t>(source);
+    if (!member[s] || visited[s]) continue;
+    visited[s] = 1;
+    order.push_back(source);
+  }
+  ContinueBreadthFirst(member, neighbours, visited, order, 0);
   for (const int start : starts) {
     const auto s = static_cast<std::size_t>(start);
     if (!member[s] || visited[s]) continue;
-    std::size_t head = order.size();
+    const std::size_t head = order.size();
     visited[s] = 1;
     order.push_back(start);
-    while (head < order.size()) {
-      for (const int g : neighbours[static_cast<std::size_t>(order[head])]) {
-        if (g < 0 || !member[static_cast<std::size_t>(g)] || visited[static_cast<std::size_t>(g)])
-          continue;
-        visited[static_cast<std::size_t>(g)] = 1;
-        order.push_back(g);
-      }
-      ++head;
-    }
+    ContinueBreadthFirst(member, neighbours, visited, order, head);
   }
   return order;
+}
+
+std::vector<int> BreadthFirstFaceOrderWithin(const std::vector<int>& starts,
+                                             const std::vector<char>& member,
+                                             const std::vector<std::array<int, 3>>& neighbours) {
+  return BreadthFirstFaceOrderFrom({}, starts, member, neighbours);
 }
 
 Eigen::Vector3d BoundingBoxCentre(const TriangleMesh& mesh) {

@@ -112,6 +112,16 @@ std::vector<int> BreadthFirstFaceOrderWithin(const std::vector<int>& starts,
                                              const std::vector<char>& member,
                                              const std::vector<std::array<int, 3>>& neighbours);
 
+/// The faces with `member[f]`, breadth first over edge adjacency within them
+/// from every face of `sources` at once: the sources first (in their order,
+/// those that are members), then their members' neighbours ring by ring, so
+/// that a front moves away from all of them together. The faces no source
+/// reaches follow as BreadthFirstFaceOrderWithin(starts, ...) orders them.
+std::vector<int> BreadthFirstFaceOrderFrom(const std::vector<int>& sources,
+                                           const std::vector<int>& starts,
+                                           const std::vector<char>& member,
+                                           const std::vector<std::array<int, 3>>& neighbours);
+
 /// Summary figures of a mesh.
 struct MeshStats {
   std::size_t vertices = 0;

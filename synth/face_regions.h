@@ -36,10 +36,10 @@ struct RankRecord {
   std::uint64_t bytes_sent = 0;    ///< what it sent rank 0
 };
 
-/// A distributed synthesis: the ranks and one region of faces per rank. Each
-/// rank places the faces of its region off the region's border, breadth first
-/// within the region; rank 0 gathers them and places the border faces, whose
-/// neighbours on both sides are then placed.
+/// A distributed synthesis: the ranks and one region of faces per rank. Rank 0
+/// places the faces on region borders first, breadth first along the borders,
+/// and sends them to every rank; each rank places the faces of its region off
+/// the border, breadth first from the borders; rank 0 gathers them.
 struct FaceRegions {
   RankCommunicator* ranks = nullptr;  ///< Size() == partition.num_regions
   mesh::FacePartition partition;

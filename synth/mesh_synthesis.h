@@ -112,7 +112,8 @@ class EdgeTally {
 /// (orthonormal space, the neighbour's turned by the unfolding) between the two
 /// faces' patches at points one texel apart along each edge. `next_to_borders`
 /// is the part of `elsewhere` between a face on a region border and a face of
-/// its own region off it (both placed, one by the border pass).
+/// its own region off it (the one placed by rank 0's border pass, the other by
+/// its region's rank).
 struct EdgeMismatch {
   EdgeTally region_borders, next_to_borders, elsewhere;
 };

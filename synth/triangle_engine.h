@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <opencv2/core.hpp>
@@ -152,12 +153,12 @@ struct TriangleSynthesis {
   /// set-up, the photometry and this rank's own faces.
   bool rank_share_only = false;
   /// A distributed run, at rank 0: what every rank did, by rank, and the faces
-  /// on region borders (placed by rank 0 last) and the edges between regions.
+  /// on region borders (placed by rank 0 first) and the edges between regions.
   std::vector<RankRecord> rank_records;
   std::vector<int> region_of_face;  ///< the partition (mesh::FacePartition)
   std::size_t region_border_faces = 0, region_cut_edges = 0;
   /// Rank 0 of a distributed run: waiting for and reading the other ranks'
-  /// faces, and placing and finishing the border faces.
+  /// faces; placing, sending and finishing the border faces.
   double seconds_gather = 0.0, seconds_region_borders = 0.0;
   /// The correction's pass after placement (detail transfer; a distributed
   /// run's rank 0: over its own and the border faces).
@@ -306,18 +307,31 @@ class TriangleEngine {
   void SynthesizeFace(std::size_t face, std::mt19937_64& rng);
   // The correction's pass after placement (PhotoCorrection::Finish) over `faces`.
   void FinishFaces(const std::vector<std::size_t>& faces, const ProgressCallback& progress);
-  // Stage 2b distributed: this rank's region off the border placed and finished,
-  // gathered at rank 0, which places and finishes the border faces; the other
-  // ranks' results are their share (rank_share_only).
-  // `neighbours`: mesh::FaceNeighbours.
+  // Stage 2b distributed: the border faces placed at rank 0 and sent to every
+  // rank, then this rank's region off the border placed from them and finished,
+  // gathered at rank 0, which finishes the border faces; the other ranks'
+  // results are their share (rank_share_only). `neighbours`: mesh::FaceNeighbours.
   void PlaceRegions(const std::vector<int>& order,
                     const std::vector<std::array<int, 3>>& neighbours,
                     const ProgressCallback& progress);
+  // The border faces, in their order, placed at rank 0 and read by the others.
+  void PlaceBorders(const std::vector<int>& border_faces, const ProgressCallback& progress);
+  // This rank's faces off the border in the order it places them: breadth first
+  // from those next to a border face at once (a front moving away from the
+  // placed borders, `border_faces` in their order), or the photo-by-photo
+  // `order` when the photos do not all fit.
+  std::vector<int> RegionOrder(const std::vector<int>& order, const std::vector<int>& border_faces,
+                               const std::vector<char>& interior, const std::vector<char>& border,
+                               const std::vector<std::array<int, 3>>& neighbours) const;
   // Throws InputError on a rank whose faces, photos, patches or regions differ
   // from rank 0's (every rank reads its own inputs).
   void RequireSameInputsAsRankZero() const;
-  // A rank's placed faces (patches, the correction's state) and record, and
-  // their reading at rank 0.
+  // Placed faces (patches, the correction's state), and their reading: each
+  // face read must be `expected` and not placed yet (else `what` is broken).
+  void WriteFaces(const std::vector<int>& faces, ByteWriter& out) const;
+  void ReadFaces(ByteReader& in, const std::function<bool(std::size_t)>& expected,
+                 const char* what);
+  // A rank's placed faces and record, and their reading at rank 0.
   void WriteRegion(const std::vector<int>& faces, const RankRecord& record, ByteWriter& out) const;
   void ReadRegion(const std::vector<char>& message);
   // The placed-by counts from the patches' sources (after a distributed run).

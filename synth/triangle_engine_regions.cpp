@@ -1,6 +1,9 @@
 // The distributed run of the per-triangle engine (issue 33, synth/face_regions.h):
-// photometry sent from rank 0, regions placed by their ranks, borders by rank 0.
+// photometry and the region borders placed at rank 0 and sent to the others, then
+// each region placed by its rank, growing from the borders.
+#include <algorithm>
 #include <chrono>
+#include <functional>
 #include <string>
 #include <tuple>
 #include <type_traits>
@@ -75,15 +78,13 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order,
     interior[f] = partition.region_of_face[f] == rank && !partition.on_border[f];
     border[f] = partition.on_border[f];
   }
-  // The region breadth first within itself (cache-warm photo-by-photo order
-  // kept when the photos do not all fit).
-  std::vector<int> region_faces;
-  if (PhotosHeldTogether(photos_)) {
-    region_faces = mesh::BreadthFirstFaceOrderWithin(order, interior, neighbours);
-  } else {
-    for (const int f : order)
-      if (interior[static_cast<std::size_t>(f)]) region_faces.push_back(f);
-  }
+  // The border faces first, breadth first along the borders as in one process;
+  // each region then grows from them, so no two separately placed regions meet.
+  const std::vector<int> border_faces =
+      mesh::BreadthFirstFaceOrderWithin(order, border, neighbours);
+  PlaceBorders(border_faces, progress);
+  const std::vector<int> region_faces =
+      RegionOrder(order, border_faces, interior, border, neighbours);
   const auto start = std::chrono::steady_clock::now();
   PlaceFaces(region_faces, options_.seed + static_cast<std::uint32_t>(rank), 0, region_faces.size(),
              progress);
@@ -111,30 +112,9 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order,
     std::vector<char>().swap(from_rank);
   });
   result_.seconds_gather = SecondsSince(gather);
-  const auto borders = std::chrono::steady_clock::now();
-  // The border faces, with their neighbours on both sides placed.
-  const std::vector<int> border_faces =
-      mesh::BreadthFirstFaceOrderWithin(order, border, neighbours);
-  // In one process the detail transfer follows the last placement: the border
-  // faces are placed against their neighbours without it too.
-  std::vector<std::pair<cv::Mat, int>> detail(mesh_.faces.size());
-  for (std::size_t f = 0; f < detail.size(); ++f) {
-    TrianglePatch& p = result_.patches[f];
-    detail[f] = {std::exchange(p.detail_source, cv::Mat()), std::exchange(p.detail_level, -1)};
-  }
-  if (progress) progress("region borders", 0, border_faces.size());
-  PlaceFaces(border_faces, options_.seed + static_cast<std::uint32_t>(ranks.Size()), 0,
-             border_faces.size(),
-             progress
-                 ? ProgressCallback([&](std::string_view, std::size_t done, std::size_t total) {
-                     progress("region borders", done, total);
-                   })
-                 : ProgressCallback());
-  for (std::size_t f = 0; f < detail.size(); ++f)
-    if (!border[f])
-      std::tie(result_.patches[f].detail_source, result_.patches[f].detail_level) = detail[f];
+  const auto finish = std::chrono::steady_clock::now();
   FinishFaces(std::vector<std::size_t>(border_faces.begin(), border_faces.end()), progress);
-  result_.seconds_region_borders = SecondsSince(borders);
+  result_.seconds_region_borders += SecondsSince(finish);
   for (std::size_t f = 0; f < done_.size(); ++f)
     TEXLUME_CHECK(done_[f], "every face is placed by a rank or at the borders");
   result_.region_border_faces = border_faces.size();
@@ -143,9 +123,67 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order,
   CountSources();
 }
 
-void TriangleEngine::WriteRegion(const std::vector<int>& faces, const RankRecord& record,
-                                 ByteWriter& out) const {
-  out.Put(record);
+void TriangleEngine::PlaceBorders(const std::vector<int>& border_faces,
+                                  const ProgressCallback& progress) {
+  RankCommunicator& ranks = *regions_->ranks;
+  const auto start = std::chrono::steady_clock::now();
+  ByteWriter out;
+  if (ranks.Rank() == 0) {
+    if (progress) progress("region borders", 0, border_faces.size());
+    PlaceFaces(border_faces, options_.seed + static_cast<std::uint32_t>(ranks.Size()), 0,
+               border_faces.size(),
+               progress
+                   ? ProgressCallback([&](std::string_view, std::size_t done, std::size_t total) {
+                       progress("region borders", done, total);
+                     })
+                   : ProgressCallback());
+    WriteFaces(border_faces, out);
+  }
+  ranks.Broadcast(out.bytes());
+  if (ranks.Rank() != 0) {
+    ByteReader in(out.bytes());
+    ReadFaces(
+        in, [this](std::size_t f) { return regions_->partition.on_border[f] != 0; },
+        "rank 0 sends the border faces, once");
+    TEXLUME_CHECK(in.Remaining() == 0, "the border faces' message is read whole");
+  }
+  result_.seconds_region_borders = SecondsSince(start);
+}
+
+std::vector<int> TriangleEngine::RegionOrder(
+    const std::vector<int>& order, const std::vector<int>& border_faces,
+    const std::vector<char>& interior, const std::vector<char>& border,
+    const std::vector<std::array<int, 3>>& neighbours) const {
+  if (!PhotosHeldTogether(photos_)) {
+    // The cache-warm photo-by-photo order, kept when the photos do not all fit.
+    std::vector<int> region_faces;
+    for (const int f : order)
+      if (interior[static_cast<std::size_t>(f)]) region_faces.push_back(f);
+    return region_faces;
+  }
+  // Breadth first from every face next to the placed borders at once, those
+  // first in the order their border neighbours were placed (the front follows
+  // the borders as they were laid).
+  std::vector<std::size_t> placed_at(border.size(), border_faces.size());
+  for (std::size_t n = 0; n < border_faces.size(); ++n)
+    placed_at[static_cast<std::size_t>(border_faces[n])] = n;
+  std::vector<std::pair<std::size_t, int>> next_to_border;
+  for (const int f : order) {
+    if (!interior[static_cast<std::size_t>(f)]) continue;
+    std::size_t first = border_faces.size();
+    for (const int g : neighbours[static_cast<std::size_t>(f)])
+      if (g >= 0 && border[static_cast<std::size_t>(g)])
+        first = std::min(first, placed_at[static_cast<std::size_t>(g)]);
+    if (first < border_faces.size()) next_to_border.emplace_back(first, f);
+  }
+  std::stable_sort(next_to_border.begin(), next_to_border.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<int> sources;
+  for (const auto& [first, f] : next_to_border) sources.push_back(f);
+  return mesh::BreadthFirstFaceOrderFrom(sources, order, interior, neighbours);
+}
+
+void TriangleEngine::WriteFaces(const std::vector<int>& faces, ByteWriter& out) const {
   out.Put<std::uint64_t>(faces.size());
   for (const int f : faces) {
     const TrianglePatch& p = result_.patches[static_cast<std::size_t>(f)];
@@ -159,25 +197,18 @@ void TriangleEngine::WriteRegion(const std::vector<int>& faces, const RankRecord
     out.PutMat(p.detail_source), out.Put<std::int32_t>(p.detail_level);
     if (correction_) correction_->SaveFace(static_cast<std::size_t>(f), out);
   }
-  if (correction_) correction_->SaveSums(out);
-  // What this message costs, counted in the record at rank 0.
-  out.Put<std::uint64_t>(out.bytes().size() + sizeof(std::uint64_t));
 }
 
-void TriangleEngine::ReadRegion(const std::vector<char>& message) {
-  ByteReader in(message);
-  RankRecord record = in.Get<RankRecord>();
+void TriangleEngine::ReadFaces(ByteReader& in, const std::function<bool(std::size_t)>& expected,
+                               const char* what) {
   const auto count = in.Get<std::uint64_t>();
   TEXLUME_CHECK(count <= mesh_.faces.size(), "a rank places faces of the mesh");
   for (std::uint64_t n = 0; n < count; ++n) {
     const auto f = in.Get<std::int32_t>();
     TEXLUME_CHECK(f >= 0 && static_cast<std::size_t>(f) < mesh_.faces.size(), "a face index");
-    const mesh::FacePartition& partition = regions_->partition;
-    TEXLUME_CHECK(partition.region_of_face[static_cast<std::size_t>(f)] == record.rank &&
-                      !partition.on_border[static_cast<std::size_t>(f)] &&
-                      !done_[static_cast<std::size_t>(f)],
-                  "a rank sends its own region's faces off the border, once");
-    TrianglePatch& p = result_.patches[static_cast<std::size_t>(f)];
+    const auto face = static_cast<std::size_t>(f);
+    TEXLUME_CHECK(expected(face) && !done_[face], what);
+    TrianglePatch& p = result_.patches[face];
     p.sample_x = in.Get<int>(), p.sample_y = in.Get<int>();
     const auto source = in.Get<std::underlying_type_t<PatchSource>>();
     TEXLUME_CHECK(
@@ -195,9 +226,30 @@ void TriangleEngine::ReadRegion(const std::vector<char>& message) {
     p.channel_gain = in.GetMats();
     p.detail_source = in.GetMat();
     p.detail_level = in.Get<std::int32_t>();
-    if (correction_) correction_->LoadFace(*this, static_cast<std::size_t>(f), in);
-    done_[static_cast<std::size_t>(f)] = 1;
+    if (correction_) correction_->LoadFace(*this, face, in);
+    done_[face] = 1;
   }
+}
+
+void TriangleEngine::WriteRegion(const std::vector<int>& faces, const RankRecord& record,
+                                 ByteWriter& out) const {
+  out.Put(record);
+  WriteFaces(faces, out);
+  if (correction_) correction_->SaveSums(out);
+  // What this message costs, counted in the record at rank 0.
+  out.Put<std::uint64_t>(out.bytes().size() + sizeof(std::uint64_t));
+}
+
+void TriangleEngine::ReadRegion(const std::vector<char>& message) {
+  ByteReader in(message);
+  RankRecord record = in.Get<RankRecord>();
+  const mesh::FacePartition& partition = regions_->partition;
+  ReadFaces(
+      in,
+      [&](std::size_t f) {
+        return partition.region_of_face[f] == record.rank && !partition.on_border[f];
+      },
+      "a rank sends its own region's faces off the border, once");
   if (correction_) correction_->AddSums(in);
   record.bytes_sent = in.Get<std::uint64_t>();
   TEXLUME_CHECK(in.Remaining() == 0, "a rank's message is read whole");

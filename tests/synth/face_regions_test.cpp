@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
 #include "datasets_synthetic/shapes.h"
 #include "mesh/mesh.h"
 
@@ -42,6 +46,59 @@ TEST(FaceRegions, BreadthFirstFaceOrderWithinVisitsARegionBreadthFirst) {
     }
     EXPECT_LE(starts, 3u) << region;  // METIS's regions are (nearly) in one piece
   }
+}
+
+// From many sources at once: the sources first, then each face one ring further
+// from the nearest source than any before it (distances counted here by their
+// own search); the piece no source reaches follows from its first start.
+TEST(FaceRegions, BreadthFirstFaceOrderFromMovesAFrontAwayFromEverySource) {
+  const mesh::TriangleMesh plane = datasets::MakeGridPlane(12, 1.0);
+  const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(plane);
+  const std::size_t n = neighbours.size();
+  std::vector<char> member(n, 1);
+  std::vector<int> sources, starts(n);
+  std::iota(starts.begin(), starts.end(), 0);
+  for (std::size_t f = 0; f < n; ++f) {
+    const double x = (plane.Corner(f, 0) + plane.Corner(f, 1) + plane.Corner(f, 2)).x() / 3.0;
+    const int column = static_cast<int>(std::floor((x + 0.5) * 12));
+    if (column == 8) member[f] = 0;  // a column of non-members: two pieces
+    if (column == 0 || column == 5) sources.push_back(static_cast<int>(f));
+  }
+  std::reverse(sources.begin(), sources.end());
+  // Ring of each member face from the nearest source, by a search of its own.
+  std::vector<int> ring(n, -1);
+  std::vector<int> queue;
+  for (const int f : sources) ring[static_cast<std::size_t>(f)] = 0, queue.push_back(f);
+  for (std::size_t head = 0; head < queue.size(); ++head)
+    for (const int g : neighbours[static_cast<std::size_t>(queue[head])])
+      if (g >= 0 && member[static_cast<std::size_t>(g)] && ring[static_cast<std::size_t>(g)] < 0) {
+        ring[static_cast<std::size_t>(g)] = ring[static_cast<std::size_t>(queue[head])] + 1;
+        queue.push_back(g);
+      }
+
+  const std::vector<int> order =
+      mesh::BreadthFirstFaceOrderFrom(sources, starts, member, neighbours);
+  ASSERT_EQ(order.size(), static_cast<std::size_t>(std::count(member.begin(), member.end(), 1)));
+  ASSERT_TRUE(std::equal(sources.begin(), sources.end(), order.begin()));
+  std::size_t reached = 0;
+  while (reached < order.size() && ring[static_cast<std::size_t>(order[reached])] >= 0) {
+    if (reached > 0) {
+      EXPECT_GE(ring[static_cast<std::size_t>(order[reached])],
+                ring[static_cast<std::size_t>(order[reached - 1])]);
+    }
+    ++reached;
+  }
+  ASSERT_GT(reached, sources.size());
+  ASSERT_LT(reached, order.size());  // the piece right of the column follows
+  const std::vector<int> rest(order.begin() + static_cast<std::ptrdiff_t>(reached), order.end());
+  std::vector<char> piece(n, 0);
+  for (const int f : rest) {
+    EXPECT_LT(ring[static_cast<std::size_t>(f)], 0);
+    piece[static_cast<std::size_t>(f)] = 1;
+  }
+  EXPECT_EQ(rest, mesh::BreadthFirstFaceOrderWithin(starts, piece, neighbours));
+  EXPECT_EQ(mesh::BreadthFirstFaceOrderFrom({}, starts, member, neighbours),
+            mesh::BreadthFirstFaceOrderWithin(starts, member, neighbours));
 }
 
 TEST(FaceRegions, RegionsForRanksHoldEqualFaceCounts) {
