@@ -223,9 +223,10 @@ class TriangleEngine {
                  const MaterialSample& sample, const TriangleEngineOptions& options,
                  PhotoCorrection* correction);
 
-  /// Makes Run distributed over `regions.ranks` (synth/face_regions.h): each
-  /// rank places its region's faces off the region border, rank 0 gathers them,
-  /// places the border faces and finishes. Set-up and frames run on every rank;
+  /// Makes Run distributed over `regions.ranks` (synth/face_regions.h): rank 0
+  /// places the border faces and sends them to every rank, each rank grows its
+  /// region's faces off the border from them, rank 0 gathers them and finishes
+  /// (the border faces' detail transfer). Set-up and frames run on every rank;
   /// the photometry on rank 0, which sends it to the others. Call on every rank
   /// with the same partition.
   void DistributeOver(FaceRegions regions);

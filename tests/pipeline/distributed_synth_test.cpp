@@ -162,11 +162,13 @@ TEST_F(DistributedSynthTest, ThreeRanksPlaceEveryFaceAndRankZeroWritesTheModel) 
     }
   }
   EXPECT_EQ(placed, three.faces);  // every face placed once, by one rank
-  // Borders placed with their neighbours on both sides agree with them no worse
-  // than other edges do (with a margin for a few dozen border edges).
+  // Borders placed first, each region grown from them: the borders and the edges
+  // next to them agree no worse than other edges do (with a margin for a few
+  // dozen border edges).
   const nlohmann::json& e = d["edge_mismatch"];
   EXPECT_GT(e["region_borders"]["edges"].get<int>(), 10);
   EXPECT_LT(e["region_borders"]["mean"].get<double>(), 1.5 * e["elsewhere"]["mean"].get<double>());
+  EXPECT_LT(e["next_to_borders"]["mean"].get<double>(), 1.5 * e["elsewhere"]["mean"].get<double>());
   EXPECT_GT(e["region_borders"]["standard_error"].get<double>(), 0.0);
   EXPECT_GT(e["next_to_borders"]["edges"].get<int>(), e["region_borders"]["edges"].get<int>());
   EXPECT_LT(e["next_to_borders"]["edges"].get<int>(), e["elsewhere"]["edges"].get<int>());

@@ -90,15 +90,28 @@ TEST(FaceRegions, BreadthFirstFaceOrderFromMovesAFrontAwayFromEverySource) {
   }
   ASSERT_GT(reached, sources.size());
   ASSERT_LT(reached, order.size());  // the piece right of the column follows
-  const std::vector<int> rest(order.begin() + static_cast<std::ptrdiff_t>(reached), order.end());
-  std::vector<char> piece(n, 0);
-  for (const int f : rest) {
-    EXPECT_LT(ring[static_cast<std::size_t>(f)], 0);
-    piece[static_cast<std::size_t>(f)] = 1;
+  // The rest: the right piece, from its lowest face (starts ascend), each face
+  // after it next to one before it.
+  std::vector<char> before(n, 0);
+  for (std::size_t k = reached; k < order.size(); ++k) {
+    const auto f = static_cast<std::size_t>(order[k]);
+    EXPECT_LT(ring[f], 0);
+    bool next_to_earlier = false;
+    for (const int g : neighbours[f])
+      next_to_earlier |= g >= 0 && before[static_cast<std::size_t>(g)];
+    EXPECT_EQ(next_to_earlier, k > reached) << k;
+    before[f] = 1;
   }
-  EXPECT_EQ(rest, mesh::BreadthFirstFaceOrderWithin(starts, piece, neighbours));
-  EXPECT_EQ(mesh::BreadthFirstFaceOrderFrom({}, starts, member, neighbours),
-            mesh::BreadthFirstFaceOrderWithin(starts, member, neighbours));
+  int lowest_unreached = -1;
+  for (std::size_t f = 0; f < n && lowest_unreached < 0; ++f)
+    if (member[f] && ring[f] < 0) lowest_unreached = static_cast<int>(f);
+  EXPECT_EQ(order[reached], lowest_unreached);
+  // Every member once, and nothing else.
+  std::vector<int> sorted = order, members;
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t f = 0; f < n; ++f)
+    if (member[f]) members.push_back(static_cast<int>(f));
+  EXPECT_EQ(sorted, members);
 }
 
 TEST(FaceRegions, RegionsForRanksHoldEqualFaceCounts) {
