@@ -322,7 +322,7 @@ class TriangleEngine {
   // placed borders, `border_faces` in their order), or the photo-by-photo
   // `order` when the photos do not all fit.
   std::vector<int> RegionOrder(const std::vector<int>& order, const std::vector<int>& border_faces,
-                               const std::vector<char>& interior, const std::vector<char>& border,
+                               const std::vector<char>& interior,
                                const std::vector<std::array<int, 3>>& neighbours) const;
   // Throws InputError on a rank whose faces, photos, patches or regions differ
   // from rank 0's (every rank reads its own inputs).

@@ -73,18 +73,15 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order,
   const mesh::FacePartition& partition = regions_->partition;
   RankCommunicator& ranks = *regions_->ranks;
   const int rank = ranks.Rank();
-  std::vector<char> interior(mesh_.faces.size(), 0), border(mesh_.faces.size(), 0);
-  for (std::size_t f = 0; f < interior.size(); ++f) {
+  std::vector<char> interior(mesh_.faces.size(), 0);
+  for (std::size_t f = 0; f < interior.size(); ++f)
     interior[f] = partition.region_of_face[f] == rank && !partition.on_border[f];
-    border[f] = partition.on_border[f];
-  }
   // The border faces first, breadth first along the borders as in one process;
   // each region then grows from them, so no two separately placed regions meet.
   const std::vector<int> border_faces =
-      mesh::BreadthFirstFaceOrderWithin(order, border, neighbours);
+      mesh::BreadthFirstFaceOrderWithin(order, partition.on_border, neighbours);
   PlaceBorders(border_faces, progress);
-  const std::vector<int> region_faces =
-      RegionOrder(order, border_faces, interior, border, neighbours);
+  const std::vector<int> region_faces = RegionOrder(order, border_faces, interior, neighbours);
   const auto start = std::chrono::steady_clock::now();
   PlaceFaces(region_faces, options_.seed + static_cast<std::uint32_t>(rank), 0, region_faces.size(),
              progress);
@@ -152,8 +149,7 @@ void TriangleEngine::PlaceBorders(const std::vector<int>& border_faces,
 
 std::vector<int> TriangleEngine::RegionOrder(
     const std::vector<int>& order, const std::vector<int>& border_faces,
-    const std::vector<char>& interior, const std::vector<char>& border,
-    const std::vector<std::array<int, 3>>& neighbours) const {
+    const std::vector<char>& interior, const std::vector<std::array<int, 3>>& neighbours) const {
   if (!PhotosHeldTogether(photos_)) {
     // The cache-warm photo-by-photo order, kept when the photos do not all fit.
     std::vector<int> region_faces;
@@ -164,7 +160,8 @@ std::vector<int> TriangleEngine::RegionOrder(
   // Breadth first from every face next to the placed borders at once, those
   // first in the order their border neighbours were placed (the front follows
   // the borders as they were laid).
-  std::vector<std::size_t> placed_at(border.size(), border_faces.size());
+  std::vector<std::size_t> placed_at(interior.size(),
+                                     border_faces.size());  // past: not a border face
   for (std::size_t n = 0; n < border_faces.size(); ++n)
     placed_at[static_cast<std::size_t>(border_faces[n])] = n;
   std::vector<std::pair<std::size_t, int>> next_to_border;
@@ -172,8 +169,7 @@ std::vector<int> TriangleEngine::RegionOrder(
     if (!interior[static_cast<std::size_t>(f)]) continue;
     std::size_t first = border_faces.size();
     for (const int g : neighbours[static_cast<std::size_t>(f)])
-      if (g >= 0 && border[static_cast<std::size_t>(g)])
-        first = std::min(first, placed_at[static_cast<std::size_t>(g)]);
+      if (g >= 0) first = std::min(first, placed_at[static_cast<std::size_t>(g)]);
     if (first < border_faces.size()) next_to_border.emplace_back(first, f);
   }
   std::stable_sort(next_to_border.begin(), next_to_border.end(),
