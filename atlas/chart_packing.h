@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "atlas/chart_parts.h"
 #include "atlas/charts.h"
 #include "core/progress.h"
 #include "synth/triangle_parts.h"
@@ -16,7 +17,7 @@
 // charts packed row by row by best fit.
 namespace texlume::atlas::chart_packing {
 
-inline constexpr double kPi = 3.14159265358979323846;
+using chart_parts::kPi;
 
 /// Turns tried for every chart when packing (every 360/16 = 22.5 degrees).
 inline constexpr int kPackingRotations = 16;

@@ -12,8 +12,6 @@
 namespace texlume::datasets {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 struct CameraAngles {
   double azimuth = 0;    ///< radians
   double elevation = 0;  ///< radians
@@ -31,8 +29,9 @@ std::vector<CameraAngles> PhotoAngles(const ObjectSceneOptions& options) {
     if (options.shape == SceneShape::kPlane) mid = 55.0, amplitude = 10.0;
     if (options.shape == SceneShape::kTorus) mid = 38.0, amplitude = 12.0;
     for (int i = 0; i < n; ++i) {
-      const double azimuth = 2 * kPi * i / n;
-      angles.push_back({azimuth, (mid + amplitude * std::sin(3.0 * azimuth)) * kPi / 180.0});
+      const double azimuth = 2 * std::numbers::pi * i / n;
+      angles.push_back(
+          {azimuth, (mid + amplitude * std::sin(3.0 * azimuth)) * std::numbers::pi / 180.0});
     }
     return angles;
   }
@@ -42,8 +41,8 @@ std::vector<CameraAngles> PhotoAngles(const ObjectSceneOptions& options) {
     const int on_ring = n / rings + (ring < n % rings ? 1 : 0);
     const double offset = ring % 2 == 0 ? 0.0 : 0.5;
     for (int i = 0; i < on_ring; ++i) {
-      angles.push_back(
-          {2 * kPi * (i + offset) / on_ring, elevations[static_cast<std::size_t>(ring)]});
+      angles.push_back({2 * std::numbers::pi * (i + offset) / on_ring,
+                        elevations[static_cast<std::size_t>(ring)]});
     }
   }
   return angles;
@@ -58,7 +57,7 @@ std::vector<double> CameraRingElevations(SceneShape shape, int rings) {
   std::vector<double> elevations;
   for (int ring = 0; ring < rings; ++ring) {
     const double t = rings == 1 ? 0.5 : static_cast<double>(ring) / (rings - 1);
-    elevations.push_back((low + t * (high - low)) * kPi / 180.0);
+    elevations.push_back((low + t * (high - low)) * std::numbers::pi / 180.0);
   }
   return elevations;
 }
@@ -167,8 +166,8 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
     const int num_lights = 1 + static_cast<int>(uniform(rng) * options.max_lights_per_image);
     std::vector<sfm::ObjectLight> lights;
     for (int k = 0; k < num_lights; ++k) {
-      const double light_azimuth = azimuth + (uniform(rng) - 0.5) * kPi / 2.5;
-      const double light_elevation = (25.0 + 40.0 * uniform(rng)) * kPi / 180.0;
+      const double light_azimuth = azimuth + (uniform(rng) - 0.5) * std::numbers::pi / 2.5;
+      const double light_elevation = (25.0 + 40.0 * uniform(rng)) * std::numbers::pi / 180.0;
       sfm::ObjectLight light;
       light.direction_in_world = Eigen::Vector3d(
           std::cos(light_elevation) * std::cos(light_azimuth),

@@ -23,7 +23,6 @@
 namespace texlume::datasets {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr int kSampleMarginTexels = 24;  // geometry around the captured area casts shadows in
 
 Eigen::Vector3d FromAngles(double azimuth_rad, double elevation_rad) {
@@ -37,10 +36,11 @@ std::vector<Eigen::Vector3d> BtfViewDirections(int count) {
   const int rest = count - 1;
   const int high = (rest + 1) / 2, low = rest - high;
   for (int i = 0; i < high; ++i) {
-    views.push_back(FromAngles(2 * kPi * i / high, 60.0 * kPi / 180.0));
+    views.push_back(FromAngles(2 * std::numbers::pi * i / high, 60.0 * std::numbers::pi / 180.0));
   }
   for (int i = 0; i < low; ++i) {
-    views.push_back(FromAngles(2 * kPi * (i + 0.5) / low, 35.0 * kPi / 180.0));
+    views.push_back(
+        FromAngles(2 * std::numbers::pi * (i + 0.5) / low, 35.0 * std::numbers::pi / 180.0));
   }
   return views;
 }
@@ -124,7 +124,7 @@ Eigen::Vector3d TurnedRandomly(const Eigen::Vector3d& direction, double rms_deg,
                                std::mt19937_64& rng) {
   // A 2-D Gaussian offset in the tangent plane, sigma = rms / sqrt(2) per axis:
   // the angle's RMS is rms_deg.
-  std::normal_distribution<double> normal(0.0, rms_deg * kPi / 180.0 / std::sqrt(2.0));
+  std::normal_distribution<double> normal(0.0, rms_deg * std::numbers::pi / 180.0 / std::sqrt(2.0));
   const Eigen::Vector3d d = direction.normalized();
   const Eigen::Vector3d t = d.unitOrthogonal(), b = d.cross(t);
   const double a = normal(rng), c = normal(rng);
@@ -182,8 +182,8 @@ std::vector<Eigen::Vector3d> DomeLights(int count, double min_elevation_deg,
   for (int r = 0; r < rings; ++r) {
     const double t = rings == 1 ? 0.5 : (r + 0.5 * offset) / (rings - 1 + 0.5 * offset);
     const double e = min_elevation_deg + (max_elevation_deg - min_elevation_deg) * std::min(1.0, t);
-    elevations.push_back(e * kPi / 180.0);
-    weights.push_back(std::cos(e * kPi / 180.0));
+    elevations.push_back(e * std::numbers::pi / 180.0);
+    weights.push_back(std::cos(e * std::numbers::pi / 180.0));
     total += weights.back();
   }
   // Ring sizes proportional to cos(elevation), at least one each, summing to count.
@@ -201,7 +201,8 @@ std::vector<Eigen::Vector3d> DomeLights(int count, double min_elevation_deg,
   }
   for (std::size_t r = 0; r < sizes.size() && static_cast<int>(lights.size()) < count; ++r) {
     for (int i = 0; i < sizes[r] && static_cast<int>(lights.size()) < count; ++i) {
-      const double azimuth = 2 * kPi * (i + offset + 0.37 * static_cast<double>(r)) / sizes[r];
+      const double azimuth =
+          2 * std::numbers::pi * (i + offset + 0.37 * static_cast<double>(r)) / sizes[r];
       lights.push_back(FromAngles(azimuth, elevations[r]));
     }
   }
@@ -545,7 +546,7 @@ class SceneGenerator {
             TurnedRandomly(l.direction_in_world, options_.light_error_deg, rng);
         const double cosine =
             std::clamp(recorded.dot(l.direction_in_world.normalized()), -1.0, 1.0);
-        errors.push_back(std::acos(cosine) * 180.0 / kPi);
+        errors.push_back(std::acos(cosine) * 180.0 / std::numbers::pi);
         l.direction_in_world = recorded;
       }
       photos_[name]["light_error_deg"] = errors;
@@ -565,8 +566,8 @@ class SceneGenerator {
         static_cast<std::size_t>(options_.num_held_out_views * options_.held_out_lights_per_view);
     const bool plane = options_.shape == SceneShape::kPlane;
     for (int v = 0; v < options_.num_held_out_views; ++v) {
-      const double azimuth = 2 * kPi * (v + 0.5) / options_.num_held_out_views + 0.2;
-      const double elevation = (plane ? 50.0 : 22.0) * kPi / 180.0;
+      const double azimuth = 2 * std::numbers::pi * (v + 0.5) / options_.num_held_out_views + 0.2;
+      const double elevation = (plane ? 50.0 : 22.0) * std::numbers::pi / 180.0;
       const sfm::Rigid3d pose = LookAt(options_.camera_distance * FromAngles(azimuth, elevation),
                                        Eigen::Vector3d::Zero());
       const auto dome =

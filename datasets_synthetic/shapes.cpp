@@ -13,8 +13,6 @@
 namespace texlume::datasets {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 // Shape dimensions (world units).
 constexpr double kSphereRadius = 1.0;
 constexpr double kCylinderRadius = 0.6;
@@ -73,9 +71,9 @@ std::vector<SurfacePatch> ShapePatches(SceneShape shape) {
       // the equator, stretched towards the poles.
       SurfacePatch p;
       p.u0 = 0;
-      p.u1 = 2 * kPi * kSphereRadius;
-      p.v0 = -kPi / 2 * kSphereRadius;
-      p.v1 = kPi / 2 * kSphereRadius;
+      p.u1 = 2 * std::numbers::pi * kSphereRadius;
+      p.v0 = -std::numbers::pi / 2 * kSphereRadius;
+      p.v1 = std::numbers::pi / 2 * kSphereRadius;
       p.periodic_u = true;
       p.eval = [](double u, double v) {
         const double phi = u / kSphereRadius, lat = v / kSphereRadius;
@@ -95,7 +93,7 @@ std::vector<SurfacePatch> ShapePatches(SceneShape shape) {
     case SceneShape::kCylinder: {
       SurfacePatch side;
       side.u0 = 0;
-      side.u1 = 2 * kPi * kCylinderRadius;
+      side.u1 = 2 * std::numbers::pi * kCylinderRadius;
       side.v0 = -kCylinderHeight / 2;
       side.v1 = kCylinderHeight / 2;
       side.periodic_u = true;
@@ -128,9 +126,9 @@ std::vector<SurfacePatch> ShapePatches(SceneShape shape) {
     case SceneShape::kTorus: {
       SurfacePatch p;
       p.u0 = 0;
-      p.u1 = 2 * kPi * kTorusMajor;
+      p.u1 = 2 * std::numbers::pi * kTorusMajor;
       p.v0 = 0;
-      p.v1 = 2 * kPi * kTorusMinor;
+      p.v1 = 2 * std::numbers::pi * kTorusMinor;
       p.periodic_u = p.periodic_v = true;
       p.eval = [](double u, double v) {
         const double phi = u / kTorusMajor, theta = v / kTorusMinor;
@@ -177,8 +175,9 @@ mesh::TriangleMesh ShapeMeshWithFaces(SceneShape shape, std::int64_t target_face
     }
     case SceneShape::kCylinder: {
       // 2 * around * along (side) + about around^2 / pi (the caps' rings) faces.
-      const double aspect = 2 * kPi * kCylinderRadius / kCylinderHeight;
-      const int along = segments(std::sqrt(n / (2 * aspect + aspect * aspect / kPi)), 1);
+      const double aspect = 2 * std::numbers::pi * kCylinderRadius / kCylinderHeight;
+      const int along =
+          segments(std::sqrt(n / (2 * aspect + aspect * aspect / std::numbers::pi)), 1);
       return MakeColumn(segments(aspect * along, 3), along, kCylinderRadius, kCylinderHeight);
     }
     case SceneShape::kPlane:
@@ -195,9 +194,9 @@ mesh::TriangleMesh ShapeMeshWithFaces(SceneShape shape, std::int64_t target_face
 mesh::TriangleMesh MakeTorus(int around, int tube, double major, double minor) {
   mesh::TriangleMesh mesh;
   for (int j = 0; j < tube; ++j) {
-    const double theta = 2 * kPi * j / tube;
+    const double theta = 2 * std::numbers::pi * j / tube;
     for (int i = 0; i < around; ++i) {
-      const double phi = 2 * kPi * i / around;
+      const double phi = 2 * std::numbers::pi * i / around;
       const double ring = major + minor * std::cos(theta);
       mesh.vertices.emplace_back(ring * std::cos(phi), ring * std::sin(phi),
                                  minor * std::sin(theta));
@@ -310,7 +309,7 @@ mesh::TriangleMesh MakeCylinder(int around, int along, double radius, double hei
   for (int j = 0; j <= along; ++j) {
     const double z = -height / 2 + height * j / along;
     for (int i = 0; i < around; ++i) {
-      const double a = 2 * kPi * i / around;
+      const double a = 2 * std::numbers::pi * i / around;
       mesh.vertices.emplace_back(radius * std::cos(a), radius * std::sin(a), z);
     }
   }
@@ -338,7 +337,7 @@ namespace {
 std::vector<int> AddRing(mesh::TriangleMesh& mesh, int count, double radius, double z) {
   std::vector<int> ring;
   for (int i = 0; i < count; ++i) {
-    const double a = 2 * kPi * i / count;
+    const double a = 2 * std::numbers::pi * i / count;
     ring.push_back(static_cast<int>(mesh.vertices.size()));
     mesh.vertices.emplace_back(radius * std::cos(a), radius * std::sin(a), z);
   }
@@ -372,7 +371,7 @@ void ZipRings(mesh::TriangleMesh& mesh, const std::vector<int>& inner,
 void AddDiskCap(mesh::TriangleMesh& mesh, const std::vector<int>& rim, double radius, double z,
                 bool up) {
   const int around = static_cast<int>(rim.size());
-  const int rings = std::max(1, static_cast<int>(std::lround(around / (2 * kPi))));
+  const int rings = std::max(1, static_cast<int>(std::lround(around / (2 * std::numbers::pi))));
   std::vector<int> outer = rim;
   for (int r = rings - 1; r >= 1; --r) {
     const int count = std::max(3, static_cast<int>(std::lround(around * r / double(rings))));

@@ -8,7 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install_deps.sh
-TEXLUME_CMAKE_ARGS="-DTEXLUME_WERROR=ON" ./scripts/build.sh
+TEXLUME_CMAKE_ARGS="-DTEXLUME_WERROR=ON -DTEXLUME_UNITY_BUILD=ON" ./scripts/build.sh
 cmake --build build --target check-format
 ctest --test-dir build -j"$(nproc)" --output-on-failure
 # Both in build-sanitize/, at -O0: a shorter build, and neither needs speed.
