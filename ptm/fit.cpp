@@ -1,6 +1,8 @@
 #include "ptm/fit.h"
 
-#include <ceres/ceres.h>
+#include <ceres/loss_function.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
 #include <omp.h>
 
 #include <Eigen/SVD>
@@ -19,6 +21,7 @@
 #include "core/image_io.h"
 #include "ptm/image_bands.h"
 #include "ptm/least_squares_bands.h"
+#include "ptm/ptm_sample_cost.h"
 #include "sfm/lights.h"
 
 namespace texlume::ptm {
@@ -43,9 +46,7 @@ void RobustRefine(const MatrixX6& basis, const std::vector<double>& values,
     std::array<double, 6> b;
     for (int i = 0; i < 6; ++i)
       b[static_cast<std::size_t>(i)] = basis(static_cast<Eigen::Index>(k), i);
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PtmSampleResidual, 1, 6>(
-                                 new PtmSampleResidual(b, values[k])),
-                             &loss, a);
+    problem.AddResidualBlock(new PtmSampleCost(b, values[k]), &loss, a);
   }
   ceres::Solver::Options solver_options;
   solver_options.linear_solver_type = ceres::DENSE_QR;

@@ -108,22 +108,4 @@ void CheckLightsForBasis(const std::vector<Eigen::Vector3d>& lights,
                          double max_condition_number, const std::string& basis,
                          const std::string& label);
 
-/// Ceres residual of one sample, r = b(l) . a - I (paper 003 eq. 1), exposed for
-/// the gradient check in the tests.
-struct PtmSampleResidual {
-  PtmSampleResidual(const std::array<double, 6>& basis, double observed)
-      : basis_(basis), observed_(observed) {}
-  template <typename T>
-  bool operator()(const T* a, T* residual) const {
-    T sum = T(-observed_);
-    for (int i = 0; i < 6; ++i) sum += T(basis_[static_cast<std::size_t>(i)]) * a[i];
-    residual[0] = sum;
-    return true;
-  }
-
- private:
-  std::array<double, 6> basis_;
-  double observed_;
-};
-
 }  // namespace texlume::ptm

@@ -117,13 +117,23 @@ TEST(ChartOutline, HoldsExactlyTheTexelsWithinReachAndIsTheUnionOfItsFaces) {
   }
 }
 
+// True when no texel of `outline` (CV_8UC1) put at (x, y) meets a used texel of `used`.
+bool FreeAt(const cv::Mat& used, const cv::Mat& outline, int x, int y) {
+  for (int r = 0; r < outline.rows; ++r) {
+    const uchar* in_outline = outline.ptr<uchar>(r);
+    const uchar* in_used = used.ptr<uchar>(y + r) + x;
+    for (int c = 0; c < outline.cols; ++c)
+      if ((in_outline[c] & in_used[c]) != 0) return false;
+  }
+  return true;
+}
+
 // Brute force: the first position, by rows then columns, where no texel of the
 // outline meets a used texel of `used`, its bottom not below `max_bottom`.
 std::pair<int, int> FirstFreePosition(const cv::Mat& used, const cv::Mat& outline, int max_bottom) {
   for (int y = 0; y + outline.rows <= std::min(used.rows, max_bottom); ++y)
     for (int x = 0; x + outline.cols <= used.cols; ++x)
-      if (cv::countNonZero(used(cv::Rect(x, y, outline.cols, outline.rows)) & outline) == 0)
-        return {x, y};
+      if (FreeAt(used, outline, x, y)) return {x, y};
   return {-1, -1};
 }
 

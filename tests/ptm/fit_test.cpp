@@ -1,6 +1,5 @@
 #include "ptm/fit.h"
 
-#include <ceres/autodiff_cost_function.h>
 #include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
 
@@ -12,6 +11,7 @@
 
 #include "core/errors.h"
 #include "datasets_synthetic/scene.h"
+#include "ptm/ptm_sample_cost.h"
 #include "sfm/lights.h"
 #include "tests/test_util.h"
 
@@ -104,9 +104,17 @@ TEST(Fit, RobustFitIgnoresShadowsAndHighlightsThatPullLeastSquares) {
 
 TEST(Fit, CeresCostFunctionPassesTheGradientCheck) {
   const auto basis = PtmBasis(0.3, -0.5);
-  ceres::AutoDiffCostFunction<PtmSampleResidual, 1, 6> cost(new PtmSampleResidual(basis, 0.42));
+  const PtmSampleCost cost(basis, 0.42);
   double a[6] = {0.1, -0.2, 0.3, 0.05, -0.4, 0.5};
   const double* parameters[] = {a};
+  // The known answer: r = b . a - I, and dr/da = b.
+  double residual = 0.0, jacobian[6] = {};
+  double* jacobians[] = {jacobian};
+  ASSERT_TRUE(cost.Evaluate(parameters, &residual, jacobians));
+  double expected = -0.42;
+  for (int i = 0; i < 6; ++i) expected += basis[static_cast<std::size_t>(i)] * a[i];
+  EXPECT_NEAR(residual, expected, 1e-15);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(jacobian[i], basis[static_cast<std::size_t>(i)]);
   ceres::NumericDiffOptions numeric;
   const std::vector<const ceres::Manifold*>* no_manifolds = nullptr;
   ceres::GradientChecker checker(&cost, no_manifolds, numeric);
