@@ -56,6 +56,11 @@ void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords
   sub->add_option("--photo-cache", w.photo_cache,
                   "decoded photos held at once, e.g. 4G (default: half of --memory-limit; the "
                   "photos are decoded on demand)");
+  sub->add_option("--compare-regions", j.compare_regions,
+                  "one process: also measure the edge mismatch on the borders of the N regions "
+                  "mpirun -np N would place apart, for each N of a list such as 2,4 (manifest "
+                  "region_comparison)")
+      ->delimiter(',');
 }
 
 void BindEngine(CLI::App* sub, synth::MeshSynthesisOptions& s, SynthWords& w) {
@@ -229,7 +234,7 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
        {"--fill-unseen", "--seam-band", "--strip", "--max-subdivisions", "--correction-iterations",
         "--correction-noise", "--correction-sigma", "--correction-prior-shrink",
         "--no-additive-correction", "--no-channel-correction", "--no-detail-transfer", "--search",
-        "--search-candidates", "--photometry-faces"})
+        "--search-candidates", "--photometry-faces", "--compare-regions"})
     if (sub->count(name) > 0)
       throw UsageError(std::string(name) + " is not taken by --engine graphcut (docs/quilting.md)");
   TakePhotos(sub, w, o, q);
@@ -330,6 +335,10 @@ void AddSynthCommand(CLI::App& app, CommandRunners& run) {
       return 0;
     }
     Resolve(sub, *w, q->quilt, *o);
+    if (ranks && ranks->Size() > 1 && !o->job.compare_regions.empty())
+      throw UsageError(
+          "--compare-regions is for one process: mpirun's manifest measures its own "
+          "regions");
     o->job.ranks = ranks;
     if (ranks && ranks->Rank() != 0) {  // rank 0 shows the progress and writes the model
       std::ostream quiet(nullptr);

@@ -51,8 +51,11 @@ synth=("$texlume" synth --model "$object/sparse" --images "$object/images"
 run() {  # NAME THREADS [mpirun ARGS...]
   local name=$1 threads=$2
   shift 2
+  # One process measures its edges on the regions the ranks place apart.
+  local compare=()
+  [ $# -gt 0 ] || compare=(--compare-regions "$ranks")
   rm -rf "$dir/$name" "$dir/render_$name"
-  OMP_NUM_THREADS=$threads measure "$name" "$@" "${synth[@]}" --out "$dir/$name"
+  OMP_NUM_THREADS=$threads measure "$name" "$@" "${synth[@]}" "${compare[@]}" --out "$dir/$name"
   measure "render_$name" "$texlume" render --model "$dir/$name" --cameras "$held/sparse" \
     --lights "$held/lights.json" --truth "$held/images" --truth-masks "$held/masks" \
     --reduced-factor 4 --out "$dir/render_$name/out"
@@ -84,11 +87,18 @@ wall1, walln = job(names[0])["wall_s"], job(names[1])["wall_s"]
 syn1, synn = m1["timings_s"]["synthesis"], mn["timings_s"]["synthesis"]
 print(f"\nefficiency at {n} ranks: synthesis {syn1 / (n * synn):.2f}, whole command "
       f"{wall1 / (n * walln):.2f} (speed-up {syn1 / synn:.2f} / {wall1 / walln:.2f})")
-e = dist["edge_mismatch"]
-for name in ("region_borders", "next_to_borders", "elsewhere"):
-    t = e[name]
-    print(f"edge mismatch, {name.replace('_', ' ')}: {t['mean']:.5f} +- {t['standard_error']:.5f} "
-          f"({t['edges']} edges)")
+# The same edges in each run: the ranks' own, and one process's on the same regions
+# (--compare-regions).
+print(f"\nedge mismatch (mean +- standard error) on the regions of {n} ranks\n")
+print("| edges | " + " | ".join(names) + " |")
+print("|---|" + "---|" * len(names))
+mismatch = [manifest(names[0])["region_comparison"][0]["edge_mismatch"],
+            mn["distributed"]["edge_mismatch"],
+            manifest(names[2])["region_comparison"][0]["edge_mismatch"]]
+for edges in ("region_borders", "next_to_borders", "elsewhere"):
+    cells = [f"{m[edges]['mean']:.5f} +- {m[edges]['standard_error']:.5f}" for m in mismatch]
+    print(f"| {edges.replace('_', ' ')} ({mismatch[1][edges]['edges']}) | " + " | ".join(cells) + " |")
+print()
 for r in dist["per_rank"]:
     print(f"rank {r['rank']}: {r['faces']} faces, placed {r['faces_placed']} in "
           f"{r['seconds_region']:.1f} s, detail transfer {r['seconds_finish']:.1f} s (prepare "

@@ -455,6 +455,8 @@ void SynthCommandOptions::Check() const {
   if (!job.sample_file.empty()) throw OptionError("give a PTM sample or a BTF, not both");
   job.CheckInputsAndLayout();
   if (components < 1) throw OptionError("components must be >= 1");
+  if (!job.compare_regions.empty())
+    throw OptionError("--compare-regions measures a PTM or colour sample's edges, not a BTF's");
 }
 
 namespace {

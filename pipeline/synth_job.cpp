@@ -285,6 +285,10 @@ void SynthJobOptions::CheckInputsAndLayout() const {
   visibility.Check();
   if (max_subdivisions < 0 || max_subdivisions > 6)
     throw OptionError("max subdivisions must be in [0, 6]");
+  for (const int regions : compare_regions)
+    if (regions < 2 || regions > 4096)
+      throw OptionError("--compare-regions takes 2 to 4096 regions, not " +
+                        std::to_string(regions));
   CheckWorldUnit(mm_per_world_unit);
 }
 
@@ -350,6 +354,30 @@ std::optional<synth::FaceRegions> RegionsOfJob(const SynthJobOptions& options,
   return regions;
 }
 
+namespace {
+
+nlohmann::json EdgeMismatchJson(const synth::EdgeMismatch& mismatch) {
+  const auto tally = [](const synth::EdgeTally& t) {
+    return nlohmann::json{
+        {"mean", t.Mean()}, {"standard_error", t.StandardError()}, {"edges", t.Edges()}};
+  };
+  return {{"region_borders", tally(mismatch.region_borders)},
+          {"next_to_borders", tally(mismatch.next_to_borders)},
+          {"elsewhere", tally(mismatch.elsewhere)}};
+}
+
+}  // namespace
+
+nlohmann::json RegionComparisonJson(const synth::MeshSynthesis& synthesis,
+                                    const std::vector<std::array<int, 3>>& neighbours,
+                                    int num_regions, std::uint32_t seed) {
+  const mesh::FacePartition partition = synth::RegionsForRanks(neighbours, num_regions, seed);
+  return {{"regions", num_regions},
+          {"region_cut_edges", partition.cut_edges},
+          {"edge_mismatch",
+           EdgeMismatchJson(synth::MeasureEdgeMismatch(synthesis, partition.region_of_face))}};
+}
+
 nlohmann::json RanksJson(const synth::TriangleSynthesis& synthesis,
                          const std::optional<synth::EdgeMismatch>& mismatch) {
   if (synthesis.rank_records.empty()) return nullptr;
@@ -368,15 +396,7 @@ nlohmann::json RanksJson(const synth::TriangleSynthesis& synthesis,
                            {"seconds_gather", synthesis.seconds_gather},
                            {"seconds_region_borders", synthesis.seconds_region_borders},
                            {"per_rank", ranks}};
-  if (mismatch) {
-    const auto tally = [](const synth::EdgeTally& t) {
-      return nlohmann::json{
-          {"mean", t.Mean()}, {"standard_error", t.StandardError()}, {"edges", t.Edges()}};
-    };
-    record["edge_mismatch"] = {{"region_borders", tally(mismatch->region_borders)},
-                               {"next_to_borders", tally(mismatch->next_to_borders)},
-                               {"elsewhere", tally(mismatch->elsewhere)}};
-  }
+  if (mismatch) record["edge_mismatch"] = EdgeMismatchJson(*mismatch);
   return record;
 }
 
@@ -524,6 +544,13 @@ class SynthJob {
     if (synthesis_.rank_share_only) return;
     if (regions) edge_mismatch_ = synth::MeasureEdgeMismatch(synthesis_, synthesis_.region_of_face);
     summary_.seconds_synthesis = SecondsSince(t);
+    if (!regions && !options_.compare_regions.empty()) {
+      const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(in.mesh);
+      region_comparison_ = nlohmann::json::array();
+      for (const int n : options_.compare_regions)
+        region_comparison_.push_back(
+            RegionComparisonJson(synthesis_, neighbours, n, options_.synthesis.seed));
+    }
     summary_.from_photos = synthesis_.num_from_photos;
     summary_.from_neighbours = synthesis_.num_from_neighbours;
     summary_.random = synthesis_.num_random;
@@ -604,6 +631,7 @@ class SynthJob {
         {"white_balance", so.white_balance},
         {"photo_blur", so.photo_blur},
         {"seed", so.seed},
+        {"compare_regions", options_.compare_regions},
         {"sample_kind", sample_.colour.empty() ? "PTM" : "colour"}};
     settings.update(FillUnseenSettingsJson(options_));
     settings.update(AtlasSettingsJson(options_.atlas));
@@ -644,6 +672,7 @@ class SynthJob {
     record["resources"] = {{"peak_resident_bytes", PeakResidentBytes()}};
     if (const nlohmann::json d = RanksJson(synthesis_, edge_mismatch_); !d.is_null())
       record["distributed"] = d;
+    if (!region_comparison_.is_null()) record["region_comparison"] = region_comparison_;
     return record;
   }
 
@@ -709,6 +738,7 @@ class SynthJob {
   Sample sample_;
   synth::MeshSynthesis synthesis_;
   std::optional<synth::EdgeMismatch> edge_mismatch_;  // a distributed run's
+  nlohmann::json region_comparison_;                  // one process's (--compare-regions)
   model::TexturedModel model_;
   std::vector<cv::Mat> baked_;
   Eigen::Vector3f flat_albedo_ = Eigen::Vector3f::Constant(0.5f);

@@ -82,6 +82,11 @@ struct SynthJobOptions {
   /// rank (synth/face_regions.h), and rank 0 finishes and writes the model.
   /// Null or one rank: one process.
   synth::RankCommunicator* ranks = nullptr;
+  /// One process (`--compare-regions N,...`): also measures the edge mismatch on
+  /// the regions `mpirun -np N` would place apart (the same partition), for each N,
+  /// so that a distributed run's figures have a one-process baseline on the same
+  /// edges (manifest "region_comparison"). Empty: not measured.
+  std::vector<int> compare_regions;
 
   /// Throws OptionError when a path is missing or a setting is out of range.
   void Check() const;
@@ -164,6 +169,13 @@ std::optional<synth::FaceRegions> RegionsOfJob(const SynthJobOptions& options,
 /// elsewhere); null in one process.
 nlohmann::json RanksJson(const synth::TriangleSynthesis& synthesis,
                          const std::optional<synth::EdgeMismatch>& mismatch);
+
+/// The edge mismatch of a one-process model on the borders of `num_regions`
+/// regions (synth::RegionsForRanks with the engine's seed), with the other two
+/// classes, as a distributed run's manifest records its own.
+nlohmann::json RegionComparisonJson(const synth::MeshSynthesis& synthesis,
+                                    const std::vector<std::array<int, 3>>& neighbours,
+                                    int num_regions, std::uint32_t seed);
 
 /// Reads the COLMAP model, object lights, mesh and photos named in `options`
 /// (sample and out_dir are not touched). Throws InputError as RunSynthJob describes.

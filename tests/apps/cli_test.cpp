@@ -227,6 +227,11 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
                     &out),
             2);
   EXPECT_NE(out.find("photometry_faces must be >= 64"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --compare-regions 2,1",
+                    &out),
+            2);
+  EXPECT_NE(out.find("--compare-regions takes 2 to 4096 regions, not 1"), std::string::npos) << out;
   // A photo cache that is not a size (photos on demand, docs/cli.md).
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
                     "--sample-texel-size 0.01 --out f --photo-cache lots",

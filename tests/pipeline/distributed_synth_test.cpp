@@ -61,7 +61,9 @@ class DistributedSynthTest : public ::testing::Test {
     o.write_btf = false;
     datasets::GenerateScene(o, tmp_->path() / "scene");
     ptm::WritePtmExr(datasets::FitSceneSample(tmp_->path() / "scene"), tmp_->path() / "sample.exr");
-    one_ = new SynthJobSummary(RunSynthJob(Job("one")));
+    SynthJobOptions one = Job("one");
+    one.compare_regions = {2, 3};  // the regions of ThreeRanks... among them
+    one_ = new SynthJobSummary(RunSynthJob(one));
   }
   static void TearDownTestSuite() {
     delete one_;
@@ -172,7 +174,21 @@ TEST_F(DistributedSynthTest, ThreeRanksPlaceEveryFaceAndRankZeroWritesTheModel) 
   EXPECT_GT(e["region_borders"]["standard_error"].get<double>(), 0.0);
   EXPECT_GT(e["next_to_borders"]["edges"].get<int>(), e["region_borders"]["edges"].get<int>());
   EXPECT_LT(e["next_to_borders"]["edges"].get<int>(), e["elsewhere"]["edges"].get<int>());
-  EXPECT_FALSE(Manifest("one").contains("distributed"));  // one process: as before
+  const nlohmann::json one = Manifest("one");
+  EXPECT_FALSE(one.contains("distributed"));  // one process: as before
+  // ...but it measures the same edge classes on the same three regions.
+  ASSERT_EQ(one["region_comparison"].size(), 2u);
+  EXPECT_EQ(one["settings"]["compare_regions"], nlohmann::json({2, 3}));
+  const nlohmann::json& c = one["region_comparison"][1];
+  EXPECT_EQ(c["regions"], 3);
+  EXPECT_EQ(c["region_cut_edges"], d["region_cut_edges"]);
+  // Two regions have fewer edges between them than three.
+  EXPECT_LT(one["region_comparison"][0]["edge_mismatch"]["region_borders"]["edges"].get<int>(),
+            c["edge_mismatch"]["region_borders"]["edges"].get<int>());
+  for (const char* edges : {"region_borders", "next_to_borders", "elsewhere"}) {
+    EXPECT_EQ(c["edge_mismatch"][edges]["edges"], e[edges]["edges"]) << edges;
+    EXPECT_GT(c["edge_mismatch"][edges]["mean"].get<double>(), 0.0) << edges;
+  }
 }
 
 TEST_F(DistributedSynthTest, ARankWithOtherInputsStopsWithAnErrorNamingIt) {
