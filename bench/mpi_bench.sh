@@ -7,6 +7,8 @@
 #   one_1t     one process, one thread (OMP_NUM_THREADS=1): the baseline of the efficiency;
 #   ranks_Nt1  mpirun -np RANKS, one thread per rank;
 #   one_Nt     one process, RANKS threads (the same cores used by OpenMP alone).
+# The one-process runs measure their edge mismatch on the ranks' regions (--compare-regions
+# RANKS; within their times, as the ranks' run measures its own), printed beside the ranks'.
 # Efficiency = wall(one_1t) / (RANKS x wall(ranks)), for the synthesis stage (the
 # manifests' timings) and the whole command. The model of N ranks takes the measured
 # region work, imbalance, border faces, bytes sent and serial stages of the RANKS run (its

@@ -289,6 +289,9 @@ void SynthJobOptions::CheckInputsAndLayout() const {
     if (regions < 2 || regions > 4096)
       throw OptionError("--compare-regions takes 2 to 4096 regions, not " +
                         std::to_string(regions));
+  if (!compare_regions.empty() && ranks && ranks->Size() > 1)
+    throw OptionError(
+        "--compare-regions is for one process: mpirun's manifest measures its own regions");
   CheckWorldUnit(mm_per_world_unit);
 }
 

@@ -232,6 +232,20 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
                     &out),
             2);
   EXPECT_NE(out.find("--compare-regions takes 2 to 4096 regions, not 1"), std::string::npos) << out;
+  // Region comparison measures blended seams: not a BTF's graph cuts, nor the graph-cut engine's.
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --btf " + tmp.path().string() +
+                        " --out f --compare-regions 2",
+                    &out),
+            2);
+  EXPECT_NE(out.find("--compare-regions measures a PTM or colour sample's edges"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(Texlume("synth --engine graphcut --mesh d --sample e --sample-texel-size 0.01 --out f "
+                    "--compare-regions 2",
+                    &out),
+            2);
+  EXPECT_NE(out.find("--compare-regions is not taken by --engine graphcut"), std::string::npos)
+      << out;
   // A photo cache that is not a size (photos on demand, docs/cli.md).
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
                     "--sample-texel-size 0.01 --out f --photo-cache lots",

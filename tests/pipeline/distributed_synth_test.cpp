@@ -164,6 +164,7 @@ TEST_F(DistributedSynthTest, ThreeRanksPlaceEveryFaceAndRankZeroWritesTheModel) 
     }
   }
   EXPECT_EQ(placed, three.faces);  // every face placed once, by one rank
+  EXPECT_FALSE(Manifest("threads3").contains("region_comparison"));  // not asked for
   // Borders placed first, each region grown from them: the borders and the edges
   // next to them agree no worse than other edges do (with a margin for a few
   // dozen border edges).
