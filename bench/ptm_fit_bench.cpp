@@ -1,5 +1,5 @@
 // PTM fitting benchmarks (issues 4 and 33). Run: build/bench/ptm_fit_bench [--images N]
-//   [--size S | --width W --height H] [--format png|jpg] [--part all|throughput]
+//   [--size S | --width W --height H] [--format png|jpg] [--part all|throughput|horizon]
 // 1. Throughput: N synthetic RTI images of S x S (or W x H) pixels (default 50 of
 //    2048 x 2048, 4.2 MP; issue 33 measures 50 JPEGs of 6000 x 4000, 24 MP) are
 //    written once, then in one run: decoding every band of every image alone on one
@@ -15,28 +15,42 @@
 //    luma-gradient histograms of the relit images and the held-out photos (render/fidelity.h),
 //    beside that of another instance of the material (material seed 1001) photographed under the
 //    same lights: how much of the relief's sharpness each basis keeps (issue 29's gradient aim).
+// 4. Self-shadowing (issue 29; --part horizon): on the same captures and split, an RGB PTM
+//    relit as it is, and times the visibility of a horizon map (ptm/horizon.h), the
+//    PTM then refitted to the lit samples only: the horizon from the true relief
+//    (material/ground_truth/height.exr, the bound of what self-shadowing costs) and from
+//    the PTM's own normals integrated. PSNR and gradient distance at every held-out light
+//    and at those below 35 degrees of elevation, where the relief's shadows are longest.
 #include <OpenImageIO/imageio.h>
 #include <omp.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 
+#include "core/srgb.h"
 #include "datasets_synthetic/renderer.h"
 #include "datasets_synthetic/scene.h"
+#include "ptm/exr_io.h"
 #include "ptm/fit.h"
+#include "ptm/horizon.h"
 #include "ptm/hsh.h"
 #include "ptm/image_bands.h"
 #include "ptm/least_squares_bands.h"
 #include "ptm/ptm_io.h"
+#include "ptm/shadowed_fit.h"
 #include "render/fidelity.h"
 #include "sfm/lights.h"
 
@@ -256,6 +270,131 @@ void PtmAgainstHsh(const fs::path& work, bool realistic) {
   }
 }
 
+// Section 4: what the relief's self-shadowing costs a PTM, and what a horizon map
+// fitted from the capture alone (ptm/shadowed_fit.h) gives back.
+constexpr double kLowLightDeg = 35.0;
+
+double ElevationDeg(const Eigen::Vector3d& l) {
+  return std::asin(std::clamp(l.z(), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+}
+
+cv::Mat TrueHeightTexels(const fs::path& scene_dir) {
+  std::ifstream in(scene_dir / "scene.json");
+  const double texel_size = nlohmann::json::parse(in)["material"]["texel_size"].get<double>();
+  const std::vector<cv::Mat> planes = ptm::ReadExr(scene_dir / "material/ground_truth/height.exr");
+  cv::Mat h;
+  planes.at(0).convertTo(h, CV_64FC1, 1.0 / texel_size);
+  return h;
+}
+
+// The bound: the horizon of the true relief, the PTM refitted to the samples it
+// leaves lit.
+ptm::ShadowedPtm TrueReliefShadowedPtm(const fs::path& scene_dir,
+                                       const std::vector<cv::Mat>& images,
+                                       const std::vector<Eigen::Vector3d>& lights) {
+  const ptm::ShadowedFitOptions o;
+  ptm::ShadowedPtm out;
+  out.penumbra_rad = o.penumbra_deg * std::numbers::pi / 180.0;
+  out.horizon = ptm::ComputeHorizonMap(TrueHeightTexels(scene_dir), o.sectors, o.reach_texels);
+  std::vector<std::vector<float>> lit(lights.size(), std::vector<float>(out.horizon.NumTexels()));
+  for (std::size_t k = 0; k < lights.size(); ++k)
+    for (std::size_t t = 0; t < out.horizon.NumTexels(); ++t)
+      lit[k][t] = ptm::HorizonVisibility(out.horizon, t, lights[k], out.penumbra_rad) > 0.5;
+  out.ptm = ptm::FitRgbPtmToLitSamples(images, lights, lit, o.min_lit_lights);
+  // The floor as FitShadowedPtm measures it, from a shadowed fit with this horizon.
+  out.shadow_floor = 0.0;
+  double best = 1e300;
+  for (double f = 0.0; f <= 1.0; f += 0.05) {
+    double error = 0;
+    for (std::size_t k = 0; k < lights.size(); ++k)
+      error -= Psnr(ptm::RelightShadowed(out.ptm, out.horizon, lights[k], f, out.penumbra_rad),
+                    images[k]);
+    if (error < best) best = error, out.shadow_floor = f;
+  }
+  return out;
+}
+
+struct HeldOutScore {
+  double psnr_all = 0, psnr_low = 0, gradient_all = 0, gradient_low = 0;
+  int low = 0;
+};
+
+template <typename Relight>
+HeldOutScore ScoreHeldOut(const ptm::RtiCapture& held, const std::vector<cv::Mat>& truth,
+                          const Relight& relight) {
+  HeldOutScore score;
+  std::vector<cv::Mat> relit, relit_low, truth_low;
+  for (std::size_t k = 0; k < held.files.size(); ++k) {
+    const std::vector<float> rgb = relight(held.lights[k]);
+    const double psnr = Psnr(rgb, truth[k]);
+    relit.push_back(AsImage(rgb, truth[k].size()));
+    score.psnr_all += psnr;
+    if (ElevationDeg(held.lights[k]) < kLowLightDeg) {
+      score.psnr_low += psnr;
+      ++score.low;
+      relit_low.push_back(relit.back());
+      truth_low.push_back(truth[k]);
+    }
+  }
+  score.psnr_all /= static_cast<double>(held.files.size());
+  score.gradient_all = MeanGradientDistance(relit, truth);
+  if (score.low > 0) {
+    score.psnr_low /= score.low;
+    score.gradient_low = MeanGradientDistance(relit_low, truth_low);
+  }
+  return score;
+}
+
+void PrintScore(const char* label, const HeldOutScore& s) {
+  std::printf("  %-40s %6.2f dB  %.5f   %6.2f dB  %.5f\n", label, s.psnr_all, s.gradient_all,
+              s.psnr_low, s.gradient_low);
+}
+
+void SelfShadowing(const fs::path& work) {
+  for (const datasets::MaterialKind kind :
+       {datasets::MaterialKind::kStone, datasets::MaterialKind::kBrick,
+        datasets::MaterialKind::kGrooves}) {
+    datasets::SceneOptions scene = datasets::MaterialOnlySceneOptions(kind, 256, 40);
+    datasets::UseRealisticCapture(scene);
+    const std::string name(datasets::MaterialKindName(kind));
+    const fs::path dir = work / ("hsh_" + name);
+    if (!fs::exists(dir / "material/capture/lights.lp")) datasets::GenerateScene(scene, dir);
+    const HeldOutSplit split = SplitCapture(dir);
+    std::vector<cv::Mat> train_images, truth;
+    for (const auto& f : split.train.files) train_images.push_back(ReadRgb(f));
+    for (const auto& f : split.held.files) truth.push_back(ReadRgb(f));
+
+    ptm::FitOptions o;
+    o.format = ptm::PtmFormat::kRgb;
+    const ptm::Ptm plain = ptm::FitPtmFromFiles(split.train.files, split.train.lights, o).ptm;
+    const auto t0 = std::chrono::steady_clock::now();
+    const ptm::ShadowedPtm fitted = ptm::FitShadowedPtm(train_images, split.train.lights);
+    const double fit_seconds = Seconds(t0);
+    const ptm::ShadowedPtm bound = TrueReliefShadowedPtm(dir, train_images, split.train.lights);
+
+    const HeldOutScore base = ScoreHeldOut(
+        split.held, truth, [&](const Eigen::Vector3d& l) { return ptm::Relight(plain, l); });
+    std::printf(
+        "%s realistic capture 256x256, %zu lights fitted, %zu held out (%d below %.0f deg)\n"
+        "  %-40s %9s  %7s   %9s  %7s\n",
+        name.c_str(), split.train.files.size(), split.held.files.size(), base.low, kLowLightDeg, "",
+        "PSNR", "grad", "PSNR low", "grad low");
+    PrintScore("PTM RGB", base);
+    PrintScore("shadowed PTM, horizon of the true relief",
+               ScoreHeldOut(split.held, truth, [&](const Eigen::Vector3d& l) {
+                 return ptm::RelightShadowed(bound, l);
+               }));
+    PrintScore("shadowed PTM fitted from the capture",
+               ScoreHeldOut(split.held, truth, [&](const Eigen::Vector3d& l) {
+                 return ptm::RelightShadowed(fitted, l);
+               }));
+    std::printf(
+        "  fitted: height scale %.2f, shadow keeps %.2f of the light, %.1f s (true relief: "
+        "%.2f)\n",
+        fitted.height_scale, fitted.shadow_floor, fit_seconds, bound.shadow_floor);
+  }
+}
+
 // Section 1: decode + fit + write against decoding alone, LRGB and RGB, the
 // decode-only baseline measured before and after the fits (its mean is the ratio's
 // denominator: the machine's speed drifts).
@@ -323,6 +462,10 @@ int main(int argc, char** argv) {
   if (part == "all" || part == "throughput")
     Throughput(n, cv::Size(width > 0 ? width : size, height > 0 ? height : size), format, work);
   if (part == "throughput") return 0;
+  if (part == "horizon") {
+    SelfShadowing(work);
+    return 0;
+  }
 
   // Leave-out quality on a synthetic capture.
   const datasets::SceneOptions scene =

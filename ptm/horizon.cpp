@@ -1,0 +1,163 @@
+#include "ptm/horizon.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace texlume::ptm {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+// The slopes of the height field per texel: p = dH/dcolumn = -n_x / n_z and
+// q = dH/drow = +n_y / n_z (rows run down, y up).
+void SlopesFromNormals(const std::vector<float>& normals_xyz, int width, int height,
+                       double min_normal_z, cv::Mat& p, cv::Mat& q) {
+  p.create(height, width, CV_64FC1);
+  q.create(height, width, CV_64FC1);
+  for (int r = 0; r < height; ++r)
+    for (int c = 0; c < width; ++c) {
+      const float* n = normals_xyz.data() + (static_cast<std::size_t>(r) * width + c) * 3;
+      const double nz = std::max(static_cast<double>(n[2]), min_normal_z);
+      p.at<double>(r, c) = -n[0] / nz;
+      q.at<double>(r, c) = n[1] / nz;
+    }
+}
+
+// The divergence of the slopes taken at the half-texel edges (the mean of the two
+// texels' slopes), with no flux across the map's border: the right-hand side of
+// the least-squares normal equations L H = f.
+cv::Mat EdgeDivergence(const cv::Mat& p, const cv::Mat& q) {
+  cv::Mat f = cv::Mat::zeros(p.size(), CV_64FC1);
+  for (int r = 0; r < p.rows; ++r)
+    for (int c = 0; c + 1 < p.cols; ++c) {
+      const double edge = 0.5 * (p.at<double>(r, c) + p.at<double>(r, c + 1));
+      f.at<double>(r, c) += edge;
+      f.at<double>(r, c + 1) -= edge;
+    }
+  for (int r = 0; r + 1 < p.rows; ++r)
+    for (int c = 0; c < p.cols; ++c) {
+      const double edge = 0.5 * (q.at<double>(r, c) + q.at<double>(r + 1, c));
+      f.at<double>(r, c) += edge;
+      f.at<double>(r + 1, c) -= edge;
+    }
+  return f;
+}
+
+// Solves L H = f, L the Neumann Laplacian, in the cosine basis where L is
+// diagonal: eigenvalue (2 cos(pi k / W) - 2) + (2 cos(pi l / H) - 2).
+cv::Mat SolveNeumannPoisson(const cv::Mat& f) {
+  cv::Mat coefficients;
+  cv::dct(f, coefficients);
+  for (int l = 0; l < f.rows; ++l)
+    for (int k = 0; k < f.cols; ++k) {
+      const double eigenvalue = 2.0 * std::cos(std::numbers::pi * k / f.cols) - 2.0 +
+                                2.0 * std::cos(std::numbers::pi * l / f.rows) - 2.0;
+      double& a = coefficients.at<double>(l, k);
+      a = (k == 0 && l == 0) ? 0.0 : a / eigenvalue;
+    }
+  cv::Mat height_texels;
+  cv::dct(coefficients, height_texels, cv::DCT_INVERSE);
+  return height_texels;
+}
+
+double Bilinear(const cv::Mat& map, double column, double row) {
+  const int c0 = std::min(static_cast<int>(column), map.cols - 2);
+  const int r0 = std::min(static_cast<int>(row), map.rows - 2);
+  const double fc = column - c0, fr = row - r0;
+  const double top = map.at<double>(r0, c0) * (1 - fc) + map.at<double>(r0, c0 + 1) * fc;
+  const double bottom = map.at<double>(r0 + 1, c0) * (1 - fc) + map.at<double>(r0 + 1, c0 + 1) * fc;
+  return top * (1 - fr) + bottom * fr;
+}
+
+// The largest elevation of the relief seen from texel (row, column) along the
+// image-space direction (d_column, d_row), up to `max_distance` texels.
+double HorizonAlong(const cv::Mat& height_texels, int row, int column, double d_column,
+                    double d_row, int max_distance) {
+  const double h0 = height_texels.at<double>(row, column);
+  double best_slope = 0.0;
+  for (int t = 1; t <= max_distance; ++t) {
+    const double c = column + t * d_column, r = row + t * d_row;
+    if (c < 0 || r < 0 || c > height_texels.cols - 1 || r > height_texels.rows - 1) break;
+    best_slope = std::max(best_slope, (Bilinear(height_texels, c, r) - h0) / t);
+  }
+  return std::atan(best_slope);
+}
+
+}  // namespace
+
+cv::Mat HeightFromNormals(const std::vector<float>& normals_xyz, int width, int height,
+                          double min_normal_z) {
+  if (width < 2 || height < 2)
+    throw std::invalid_argument("HeightFromNormals: the map must be at least 2 x 2 texels");
+  if (normals_xyz.size() != static_cast<std::size_t>(width) * height * 3)
+    throw std::invalid_argument("HeightFromNormals: " + std::to_string(normals_xyz.size()) +
+                                " floats for a " + std::to_string(width) + " x " +
+                                std::to_string(height) + " normal map");
+  // cv::dct takes even sizes only: an odd side is solved with its last texels
+  // repeated once, then cropped.
+  const int solve_width = width + width % 2, solve_height = height + height % 2;
+  std::vector<float> padded(static_cast<std::size_t>(solve_width) * solve_height * 3);
+  for (int r = 0; r < solve_height; ++r)
+    for (int c = 0; c < solve_width; ++c)
+      std::copy_n(normals_xyz.data() + (static_cast<std::size_t>(std::min(r, height - 1)) * width +
+                                        std::min(c, width - 1)) *
+                                           3,
+                  3, padded.data() + (static_cast<std::size_t>(r) * solve_width + c) * 3);
+  cv::Mat p, q;
+  SlopesFromNormals(padded, solve_width, solve_height, min_normal_z, p, q);
+  cv::Mat height_texels =
+      SolveNeumannPoisson(EdgeDivergence(p, q))(cv::Rect(0, 0, width, height)).clone();
+  height_texels -= cv::mean(height_texels)[0];
+  return height_texels;
+}
+
+double HorizonMap::ElevationAt(std::size_t texel, double azimuth_rad) const {
+  double at = azimuth_rad / kTwoPi * sectors;
+  at -= std::floor(at / sectors) * sectors;
+  const int s0 = std::min(static_cast<int>(at), sectors - 1);
+  const int s1 = (s0 + 1) % sectors;
+  const double f = at - s0;
+  const float* e = elevation_rad.data() + texel * static_cast<std::size_t>(sectors);
+  return e[s0] * (1 - f) + e[s1] * f;
+}
+
+HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_distance_texels) {
+  if (sectors < 4 || sectors > 64)
+    throw std::invalid_argument("ComputeHorizonMap: sectors " + std::to_string(sectors) +
+                                " outside [4, 64]");
+  if (max_distance_texels < 1 || max_distance_texels > 4096)
+    throw std::invalid_argument("ComputeHorizonMap: distance " +
+                                std::to_string(max_distance_texels) + " outside [1, 4096]");
+  if (height_texels.type() != CV_64FC1 || height_texels.cols < 2 || height_texels.rows < 2)
+    throw std::invalid_argument(
+        "ComputeHorizonMap: expects a CV_64FC1 height map of 2 x 2 or more");
+  HorizonMap horizon;
+  horizon.width = height_texels.cols;
+  horizon.height = height_texels.rows;
+  horizon.sectors = sectors;
+  horizon.elevation_rad.resize(horizon.NumTexels() * static_cast<std::size_t>(sectors));
+#pragma omp parallel for schedule(dynamic, 8)
+  for (int r = 0; r < horizon.height; ++r)
+    for (int c = 0; c < horizon.width; ++c)
+      for (int s = 0; s < sectors; ++s) {
+        const double phi = kTwoPi * s / sectors;
+        // Texel frame (cos phi, sin phi) is image (column +cos, row -sin).
+        horizon.elevation_rad[(static_cast<std::size_t>(r) * horizon.width + c) * sectors +
+                              static_cast<std::size_t>(s)] =
+            static_cast<float>(HorizonAlong(height_texels, r, c, std::cos(phi), -std::sin(phi),
+                                            max_distance_texels));
+      }
+  return horizon;
+}
+
+double HorizonVisibility(const HorizonMap& horizon, std::size_t texel, const Eigen::Vector3d& light,
+                         double penumbra_rad) {
+  const double elevation = std::asin(std::clamp(light.z(), -1.0, 1.0));
+  const double horizon_elevation = horizon.ElevationAt(texel, std::atan2(light.y(), light.x()));
+  return std::clamp((elevation - horizon_elevation) / penumbra_rad + 0.5, 0.0, 1.0);
+}
+
+}  // namespace texlume::ptm

@@ -1,0 +1,54 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace texlume::ptm {
+
+/// Self-shadowing of a sample's relief by horizon mapping (Max 1988; Sloan and
+/// Cohen 2000): per texel and azimuth, the elevation above which the relief
+/// around it leaves a directional light unblocked. A biquadratic PTM cannot carry
+/// cast shadows; a horizon map can, as a visibility factor on the linear light.
+///
+/// Frames: texel (tangent) frame x right, y up, z out of the surface, as the PTM's
+/// lights; images and maps row 0 at the top. Heights are in texel units (one unit
+/// is one texel's width), so slopes are dimensionless.
+
+/// Height field (CV_64FC1, texel units, mean 0) whose gradient best fits the
+/// normals' slopes in the least-squares sense: the Poisson equation with Neumann
+/// boundaries solved by the discrete cosine transform (Simchony, Chellappa and
+/// Shao 1990; the non-periodic form of Frankot and Chellappa 1988).
+/// `normals_xyz`: row-major, 3 floats per texel, unit vectors in the texel frame;
+/// z is clamped to at least `min_normal_z` so grazing normals keep a finite slope.
+/// Throws std::invalid_argument for a size mismatch or a map under 2 x 2.
+cv::Mat HeightFromNormals(const std::vector<float>& normals_xyz, int width, int height,
+                          double min_normal_z = 0.2);
+
+/// Per texel, the horizon elevation (radians, >= 0) in `sectors` azimuths
+/// phi_s = 2 pi s / sectors (phi from +x towards +y, texel frame).
+struct HorizonMap {
+  int width = 0, height = 0, sectors = 0;
+  /// Texel-major: `sectors` elevations per texel.
+  std::vector<float> elevation_rad;
+
+  std::size_t NumTexels() const { return static_cast<std::size_t>(width) * height; }
+  /// The horizon at a light's azimuth (radians), linear between sectors.
+  double ElevationAt(std::size_t texel, double azimuth_rad) const;
+};
+
+/// The horizon of every texel of `height_texels` (CV_64FC1, texel units): in each
+/// sector the largest elevation atan(dh / d) of the relief up to
+/// `max_distance_texels` away, read bilinearly along the ray; 0 where nothing rises
+/// above the texel. The ray leaving the map sees nothing beyond its edge.
+/// Throws std::invalid_argument for sectors outside [4, 64] or a distance outside
+/// [1, 4096].
+HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_distance_texels);
+
+/// The fraction of a directional light (unit, texel frame) that reaches the texel:
+/// 0 below the horizon, 1 above it, a linear ramp of `penumbra_rad` across it (a
+/// texel's footprint and a light's size soften the edge).
+double HorizonVisibility(const HorizonMap& horizon, std::size_t texel, const Eigen::Vector3d& light,
+                         double penumbra_rad);
+
+}  // namespace texlume::ptm

@@ -1,0 +1,64 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "ptm/horizon.h"
+#include "ptm/ptm.h"
+
+namespace texlume::ptm {
+
+/// A PTM of a sample's lit appearance and the horizon map of its relief (issue 29):
+/// relit, the PTM's linear light is scaled by the horizon's visibility, down to
+/// `shadow_floor` in full shadow. Both come from the RTI capture alone.
+struct ShadowedPtm {
+  Ptm ptm;  ///< RGB, display values (as fit.h fits), fitted to the lit samples only
+  HorizonMap horizon;
+  /// The integrated PTM normals' heights times this are the relief's (texel units):
+  /// a biquadratic's normals are flatter than the surface's.
+  double height_scale = 1.0;
+  /// Linear fraction of the lit light that a shadowed texel keeps (ambient and
+  /// interreflected light), the median over the capture's shadowed samples.
+  double shadow_floor = 1.0;
+  double penumbra_rad = 0.0;
+};
+
+struct ShadowedFitOptions {
+  int sectors = 16;           ///< horizon azimuths, [4, 64]
+  int reach_texels = 48;      ///< how far the horizon looks, [1, 4096]
+  double penumbra_deg = 4.0;  ///< width of the shadow's edge in light elevation, (0, 45]
+  /// Height scales tried; the one whose horizon best predicts an inner held-out
+  /// quarter of the capture's lights is kept. 0 (no shadows) among them.
+  std::vector<double> height_scales = {0.0, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0};
+  /// A texel lit under fewer lights than this is fitted to all its samples. >= 6.
+  int min_lit_lights = 8;
+
+  /// Throws OptionError naming the first setting out of range.
+  void Check() const;
+};
+
+/// The capture's images (CV_32FC3 display RGB in [0, 1], one per light, all one
+/// size) and lights (unit, texel frame, above the horizon). Steps (a class, one
+/// method each): fit an RGB PTM to every sample; integrate its normals into heights
+/// (HeightFromNormals); choose the height scale on an inner split of the lights;
+/// refit the PTM to the samples the chosen horizon leaves lit; measure the shadow
+/// floor. Throws InputError for fewer than 8 lights or images of different sizes.
+ShadowedPtm FitShadowedPtm(const std::vector<cv::Mat>& images,
+                           const std::vector<Eigen::Vector3d>& lights,
+                           const ShadowedFitOptions& options = {});
+
+/// Least-squares RGB PTM of the samples marked lit (`lit[k][texel]` 1 or 0, one
+/// vector per light), every sample where fewer than `min_lit_lights` are lit.
+Ptm FitRgbPtmToLitSamples(const std::vector<cv::Mat>& images,
+                          const std::vector<Eigen::Vector3d>& lights,
+                          const std::vector<std::vector<float>>& lit, int min_lit_lights);
+
+/// The PTM relit under `light` (Relight's display RGB, row-major), its linear light
+/// times the horizon's visibility, `shadow_floor` of it kept in full shadow.
+std::vector<float> RelightShadowed(const Ptm& ptm, const HorizonMap& horizon,
+                                   const Eigen::Vector3d& light, double shadow_floor,
+                                   double penumbra_rad);
+std::vector<float> RelightShadowed(const ShadowedPtm& shadowed, const Eigen::Vector3d& light);
+
+}  // namespace texlume::ptm

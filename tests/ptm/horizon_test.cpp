@@ -1,0 +1,84 @@
+// Horizon mapping: normals integrate to the relief they came from, and a wall's
+// horizon and shadow fall where its geometry puts them.
+#include "ptm/horizon.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace texlume::ptm {
+namespace {
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+// Unit normals of the height field H(x, y) = a x + b y (texel frame, y up).
+std::vector<float> PlaneNormals(int width, int height, double a, double b) {
+  const Eigen::Vector3d n = Eigen::Vector3d(-a, -b, 1.0).normalized();
+  std::vector<float> normals;
+  for (int i = 0; i < width * height; ++i)
+    for (int k = 0; k < 3; ++k) normals.push_back(static_cast<float>(n[k]));
+  return normals;
+}
+
+TEST(HeightFromNormals, APlanesNormalsIntegrateToThePlaneOnEvenAndOddSizes) {
+  for (const auto& [width, height] : {std::pair{16, 12}, std::pair{7, 5}}) {
+    const double a = 0.3, b = -0.2;
+    const cv::Mat h = HeightFromNormals(PlaneNormals(width, height, a, b), width, height);
+    ASSERT_EQ(h.cols, width);
+    ASSERT_EQ(h.rows, height);
+    EXPECT_NEAR(cv::mean(h)[0], 0.0, 1e-9);
+    // Rows run down, so y = -row.
+    for (int r = 0; r < height; ++r)
+      for (int c = 0; c + 1 < width; ++c) {
+        EXPECT_NEAR(h.at<double>(r, c + 1) - h.at<double>(r, c), a, 2e-4) << width;
+        if (r + 1 < height) {
+          EXPECT_NEAR(h.at<double>(r + 1, c) - h.at<double>(r, c), -b, 2e-4);
+        }
+      }
+  }
+}
+
+TEST(HeightFromNormals, RefusesMismatchedSizes) {
+  EXPECT_THROW(HeightFromNormals(PlaneNormals(4, 4, 0, 0), 4, 5), std::invalid_argument);
+  EXPECT_THROW(HeightFromNormals(PlaneNormals(1, 4, 0, 0), 1, 4), std::invalid_argument);
+}
+
+// A wall 10 texels high from column 20 on: seen from column 10 it rises 45 degrees
+// towards +x and not at all towards -x.
+TEST(HorizonMap, AWallsHorizonAndShadowFollowItsGeometry) {
+  cv::Mat h = cv::Mat::zeros(8, 40, CV_64FC1);
+  h(cv::Rect(20, 0, 20, 8)).setTo(10.0);
+  const HorizonMap horizon = ComputeHorizonMap(h, 8, 32);
+  const std::size_t texel = 4 * 40 + 10;
+  EXPECT_NEAR(horizon.ElevationAt(texel, 0.0), 45.0 * kDegree, 1e-6);
+  EXPECT_NEAR(horizon.ElevationAt(texel, std::numbers::pi), 0.0, 1e-9);
+  // Half-way between sectors 0 and 1 (0 and 45 degrees of azimuth): the mean.
+  const double diagonal = horizon.ElevationAt(texel, 45.0 * kDegree);
+  EXPECT_NEAR(horizon.ElevationAt(texel, 22.5 * kDegree), 0.5 * (45.0 * kDegree + diagonal), 1e-6);
+  // Out of reach: a wall 25 texels away is beyond a 16-texel search.
+  EXPECT_NEAR(ComputeHorizonMap(h, 8, 16).ElevationAt(4 * 40 + 0, 0.0), 0.0, 1e-9);
+  // On top of the wall nothing rises.
+  EXPECT_NEAR(horizon.ElevationAt(4 * 40 + 25, 0.0), 0.0, 1e-9);
+
+  const auto light = [](double elevation_deg, double azimuth_deg) {
+    const double e = elevation_deg * kDegree, a = azimuth_deg * kDegree;
+    return Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+  };
+  const double penumbra = 4.0 * kDegree;
+  EXPECT_EQ(HorizonVisibility(horizon, texel, light(30, 0), penumbra), 0.0);
+  EXPECT_EQ(HorizonVisibility(horizon, texel, light(60, 0), penumbra), 1.0);
+  EXPECT_NEAR(HorizonVisibility(horizon, texel, light(45, 0), penumbra), 0.5, 1e-6);
+  EXPECT_EQ(HorizonVisibility(horizon, texel, light(10, 180), penumbra), 1.0);
+}
+
+TEST(HorizonMap, RefusesSettingsOutOfRange) {
+  const cv::Mat h = cv::Mat::zeros(4, 4, CV_64FC1);
+  EXPECT_THROW(ComputeHorizonMap(h, 3, 8), std::invalid_argument);
+  EXPECT_THROW(ComputeHorizonMap(h, 8, 0), std::invalid_argument);
+  EXPECT_THROW(ComputeHorizonMap(cv::Mat::zeros(4, 4, CV_32FC1), 8, 8), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace texlume::ptm
