@@ -86,6 +86,9 @@ void AddFitCommand(CLI::App& app, CommandRunners& run) {
   sub->add_option("--web", o->web_dir, "also write the relight/OpenLIME web format");
   sub->add_option("--band-rows", o->fit.band_rows, "rows decoded and fitted at a time")
       ->capture_default_str();
+  sub->add_option("--horizon", o->horizon_file,
+                  "also fit the relief's self-shadowing: the PTM of the lit samples, and "
+                  "the horizon map written to FILE.exr (every image in memory)");
   run[sub] = [o](std::ostream& out, std::ostream& err) {
     ProgressBar bar;
     pipeline::RunFitJob(*o, out, err, bar.Callback());
@@ -122,6 +125,8 @@ void AddRelightCommand(CLI::App& app, CommandRunners& run) {
       ->expected(3);
   sub->add_option("--out", o->out_file, "the image to write (.png, .jpg, .tif)")->required();
   sub->add_option("--normals", o->normals_file, "also write the normal map");
+  sub->add_option("--horizon", o->horizon_file,
+                  "the PTM's horizon map (texlume fit --horizon): the relief's own shadows");
   sub->add_option("--gain", o->enhancement.diffuse_gain, "diffuse gain (1: off)")
       ->capture_default_str();
   sub->add_option("--specular", o->enhancement.specular, "specular enhancement (0: off)")

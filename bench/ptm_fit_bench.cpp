@@ -294,23 +294,27 @@ ptm::ShadowedPtm TrueReliefShadowedPtm(const fs::path& scene_dir,
                                        const std::vector<Eigen::Vector3d>& lights) {
   const ptm::ShadowedFitOptions o;
   ptm::ShadowedPtm out;
-  out.penumbra_rad = o.penumbra_deg * std::numbers::pi / 180.0;
-  out.horizon = ptm::ComputeHorizonMap(TrueHeightTexels(scene_dir), o.sectors, o.reach_texels);
-  std::vector<std::vector<float>> lit(lights.size(), std::vector<float>(out.horizon.NumTexels()));
+  ptm::SelfShadowing& shadowing = out.shadowing;
+  shadowing.penumbra_rad = o.penumbra_deg * std::numbers::pi / 180.0;
+  shadowing.horizon =
+      ptm::ComputeHorizonMap(TrueHeightTexels(scene_dir), o.sectors, o.reach_texels);
+  std::vector<std::vector<float>> lit(lights.size(),
+                                      std::vector<float>(shadowing.horizon.NumTexels()));
   for (std::size_t k = 0; k < lights.size(); ++k)
-    for (std::size_t t = 0; t < out.horizon.NumTexels(); ++t)
-      lit[k][t] = ptm::HorizonVisibility(out.horizon, t, lights[k], out.penumbra_rad) > 0.5;
-  out.ptm = ptm::FitRgbPtmToLitSamples(images, lights, lit, o.min_lit_lights);
-  // The floor as FitShadowedPtm measures it, from a shadowed fit with this horizon.
-  out.shadow_floor = 0.0;
-  double best = 1e300;
+    for (std::size_t t = 0; t < shadowing.horizon.NumTexels(); ++t)
+      lit[k][t] =
+          ptm::HorizonVisibility(shadowing.horizon, t, lights[k], shadowing.penumbra_rad) > 0.5;
+  out.ptm = ptm::FitPtmToLitSamples(images, lights, lit, ptm::PtmFormat::kRgb, o.min_lit_lights);
+  // The floor that best fits the capture itself.
+  double best = 1e300, best_floor = 0.0;
   for (double f = 0.0; f <= 1.0; f += 0.05) {
+    shadowing.shadow_floor = f;
     double error = 0;
     for (std::size_t k = 0; k < lights.size(); ++k)
-      error -= Psnr(ptm::RelightShadowed(out.ptm, out.horizon, lights[k], f, out.penumbra_rad),
-                    images[k]);
-    if (error < best) best = error, out.shadow_floor = f;
+      error -= Psnr(ptm::RelightShadowed(out, lights[k]), images[k]);
+    if (error < best) best = error, best_floor = f;
   }
+  shadowing.shadow_floor = best_floor;
   return out;
 }
 
@@ -350,7 +354,7 @@ void PrintScore(const char* label, const HeldOutScore& s) {
               s.psnr_low, s.gradient_low);
 }
 
-void SelfShadowing(const fs::path& work) {
+void SelfShadowingSection(const fs::path& work) {
   for (const datasets::MaterialKind kind :
        {datasets::MaterialKind::kStone, datasets::MaterialKind::kBrick,
         datasets::MaterialKind::kGrooves}) {
@@ -367,9 +371,15 @@ void SelfShadowing(const fs::path& work) {
     ptm::FitOptions o;
     o.format = ptm::PtmFormat::kRgb;
     const ptm::Ptm plain = ptm::FitPtmFromFiles(split.train.files, split.train.lights, o).ptm;
+    o.format = ptm::PtmFormat::kLrgb;
+    const ptm::Ptm plain_lrgb = ptm::FitPtmFromFiles(split.train.files, split.train.lights, o).ptm;
+    ptm::ShadowedFitOptions shadowed_options;
+    shadowed_options.format = ptm::PtmFormat::kRgb;
     const auto t0 = std::chrono::steady_clock::now();
-    const ptm::ShadowedPtm fitted = ptm::FitShadowedPtm(train_images, split.train.lights);
+    const ptm::ShadowedPtm fitted =
+        ptm::FitShadowedPtm(train_images, split.train.lights, shadowed_options);
     const double fit_seconds = Seconds(t0);
+    const ptm::ShadowedPtm fitted_lrgb = ptm::FitShadowedPtm(train_images, split.train.lights);
     const ptm::ShadowedPtm bound = TrueReliefShadowedPtm(dir, train_images, split.train.lights);
 
     const HeldOutScore base = ScoreHeldOut(
@@ -388,10 +398,18 @@ void SelfShadowing(const fs::path& work) {
                ScoreHeldOut(split.held, truth, [&](const Eigen::Vector3d& l) {
                  return ptm::RelightShadowed(fitted, l);
                }));
+    PrintScore("PTM LRGB", ScoreHeldOut(split.held, truth, [&](const Eigen::Vector3d& l) {
+                 return ptm::Relight(plain_lrgb, l);
+               }));
+    PrintScore("shadowed PTM LRGB fitted from the capture",
+               ScoreHeldOut(split.held, truth, [&](const Eigen::Vector3d& l) {
+                 return ptm::RelightShadowed(fitted_lrgb, l);
+               }));
     std::printf(
         "  fitted: height scale %.2f, shadow keeps %.2f of the light, %.1f s (true relief: "
         "%.2f)\n",
-        fitted.height_scale, fitted.shadow_floor, fit_seconds, bound.shadow_floor);
+        fitted.shadowing.height_scale, fitted.shadowing.shadow_floor, fit_seconds,
+        bound.shadowing.shadow_floor);
   }
 }
 
@@ -463,7 +481,7 @@ int main(int argc, char** argv) {
     Throughput(n, cv::Size(width > 0 ? width : size, height > 0 ? height : size), format, work);
   if (part == "throughput") return 0;
   if (part == "horizon") {
-    SelfShadowing(work);
+    SelfShadowingSection(work);
     return 0;
   }
 

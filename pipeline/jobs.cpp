@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -12,12 +13,15 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
+#include "core/memory_budget.h"
 #include "core/partial_output.h"
 #include "core/timing.h"
 #include "model/model_io.h"
 #include "pipeline/btf_synth_job.h"
+#include "ptm/horizon.h"
 #include "ptm/hsh.h"
 #include "ptm/ptm_io.h"
+#include "ptm/shadowed_fit.h"
 #include "sfm/lights.h"
 
 namespace texlume::pipeline {
@@ -113,6 +117,12 @@ void FitJobOptions::Check() const {
     if (LowerCaseExtension(out_file) != ".rti")
       throw OptionError("an HSH fit writes RTIViewer's .rti: name --out FILE.rti");
   }
+  if (!horizon_file.empty()) {
+    if (basis != "ptm") throw OptionError("--horizon goes with a PTM fit (--basis ptm)");
+    if (fit.robust) throw OptionError("--horizon and --robust both set shadows aside: choose one");
+    if (LowerCaseExtension(horizon_file) != ".exr")
+      throw OptionError("the horizon map is an OpenEXR file: name --horizon FILE.exr");
+  }
 }
 
 nlohmann::json FitJobOptions::ToJson() const {
@@ -128,7 +138,8 @@ nlohmann::json FitJobOptions::ToJson() const {
           {"format", fit.format == ptm::PtmFormat::kLrgb ? "lrgb" : "rgb"},
           {"robust", fit.robust},
           {"band_rows", fit.band_rows},
-          {"robust_scale", fit.robust_scale}};
+          {"robust_scale", fit.robust_scale},
+          {"horizon", horizon_file.string()}};
 }
 
 namespace {
@@ -166,6 +177,73 @@ FitOutcome FitAndWritePtm(const FitJobOptions& options, const ptm::RtiCapture& c
   return o;
 }
 
+// The capture's images, all in memory (the memory limit is checked against the
+// first image's size before the others are read).
+std::vector<cv::Mat> ReadWholeCapture(const ptm::RtiCapture& capture, const std::string& label,
+                                      const ProgressCallback& progress) {
+  std::vector<cv::Mat> images;
+  for (std::size_t k = 0; k < capture.files.size(); ++k) {
+    if (progress) progress("reading the capture", k, capture.files.size());
+    images.push_back(ReadPhotoRgb(capture.files[k]));
+    if (images[k].size() != images[0].size())
+      throw InputError(capture.files[k].string(),
+                       std::to_string(images[k].cols) + " x " + std::to_string(images[k].rows) +
+                           " pixels, where the capture's first image has " +
+                           std::to_string(images[0].cols) + " x " + std::to_string(images[0].rows));
+    // Per image and texel: 12 bytes of RGB and 8 of lit masks; per texel, the horizon
+    // maps, heights and PTMs of the steps.
+    if (k == 0)
+      RequireMemory((20.0 * static_cast<double>(capture.files.size()) + 400.0) *
+                        static_cast<double>(images[0].total()),
+                    "the shadowed fit (every image of the capture in memory)", label);
+  }
+  return images;
+}
+
+FitOutcome FitAndWriteShadowedPtm(const FitJobOptions& options, const ptm::RtiCapture& capture,
+                                  const ProgressCallback& progress) {
+  ptm::CheckLightSet(capture.lights, options.fit, options.lights_file.string());
+  if (capture.lights.size() < 8)
+    throw InputError(options.lights_file.string(),
+                     std::to_string(capture.lights.size()) +
+                         " lights: a fit with --horizon needs at least 8 (a quarter of them "
+                         "checks the horizon's height)");
+  const auto t_read = std::chrono::steady_clock::now();
+  const std::vector<cv::Mat> images =
+      ReadWholeCapture(capture, options.images_dir.string(), progress);
+  const double read_seconds = SecondsSince(t_read);
+  const auto t_fit = std::chrono::steady_clock::now();
+  ptm::ShadowedFitOptions shadowed;
+  shadowed.format = options.fit.format;
+  const ptm::ShadowedPtm fit = ptm::FitShadowedPtm(images, capture.lights, shadowed, progress);
+  FitOutcome o;
+  o.fit_seconds = read_seconds + SecondsSince(t_fit);
+  const auto t0 = std::chrono::steady_clock::now();
+  ptm::WritePtmFile(fit.ptm, options.out_file);
+  if (!options.exr_file.empty()) ptm::WritePtmExr(fit.ptm, options.exr_file);
+  if (!options.web_dir.empty()) ptm::WriteRelightWeb(fit.ptm, options.web_dir);
+  ptm::WriteSelfShadowingExr(fit.shadowing, options.horizon_file);
+  o.write_seconds = SecondsSince(t0);
+  std::ostringstream line;
+  line << "Fitted a " << fit.ptm.width << "x" << fit.ptm.height << " "
+       << (options.fit.format == ptm::PtmFormat::kLrgb ? "LRGB" : "RGB")
+       << " PTM to the lit samples of " << images.size()
+       << " images and its horizon map (height scale " << fit.shadowing.height_scale
+       << ", shadows keep " << fit.shadowing.shadow_floor << " of the light) in " << o.fit_seconds
+       << " s. Wrote " << options.out_file.string() << " and " << options.horizon_file.string();
+  o.summary = line.str();
+  o.result = {{"width", fit.ptm.width},
+              {"height", fit.ptm.height},
+              {"images", images.size()},
+              {"horizon",
+               {{"file", options.horizon_file.string()},
+                {"sectors", fit.shadowing.horizon.sectors},
+                {"height_scale", fit.shadowing.height_scale},
+                {"shadow_floor", fit.shadowing.shadow_floor},
+                {"penumbra_deg", fit.shadowing.penumbra_rad * 180.0 / std::numbers::pi}}}};
+  return o;
+}
+
 FitOutcome FitAndWriteHsh(const FitJobOptions& options, const ptm::RtiCapture& capture,
                           const ProgressCallback& progress) {
   const ptm::HshFitResult result = ptm::FitHshFromFiles(
@@ -197,6 +275,7 @@ void RunFitJob(const FitJobOptions& options, std::ostream& out, std::ostream& er
   options.Check();
   RequireWritableFilePath(options.out_file);
   if (!options.exr_file.empty()) RequireWritableFilePath(options.exr_file);
+  if (!options.horizon_file.empty()) RequireWritableFilePath(options.horizon_file);
   std::error_code ec;
   if (!options.web_dir.empty() && fs::exists(options.web_dir, ec) &&
       !fs::is_directory(options.web_dir, ec)) {
@@ -205,7 +284,9 @@ void RunFitJob(const FitJobOptions& options, std::ostream& out, std::ostream& er
   const ptm::RtiCapture capture = ptm::ReadRtiCapture(options.lights_file, options.images_dir);
   for (const std::string& w : capture.warnings) err << "warning: " << w << "\n";
   const FitOutcome fit = options.basis == "hsh" ? FitAndWriteHsh(options, capture, progress)
-                                                : FitAndWritePtm(options, capture, progress);
+                         : !options.horizon_file.empty()
+                             ? FitAndWriteShadowedPtm(options, capture, progress)
+                             : FitAndWritePtm(options, capture, progress);
   out << fit.summary << "\n";
   nlohmann::json record;
   record["command"] = "fit";
@@ -275,13 +356,16 @@ void RelightJobOptions::Check() const {
   if (!(light.normalized().z() > 0))
     throw OptionError("the light must be above the horizon (z > 0)");
   enhancement.Check();
+  if (!horizon_file.empty() && (enhancement.diffuse_gain != 1.0 || enhancement.specular > 0.0))
+    throw OptionError("--horizon relights the PTM as captured: no --gain or --specular with it");
 }
 
 nlohmann::json RelightJobOptions::ToJson() const {
   return {{"ptm", ptm_file.string()},
           {"light", {light.x(), light.y(), light.z()}},
           {"gain", enhancement.diffuse_gain},
-          {"specular", enhancement.specular}};
+          {"specular", enhancement.specular},
+          {"horizon", horizon_file.string()}};
 }
 
 void RunRelightJob(const RelightJobOptions& options, std::ostream& out) {
@@ -290,8 +374,20 @@ void RunRelightJob(const RelightJobOptions& options, std::ostream& out) {
   if (!options.normals_file.empty()) RequireWritableFilePath(options.normals_file);
   const Eigen::Vector3d light = options.light.normalized();
   const ptm::Ptm ptm = ptm::ReadPtmAnyFormat(options.ptm_file);
-  WriteRgbImage(options.out_file, ptm::Relight(ptm, light, options.enhancement), ptm.width,
-                ptm.height, false);
+  std::vector<float> relit;
+  if (options.horizon_file.empty()) {
+    relit = ptm::Relight(ptm, light, options.enhancement);
+  } else {
+    const ptm::SelfShadowing shadowing = ptm::ReadSelfShadowingExr(options.horizon_file);
+    if (shadowing.horizon.width != ptm.width || shadowing.horizon.height != ptm.height)
+      throw InputError(options.horizon_file.string(),
+                       "a " + std::to_string(shadowing.horizon.width) + " x " +
+                           std::to_string(shadowing.horizon.height) + " horizon map for the " +
+                           std::to_string(ptm.width) + " x " + std::to_string(ptm.height) +
+                           " PTM " + options.ptm_file.string());
+    relit = ptm::RelightShadowed(ptm, shadowing, light);
+  }
+  WriteRgbImage(options.out_file, relit, ptm.width, ptm.height, false);
   if (!options.normals_file.empty())
     WriteRgbImage(options.normals_file, ptm::NormalMap(ptm), ptm.width, ptm.height, true);
   out << "Relit " << ptm.width << "x" << ptm.height << " PTM under (" << light.transpose()

@@ -46,6 +46,10 @@ struct FitJobOptions {
   /// RTIViewer's .rti; the web format of an HSH; no EXR, no robust fit).
   std::string basis = "ptm";
   int hsh_order = 3;
+  /// Not empty: the PTM is fitted to the samples the relief leaves lit and the
+  /// relief's horizon map is written here (ptm/shadowed_fit.h; every image is held
+  /// in memory).
+  std::filesystem::path horizon_file;
   void Check() const;
   nlohmann::json ToJson() const;
 };
@@ -66,6 +70,7 @@ void RunBtfJob(const BtfJobOptions& options, std::ostream& out,
 struct RelightJobOptions {
   std::filesystem::path ptm_file, out_file;
   std::filesystem::path normals_file;                ///< empty: not written
+  std::filesystem::path horizon_file;                ///< empty: no self-shadowing
   Eigen::Vector3d light = Eigen::Vector3d::UnitZ();  ///< towards the light, z > 0
   ptm::EnhancementOptions enhancement;
   void Check() const;

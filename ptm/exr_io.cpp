@@ -30,7 +30,8 @@ constexpr std::int64_t kMaxExrSide = 1 << 16;
 }  // namespace
 
 void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& planes,
-              const std::vector<std::string>& channel_names) {
+              const std::vector<std::string>& channel_names,
+              const std::map<std::string, float>& float_attributes) {
   TEXLUME_CHECK(!planes.empty() && planes.size() == channel_names.size(), "one name per plane");
   const int width = planes[0].cols, height = planes[0].rows;
   for (const cv::Mat& p : planes) {
@@ -66,6 +67,7 @@ void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& pla
   spec.attribute("compression", "zip");
   // No capture date: the same data must give the same bytes.
   spec.attribute("DateTime", "");
+  for (const auto& [name, value] : float_attributes) spec.attribute(name, value);
   const bool ok = out->open(tmp.string(), spec) &&
                   out->write_image(OIIO::TypeDesc::FLOAT, interleaved.data()) && out->close();
   if (!ok) throw std::runtime_error(path.string() + ": cannot write EXR: " + out->geterror());
@@ -256,7 +258,8 @@ std::unique_ptr<OIIO::ImageInput> OpenExr(const std::string& label,
 }
 
 std::vector<cv::Mat> ReadPlanes(OIIO::ImageInput& in, const std::string& label,
-                                std::vector<std::string>* channel_names) {
+                                std::vector<std::string>* channel_names,
+                                std::map<std::string, float>* float_attributes = nullptr) {
   const OIIO::ImageSpec& spec = in.spec();
   RequirePlausibleSize(spec.width, spec.height, spec.nchannels, label);
   std::vector<float> data(static_cast<std::size_t>(spec.width) * spec.height * spec.nchannels);
@@ -275,13 +278,20 @@ std::vector<cv::Mat> ReadPlanes(OIIO::ImageInput& in, const std::string& label,
     planes.push_back(p);
   }
   if (channel_names) *channel_names = spec.channelnames;
+  if (float_attributes) {
+    float_attributes->clear();
+    for (const OIIO::ParamValue& p : spec.extra_attribs)
+      if (p.type() == OIIO::TypeFloat && p.name().string().rfind("texlume:", 0) == 0)
+        (*float_attributes)[p.name().string()] = p.get_float();
+  }
   return planes;
 }
 
 }  // namespace
 
 std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
-                             std::vector<std::string>* channel_names) {
+                             std::vector<std::string>* channel_names,
+                             std::map<std::string, float>* float_attributes) {
   {
     std::ifstream file = OpenForReading(path, true);
     std::error_code ec;
@@ -290,7 +300,7 @@ std::vector<cv::Mat> ReadExr(const std::filesystem::path& path,
     CheckExrHeader(file, size, path.string());
   }
   const std::unique_ptr<OIIO::ImageInput> in = OpenExr(path.string(), nullptr);
-  return ReadPlanes(*in, path.string(), channel_names);
+  return ReadPlanes(*in, path.string(), channel_names, float_attributes);
 }
 
 std::vector<cv::Mat> ReadExrBytes(std::string_view bytes, const std::string& label,

@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <stdexcept>
 #include <string>
+
+#include "core/errors.h"
+#include "ptm/exr_io.h"
 
 namespace texlume::ptm {
 namespace {
@@ -158,6 +162,88 @@ double HorizonVisibility(const HorizonMap& horizon, std::size_t texel, const Eig
   const double elevation = std::asin(std::clamp(light.z(), -1.0, 1.0));
   const double horizon_elevation = horizon.ElevationAt(texel, std::atan2(light.y(), light.x()));
   return std::clamp((elevation - horizon_elevation) / penumbra_rad + 0.5, 0.0, 1.0);
+}
+
+double SelfShadowing::LightFactor(std::size_t texel, const Eigen::Vector3d& light) const {
+  const double v = HorizonVisibility(horizon, texel, light, penumbra_rad);
+  return v + (1.0 - v) * shadow_floor;
+}
+
+namespace {
+
+// "horizon.00" to "horizon.63": zero-padded so that name order is sector order.
+std::string SectorChannel(int s) {
+  return std::string("horizon.") + static_cast<char>('0' + s / 10) +
+         static_cast<char>('0' + s % 10);
+}
+
+double RequireAttribute(const std::map<std::string, float>& attributes, const std::string& name,
+                        double low, double high, const std::string& label) {
+  const auto it = attributes.find(name);
+  if (it == attributes.end())
+    throw InputError(label, "is not a texlume horizon file: no " + name + " attribute");
+  if (!(it->second >= low && it->second <= high))
+    throw InputError(label, name + " " + std::to_string(it->second) + " is outside [" +
+                                std::to_string(low) + ", " + std::to_string(high) + "]");
+  return it->second;
+}
+
+}  // namespace
+
+void WriteSelfShadowingExr(const SelfShadowing& shadowing, const std::filesystem::path& path) {
+  const HorizonMap& h = shadowing.horizon;
+  std::vector<cv::Mat> planes;
+  std::vector<std::string> names;
+  for (int s = 0; s < h.sectors; ++s) {
+    cv::Mat plane(h.height, h.width, CV_32FC1);
+    for (std::size_t t = 0; t < h.NumTexels(); ++t)
+      plane.at<float>(static_cast<int>(t / static_cast<std::size_t>(h.width)),
+                      static_cast<int>(t % static_cast<std::size_t>(h.width))) =
+          h.elevation_rad[t * static_cast<std::size_t>(h.sectors) + static_cast<std::size_t>(s)];
+    planes.push_back(plane);
+    names.push_back(SectorChannel(s));
+  }
+  WriteExr(path, planes, names,
+           {{"texlume:height_scale", static_cast<float>(shadowing.height_scale)},
+            {"texlume:shadow_floor", static_cast<float>(shadowing.shadow_floor)},
+            {"texlume:penumbra_rad", static_cast<float>(shadowing.penumbra_rad)}});
+}
+
+SelfShadowing ReadSelfShadowingExr(const std::filesystem::path& path) {
+  const std::string label = path.string();
+  std::vector<std::string> names;
+  std::map<std::string, float> attributes;
+  const std::vector<cv::Mat> planes = ReadExr(path, &names, &attributes);
+  const int sectors = static_cast<int>(planes.size());
+  if (sectors < 4 || sectors > 64)
+    throw InputError(label, "is not a texlume horizon file: " + std::to_string(sectors) +
+                                " channels, not 4 to 64 sectors");
+  SelfShadowing out;
+  HorizonMap& h = out.horizon;
+  h.width = planes[0].cols;
+  h.height = planes[0].rows;
+  h.sectors = sectors;
+  h.elevation_rad.resize(h.NumTexels() * static_cast<std::size_t>(sectors));
+  for (int s = 0; s < sectors; ++s) {
+    // The reader may order channels by name: find each sector's.
+    const auto it = std::find(names.begin(), names.end(), SectorChannel(s));
+    if (it == names.end())
+      throw InputError(label, "is not a texlume horizon file: no channel " + SectorChannel(s));
+    const cv::Mat& plane = planes[static_cast<std::size_t>(it - names.begin())];
+    for (std::size_t t = 0; t < h.NumTexels(); ++t) {
+      const float e = plane.at<float>(static_cast<int>(t / static_cast<std::size_t>(h.width)),
+                                      static_cast<int>(t % static_cast<std::size_t>(h.width)));
+      if (!(e >= 0.0f && e <= static_cast<float>(std::numbers::pi / 2)))
+        throw InputError(label, SectorChannel(s) + " holds " + std::to_string(e) +
+                                    ", not an elevation in [0, pi / 2]");
+      h.elevation_rad[t * static_cast<std::size_t>(sectors) + static_cast<std::size_t>(s)] = e;
+    }
+  }
+  out.height_scale = RequireAttribute(attributes, "texlume:height_scale", 0.0, 100.0, label);
+  out.shadow_floor = RequireAttribute(attributes, "texlume:shadow_floor", 0.0, 1.0, label);
+  out.penumbra_rad =
+      RequireAttribute(attributes, "texlume:penumbra_rad", 1e-6, std::numbers::pi / 4, label);
+  return out;
 }
 
 }  // namespace texlume::ptm

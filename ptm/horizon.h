@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -50,5 +51,31 @@ HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_
 /// texel's footprint and a light's size soften the edge).
 double HorizonVisibility(const HorizonMap& horizon, std::size_t texel, const Eigen::Vector3d& light,
                          double penumbra_rad);
+
+/// A sample's self-shadowing: its horizon map and how much light a shadow keeps.
+/// Relit, a texel's linear light is multiplied by LightFactor (RelightShadowed in
+/// shadowed_fit.h).
+struct SelfShadowing {
+  HorizonMap horizon;
+  /// The integrated PTM normals' heights times this are the relief's (texel units):
+  /// a biquadratic's normals are flatter than the surface's.
+  double height_scale = 1.0;
+  /// Linear fraction of the lit light that a shadowed texel keeps (ambient and
+  /// interreflected light). [0, 1].
+  double shadow_floor = 1.0;
+  /// Width of the shadow's edge in light elevation, radians. (0, pi / 4].
+  double penumbra_rad = 0.07;
+
+  /// v + (1 - v) shadow_floor, v the horizon's visibility of the light (unit, texel frame).
+  double LightFactor(std::size_t texel, const Eigen::Vector3d& light) const;
+};
+
+/// A horizon file: OpenEXR, one channel per sector ("horizon.00", "horizon.01", ...:
+/// elevation in radians), float attributes texlume:height_scale, texlume:shadow_floor
+/// and texlume:penumbra_rad. Written atomically.
+void WriteSelfShadowingExr(const SelfShadowing& shadowing, const std::filesystem::path& path);
+/// Throws InputError naming the file when it is not a horizon file, a channel or
+/// attribute is missing, or a value is out of range (elevations in [0, pi / 2]).
+SelfShadowing ReadSelfShadowingExr(const std::filesystem::path& path);
 
 }  // namespace texlume::ptm

@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <string_view>
 
 #include "core/errors.h"
 #include "core/srgb.h"
@@ -71,21 +72,27 @@ double MeanSquaredError(const std::vector<float>& rgb, const cv::Mat& image) {
   return sum / (static_cast<double>(image.total()) * 3.0);
 }
 
-// FitShadowedPtm's steps, in order.
+// FitShadowedPtm's steps, in order; each reports its progress.
 class ShadowedFit {
  public:
+  static constexpr std::string_view kStage = "fitting the PTM and its horizon";
+
   ShadowedFit(const std::vector<cv::Mat>& images, const std::vector<Eigen::Vector3d>& lights,
-              const ShadowedFitOptions& options)
+              const ShadowedFitOptions& options, const ProgressCallback& progress)
       : images_(images),
         lights_(lights),
         options_(options),
-        penumbra_rad_(options.penumbra_deg * kDegree) {}
+        progress_(progress),
+        steps_(options.height_scales.size() + 2) {
+    shadowing_.penumbra_rad = options.penumbra_deg * kDegree;
+  }
 
   // An RGB PTM of every sample, whose normals (Malzbender et al. eq. 16) are
   // integrated into the relief's heights, in texel units.
   void IntegrateNormals() {
-    const Ptm all =
-        FitRgbPtmToLitSamples(images_, lights_, AllLit(lights_.size(), images_[0].total()), 6);
+    Report();
+    const Ptm all = FitPtmToLitSamples(images_, lights_, AllLit(lights_.size(), images_[0].total()),
+                                       PtmFormat::kRgb, 6);
     heights_texels_ = HeightFromNormals(NormalMap(all), all.width, all.height);
   }
 
@@ -100,39 +107,49 @@ class ShadowedFit {
     }
     double best_error = std::numeric_limits<double>::infinity();
     for (const double scale : options_.height_scales) {
-      const HorizonMap horizon = HorizonAtScale(scale);
-      const LitMask lit = LitSamples(horizon, fit_lights, penumbra_rad_);
-      const Ptm fit = FitRgbPtmToLitSamples(fit_images, fit_lights, lit, options_.min_lit_lights);
-      const double floor = ShadowFloor(fit, fit_images, fit_lights, lit);
+      Report();
+      SelfShadowing trial = shadowing_;
+      trial.horizon = HorizonAtScale(scale);
+      const LitMask lit = LitSamples(trial.horizon, fit_lights, trial.penumbra_rad);
+      const Ptm fit =
+          FitPtmToLitSamples(fit_images, fit_lights, lit, options_.format, options_.min_lit_lights);
+      trial.shadow_floor = ShadowFloor(fit, fit_images, fit_lights, lit);
       double error = 0;
       for (std::size_t k = 0; k < check_lights.size(); ++k)
-        error += MeanSquaredError(
-            RelightShadowed(fit, horizon, check_lights[k], floor, penumbra_rad_), check_images[k]);
-      if (error < best_error) best_error = error, result_.height_scale = scale;
+        error += MeanSquaredError(RelightShadowed(fit, trial, check_lights[k]), check_images[k]);
+      if (error < best_error) best_error = error, shadowing_.height_scale = scale;
     }
   }
 
   // The PTM of the samples the chosen horizon leaves lit, and the shadow floor.
   ShadowedPtm RefitLitSamples() {
-    result_.horizon = HorizonAtScale(result_.height_scale);
-    const LitMask lit = LitSamples(result_.horizon, lights_, penumbra_rad_);
-    result_.ptm = FitRgbPtmToLitSamples(images_, lights_, lit, options_.min_lit_lights);
-    result_.shadow_floor = ShadowFloor(result_.ptm, images_, lights_, lit);
-    result_.penumbra_rad = penumbra_rad_;
-    return std::move(result_);
+    Report();
+    ShadowedPtm out;
+    shadowing_.horizon = HorizonAtScale(shadowing_.height_scale);
+    const LitMask lit = LitSamples(shadowing_.horizon, lights_, shadowing_.penumbra_rad);
+    out.ptm = FitPtmToLitSamples(images_, lights_, lit, options_.format, options_.min_lit_lights);
+    shadowing_.shadow_floor = ShadowFloor(out.ptm, images_, lights_, lit);
+    out.shadowing = std::move(shadowing_);
+    if (progress_) progress_(kStage, steps_, steps_);
+    return out;
   }
 
  private:
   HorizonMap HorizonAtScale(double scale) const {
     return ComputeHorizonMap(heights_texels_ * scale, options_.sectors, options_.reach_texels);
   }
+  void Report() {
+    if (progress_) progress_(kStage, step_++, steps_);
+  }
 
   const std::vector<cv::Mat>& images_;
   const std::vector<Eigen::Vector3d>& lights_;
   const ShadowedFitOptions& options_;
-  const double penumbra_rad_;
+  const ProgressCallback& progress_;
+  const std::size_t steps_;
+  std::size_t step_ = 0;
   cv::Mat heights_texels_;
-  ShadowedPtm result_;
+  SelfShadowing shadowing_;
 };
 
 }  // namespace
@@ -149,12 +166,12 @@ void ShadowedFitOptions::Check() const {
   if (min_lit_lights < 6) throw OptionError("min_lit_lights must be >= 6");
 }
 
-Ptm FitRgbPtmToLitSamples(const std::vector<cv::Mat>& images,
-                          const std::vector<Eigen::Vector3d>& lights, const LitMask& lit,
-                          int min_lit_lights) {
+Ptm FitPtmToLitSamples(const std::vector<cv::Mat>& images,
+                       const std::vector<Eigen::Vector3d>& lights, const LitMask& lit,
+                       PtmFormat format, int min_lit_lights) {
   const int width = images[0].cols, height = images[0].rows;
   Ptm out;
-  out.Resize(PtmFormat::kRgb, width, height);
+  out.Resize(format, width, height);
   const Eigen::Matrix<double, Eigen::Dynamic, 6> a = PtmLightMatrix(lights);
 #pragma omp parallel for schedule(dynamic, 4)
   for (int y = 0; y < height; ++y)
@@ -162,31 +179,60 @@ Ptm FitRgbPtmToLitSamples(const std::vector<cv::Mat>& images,
       const std::size_t t = static_cast<std::size_t>(y) * width + x;
       int lit_count = 0;
       for (const auto& w : lit) lit_count += w[t] > 0.5f;
-      // Normal equations of eq. 1 over the kept samples, one right side per channel.
+      const auto kept = [&](std::size_t k) {
+        return lit_count < min_lit_lights || lit[k][t] > 0.5f;
+      };
+      const auto rgb = [&](std::size_t k) {
+        const cv::Vec3f v = images[k].ptr<cv::Vec3f>(y)[x];
+        return Eigen::Vector3d(v[0], v[1], v[2]);
+      };
+      // LRGB (fit.h): the luminance-weighted mean colour, largest channel 1; the
+      // polynomial fits each sample's projection on it.
+      Eigen::Vector3d colour = Eigen::Vector3d::Ones();
+      if (format == PtmFormat::kLrgb) {
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        for (std::size_t k = 0; k < lights.size(); ++k)
+          if (kept(k)) sum += rgb(k).mean() * rgb(k);
+        if (sum.maxCoeff() > 1e-9) colour = sum / sum.maxCoeff();
+        for (int c = 0; c < 3; ++c)
+          out.colour[t * 3 + static_cast<std::size_t>(c)] = static_cast<float>(colour[c]);
+      }
+      const Eigen::Vector3d projection = colour / colour.squaredNorm();
+      // Normal equations of eq. 1 over the kept samples, one right side per polynomial.
       Eigen::Matrix<double, 6, 6> normal = Eigen::Matrix<double, 6, 6>::Zero();
       Eigen::Matrix<double, 6, 3> rhs = Eigen::Matrix<double, 6, 3>::Zero();
       for (std::size_t k = 0; k < lights.size(); ++k) {
-        if (lit_count >= min_lit_lights && lit[k][t] < 0.5f) continue;
+        if (!kept(k)) continue;
         const Eigen::Matrix<double, 6, 1> row = a.row(static_cast<Eigen::Index>(k)).transpose();
         normal += row * row.transpose();
-        const cv::Vec3f v = images[k].ptr<cv::Vec3f>(y)[x];
-        for (int c = 0; c < 3; ++c) rhs.col(c) += row * static_cast<double>(v[c]);
+        const Eigen::Vector3d v = rgb(k);
+        if (format == PtmFormat::kLrgb) {
+          rhs.col(0) += row * v.dot(projection);
+        } else {
+          for (int c = 0; c < 3; ++c) rhs.col(c) += row * v[c];
+        }
       }
       const Eigen::Matrix<double, 6, 3> coefficients = normal.ldlt().solve(rhs);
-      for (int c = 0; c < 3; ++c)
+      for (int c = 0; c < out.NumPolynomials(); ++c)
         for (int i = 0; i < 6; ++i)
           out.Coefficients(t, c)[i] = static_cast<float>(coefficients(i, c));
     }
   return out;
 }
 
-std::vector<float> RelightShadowed(const Ptm& ptm, const HorizonMap& horizon,
-                                   const Eigen::Vector3d& light, double shadow_floor,
-                                   double penumbra_rad) {
-  std::vector<float> rgb = Relight(ptm, light);
-  for (std::size_t t = 0; t < ptm.NumTexels(); ++t) {
-    const double v = HorizonVisibility(horizon, t, light.normalized(), penumbra_rad);
-    const auto keep = static_cast<float>(v + (1.0 - v) * shadow_floor);
+std::vector<float> RelightShadowed(const Ptm& ptm, const SelfShadowing& shadowing,
+                                   const Eigen::Vector3d& light) {
+  if (shadowing.horizon.width != ptm.width || shadowing.horizon.height != ptm.height)
+    throw std::invalid_argument("a " + std::to_string(shadowing.horizon.width) + " x " +
+                                std::to_string(shadowing.horizon.height) + " horizon map for a " +
+                                std::to_string(ptm.width) + " x " + std::to_string(ptm.height) +
+                                " PTM");
+  const Eigen::Vector3d l = light.normalized();
+  std::vector<float> rgb = Relight(ptm, l);
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < static_cast<long>(ptm.NumTexels()); ++i) {
+    const auto t = static_cast<std::size_t>(i);
+    const auto keep = static_cast<float>(shadowing.LightFactor(t, l));
     for (std::size_t c = 0; c < 3; ++c) {
       float& value = rgb[t * 3 + c];
       value = srgb::FromLinear(srgb::ToLinear(value) * keep);
@@ -196,13 +242,12 @@ std::vector<float> RelightShadowed(const Ptm& ptm, const HorizonMap& horizon,
 }
 
 std::vector<float> RelightShadowed(const ShadowedPtm& shadowed, const Eigen::Vector3d& light) {
-  return RelightShadowed(shadowed.ptm, shadowed.horizon, light, shadowed.shadow_floor,
-                         shadowed.penumbra_rad);
+  return RelightShadowed(shadowed.ptm, shadowed.shadowing, light);
 }
 
 ShadowedPtm FitShadowedPtm(const std::vector<cv::Mat>& images,
                            const std::vector<Eigen::Vector3d>& lights,
-                           const ShadowedFitOptions& options) {
+                           const ShadowedFitOptions& options, const ProgressCallback& progress) {
   options.Check();
   if (images.size() != lights.size() || lights.size() < 8)
     throw InputError(
@@ -211,7 +256,7 @@ ShadowedPtm FitShadowedPtm(const std::vector<cv::Mat>& images,
   for (const cv::Mat& image : images)
     if (image.type() != CV_32FC3 || image.size() != images[0].size())
       throw InputError("capture", "the images must all be float RGB of one size");
-  ShadowedFit fit(images, lights, options);
+  ShadowedFit fit(images, lights, options, progress);
   fit.IntegrateNormals();
   fit.ChooseHeightScale();
   return fit.RefitLitSamples();

@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "core/progress.h"
 #include "ptm/horizon.h"
 #include "ptm/ptm.h"
 
@@ -13,18 +14,15 @@ namespace texlume::ptm {
 /// relit, the PTM's linear light is scaled by the horizon's visibility, down to
 /// `shadow_floor` in full shadow. Both come from the RTI capture alone.
 struct ShadowedPtm {
-  Ptm ptm;  ///< RGB, display values (as fit.h fits), fitted to the lit samples only
-  HorizonMap horizon;
-  /// The integrated PTM normals' heights times this are the relief's (texel units):
-  /// a biquadratic's normals are flatter than the surface's.
-  double height_scale = 1.0;
-  /// Linear fraction of the lit light that a shadowed texel keeps (ambient and
-  /// interreflected light), the median over the capture's shadowed samples.
-  double shadow_floor = 1.0;
-  double penumbra_rad = 0.0;
+  /// Display values (as fit.h fits), fitted to the lit samples only, in the
+  /// options' format (LRGB: fit.h's chromaticity, of the lit samples).
+  Ptm ptm;
+  /// The shadow floor is the median over the capture's shadowed samples.
+  SelfShadowing shadowing;
 };
 
 struct ShadowedFitOptions {
+  PtmFormat format = PtmFormat::kLrgb;
   int sectors = 16;           ///< horizon azimuths, [4, 64]
   int reach_texels = 48;      ///< how far the horizon looks, [1, 4096]
   double penumbra_deg = 4.0;  ///< width of the shadow's edge in light elevation, (0, 45]
@@ -46,19 +44,23 @@ struct ShadowedFitOptions {
 /// floor. Throws InputError for fewer than 8 lights or images of different sizes.
 ShadowedPtm FitShadowedPtm(const std::vector<cv::Mat>& images,
                            const std::vector<Eigen::Vector3d>& lights,
-                           const ShadowedFitOptions& options = {});
+                           const ShadowedFitOptions& options = {},
+                           const ProgressCallback& progress = {});
 
-/// Least-squares RGB PTM of the samples marked lit (`lit[k][texel]` 1 or 0, one
-/// vector per light), every sample where fewer than `min_lit_lights` are lit.
-Ptm FitRgbPtmToLitSamples(const std::vector<cv::Mat>& images,
-                          const std::vector<Eigen::Vector3d>& lights,
-                          const std::vector<std::vector<float>>& lit, int min_lit_lights);
+/// Least-squares PTM of the samples marked lit (`lit[k][texel]` 1 or 0, one vector
+/// per light), every sample where fewer than `min_lit_lights` are lit. LRGB: the
+/// chromaticity is fit.h's (the luminance-weighted mean colour, largest channel 1)
+/// and the polynomial fits each sample's projection on it.
+Ptm FitPtmToLitSamples(const std::vector<cv::Mat>& images,
+                       const std::vector<Eigen::Vector3d>& lights,
+                       const std::vector<std::vector<float>>& lit, PtmFormat format,
+                       int min_lit_lights);
 
 /// The PTM relit under `light` (Relight's display RGB, row-major), its linear light
-/// times the horizon's visibility, `shadow_floor` of it kept in full shadow.
-std::vector<float> RelightShadowed(const Ptm& ptm, const HorizonMap& horizon,
-                                   const Eigen::Vector3d& light, double shadow_floor,
-                                   double penumbra_rad);
+/// times SelfShadowing::LightFactor. Throws std::invalid_argument when the horizon
+/// map's size is not the PTM's.
+std::vector<float> RelightShadowed(const Ptm& ptm, const SelfShadowing& shadowing,
+                                   const Eigen::Vector3d& light);
 std::vector<float> RelightShadowed(const ShadowedPtm& shadowed, const Eigen::Vector3d& light);
 
 }  // namespace texlume::ptm

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "datasets_synthetic/object_scene.h"
@@ -354,6 +355,51 @@ TEST_F(FitCliTest, FitWritesPtmExrWebAndRecordThenRelights) {
             0)
       << out;
   EXPECT_TRUE(std::filesystem::exists(tmp_ / "normals.png"));
+}
+
+// fit --horizon writes the horizon map beside the PTM of the lit samples; relight
+// --horizon casts the relief's shadows, which only ever take light away.
+TEST_F(FitCliTest, FitWithHorizonWritesItAndRelightCastsItsShadows) {
+  std::string out;
+  const std::string ptm = (tmp_ / "lit.ptm").string(), horizon = (tmp_ / "horizon.exr").string();
+  const std::string fit =
+      "fit --images " + capture_ + " --lights " + capture_ + "/lights.lp --out ";
+  ASSERT_EQ(Texlume(fit + ptm + " --format rgb --horizon " + horizon, &out), 0) << out;
+  std::ifstream record_file(ptm + ".json");
+  const nlohmann::json record = nlohmann::json::parse(record_file);
+  EXPECT_EQ(record["settings"]["horizon"], horizon);
+  EXPECT_EQ(record["result"]["horizon"]["sectors"], 16);
+  EXPECT_GE(record["result"]["horizon"]["shadow_floor"].get<double>(), 0.0);
+  EXPECT_LE(record["result"]["horizon"]["shadow_floor"].get<double>(), 1.0);
+
+  const std::string relight = "relight --ptm " + ptm + " --light 0.9,0,0.42 --out ";
+  ASSERT_EQ(Texlume(relight + (tmp_ / "shadowed.png").string() + " --horizon " + horizon, &out), 0)
+      << out;
+  ASSERT_EQ(Texlume(relight + (tmp_ / "unshadowed.png").string(), &out), 0) << out;
+  const cv::Mat shadowed = cv::imread((tmp_ / "shadowed.png").string());
+  const cv::Mat unshadowed = cv::imread((tmp_ / "unshadowed.png").string());
+  ASSERT_EQ(shadowed.size(), unshadowed.size());
+  cv::Mat brighter;
+  cv::compare(shadowed, unshadowed + cv::Scalar::all(1), brighter, cv::CMP_GT);
+  EXPECT_EQ(cv::countNonZero(brighter.reshape(1)), 0);
+
+  // Refused: with --robust or an HSH fit, a horizon that is not .exr, a PTM EXR given
+  // as the horizon, --gain with a horizon. Nothing is written.
+  const std::string other = (tmp_ / "other.exr").string();
+  EXPECT_EQ(Texlume(fit + (tmp_ / "r.ptm").string() + " --robust --horizon " + other, &out), 2);
+  EXPECT_NE(out.find("--robust"), std::string::npos) << out;
+  EXPECT_EQ(Texlume(fit + (tmp_ / "h.rti").string() + " --basis hsh --horizon " + other, &out), 2);
+  EXPECT_EQ(
+      Texlume(fit + (tmp_ / "p.ptm").string() + " --horizon " + (tmp_ / "h.png").string(), &out),
+      2);
+  EXPECT_FALSE(std::filesystem::exists(other));
+  ASSERT_EQ(Texlume(fit + (tmp_ / "s.ptm").string() + " --exr " + other, &out), 0) << out;
+  EXPECT_EQ(Texlume(relight + (tmp_ / "x.png").string() + " --horizon " + other, &out), 1);
+  EXPECT_NE(out.find("horizon"), std::string::npos) << out;
+  EXPECT_EQ(
+      Texlume(relight + (tmp_ / "x.png").string() + " --horizon " + horizon + " --gain 2", &out),
+      2);
+  EXPECT_FALSE(std::filesystem::exists(tmp_ / "x.png"));
 }
 
 TEST_F(FitCliTest, BadCapturesAreCleanErrorsWithNothingWritten) {

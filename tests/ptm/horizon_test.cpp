@@ -8,6 +8,10 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/errors.h"
+#include "ptm/exr_io.h"
+#include "tests/test_util.h"
+
 namespace texlume::ptm {
 namespace {
 
@@ -78,6 +82,47 @@ TEST(HorizonMap, RefusesSettingsOutOfRange) {
   EXPECT_THROW(ComputeHorizonMap(h, 3, 8), std::invalid_argument);
   EXPECT_THROW(ComputeHorizonMap(h, 8, 0), std::invalid_argument);
   EXPECT_THROW(ComputeHorizonMap(cv::Mat::zeros(4, 4, CV_32FC1), 8, 8), std::invalid_argument);
+}
+
+TEST(SelfShadowingExr, RoundTripsAndRefusesFilesThatAreNotHorizons) {
+  cv::Mat h = cv::Mat::zeros(6, 10, CV_64FC1);
+  h(cv::Rect(5, 0, 5, 6)).setTo(3.0);
+  SelfShadowing shadowing;
+  shadowing.horizon = ComputeHorizonMap(h, 8, 16);
+  shadowing.height_scale = 1.75;
+  shadowing.shadow_floor = 0.25;
+  shadowing.penumbra_rad = 4.0 * kDegree;
+  testing::TempDir dir;
+  const std::filesystem::path file = dir.path() / "horizon.exr";
+  WriteSelfShadowingExr(shadowing, file);
+  const SelfShadowing back = ReadSelfShadowingExr(file);
+  EXPECT_EQ(back.horizon.width, 10);
+  EXPECT_EQ(back.horizon.height, 6);
+  EXPECT_EQ(back.horizon.sectors, 8);
+  EXPECT_EQ(back.horizon.elevation_rad, shadowing.horizon.elevation_rad);
+  EXPECT_FLOAT_EQ(static_cast<float>(back.height_scale), 1.75f);
+  EXPECT_FLOAT_EQ(static_cast<float>(back.shadow_floor), 0.25f);
+  EXPECT_FLOAT_EQ(static_cast<float>(back.penumbra_rad), static_cast<float>(4.0 * kDegree));
+  // The light factor: the floor in full shadow, 1 in full light.
+  const Eigen::Vector3d low(std::cos(10 * kDegree), 0.0, std::sin(10 * kDegree));
+  EXPECT_NEAR(back.LightFactor(3 * 10 + 3, low), 0.25, 1e-6);
+  EXPECT_NEAR(back.LightFactor(3 * 10 + 3, Eigen::Vector3d::UnitZ()), 1.0, 1e-6);
+
+  // Sector channels without the attributes, and an elevation beyond the zenith.
+  std::vector<cv::Mat> planes(8, cv::Mat(4, 4, CV_32FC1, cv::Scalar(0.1f)));
+  std::vector<std::string> names;
+  for (int s = 0; s < 8; ++s) names.push_back("horizon.0" + std::to_string(s));
+  WriteExr(dir.path() / "bare.exr", planes, names);
+  EXPECT_THROW(ReadSelfShadowingExr(dir.path() / "bare.exr"), InputError);
+  planes[3] = cv::Mat(4, 4, CV_32FC1, cv::Scalar(2.0f));
+  WriteExr(dir.path() / "steep.exr", planes, names,
+           {{"texlume:height_scale", 1.f},
+            {"texlume:shadow_floor", 0.2f},
+            {"texlume:penumbra_rad", 0.07f}});
+  EXPECT_THROW(ReadSelfShadowingExr(dir.path() / "steep.exr"), InputError);
+  names[2] = "R";
+  WriteExr(dir.path() / "other.exr", planes, names);
+  EXPECT_THROW(ReadSelfShadowingExr(dir.path() / "other.exr"), InputError);
 }
 
 }  // namespace

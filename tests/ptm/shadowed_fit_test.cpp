@@ -84,15 +84,15 @@ TEST(FitShadowedPtm, PillarsHorizonFromItsCapturePredictsHeldOutShadows) {
       images.push_back(Render(heights, true_horizon, lights.back()));
     }
   const ShadowedPtm fitted = FitShadowedPtm(images, lights);
-  EXPECT_GT(fitted.height_scale, 0.0);
+  EXPECT_GT(fitted.shadowing.height_scale, 0.0);
   // Attached shadows (n.l < 0) keep nothing and pull the median below the ambient.
-  EXPECT_NEAR(fitted.shadow_floor, kAmbient, 0.12);
+  EXPECT_NEAR(fitted.shadowing.shadow_floor, kAmbient, 0.12);
 
   Ptm plain;
   {
     const std::vector<std::vector<float>> all(lights.size(),
                                               std::vector<float>(kSize * kSize, 1.f));
-    plain = FitRgbPtmToLitSamples(images, lights, all, 6);
+    plain = FitPtmToLitSamples(images, lights, all, PtmFormat::kLrgb, 6);
   }
   // Held-out low lights between the capture's azimuths: the shadows take away more
   // than half the plain PTM's error (measured: 0.0097 against 0.0333).
