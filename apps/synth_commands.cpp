@@ -36,6 +36,10 @@ void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords
       sub->add_option("--sample", j.sample_file,
                       "sample: a PTM (.ptm, .exr) or a colour photo (.png, .jpg, .tif, RGB .exr); "
                       "graphcut also a BTF capture or factorisation folder");
+  sub->add_option("--sample-horizon", j.sample_horizon_file,
+                  "the PTM sample's horizon map (texlume fit --horizon): the model casts the "
+                  "relief's own shadows")
+      ->needs(sample);
   sub->add_option("--btf", o.btf, "BTF capture or factorisation folder (instead of --sample)")
       ->excludes(sample);
   sub->add_option("--components", o.components, "BTF components kept when factorising a capture")
@@ -234,7 +238,7 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
        {"--fill-unseen", "--seam-band", "--strip", "--max-subdivisions", "--correction-iterations",
         "--correction-noise", "--correction-sigma", "--correction-prior-shrink",
         "--no-additive-correction", "--no-channel-correction", "--no-detail-transfer", "--search",
-        "--search-candidates", "--photometry-faces", "--compare-regions"})
+        "--search-candidates", "--photometry-faces", "--compare-regions", "--sample-horizon"})
     if (sub->count(name) > 0)
       throw UsageError(std::string(name) + " is not taken by --engine graphcut (docs/quilting.md)");
   TakePhotos(sub, w, o, q);

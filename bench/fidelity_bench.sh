@@ -21,6 +21,9 @@
 # also hold a BTF capture of the material (BTF_ARGS, by default 256 x 256 texels,
 # 13 views x 40 lights) and a row "btf" renders the model `texlume synth --btf`
 # builds from it: a model that keeps the capture's own images, shadows included.
+# With HORIZON=1 the sample is also fitted with its horizon map (texlume fit
+# --horizon) and a row "texlume_horizon" renders the model that casts the relief's
+# own shadows (texlume synth --sample-horizon).
 # Usage: bench/fidelity_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [SHAPES (sphere cylinder)]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -68,6 +71,11 @@ for shape in $shapes; do
     shift 2
     local sample=(--sample "$dir/sample.ptm" --sample-texel-size 0.002)
     if [ "$#" -gt 0 ] && [ "$1" = --btf ]; then sample=(); fi
+    if [ "$#" -gt 0 ] && [ "$1" = --horizon ]; then
+      sample=(--sample "$dir/sample_lit.ptm" --sample-texel-size 0.002
+        --sample-horizon "$dir/horizon.exr")
+      shift
+    fi
     rm -rf "$dir/model_$name"
     local start=$SECONDS
     "$texlume" synth --model "$cameras" --images "$object/images" \
@@ -105,6 +113,12 @@ for shape in $shapes; do
       synth colmap "$dir/colmap_model"
       rows+=(texlume_colmap="$dir/render_colmap")
     fi
+  fi
+  if [ "${HORIZON:-0}" = 1 ]; then
+    "$texlume" fit --images "$capture" --lights "$capture/lights.lp" \
+      --out "$dir/sample_lit.ptm" --horizon "$dir/horizon.exr" > /dev/null
+    synth horizon "$object/sparse" --horizon
+    rows+=(texlume_horizon="$dir/render_horizon")
   fi
   if [ "${BTF:-0}" = 1 ]; then
     synth btf "$object/sparse" --btf "$dir/scene/material/btf"

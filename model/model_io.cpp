@@ -168,6 +168,12 @@ class ModelFolderWriter {
         {"below_horizon_elevation",
          "value at horizon_elevation_deg (same azimuth) times l_z / sin(horizon_elevation_deg)"},
         {"light_response", LightResponseJson(model.light_response)}};
+    if (!model.shadowing.empty())
+      manifest_["ptm_evaluation"]["self_shadowing"] =
+          "per atlas, \"horizon\": the relief's horizon per texel (channels horizon.SS: "
+          "elevation in radians at azimuth 2 pi SS / sectors from x towards y); each light's "
+          "linear contribution times v + (1 - v) texlume:shadow_floor, v rising linearly from 0 "
+          "to 1 across texlume:penumbra_rad about the horizon (the ambient term unshadowed)";
     manifest_["gltf_frame"] = GltfFrameJson(model);
     manifest_["atlases"] = nlohmann::json::array();
     mtl_ << "# texlume: albedo and normal map from the PTM atlases (model.glb carries them too)\n";
@@ -224,6 +230,11 @@ class ModelFolderWriter {
                                     {"width", atlas.width},
                                     {"height", atlas.height},
                                     {"format", format}});
+    if (!model_.shadowing.empty()) {
+      const std::string horizon_file = "horizon_atlas_" + k + ".exr";
+      ptm::WriteSelfShadowingExr(model_.shadowing[a], tmp_ / horizon_file);
+      manifest_["atlases"].back()["horizon"] = horizon_file;
+    }
     const nlohmann::json ptm_fields = {
         {"format", format},
         {"frame", manifest_["ptm_frame"]},
@@ -408,7 +419,18 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
     if (!entry.is_object() || !entry.contains("exr") || !entry["exr"].is_string())
       throw InputError(manifest_path.string(), "an atlas entry has no \"exr\" file");
     model.atlases.push_back(ptm::ReadPtmExr(dir / ManifestFileName(entry["exr"], dir, "exr")));
+    if (!entry.contains("horizon")) continue;
+    const fs::path horizon_path = dir / ManifestFileName(entry["horizon"], dir, "horizon");
+    model.shadowing.push_back(ptm::ReadSelfShadowingExr(horizon_path));
+    const ptm::HorizonMap& h = model.shadowing.back().horizon;
+    if (h.width != model.atlases.back().width || h.height != model.atlases.back().height)
+      throw InputError(horizon_path.string(),
+                       "a " + std::to_string(h.width) + " x " + std::to_string(h.height) +
+                           " horizon map for a " + std::to_string(model.atlases.back().width) +
+                           " x " + std::to_string(model.atlases.back().height) + " atlas");
   }
+  if (!model.shadowing.empty() && model.shadowing.size() != model.atlases.size())
+    throw InputError(manifest_path.string(), "some atlases have a \"horizon\" and some not");
   const fs::path obj_path = dir / "model.obj";
   std::ifstream obj = OpenForReading(obj_path, false);
   std::vector<Eigen::Vector2d> texcoords;

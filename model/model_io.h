@@ -12,6 +12,7 @@
 #include "core/image_io.h"
 #include "core/json_io.h"
 #include "mesh/mesh.h"
+#include "ptm/horizon.h"
 #include "ptm/ptm.h"
 #include "sfm/alignment.h"
 
@@ -30,6 +31,9 @@ struct TexturedModel {
   std::vector<std::array<Eigen::Vector2f, 3>> corner_px;
   std::vector<int> face_atlas;
   std::vector<ptm::Ptm> atlases;
+  /// Empty, or one per atlas (its size): the relief's horizon and shadow floor, from a
+  /// sample fitted with `texlume fit --horizon` (ptm/horizon.h).
+  std::vector<ptm::SelfShadowing> shadowing;
   ptm::LightResponse light_response;
   /// Up and the photos' side in the model's frame (sfm::OrientationFromCameras): how
   /// the GLB stands in glTF's frame. COLMAP's convention when not set.

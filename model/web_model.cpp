@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstring>
 #include <fstream>
+#include <numbers>
 #include <numeric>
 #include <opencv2/core.hpp>
 #include <unordered_map>
@@ -122,6 +123,46 @@ QuantisedPlane QuantisePlane(const std::vector<float>& values) {
   return q;
 }
 
+namespace {
+
+// The relief's horizon (model's SelfShadowing) at kWebHorizonSectors azimuths
+// 2 pi s / 16, four sectors per RGBA PNG, byte = elevation / (pi / 2) x 255; and
+// how the light falls in shadow (docs/viewer.md, "Web model").
+constexpr int kWebHorizonSectors = 16;
+
+nlohmann::json HorizonTextures(const ptm::SelfShadowing& shadowing, const std::string& k,
+                               WebModel& web) {
+  const ptm::HorizonMap& h = shadowing.horizon;
+  constexpr double kQuarterTurn = std::numbers::pi / 2.0;
+  std::vector<QuantisedPlane> planes(kWebHorizonSectors);
+  for (int s = 0; s < kWebHorizonSectors; ++s) {
+    QuantisedPlane& q = planes[static_cast<std::size_t>(s)];
+    q.scale = kQuarterTurn;
+    q.bias = 0.0;
+    q.bytes.resize(h.NumTexels());
+    const double azimuth = 2.0 * std::numbers::pi * s / kWebHorizonSectors;
+    for (std::size_t t = 0; t < h.NumTexels(); ++t)
+      q.bytes[t] = static_cast<unsigned char>(
+          std::clamp(std::lround(h.ElevationAt(t, azimuth) / kQuarterTurn * 255.0), 0L, 255L));
+  }
+  nlohmann::json files = nlohmann::json::array();
+  for (int first = 0; first < kWebHorizonSectors; first += 4) {
+    const std::vector<const QuantisedPlane*> rgba = {
+        &planes[static_cast<std::size_t>(first)], &planes[static_cast<std::size_t>(first) + 1],
+        &planes[static_cast<std::size_t>(first) + 2], &planes[static_cast<std::size_t>(first) + 3]};
+    const std::string name = "horizon_" + k + "_" + std::to_string(first / 4) + ".png";
+    web.files[name] = PlanesPng(rgba, h.width, h.height, name);
+    files.push_back(name);
+  }
+  return {{"files", files},
+          {"sectors", kWebHorizonSectors},
+          {"elevation_scale", kQuarterTurn},
+          {"shadow_floor", shadowing.shadow_floor},
+          {"penumbra_rad", shadowing.penumbra_rad}};
+}
+
+}  // namespace
+
 WebModel BuildWebModel(const fs::path& model_dir) {
   const TexturedModel model = ReadModelFolder(model_dir);
   const nlohmann::json manifest = ReadModelManifest(model_dir);
@@ -222,6 +263,7 @@ WebModel BuildWebModel(const fs::path& model_dir) {
       textures.push_back({{"file", name}, {"scale", scale}, {"bias", bias}});
     }
     entry["textures"] = textures;
+    if (!model.shadowing.empty()) entry["horizon"] = HorizonTextures(model.shadowing[a], k, web);
     if (a < entries.size() && entries[a].is_object() && entries[a].contains("base_colour")) {
       const std::string name =
           ManifestFileName(entries[a]["base_colour"], model_dir, "base_colour");

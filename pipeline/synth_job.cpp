@@ -8,8 +8,10 @@
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -21,6 +23,7 @@
 #include "model/baselines.h"
 #include "pipeline/report_pictures.h"
 #include "ptm/ptm_io.h"
+#include "ptm/shadowed_fit.h"
 #include "render/model_render.h"
 #include "report/report.h"
 #include "sfm/alignment.h"
@@ -129,6 +132,8 @@ std::vector<std::pair<std::string, fs::path>> InputFiles(const SynthJobOptions& 
   files.emplace_back("lights", options.lights_file);
   files.emplace_back("mesh", options.mesh_file);
   if (!options.sample_file.empty()) files.emplace_back("sample", options.sample_file);
+  if (!options.sample_horizon_file.empty())
+    files.emplace_back("sample horizon", options.sample_horizon_file);
   return files;
 }
 
@@ -292,6 +297,8 @@ void SynthJobOptions::CheckInputsAndLayout() const {
   if (!compare_regions.empty() && ranks && ranks->Size() > 1)
     throw OptionError(
         "--compare-regions is for one process: mpirun's manifest measures its own regions");
+  if (!sample_horizon_file.empty() && LowerCaseExtension(sample_horizon_file) != ".exr")
+    throw OptionError("--sample-horizon is the .exr that texlume fit --horizon writes");
   CheckWorldUnit(mm_per_world_unit);
 }
 
@@ -523,11 +530,41 @@ class SynthJob {
   void Load() {
     inputs_ = LoadSynthInputs(options_);
     sample_ = options_.sample ? Sample{*options_.sample, {}} : ReadSample(options_.sample_file);
+    if (!options_.sample_horizon_file.empty()) ReadSampleHorizon();
     PrepareSynthMesh(inputs_, options_, std::min(sample_.ptm.width, sample_.ptm.height),
                      options_.synthesis.sample_texel_size, options_.synthesis.strip, progress_);
     summary_.CountInputs(inputs_);
     summary_.seconds_load = inputs_.seconds_load;
     summary_.seconds_visibility = inputs_.seconds_visibility;
+  }
+
+  // The PTM sample's self-shadowing, refused for a colour sample or another size.
+  void ReadSampleHorizon() {
+    const std::string file = options_.sample_horizon_file.string();
+    if (!sample_.colour.empty())
+      throw InputError(file, "a horizon map goes with a PTM sample, not a colour photo");
+    sample_shadowing_ = ptm::ReadSelfShadowingExr(options_.sample_horizon_file);
+    const ptm::HorizonMap& h = sample_shadowing_->horizon;
+    if (h.width != sample_.ptm.width || h.height != sample_.ptm.height)
+      throw InputError(file, "a " + std::to_string(h.width) + " x " + std::to_string(h.height) +
+                                 " horizon map for a " + std::to_string(sample_.ptm.width) + " x " +
+                                 std::to_string(sample_.ptm.height) + " sample");
+  }
+
+  // Per atlas, the relief's horizon from the atlas's own normals, at the sample's
+  // height scale (ptm::ShadowingOfPtm).
+  void ShadowAtlases() {
+    if (!sample_shadowing_) return;
+    const auto t = std::chrono::steady_clock::now();
+    for (std::size_t a = 0; a < model_.atlases.size(); ++a) {
+      if (progress_) progress_("the atlases' horizons", a, model_.atlases.size());
+      const ptm::Ptm& atlas = model_.atlases[a];
+      RequireMemory(static_cast<double>(atlas.NumTexels()) *
+                        (4.0 * sample_shadowing_->horizon.sectors + 64.0),
+                    "the atlas's horizon map", options_.sample_horizon_file.string());
+      model_.shadowing.push_back(ptm::ShadowingOfPtm(atlas, *sample_shadowing_));
+    }
+    summary_.seconds_atlas += SecondsSince(t);
   }
 
   // Synthesis (Algorithm 2) with the sample's kind.
@@ -592,6 +629,7 @@ class SynthJob {
     summary_.stretch = atlases.stretch;
     model_ = TexturedModelOf(inputs_, std::move(atlases.ptms), atlases.faces);
     model_.light_response = synthesis_.light_response;
+    ShadowAtlases();
   }
 
   // The baselines `texlume render --baseline` draws.
@@ -659,6 +697,12 @@ class SynthJob {
     record["command"] = "synth";
     record["inputs"] = options_.InputsJson();
     record["inputs"]["sample"] = options_.sample_file.string();
+    if (sample_shadowing_)
+      record["inputs"]["sample_horizon"] = {
+          {"file", options_.sample_horizon_file.string()},
+          {"height_scale", sample_shadowing_->height_scale},
+          {"shadow_floor", sample_shadowing_->shadow_floor},
+          {"penumbra_deg", sample_shadowing_->penumbra_rad * 180.0 / std::numbers::pi}};
     record["settings"] = Settings();
     record["summary"] = Summary();
     record["warnings"] = summary_.warnings;
@@ -743,6 +787,7 @@ class SynthJob {
   std::optional<synth::EdgeMismatch> edge_mismatch_;  // a distributed run's
   nlohmann::json region_comparison_;                  // one process's (--compare-regions)
   model::TexturedModel model_;
+  std::optional<ptm::SelfShadowing> sample_shadowing_;  // --sample-horizon
   std::vector<cv::Mat> baked_;
   Eigen::Vector3f flat_albedo_ = Eigen::Vector3f::Constant(0.5f);
   std::vector<std::pair<std::string, cv::Mat>> extra_images_;

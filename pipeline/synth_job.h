@@ -53,6 +53,9 @@ struct SynthJobOptions {
   /// The PTM sample already in memory (borrowed): used instead of reading
   /// `sample_file`, which then only names it in the manifest.
   const ptm::Ptm* sample = nullptr;
+  /// Not empty: the PTM sample's horizon map (`texlume fit --horizon`); the model's
+  /// atlases then carry the relief's self-shadowing (ptm::ShadowingOfPtm).
+  std::filesystem::path sample_horizon_file;
   std::filesystem::path out_dir;          ///< the model folder written
   synth::MeshSynthesisOptions synthesis;  ///< sample_texel_size required
   atlas::AtlasOptions atlas;

@@ -157,11 +157,16 @@ HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_
   return horizon;
 }
 
+double VisibilityAboveHorizon(double light_elevation_rad, double horizon_elevation_rad,
+                              double penumbra_rad) {
+  return std::clamp((light_elevation_rad - horizon_elevation_rad) / penumbra_rad + 0.5, 0.0, 1.0);
+}
+
 double HorizonVisibility(const HorizonMap& horizon, std::size_t texel, const Eigen::Vector3d& light,
                          double penumbra_rad) {
-  const double elevation = std::asin(std::clamp(light.z(), -1.0, 1.0));
-  const double horizon_elevation = horizon.ElevationAt(texel, std::atan2(light.y(), light.x()));
-  return std::clamp((elevation - horizon_elevation) / penumbra_rad + 0.5, 0.0, 1.0);
+  return VisibilityAboveHorizon(std::asin(std::clamp(light.z(), -1.0, 1.0)),
+                                horizon.ElevationAt(texel, std::atan2(light.y(), light.x())),
+                                penumbra_rad);
 }
 
 double SelfShadowing::LightFactor(std::size_t texel, const Eigen::Vector3d& light) const {

@@ -46,6 +46,11 @@ struct HorizonMap {
 /// [1, 4096].
 HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_distance_texels);
 
+/// The ramp of HorizonVisibility: 0 at `penumbra_rad` / 2 below the horizon, 1 as far
+/// above it (elevations in radians).
+double VisibilityAboveHorizon(double light_elevation_rad, double horizon_elevation_rad,
+                              double penumbra_rad);
+
 /// The fraction of a directional light (unit, texel frame) that reaches the texel:
 /// 0 below the horizon, 1 above it, a linear ramp of `penumbra_rad` across it (a
 /// texel's footprint and a light's size soften the edge).

@@ -63,4 +63,10 @@ std::vector<float> RelightShadowed(const Ptm& ptm, const SelfShadowing& shadowin
                                    const Eigen::Vector3d& light);
 std::vector<float> RelightShadowed(const ShadowedPtm& shadowed, const Eigen::Vector3d& light);
 
+/// The self-shadowing of a PTM made of a sample's texels at the sample's texel size
+/// (a synthesised atlas): its own normals integrated (HeightFromNormals) at the
+/// sample's height scale, with the sample's sectors, shadow floor and penumbra. The
+/// horizon sees no relief beyond the map (or a chart's dilated border).
+SelfShadowing ShadowingOfPtm(const Ptm& ptm, const SelfShadowing& sample, int reach_texels = 48);
+
 }  // namespace texlume::ptm

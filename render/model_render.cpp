@@ -31,6 +31,26 @@ void Bilinear(int width, int height, double x, double y, int count, const Get& g
   }
 }
 
+// The light factor of the relief's self-shadowing (SelfShadowing::LightFactor) at an
+// atlas position: the horizon at the light's azimuth read bilinearly, as the atlas is.
+double ShadowFactor(const ptm::SelfShadowing& shadowing, const Eigen::Vector2d& atlas_px,
+                    const Eigen::Vector3d& light_in_texel_frame) {
+  const ptm::HorizonMap& h = shadowing.horizon;
+  const Eigen::Vector3d l = light_in_texel_frame.normalized();
+  const double azimuth = std::atan2(l.y(), l.x());
+  float horizon = 0.0f;
+  Bilinear(
+      h.width, h.height, atlas_px.x(), atlas_px.y(), 1,
+      [&](int xx, int yy, int) {
+        return static_cast<float>(
+            h.ElevationAt(static_cast<std::size_t>(yy) * h.width + xx, azimuth));
+      },
+      &horizon);
+  const double v = ptm::VisibilityAboveHorizon(std::asin(std::clamp(l.z(), -1.0, 1.0)), horizon,
+                                               shadowing.penumbra_rad);
+  return v + (1.0 - v) * shadowing.shadow_floor;
+}
+
 // A photo's gain times its white balance (when given), per channel.
 std::array<double, 3> ChannelGains(const std::vector<double>& gains,
                                    const std::vector<std::array<double, 3>>& white_balance,
@@ -176,8 +196,15 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
           },
           texel.data());
       std::vector<std::pair<Eigen::Vector3d, double>> local;  // lights in the face frame
-      for (const sfm::ObjectLight& l : lights)
-        local.emplace_back(s.frame.transpose() * l.DirectionFrom(s.point), l.intensity);
+      for (const sfm::ObjectLight& l : lights) {
+        const Eigen::Vector3d direction = s.frame.transpose() * l.DirectionFrom(s.point);
+        const double shadow =
+            model_.shadowing.empty()
+                ? 1.0
+                : ShadowFactor(model_.shadowing[static_cast<std::size_t>(s.atlas)], s.atlas_px,
+                               direction);
+        local.emplace_back(direction, l.intensity * shadow);
+      }
       value = synth::RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format,
                                     local, 1.0, model_.light_response);
     }

@@ -10,6 +10,7 @@
 
 #include "datasets_synthetic/object_scene.h"
 #include "datasets_synthetic/scene.h"
+#include "ptm/horizon.h"
 #include "tests/test_util.h"
 
 namespace texlume {
@@ -246,6 +247,23 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
                     &out),
             2);
   EXPECT_NE(out.find("--compare-regions is not taken by --engine graphcut"), std::string::npos)
+      << out;
+  // A sample horizon that is not the EXR of texlume fit --horizon, or without a PTM
+  // sample, or with the graph-cut engine.
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --sample-horizon h.png",
+                    &out),
+            2);
+  EXPECT_NE(out.find("--sample-horizon is the .exr"), std::string::npos) << out;
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --btf " + tmp.path().string() +
+                        " --out f --sample-horizon h.exr",
+                    &out),
+            2);
+  EXPECT_EQ(Texlume("synth --engine graphcut --mesh d --sample e --sample-texel-size 0.01 --out f "
+                    "--sample-horizon h.exr",
+                    &out),
+            2);
+  EXPECT_NE(out.find("--sample-horizon is not taken by --engine graphcut"), std::string::npos)
       << out;
   // A photo cache that is not a size (photos on demand, docs/cli.md).
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
@@ -655,6 +673,19 @@ TEST(Cli, SynthWithAColourSampleWritesAModelThatRenders) {
                     &out),
             1);
   EXPECT_NE(out.find("not_an_image.png"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
+  // A horizon map goes with a PTM sample: refused with a colour photo, naming the file.
+  const std::string capture = scene + "/material/capture";
+  ptm::SelfShadowing shadowing;
+  shadowing.horizon.width = shadowing.horizon.height = 64;
+  shadowing.horizon.sectors = 8;
+  shadowing.horizon.elevation_rad.assign(64 * 64 * 8, 0.1f);
+  ptm::WriteSelfShadowingExr(shadowing, tmp / "h.exr");
+  EXPECT_EQ(Texlume("synth" + inputs + " --sample " + capture + "/rti_005.png --sample-horizon " +
+                        (tmp / "h.exr").string() + " --out " + (tmp / "bad").string(),
+                    &out),
+            1);
+  EXPECT_NE(out.find("h.exr: a horizon map goes with a PTM sample"), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(tmp / "bad"));
 }
 

@@ -27,8 +27,12 @@
     geometry: scene.then((s) => fetchOk('/model/' + s.geometry.file, 'binary')),
     // Per atlas: its PTM textures, decoded.
     ptmTextures: scene.then((s) => s.atlases.map((atlas) => Promise.all(atlas.textures.map((t) => decode(t.file))))),
+    // Per atlas: its horizon textures (the relief's self-shadowing), none without one.
+    horizonTextures: scene.then((s) => s.atlases.map((atlas) =>
+      Promise.all(atlas.horizon ? atlas.horizon.files.map((f) => decode(f)) : []))),
   };
   // Rejections are handled by viewer.js; keep the console free of unhandled ones meanwhile.
-  for (const p of [prefetch.scene, prefetch.geometry, prefetch.ptmTextures]) p.catch(() => {});
+  for (const p of [prefetch.scene, prefetch.geometry, prefetch.ptmTextures, prefetch.horizonTextures])
+    p.catch(() => {});
   window.texlumePrefetch = prefetch;
 })();

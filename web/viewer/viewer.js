@@ -54,6 +54,11 @@ uniform vec3 flatAlbedo;     // display domain
 uniform float horizonZ;      // sin of the horizon elevation (PTM evaluation)
 uniform float responseFactor[10];  // light response: factor per 10 degrees of elevation
 uniform float ambient;       // light response: ambient times the zenith value (linear)
+uniform sampler2D horizon0, horizon1, horizon2, horizon3;  // the relief's horizon, 16 sectors
+uniform bool hasHorizon;
+uniform float horizonScale;  // radians per unit of a horizon texture's value
+uniform float shadowFloor;   // linear fraction of the light a shadow keeps
+uniform float penumbra;      // radians across which the light rises from shadow
 ${varyings}
 float srgbToLinear(float v) { return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4); }
 vec3 srgbToLinear(vec3 v) { return vec3(srgbToLinear(v.r), srgbToLinear(v.g), srgbToLinear(v.b)); }
@@ -117,13 +122,37 @@ float responseAt(float lz) {
   return mix(lo, hi, f);
 }
 
+// The relief's self-shadowing of the light l (texel frame), as texlume's renderer
+// (ptm::SelfShadowing::LightFactor): the horizon at l's azimuth, linear between
+// the two nearest of 16 sectors, and v + (1 - v) shadowFloor, v rising linearly
+// across the penumbra about it.
+float shadowFactor(vec3 l) {
+  if (!hasHorizon) return 1.0;
+  vec4 h0 = texture2D(horizon0, vUv), h1 = texture2D(horizon1, vUv);
+  vec4 h2 = texture2D(horizon2, vUv), h3 = texture2D(horizon3, vUv);
+  float at = mod(atan(l.y, l.x) / 6.2831853 * 16.0, 16.0);
+  int i = int(min(floor(at), 15.0));
+  float f = at - float(i);
+  float lo = 0.0, hi = 0.0;
+  for (int j = 0; j < 16; ++j) {  // constant-index access (GLSL ES 1.0)
+    vec4 h = j < 4 ? h0 : j < 8 ? h1 : j < 12 ? h2 : h3;
+    int c = j - 4 * (j / 4);
+    float e = c == 0 ? h.x : c == 1 ? h.y : c == 2 ? h.z : h.w;
+    if (j == i) lo = e;
+    if (j == i + 1 || (i == 15 && j == 0)) hi = e;
+  }
+  float horizon = mix(lo, hi, f) * horizonScale;
+  float v = clamp((asin(clamp(l.z, -1.0, 1.0)) - horizon) / penumbra + 0.5, 0.0, 1.0);
+  return v + (1.0 - v) * shadowFloor;
+}
+
 // As texlume's renderer: lights below the horizon elevation are evaluated at it
 // (same azimuth), fading linearly with l_z to 0 at the horizon; the light
 // response's factor and ambient term apply (ptm::EffectiveLights).
 vec3 relight(vec3 c[6], vec3 colour, vec3 l) {
   vec3 linear = ambient * srgbToLinear(max(evaluate(c, colour, vec2(0.0)), vec3(0.0)));
   if (l.z <= 0.0) return linearToSrgb(linear);
-  float fall = responseAt(l.z);
+  float fall = responseAt(l.z) * shadowFactor(l);
   vec3 at = l;
   if (l.z < horizonZ) {
     fall *= l.z / horizonZ;
@@ -292,8 +321,13 @@ async function main() {
       bias.push(four(t.bias, 0));
     }
     const uniforms = { ...uniformsShared, lrgb: { value: atlas.format === 'LRGB' },
-      ptmScale: { value: scale }, ptmBias: { value: bias }, bakedTexture: { value: placeholder } };
+      ptmScale: { value: scale }, ptmBias: { value: bias }, bakedTexture: { value: placeholder },
+      hasHorizon: { value: false },  // until its textures are in
+      horizonScale: { value: atlas.horizon ? atlas.horizon.elevation_scale : 0 },
+      shadowFloor: { value: atlas.horizon ? atlas.horizon.shadow_floor : 1 },
+      penumbra: { value: atlas.horizon ? atlas.horizon.penumbra_rad : 1 } };
     for (let k = 0; k < 5; ++k) uniforms['ptm' + k] = { value: placeholder };  // until they are in
+    for (let k = 0; k < 4; ++k) uniforms['horizon' + k] = { value: placeholder };
     const material = new THREE.ShaderMaterial({ uniforms, vertexShader, fragmentShader });
     materials.push(material);
     const geometry = new THREE.BufferGeometry();
@@ -421,12 +455,19 @@ async function main() {
   toggle('specular', 'specular', 0.6);
 
   const texturesOfAtlas = await prefetch.ptmTextures;
-  const ptmTextures = [];  // per atlas
+  const horizonsOfAtlas = await prefetch.horizonTextures;
+  const ptmTextures = [], horizonTextures = [];  // per atlas
   await Promise.all(g.ranges.map(async (range, i) => {
     const bitmaps = await texturesOfAtlas[range.atlas];
     const u = materials[i].uniforms;
     ptmTextures[range.atlas] = ptmTextures[range.atlas] || bitmaps.map(textureOf);
     for (let k = 0; k < bitmaps.length; ++k) u['ptm' + k].value = ptmTextures[range.atlas][k];
+    const horizon = await horizonsOfAtlas[range.atlas];
+    if (horizon.length === 4) {
+      horizonTextures[range.atlas] = horizonTextures[range.atlas] || horizon.map(textureOf);
+      for (let k = 0; k < 4; ++k) u['horizon' + k].value = horizonTextures[range.atlas][k];
+      u.hasHorizon.value = true;
+    }
   }));
   api.marks.textures = performance.now();
   renderer.compile(world, camera);
