@@ -231,6 +231,10 @@ class ModelFolderWriter {
                                     {"height", atlas.height},
                                     {"format", format}});
     if (!model_.shadowing.empty()) {
+      TEXLUME_CHECK(model_.shadowing.size() == model_.atlases.size() &&
+                        model_.shadowing[a].horizon.width == atlas.width &&
+                        model_.shadowing[a].horizon.height == atlas.height,
+                    "one horizon map of its atlas's size per atlas");
       const std::string horizon_file = "horizon_atlas_" + k + ".exr";
       ptm::WriteSelfShadowingExr(model_.shadowing[a], tmp_ / horizon_file);
       manifest_["atlases"].back()["horizon"] = horizon_file;

@@ -122,6 +122,9 @@ void FitJobOptions::Check() const {
     if (fit.robust) throw OptionError("--horizon and --robust both set shadows aside: choose one");
     if (LowerCaseExtension(horizon_file) != ".exr")
       throw OptionError("the horizon map is an OpenEXR file: name --horizon FILE.exr");
+    if (fs::path(horizon_file).lexically_normal() == fs::path(exr_file).lexically_normal() ||
+        fs::path(horizon_file).lexically_normal() == fs::path(out_file).lexically_normal())
+      throw OptionError("--horizon must name another file than --out and --exr");
   }
 }
 
@@ -132,14 +135,15 @@ nlohmann::json FitJobOptions::ToJson() const {
             {"basis", "hsh"},
             {"order", hsh_order},
             {"band_rows", fit.band_rows}};
-  return {{"images", images_dir.string()},
-          {"lights", lights_file.string()},
-          {"basis", "ptm"},
-          {"format", fit.format == ptm::PtmFormat::kLrgb ? "lrgb" : "rgb"},
-          {"robust", fit.robust},
-          {"band_rows", fit.band_rows},
-          {"robust_scale", fit.robust_scale},
-          {"horizon", horizon_file.string()}};
+  nlohmann::json j = {{"images", images_dir.string()},
+                      {"lights", lights_file.string()},
+                      {"basis", "ptm"},
+                      {"format", fit.format == ptm::PtmFormat::kLrgb ? "lrgb" : "rgb"},
+                      {"robust", fit.robust},
+                      {"band_rows", fit.band_rows},
+                      {"robust_scale", fit.robust_scale}};
+  if (!horizon_file.empty()) j["horizon"] = horizon_file.string();
+  return j;
 }
 
 namespace {
@@ -219,10 +223,11 @@ FitOutcome FitAndWriteShadowedPtm(const FitJobOptions& options, const ptm::RtiCa
   FitOutcome o;
   o.fit_seconds = read_seconds + SecondsSince(t_fit);
   const auto t0 = std::chrono::steady_clock::now();
+  // The horizon first: a PTM of the lit samples is not left without it.
+  ptm::WriteSelfShadowingExr(fit.shadowing, options.horizon_file);
   ptm::WritePtmFile(fit.ptm, options.out_file);
   if (!options.exr_file.empty()) ptm::WritePtmExr(fit.ptm, options.exr_file);
   if (!options.web_dir.empty()) ptm::WriteRelightWeb(fit.ptm, options.web_dir);
-  ptm::WriteSelfShadowingExr(fit.shadowing, options.horizon_file);
   o.write_seconds = SecondsSince(t0);
   std::ostringstream line;
   line << "Fitted a " << fit.ptm.width << "x" << fit.ptm.height << " "
@@ -364,8 +369,7 @@ nlohmann::json RelightJobOptions::ToJson() const {
   return {{"ptm", ptm_file.string()},
           {"light", {light.x(), light.y(), light.z()}},
           {"gain", enhancement.diffuse_gain},
-          {"specular", enhancement.specular},
-          {"horizon", horizon_file.string()}};
+          {"specular", enhancement.specular}};
 }
 
 void RunRelightJob(const RelightJobOptions& options, std::ostream& out) {

@@ -556,13 +556,19 @@ class SynthJob {
   void ShadowAtlases() {
     if (!sample_shadowing_) return;
     const auto t = std::chrono::steady_clock::now();
+    // Every atlas's horizon is kept (4 bytes a sector), and written through planes and
+    // an interleaved copy (twice that again); one atlas's heights and normals at a time.
+    double kept_texels = 0.0, largest = 0.0;
+    for (const ptm::Ptm& atlas : model_.atlases) {
+      kept_texels += static_cast<double>(atlas.NumTexels());
+      largest = std::max(largest, static_cast<double>(atlas.NumTexels()));
+    }
+    RequireMemory(kept_texels * 4.0 * sample_shadowing_->horizon.sectors +
+                      largest * (8.0 * sample_shadowing_->horizon.sectors + 64.0),
+                  "the atlases' horizon maps", options_.sample_horizon_file.string());
     for (std::size_t a = 0; a < model_.atlases.size(); ++a) {
       if (progress_) progress_("the atlases' horizons", a, model_.atlases.size());
-      const ptm::Ptm& atlas = model_.atlases[a];
-      RequireMemory(static_cast<double>(atlas.NumTexels()) *
-                        (4.0 * sample_shadowing_->horizon.sectors + 64.0),
-                    "the atlas's horizon map", options_.sample_horizon_file.string());
-      model_.shadowing.push_back(ptm::ShadowingOfPtm(atlas, *sample_shadowing_));
+      model_.shadowing.push_back(ptm::ShadowingOfPtm(model_.atlases[a], *sample_shadowing_));
     }
     summary_.seconds_atlas += SecondsSince(t);
   }

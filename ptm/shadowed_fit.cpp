@@ -129,12 +129,25 @@ class ShadowedFit {
     const LitMask lit = LitSamples(shadowing_.horizon, lights_, shadowing_.penumbra_rad);
     out.ptm = FitPtmToLitSamples(images_, lights_, lit, options_.format, options_.min_lit_lights);
     shadowing_.shadow_floor = ShadowFloor(out.ptm, images_, lights_, lit);
+    shadowing_.height_scale = ScaleForRefittedNormals(out.ptm);
     out.shadowing = std::move(shadowing_);
     if (progress_) progress_(kStage, steps_, steps_);
     return out;
   }
 
  private:
+  // The refitted PTM's normals are steeper than the first fit's (its shadowed
+  // samples are gone): the scale that takes their integrated heights to the chosen
+  // relief by least squares, so that ShadowingOfPtm of the refitted PTM (and of an
+  // atlas made of it) finds the horizon chosen here.
+  double ScaleForRefittedNormals(const Ptm& refitted) const {
+    const cv::Mat refitted_heights =
+        HeightFromNormals(NormalMap(refitted), refitted.width, refitted.height);
+    const double power = refitted_heights.dot(refitted_heights);
+    if (!(power > 0.0)) return shadowing_.height_scale;
+    return std::max(0.0, shadowing_.height_scale * heights_texels_.dot(refitted_heights) / power);
+  }
+
   HorizonMap HorizonAtScale(double scale) const {
     return ComputeHorizonMap(heights_texels_ * scale, options_.sectors, options_.reach_texels);
   }

@@ -17,7 +17,8 @@ struct ShadowedPtm {
   /// Display values (as fit.h fits), fitted to the lit samples only, in the
   /// options' format (LRGB: fit.h's chromaticity, of the lit samples).
   Ptm ptm;
-  /// The shadow floor is the median over the capture's shadowed samples.
+  /// The shadow floor is the median over the capture's shadowed samples; the height
+  /// scale is that of `ptm`'s own integrated normals (ShadowingOfPtm).
   SelfShadowing shadowing;
 };
 
@@ -65,8 +66,10 @@ std::vector<float> RelightShadowed(const ShadowedPtm& shadowed, const Eigen::Vec
 
 /// The self-shadowing of a PTM made of a sample's texels at the sample's texel size
 /// (a synthesised atlas): its own normals integrated (HeightFromNormals) at the
-/// sample's height scale, with the sample's sectors, shadow floor and penumbra. The
-/// horizon sees no relief beyond the map (or a chart's dilated border).
+/// sample's height scale, with the sample's sectors, shadow floor and penumbra. On
+/// the fitted sample itself it gives back the fit's horizon. The horizon sees no
+/// relief beyond the map; in an atlas its rays may cross a chart's gutter into the
+/// next chart's relief (one integration over the whole atlas).
 SelfShadowing ShadowingOfPtm(const Ptm& ptm, const SelfShadowing& sample, int reach_texels = 48);
 
 }  // namespace texlume::ptm

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "core/check.h"
 #include "core/errors.h"
 #include "mesh/ray_caster.h"
 #include "synth/face_order.h"
@@ -86,6 +87,8 @@ const char* RenderModeName(RenderMode mode) {
 ModelRenderer::ModelRenderer(const model::TexturedModel& model) : model_(model), impl_(new Impl) {
   const mesh::TriangleMesh& mesh = model.mesh;
   vertex_normals_ = mesh::VertexNormals(mesh);
+  TEXLUME_CHECK(model_.shadowing.empty() || model_.shadowing.size() == model_.atlases.size(),
+                "no horizon maps, or one per atlas");
   face_frames_.resize(mesh.faces.size());
   for (std::size_t f = 0; f < mesh.faces.size(); ++f)
     face_frames_[f] = model::AtlasFaceFrame(model, f);

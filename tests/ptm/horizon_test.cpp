@@ -65,6 +65,14 @@ TEST(HorizonMap, AWallsHorizonAndShadowFollowItsGeometry) {
   EXPECT_NEAR(ComputeHorizonMap(h, 8, 16).ElevationAt(4 * 40 + 0, 0.0), 0.0, 1e-9);
   // On top of the wall nothing rises.
   EXPECT_NEAR(horizon.ElevationAt(4 * 40 + 25, 0.0), 0.0, 1e-9);
+  // y is up the image: a ridge along the top rows rises towards +y (azimuth 90
+  // degrees), not towards -y.
+  cv::Mat ridge = cv::Mat::zeros(40, 8, CV_64FC1);
+  ridge(cv::Rect(0, 0, 8, 20)).setTo(10.0);
+  const HorizonMap up = ComputeHorizonMap(ridge, 8, 32);
+  const std::size_t below = 29 * 8 + 4;  // 10 rows below the ridge's edge (row 19)
+  EXPECT_NEAR(up.ElevationAt(below, 90.0 * kDegree), 45.0 * kDegree, 1e-6);
+  EXPECT_NEAR(up.ElevationAt(below, -90.0 * kDegree), 0.0, 1e-9);
 
   const auto light = [](double elevation_deg, double azimuth_deg) {
     const double e = elevation_deg * kDegree, a = azimuth_deg * kDegree;

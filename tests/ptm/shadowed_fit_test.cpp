@@ -104,6 +104,19 @@ TEST(FitShadowedPtm, PillarsHorizonFromItsCapturePredictsHeldOutShadows) {
     shadowed_error += MeanSquaredError(RelightShadowed(fitted, l), truth);
   }
   EXPECT_LT(shadowed_error, 0.5 * plain_error) << shadowed_error << " vs " << plain_error;
+
+  // An atlas made of the fitted PTM finds the fit's horizon again from its own
+  // normals (ShadowingOfPtm: the height scale is the refitted PTM's). Measured: a
+  // mean difference of 13 % of the mean elevation (17 degrees).
+  const SelfShadowing again = ShadowingOfPtm(fitted.ptm, fitted.shadowing);
+  double difference = 0, elevation = 0;
+  for (std::size_t i = 0; i < again.horizon.elevation_rad.size(); ++i) {
+    difference +=
+        std::abs(again.horizon.elevation_rad[i] - fitted.shadowing.horizon.elevation_rad[i]);
+    elevation += fitted.shadowing.horizon.elevation_rad[i];
+  }
+  EXPECT_LT(difference, 0.25 * elevation) << difference / elevation;
+  EXPECT_EQ(again.shadow_floor, fitted.shadowing.shadow_floor);
 }
 
 TEST(FitShadowedPtm, RefusesTooFewLightsAndMixedSizes) {

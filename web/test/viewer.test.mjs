@@ -129,6 +129,8 @@ test('the PTM textures reach WebGL byte for byte, the alpha channel included', a
   assert.equal(scene.format, 'texlume-web-3');
   const atlas = scene.atlases[0];
   assert.equal(atlas.textures.length, atlas.format === 'LRGB' ? 2 : 5);
+  // The test model casts the relief's shadows (tests/web/viewer_test.sh).
+  assert.ok(atlas.horizon && atlas.horizon.files.length === 4, 'the atlas has its horizon textures');
   let lowAlpha = 0;
   for (let k = 0; k < atlas.textures.length; ++k) {
     const png = decodePng(Buffer.from(await (await fetch(url + 'model/' + atlas.textures[k].file)).arrayBuffer()));

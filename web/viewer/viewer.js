@@ -130,7 +130,9 @@ float shadowFactor(vec3 l) {
   if (!hasHorizon) return 1.0;
   vec4 h0 = texture2D(horizon0, vUv), h1 = texture2D(horizon1, vUv);
   vec4 h2 = texture2D(horizon2, vUv), h3 = texture2D(horizon3, vUv);
-  float at = mod(atan(l.y, l.x) / 6.2831853 * 16.0, 16.0);
+  // atan(0, 0) is undefined in GLSL: a light along the normal takes azimuth 0, as atan2 does.
+  float azimuth = length(l.xy) > 1e-6 ? atan(l.y, l.x) : 0.0;
+  float at = mod(azimuth / 6.2831853 * 16.0, 16.0);
   int i = int(min(floor(at), 15.0));
   float f = at - float(i);
   float lo = 0.0, hi = 0.0;
