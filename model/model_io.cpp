@@ -425,13 +425,8 @@ TexturedModel ReadModelFolder(const fs::path& dir) {
     model.atlases.push_back(ptm::ReadPtmExr(dir / ManifestFileName(entry["exr"], dir, "exr")));
     if (!entry.contains("horizon")) continue;
     const fs::path horizon_path = dir / ManifestFileName(entry["horizon"], dir, "horizon");
-    model.shadowing.push_back(ptm::ReadSelfShadowingExr(horizon_path));
-    const ptm::HorizonMap& h = model.shadowing.back().horizon;
-    if (h.width != model.atlases.back().width || h.height != model.atlases.back().height)
-      throw InputError(horizon_path.string(),
-                       "a " + std::to_string(h.width) + " x " + std::to_string(h.height) +
-                           " horizon map for a " + std::to_string(model.atlases.back().width) +
-                           " x " + std::to_string(model.atlases.back().height) + " atlas");
+    model.shadowing.push_back(ptm::ReadSelfShadowingExr(horizon_path, model.atlases.back().width,
+                                                        model.atlases.back().height, "its atlas"));
   }
   if (!model.shadowing.empty() && model.shadowing.size() != model.atlases.size())
     throw InputError(manifest_path.string(), "some atlases have a \"horizon\" and some not");

@@ -382,13 +382,8 @@ void RunRelightJob(const RelightJobOptions& options, std::ostream& out) {
   if (options.horizon_file.empty()) {
     relit = ptm::Relight(ptm, light, options.enhancement);
   } else {
-    const ptm::SelfShadowing shadowing = ptm::ReadSelfShadowingExr(options.horizon_file);
-    if (shadowing.horizon.width != ptm.width || shadowing.horizon.height != ptm.height)
-      throw InputError(options.horizon_file.string(),
-                       "a " + std::to_string(shadowing.horizon.width) + " x " +
-                           std::to_string(shadowing.horizon.height) + " horizon map for the " +
-                           std::to_string(ptm.width) + " x " + std::to_string(ptm.height) +
-                           " PTM " + options.ptm_file.string());
+    const ptm::SelfShadowing shadowing = ptm::ReadSelfShadowingExr(
+        options.horizon_file, ptm.width, ptm.height, "the PTM " + options.ptm_file.string());
     relit = ptm::RelightShadowed(ptm, shadowing, light);
   }
   WriteRgbImage(options.out_file, relit, ptm.width, ptm.height, false);

@@ -22,8 +22,8 @@
 #include "mesh/mesh.h"
 #include "model/baselines.h"
 #include "pipeline/report_pictures.h"
+#include "pipeline/sample_shadowing.h"
 #include "ptm/ptm_io.h"
-#include "ptm/shadowed_fit.h"
 #include "render/model_render.h"
 #include "report/report.h"
 #include "sfm/alignment.h"
@@ -530,7 +530,8 @@ class SynthJob {
   void Load() {
     inputs_ = LoadSynthInputs(options_);
     sample_ = options_.sample ? Sample{*options_.sample, {}} : ReadSample(options_.sample_file);
-    if (!options_.sample_horizon_file.empty()) ReadSampleHorizon();
+    if (!options_.sample_horizon_file.empty())
+      sample_shadowing_ = ReadSampleShadowing(options_.sample_horizon_file, sample_);
     PrepareSynthMesh(inputs_, options_, std::min(sample_.ptm.width, sample_.ptm.height),
                      options_.synthesis.sample_texel_size, options_.synthesis.strip, progress_);
     summary_.CountInputs(inputs_);
@@ -538,38 +539,11 @@ class SynthJob {
     summary_.seconds_visibility = inputs_.seconds_visibility;
   }
 
-  // The PTM sample's self-shadowing, refused for a colour sample or another size.
-  void ReadSampleHorizon() {
-    const std::string file = options_.sample_horizon_file.string();
-    if (!sample_.colour.empty())
-      throw InputError(file, "a horizon map goes with a PTM sample, not a colour photo");
-    sample_shadowing_ = ptm::ReadSelfShadowingExr(options_.sample_horizon_file);
-    const ptm::HorizonMap& h = sample_shadowing_->horizon;
-    if (h.width != sample_.ptm.width || h.height != sample_.ptm.height)
-      throw InputError(file, "a " + std::to_string(h.width) + " x " + std::to_string(h.height) +
-                                 " horizon map for a " + std::to_string(sample_.ptm.width) + " x " +
-                                 std::to_string(sample_.ptm.height) + " sample");
-  }
-
-  // Per atlas, the relief's horizon from the atlas's own normals, at the sample's
-  // height scale (ptm::ShadowingOfPtm).
+  // The relief's horizon per atlas (--sample-horizon; pipeline/sample_shadowing.h).
   void ShadowAtlases() {
     if (!sample_shadowing_) return;
     const auto t = std::chrono::steady_clock::now();
-    // Every atlas's horizon is kept (4 bytes a sector), and written through planes and
-    // an interleaved copy (twice that again); one atlas's heights and normals at a time.
-    double kept_texels = 0.0, largest = 0.0;
-    for (const ptm::Ptm& atlas : model_.atlases) {
-      kept_texels += static_cast<double>(atlas.NumTexels());
-      largest = std::max(largest, static_cast<double>(atlas.NumTexels()));
-    }
-    RequireMemory(kept_texels * 4.0 * sample_shadowing_->horizon.sectors +
-                      largest * (8.0 * sample_shadowing_->horizon.sectors + 64.0),
-                  "the atlases' horizon maps", options_.sample_horizon_file.string());
-    for (std::size_t a = 0; a < model_.atlases.size(); ++a) {
-      if (progress_) progress_("the atlases' horizons", a, model_.atlases.size());
-      model_.shadowing.push_back(ptm::ShadowingOfPtm(model_.atlases[a], *sample_shadowing_));
-    }
+    ShadowModelAtlases(*sample_shadowing_, options_.sample_horizon_file, model_, progress_);
     summary_.seconds_atlas += SecondsSince(t);
   }
 

@@ -251,4 +251,16 @@ SelfShadowing ReadSelfShadowingExr(const std::filesystem::path& path) {
   return out;
 }
 
+SelfShadowing ReadSelfShadowingExr(const std::filesystem::path& path, int width, int height,
+                                   const std::string& of_what) {
+  SelfShadowing shadowing = ReadSelfShadowingExr(path);
+  const HorizonMap& h = shadowing.horizon;
+  if (h.width != width || h.height != height)
+    throw InputError(path.string(), "a " + std::to_string(h.width) + " x " +
+                                        std::to_string(h.height) + " horizon map for " + of_what +
+                                        " of " + std::to_string(width) + " x " +
+                                        std::to_string(height));
+  return shadowing;
+}
+
 }  // namespace texlume::ptm

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 namespace texlume::ptm {
@@ -82,5 +83,9 @@ void WriteSelfShadowingExr(const SelfShadowing& shadowing, const std::filesystem
 /// Throws InputError naming the file when it is not a horizon file, a channel or
 /// attribute is missing, or a value is out of range (elevations in [0, pi / 2]).
 SelfShadowing ReadSelfShadowingExr(const std::filesystem::path& path);
+/// The same, also refused unless the map is `width` x `height`: the size of
+/// `of_what` ("the sample", "its atlas", "the PTM x.ptm"), which the message names.
+SelfShadowing ReadSelfShadowingExr(const std::filesystem::path& path, int width, int height,
+                                   const std::string& of_what);
 
 }  // namespace texlume::ptm
