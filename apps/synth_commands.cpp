@@ -1,3 +1,4 @@
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,13 +16,32 @@ namespace {
 
 // What the synth command reads besides the Options it binds directly.
 struct SynthWords {
-  std::string tangent_frame, prior_shrink, world_unit, photo_cache,
+  std::string tangent_frame, prior_shrink, relief_gain, world_unit, photo_cache,
       engine = "triangle", orientation = "field", fill_unseen = "overlap";
   std::vector<double> tangent_field;
   bool best_view_only = false, no_additive = false, no_channel = false, no_detail = false,
        no_report = false, no_light_response = false, no_white_balance = false,
        no_photo_blur = false;
 };
+
+// "auto", or a number in [low, high]: the word's check.
+CLI::Validator AutoOrNumberIn(double low, double high) {
+  char range[64];
+  std::snprintf(range, sizeof range, "[%g, %g]", low, high);
+  const std::string message = std::string("give auto or a number in ") + range;
+  return CLI::Validator(
+      [=](std::string& v) -> std::string {
+        if (v == "auto") return "";
+        try {
+          std::size_t used = 0;
+          const double x = std::stod(v, &used);
+          if (used == v.size() && x >= low && x <= high) return "";
+        } catch (const std::exception&) {
+        }
+        return message;
+      },
+      "auto|X");
+}
 
 void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords& w) {
   pipeline::SynthJobOptions& j = o.job;
@@ -40,6 +60,16 @@ void BindSynthInputs(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords
                   "the PTM sample's horizon map (texlume fit --horizon): the model casts the "
                   "relief's own shadows")
       ->needs(sample);
+  sub->add_option("--atlas-relief-gain", w.relief_gain,
+                  "with --sample-horizon: the atlases' relief heights times this (their shadows), "
+                  "or auto: as much shadow under low lights as the sample's")
+      ->check(AutoOrNumberIn(0.25, 4.0))
+      ->default_str("auto")
+      ->needs("--sample-horizon");
+  sub->add_flag("--shadowed-synthesis", j.shadowed_synthesis,
+                "with --sample-horizon: placement, gains and the photo-consistency pass also "
+                "relight the sample with its shadows (slower; docs/synth.md)")
+      ->needs("--sample-horizon");
   sub->add_option("--btf", o.btf, "BTF capture or factorisation folder (instead of --sample)")
       ->excludes(sample);
   sub->add_option("--components", o.components, "BTF components kept when factorising a capture")
@@ -140,18 +170,7 @@ void BindCorrection(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords&
                   "smoothing of the per-channel factors, photo pixels (PTM 2, BTF 0.35)");
   sub->add_option("--correction-prior-shrink", w.prior_shrink,
                   "auto, or the share in [0, 1] of the way to the sample's mean")
-      ->check(CLI::Validator(
-          [](std::string& v) -> std::string {
-            if (v == "auto") return "";
-            try {
-              std::size_t used = 0;
-              const double x = std::stod(v, &used);
-              if (used == v.size() && x >= 0.0 && x <= 1.0) return "";
-            } catch (const std::exception&) {
-            }
-            return "give auto or a number in [0, 1]";
-          },
-          "auto|W"))
+      ->check(AutoOrNumberIn(0.0, 1.0))
       ->default_str("auto");
   sub->add_flag("--no-additive-correction", w.no_additive, "no change of the luminance");
   sub->add_flag("--no-channel-correction", w.no_channel, "no per-channel factors");
@@ -238,7 +257,8 @@ pipeline::QuiltJobOptions QuiltJobFrom(const CLI::App* sub, const SynthWords& w,
        {"--fill-unseen", "--seam-band", "--strip", "--max-subdivisions", "--correction-iterations",
         "--correction-noise", "--correction-sigma", "--correction-prior-shrink",
         "--no-additive-correction", "--no-channel-correction", "--no-detail-transfer", "--search",
-        "--search-candidates", "--photometry-faces", "--compare-regions", "--sample-horizon"})
+        "--search-candidates", "--photometry-faces", "--compare-regions", "--sample-horizon",
+        "--shadowed-synthesis", "--atlas-relief-gain"})
     if (sub->count(name) > 0)
       throw UsageError(std::string(name) + " is not taken by --engine graphcut (docs/quilting.md)");
   TakePhotos(sub, w, o, q);
@@ -302,6 +322,8 @@ void Resolve(const CLI::App* sub, const SynthWords& w, const quilt::QuiltOptions
   s.photo_blur = !w.no_photo_blur;
   if (!w.prior_shrink.empty() && w.prior_shrink != "auto")
     s.correction_prior_shrink = std::stod(w.prior_shrink);
+  if (!w.relief_gain.empty() && w.relief_gain != "auto")
+    o.job.atlas_relief_gain = std::stod(w.relief_gain);
   s.tangent_frame = TangentFrameOf(w, s.tangent_frame);
   if (!w.tangent_field.empty()) {
     s.field_direction_in_world =

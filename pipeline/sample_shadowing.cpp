@@ -14,8 +14,24 @@ ptm::SelfShadowing ReadSampleShadowing(const std::filesystem::path& file, const 
   return ptm::ReadSelfShadowingExr(file, sample.ptm.width, sample.ptm.height, "the sample");
 }
 
-void ShadowModelAtlases(const ptm::SelfShadowing& sample, const std::filesystem::path& file,
-                        model::TexturedModel& model, const ProgressCallback& progress) {
+namespace {
+
+// The texels a chart of `atlas` covers: any coefficient not 0.
+std::vector<char> CoveredTexels(const ptm::Ptm& atlas) {
+  std::vector<char> covered(atlas.NumTexels(), 0);
+  for (std::size_t t = 0; t < covered.size(); ++t)
+    for (int q = 0; q < atlas.NumPolynomials() && !covered[t]; ++q)
+      for (int m = 0; m < 6; ++m)
+        if (atlas.Coefficients(t, q)[m] != 0.0f) covered[t] = 1;
+  return covered;
+}
+
+}  // namespace
+
+std::vector<double> ShadowModelAtlases(const ptm::SelfShadowing& sample,
+                                       const std::filesystem::path& file, double relief_gain,
+                                       model::TexturedModel& model,
+                                       const ProgressCallback& progress) {
   // Every atlas's horizon is kept (4 bytes a sector), and written through planes and
   // an interleaved copy (twice that again); one atlas's heights and normals at a time.
   double kept_texels = 0.0, largest = 0.0;
@@ -26,10 +42,18 @@ void ShadowModelAtlases(const ptm::SelfShadowing& sample, const std::filesystem:
   RequireMemory(
       kept_texels * 4.0 * sample.horizon.sectors + largest * (8.0 * sample.horizon.sectors + 64.0),
       "the atlases' horizon maps", file.string());
+  const double sample_loss = relief_gain > 0.0 ? 0.0 : ptm::LowLightShadowLoss(sample, {});
+  std::vector<double> relief_gains;
   for (std::size_t a = 0; a < model.atlases.size(); ++a) {
     if (progress) progress("the atlases' horizons", a, model.atlases.size());
-    model.shadowing.push_back(ptm::ShadowingOfPtm(model.atlases[a], sample));
+    ptm::SelfShadowing atlas = ptm::ShadowingOfPtm(model.atlases[a], sample);
+    relief_gains.push_back(
+        relief_gain > 0.0
+            ? ptm::ScaleRelief(atlas, relief_gain)
+            : ptm::MatchLowLightShadowLoss(atlas, CoveredTexels(model.atlases[a]), sample_loss));
+    model.shadowing.push_back(std::move(atlas));
   }
+  return relief_gains;
 }
 
 }  // namespace texlume::pipeline

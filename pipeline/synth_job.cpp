@@ -299,6 +299,8 @@ void SynthJobOptions::CheckInputsAndLayout() const {
         "--compare-regions is for one process: mpirun's manifest measures its own regions");
   if (!sample_horizon_file.empty() && LowerCaseExtension(sample_horizon_file) != ".exr")
     throw OptionError("--sample-horizon is the .exr that texlume fit --horizon writes");
+  if (atlas_relief_gain > 0.0 && (atlas_relief_gain < 0.25 || atlas_relief_gain > 4.0))
+    throw OptionError("--atlas-relief-gain is auto or in [0.25, 4]");
   CheckWorldUnit(mm_per_world_unit);
 }
 
@@ -539,11 +541,17 @@ class SynthJob {
     summary_.seconds_visibility = inputs_.seconds_visibility;
   }
 
+  // The sample's self-shadowing for the synthesis to relight it with, or none.
+  const ptm::SelfShadowing* ShadowsInSynthesis() const {
+    return sample_shadowing_ && options_.shadowed_synthesis ? &*sample_shadowing_ : nullptr;
+  }
+
   // The relief's horizon per atlas (--sample-horizon; pipeline/sample_shadowing.h).
   void ShadowAtlases() {
     if (!sample_shadowing_) return;
     const auto t = std::chrono::steady_clock::now();
-    ShadowModelAtlases(*sample_shadowing_, options_.sample_horizon_file, model_, progress_);
+    atlas_relief_gains_ = ShadowModelAtlases(*sample_shadowing_, options_.sample_horizon_file,
+                                             options_.atlas_relief_gain, model_, progress_);
     summary_.seconds_atlas += SecondsSince(t);
   }
 
@@ -554,13 +562,13 @@ class SynthJob {
     const std::optional<synth::FaceRegions> regions =
         RegionsOfJob(options_, in, options_.synthesis);
     const synth::FaceRegions* regions_or_null = regions ? &*regions : nullptr;
-    synthesis_ =
-        sample_.colour.empty()
-            ? synth::SynthesizeMeshPtm(in.mesh, in.reconstruction, in.visibility, in.photos,
-                                       sample_.ptm, options_.synthesis, progress_, regions_or_null)
-            : synth::SynthesizeMeshColour(in.mesh, in.reconstruction, in.visibility, in.photos,
-                                          sample_.colour, ColourOptions(options_.synthesis),
-                                          progress_, regions_or_null);
+    synthesis_ = sample_.colour.empty()
+                     ? synth::SynthesizeMeshPtm(in.mesh, in.reconstruction, in.visibility,
+                                                in.photos, sample_.ptm, options_.synthesis,
+                                                progress_, regions_or_null, ShadowsInSynthesis())
+                     : synth::SynthesizeMeshColour(
+                           in.mesh, in.reconstruction, in.visibility, in.photos, sample_.colour,
+                           ColourOptions(options_.synthesis), progress_, regions_or_null);
     if (synthesis_.rank_share_only) return;
     if (regions) edge_mismatch_ = synth::MeasureEdgeMismatch(synthesis_, synthesis_.region_of_face);
     summary_.seconds_synthesis = SecondsSince(t);
@@ -682,7 +690,12 @@ class SynthJob {
           {"file", options_.sample_horizon_file.string()},
           {"height_scale", sample_shadowing_->height_scale},
           {"shadow_floor", sample_shadowing_->shadow_floor},
-          {"penumbra_deg", sample_shadowing_->penumbra_rad * 180.0 / std::numbers::pi}};
+          {"penumbra_deg", sample_shadowing_->penumbra_rad * 180.0 / std::numbers::pi},
+          {"in_synthesis", options_.shadowed_synthesis},
+          {"atlas_relief_gain", options_.atlas_relief_gain > 0.0
+                                    ? nlohmann::json(options_.atlas_relief_gain)
+                                    : nlohmann::json("auto")},
+          {"atlas_relief_gains", atlas_relief_gains_}};
     record["settings"] = Settings();
     record["summary"] = Summary();
     record["warnings"] = summary_.warnings;
@@ -768,6 +781,7 @@ class SynthJob {
   nlohmann::json region_comparison_;                  // one process's (--compare-regions)
   model::TexturedModel model_;
   std::optional<ptm::SelfShadowing> sample_shadowing_;  // --sample-horizon
+  std::vector<double> atlas_relief_gains_;              // per atlas (ptm::MatchLowLightShadowLoss)
   std::vector<cv::Mat> baked_;
   Eigen::Vector3f flat_albedo_ = Eigen::Vector3f::Constant(0.5f);
   std::vector<std::pair<std::string, cv::Mat>> extra_images_;

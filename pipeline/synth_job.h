@@ -56,6 +56,14 @@ struct SynthJobOptions {
   /// Not empty: the PTM sample's horizon map (`texlume fit --horizon`); the model's
   /// atlases then carry the relief's self-shadowing (ptm::ShadowingOfPtm).
   std::filesystem::path sample_horizon_file;
+  /// With a horizon map: whether the synthesis (placement, gains, the photo-consistency
+  /// pass) also relights the sample with its shadows (`--shadowed-synthesis`), as the
+  /// render does; off, only the model casts them (docs/synth.md, "Self-shadowing").
+  bool shadowed_synthesis = false;
+  /// With a horizon map: the atlases' relief heights times this, [0.25, 4]; <= 0 (auto):
+  /// the gain that gives each atlas the sample's share of shadow under low lights
+  /// (ptm::MatchLowLightShadowLoss; `--atlas-relief-gain`).
+  double atlas_relief_gain = 0.0;
   std::filesystem::path out_dir;          ///< the model folder written
   synth::MeshSynthesisOptions synthesis;  ///< sample_texel_size required
   atlas::AtlasOptions atlas;

@@ -118,14 +118,30 @@ cv::Mat HeightFromNormals(const std::vector<float>& normals_xyz, int width, int 
   return height_texels;
 }
 
-double HorizonMap::ElevationAt(std::size_t texel, double azimuth_rad) const {
+namespace {
+
+// The sectors either side of an azimuth (phi_s = 2 pi s / sectors) and the second's weight.
+void SectorsOfAzimuth(double azimuth_rad, int sectors, int& s0, int& s1, double& f) {
   double at = azimuth_rad / kTwoPi * sectors;
   at -= std::floor(at / sectors) * sectors;
-  const int s0 = std::min(static_cast<int>(at), sectors - 1);
-  const int s1 = (s0 + 1) % sectors;
-  const double f = at - s0;
+  s0 = std::min(static_cast<int>(at), sectors - 1);
+  s1 = (s0 + 1) % sectors;
+  f = at - s0;
+}
+
+}  // namespace
+
+double HorizonMap::ElevationAt(std::size_t texel, double azimuth_rad) const {
+  int s0 = 0, s1 = 0;
+  double f = 0.0;
+  SectorsOfAzimuth(azimuth_rad, sectors, s0, s1, f);
   const float* e = elevation_rad.data() + texel * static_cast<std::size_t>(sectors);
   return e[s0] * (1 - f) + e[s1] * f;
+}
+
+LightAmongSectors::LightAmongSectors(const Eigen::Vector3d& light, int sectors)
+    : elevation_rad(std::asin(std::clamp(light.normalized().z(), -1.0, 1.0))) {
+  SectorsOfAzimuth(std::atan2(light.y(), light.x()), sectors, s0, s1, f);
 }
 
 HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_distance_texels) {
@@ -172,6 +188,83 @@ double HorizonVisibility(const HorizonMap& horizon, std::size_t texel, const Eig
 double SelfShadowing::LightFactor(std::size_t texel, const Eigen::Vector3d& light) const {
   const double v = HorizonVisibility(horizon, texel, light, penumbra_rad);
   return v + (1.0 - v) * shadow_floor;
+}
+
+double SelfShadowing::CellLightFactor(double light_elevation_rad, double horizon_mean_rad,
+                                      double horizon_variance) const {
+  const double width =
+      std::sqrt(penumbra_rad * penumbra_rad + 12.0 * std::max(0.0, horizon_variance));
+  const double v = VisibilityAboveHorizon(light_elevation_rad, horizon_mean_rad, width);
+  return v + (1.0 - v) * shadow_floor;
+}
+
+namespace {
+
+// The light elevations (degrees) whose shadows LowLightShadowLoss measures.
+constexpr double kLowLightElevationsDeg[] = {10.0, 15.0, 20.0, 25.0, 30.0};
+// Histogram bins over a horizon's tangent, [0, kMaxTangent): the loss at any gain is
+// read from it (elevations above atan(kMaxTangent) = 84 degrees share the last bin).
+constexpr int kTangentBins = 4096;
+constexpr double kMaxTangent = 10.0;
+
+// How many (texel, sector) pairs of `counted` texels have a horizon tangent in each bin.
+std::vector<double> TangentHistogram(const HorizonMap& h, const std::vector<char>& counted) {
+  std::vector<double> bins(kTangentBins, 0.0);
+  const auto sectors = static_cast<std::size_t>(h.sectors);
+  for (std::size_t t = 0; t < h.NumTexels(); ++t) {
+    if (!counted.empty() && !counted[t]) continue;
+    for (std::size_t s = 0; s < sectors; ++s) {
+      const double tangent = std::tan(h.elevation_rad[t * sectors + s]);
+      const int bin =
+          std::min(kTangentBins - 1, static_cast<int>(tangent / kMaxTangent * kTangentBins));
+      bins[static_cast<std::size_t>(std::max(0, bin))] += 1.0;
+    }
+  }
+  return bins;
+}
+
+// LowLightShadowLoss from a tangent histogram: each bin at its centre.
+double LossOfHistogram(const std::vector<double>& bins, const SelfShadowing& s, double gain) {
+  double loss = 0.0, count = 0.0;
+  for (int b = 0; b < kTangentBins; ++b) {
+    const double n = bins[static_cast<std::size_t>(b)];
+    if (n == 0.0) continue;
+    const double tangent = b == 0 ? 0.0 : (b + 0.5) * kMaxTangent / kTangentBins;
+    const double horizon = std::atan(gain * tangent);
+    for (const double e : kLowLightElevationsDeg) {
+      const double v =
+          VisibilityAboveHorizon(e * std::numbers::pi / 180.0, horizon, s.penumbra_rad);
+      loss += n * (1.0 - v) * (1.0 - s.shadow_floor);
+    }
+    count += n * std::size(kLowLightElevationsDeg);
+  }
+  return count > 0.0 ? loss / count : 0.0;
+}
+
+}  // namespace
+
+double LowLightShadowLoss(const SelfShadowing& shadowing, const std::vector<char>& counted,
+                          double relief_gain) {
+  return LossOfHistogram(TangentHistogram(shadowing.horizon, counted), shadowing, relief_gain);
+}
+
+double MatchLowLightShadowLoss(SelfShadowing& shadowing, const std::vector<char>& counted,
+                               double target_loss) {
+  const std::vector<double> bins = TangentHistogram(shadowing.horizon, counted);
+  // The loss rises with the gain: bisection on log m over [1/4, 4].
+  double low = std::log(0.25), high = std::log(4.0);
+  for (int it = 0; it < 40; ++it) {
+    const double mid = 0.5 * (low + high);
+    (LossOfHistogram(bins, shadowing, std::exp(mid)) < target_loss ? low : high) = mid;
+  }
+  return ScaleRelief(shadowing, std::exp(0.5 * (low + high)));
+}
+
+double ScaleRelief(SelfShadowing& shadowing, double gain) {
+  for (float& e : shadowing.horizon.elevation_rad)
+    e = static_cast<float>(std::atan(gain * std::tan(static_cast<double>(e))));
+  shadowing.height_scale *= gain;
+  return gain;
 }
 
 namespace {

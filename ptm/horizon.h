@@ -58,6 +58,19 @@ double VisibilityAboveHorizon(double light_elevation_rad, double horizon_elevati
 double HorizonVisibility(const HorizonMap& horizon, std::size_t texel, const Eigen::Vector3d& light,
                          double penumbra_rad);
 
+/// Where a directional light (unit, texel frame) falls among a horizon map's
+/// `sectors` azimuths, and its elevation: found once per light, read at many texels.
+struct LightAmongSectors {
+  LightAmongSectors(const Eigen::Vector3d& light, int sectors);
+  int s0 = 0, s1 = 0;  ///< the sectors either side of the light's azimuth
+  double f = 0.0;      ///< the weight of s1
+  double elevation_rad = 0.0;
+  /// The horizon at the light's azimuth, from a texel's elevations in s0 and s1.
+  double Horizon(double elevation_s0, double elevation_s1) const {
+    return elevation_s0 * (1.0 - f) + elevation_s1 * f;
+  }
+};
+
 /// A sample's self-shadowing: its horizon map and how much light a shadow keeps.
 /// Relit, a texel's linear light is multiplied by LightFactor (RelightShadowed in
 /// shadowed_fit.h).
@@ -74,7 +87,33 @@ struct SelfShadowing {
 
   /// v + (1 - v) shadow_floor, v the horizon's visibility of the light (unit, texel frame).
   double LightFactor(std::size_t texel, const Eigen::Vector3d& light) const;
+  /// The mean light factor over a cell of texels whose horizons at the light's azimuth
+  /// have this mean and variance (radians, radians^2): the horizons taken as spread
+  /// evenly about their mean, so the ramp widens to sqrt(penumbra^2 + 12 variance). At
+  /// variance 0 it is LightFactor's.
+  double CellLightFactor(double light_elevation_rad, double horizon_mean_rad,
+                         double horizon_variance) const;
 };
+
+/// The share of light a self-shadowing takes from lights low over the surface: the
+/// mean of 1 - LightFactor over the texels `counted` (empty: all), the sectors'
+/// azimuths and light elevations of 10, 15, 20, 25 and 30 degrees, with the relief's
+/// heights times `relief_gain` (the horizon's tangents times it, as a scaled height
+/// field's horizon is: the steepest rise keeps its place).
+double LowLightShadowLoss(const SelfShadowing& shadowing, const std::vector<char>& counted,
+                          double relief_gain = 1.0);
+
+/// The relief of `shadowing` with its heights times `gain` > 0: every horizon's tangent
+/// and the height scale times it. Returns `gain`.
+double ScaleRelief(SelfShadowing& shadowing, double gain);
+
+/// Scales the relief of `shadowing` (heights times m: horizon tangents and height_scale)
+/// so that its LowLightShadowLoss over `counted` equals `target_loss`, m in [1/4, 4]
+/// (clamped there when the target is out of reach). Returns m. A synthesised atlas's
+/// integrated normals, blended and resampled, are flatter than its sample's: matched,
+/// the model casts the sample's share of shadow.
+double MatchLowLightShadowLoss(SelfShadowing& shadowing, const std::vector<char>& counted,
+                               double target_loss);
 
 /// A horizon file: OpenEXR, one channel per sector ("horizon.00", "horizon.01", ...:
 /// elevation in radians), float attributes texlume:height_scale, texlume:shadow_floor

@@ -60,13 +60,20 @@ EffectiveLight Effective(const Eigen::Vector3d& light_in_frame, double intensity
 
 std::vector<EffectiveLight> EffectiveLights(
     const std::vector<std::pair<Eigen::Vector3d, double>>& lights_in_frame,
-    const LightResponse& response) {
+    const LightResponse& response, std::vector<int>* source) {
   std::vector<EffectiveLight> out;
-  for (const auto& [l, intensity] : lights_in_frame) {
+  if (source) source->clear();
+  for (std::size_t k = 0; k < lights_in_frame.size(); ++k) {
+    const auto& [l, intensity] = lights_in_frame[k];
     const EffectiveLight e = Effective(l, intensity, response);
-    if (e.weight > 0.0) out.push_back(e);
+    if (e.weight <= 0.0) continue;
+    out.push_back(e);
+    if (source) source->push_back(static_cast<int>(k));
   }
-  if (response.ambient > 0.0) out.push_back({Eigen::Vector3d::UnitZ(), response.ambient});
+  if (response.ambient > 0.0) {
+    out.push_back({Eigen::Vector3d::UnitZ(), response.ambient});
+    if (source) source->push_back(-1);
+  }
   return out;
 }
 

@@ -61,9 +61,10 @@ EffectiveLight Effective(const Eigen::Vector3d& light_in_frame, double intensity
 /// Every light as the texel answers it (Effective; those of weight 0 left out),
 /// then the ambient light as a light at the zenith of weight `response.ambient`
 /// (when > 0): the linear value is the weighted sum of the biquadratic's linear
-/// values at the directions.
+/// values at the directions. `source`, when given, receives per effective light the
+/// index in `lights_in_frame` it came from, -1 for the ambient light.
 std::vector<EffectiveLight> EffectiveLights(
     const std::vector<std::pair<Eigen::Vector3d, double>>& lights_in_frame,
-    const LightResponse& response);
+    const LightResponse& response, std::vector<int>* source = nullptr);
 
 }  // namespace texlume::ptm

@@ -44,10 +44,11 @@ void CoarseWindow(const std::vector<cv::Mat>& coarse, double x, double y, double
 // One patch's photo-consistency pass: the state the Gauss-Newton rounds share.
 class CoefficientCorrection::PatchPass {
  public:
-  PatchPass(TrianglePatch& patch, const std::vector<RectifiedView>& views,
+  PatchPass(const PtmSample& sample, TrianglePatch& patch, const std::vector<RectifiedView>& views,
             const ReducedPlanes& reduced, const CoefficientPrior& prior,
             const std::vector<double>& photo_gains, const MeshSynthesisOptions& options)
-      : patch_(patch),
+      : sample_(sample),
+        patch_(patch),
         views_(views),
         red0_(reduced),
         prior_(prior),
@@ -62,8 +63,7 @@ class CoefficientCorrection::PatchPass {
     patch.channel_gain.assign(3, cv::Mat());
     for (cv::Mat& m : patch.channel_gain) m = cv::Mat::ones(gh_, gw_, CV_32FC1);
     ComputeWayToMean();
-    for (const RectifiedView& r : views_)
-      effective_lights_.push_back(ptm::EffectiveLights(r.lighting.lights, r.lighting.response));
+    for (const RectifiedView& r : views_) texel_lights_.push_back(sample_.LightsOf(r.lighting));
   }
 
   void Run() {
@@ -143,8 +143,10 @@ class CoefficientCorrection::PatchPass {
     Eigen::Vector3d linear = Eigen::Vector3d::Zero();
     Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
     // The lights as the texel answers them (horizon fade, light response and
-    // ambient), as RelightMixture relights.
-    for (const ptm::EffectiveLight& e : effective_lights_[view]) {
+    // ambient, the relief's shadows), as PtmSample::Relight relights.
+    std::vector<ptm::EffectiveLight>& lights = shadowed_lights_;
+    sample_.ShadowLights(texel_lights_[view], red0_, BilinearTaps(p0.size(), sx, sy), lights);
+    for (const ptm::EffectiveLight& e : lights) {
       const Eigen::Vector3d& l = e.direction;
       const double intensity = e.weight;
       const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
@@ -361,6 +363,7 @@ class CoefficientCorrection::PatchPass {
     }
   }
 
+  const PtmSample& sample_;
   TrianglePatch& patch_;
   const std::vector<RectifiedView>& views_;
   const ReducedPlanes& red0_;
@@ -369,9 +372,10 @@ class CoefficientCorrection::PatchPass {
   const MeshSynthesisOptions& options_;
   int gw_, gh_;
   std::vector<Vector6d> to_mean_of_cell_;
-  // Per view, the lights as the texel answers them (EffectiveLights), once.
-  std::vector<std::vector<ptm::EffectiveLight>> effective_lights_;
-  cv::Mat known_;  // CV_8UC1: cells with a change
+  // Per view, the lights as the texel answers them (PtmSample::LightsOf), once.
+  std::vector<PtmSample::TexelLights> texel_lights_;
+  mutable std::vector<ptm::EffectiveLight> shadowed_lights_;  // Predict's, at one cell
+  cv::Mat known_;                                             // CV_8UC1: cells with a change
 };
 
 // Detail transfer's dictionary at one density level: the sample's coarse
@@ -546,7 +550,7 @@ void CoefficientCorrection::Correct(TriangleEngine& engine, std::size_t face,
       on_grid.push_back(std::move(again));
   }
   TrianglePatch& patch = engine.result().patches[face];
-  PatchPass(patch, on_grid, sample_.Reduced(primary_level), PriorAt(primary_level),
+  PatchPass(sample_, patch, on_grid, sample_.Reduced(primary_level), PriorAt(primary_level),
             engine.result().photo_gains, options_)
       .Run();
   if (correction_level_.empty()) correction_level_.assign(engine.result().patches.size(), -1);

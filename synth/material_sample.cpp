@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "core/check.h"
 #include "core/image_io.h"
 #include "core/srgb.h"
 #include "ptm/coefficient_space.h"
@@ -45,6 +46,44 @@ std::vector<cv::Mat> RawPlanes(const ptm::Ptm& p) {
     }
   }
   return planes;
+}
+
+// A horizon map as planes: per sector its elevation (radians), then per sector its
+// square (what a reduction averages into the horizon's spread over a cell).
+std::vector<cv::Mat> HorizonPlanes(const ptm::HorizonMap& h) {
+  const auto sectors = static_cast<std::size_t>(h.sectors);
+  std::vector<cv::Mat> planes(2 * sectors);
+  for (cv::Mat& m : planes) m = cv::Mat(h.height, h.width, CV_32FC1);
+  for (int y = 0; y < h.height; ++y)
+    for (int x = 0; x < h.width; ++x) {
+      const std::size_t t = static_cast<std::size_t>(y) * h.width + x;
+      for (std::size_t s = 0; s < sectors; ++s) {
+        const float e = h.elevation_rad[t * sectors + s];
+        planes[s].at<float>(y, x) = e;
+        planes[sectors + s].at<float>(y, x) = e * e;
+      }
+    }
+  return planes;
+}
+
+// RelitLinearSum's texels of a shadowed sample: at most this many a side.
+constexpr int kShadowedSumGrid = 64;
+
+// The planes' texels at the centres of a grid of at most `side` x `side` cells over
+// them, each its own texel's value (no average).
+ReducedPlanes TexelsOnAGrid(const std::vector<cv::Mat>& planes, int side) {
+  const int w = planes[0].cols, h = planes[0].rows;
+  const int gw = std::min(w, side), gh = std::min(h, side);
+  ReducedPlanes out{{}, static_cast<double>(gw) / w, static_cast<double>(gh) / h};
+  for (const cv::Mat& plane : planes) {
+    cv::Mat grid(gh, gw, CV_32FC1);
+    for (int j = 0; j < gh; ++j)
+      for (int i = 0; i < gw; ++i)
+        grid.at<float>(j, i) =
+            plane.at<float>((2 * j + 1) * h / (2 * gh), (2 * i + 1) * w / (2 * gw));
+    out.planes.push_back(grid);
+  }
+  return out;
 }
 
 // A patch texel position (u, v) (texels, centres at integers) on the patch's
@@ -216,13 +255,21 @@ bool SamplePtmPatch(const std::vector<cv::Mat>& values, ptm::PtmFormat format,
   return true;
 }
 
-PtmSample::PtmSample(const ptm::Ptm& ptm)
-    : ptm_(ptm), values_(ToOrthonormalPlanes(ptm)), raw_(RawPlanes(ptm)) {
+PtmSample::PtmSample(const ptm::Ptm& ptm, const ptm::SelfShadowing* shadowing)
+    : ptm_(ptm), shadowing_(shadowing), values_(ToOrthonormalPlanes(ptm)), raw_(RawPlanes(ptm)) {
+  if (shadowing_) {
+    TEXLUME_CHECK(shadowing_->horizon.width == ptm.width &&
+                      shadowing_->horizon.height == ptm.height && shadowing_->horizon.sectors > 0,
+                  "a sample's horizon map of the sample's size");
+    const std::vector<cv::Mat> horizon = HorizonPlanes(shadowing_->horizon);
+    raw_.insert(raw_.end(), horizon.begin(), horizon.end());
+  }
   const int coefficient_planes = ptm.format == ptm::PtmFormat::kLrgb ? 6 : 18;
   coefficients_.assign(values_.begin(), values_.begin() + coefficient_planes);
   energy_ = PlaneEnergy(coefficients_);
   coarse_level_ = std::max(
       0, static_cast<int>(std::ceil(4.0 * std::log2(std::max(ptm.width, ptm.height) / 16.0))));
+  if (shadowing_) shadowed_sum_texels_ = TexelsOnAGrid(raw_, kShadowedSumGrid);
 }
 
 bool PtmSample::PatchFeatures(const TrianglePatch& patch, double texel_size,
@@ -250,16 +297,49 @@ void PtmSample::TurnFeatures(const Unfolding& u, float* features) const {
   }
 }
 
+PtmSample::TexelLights PtmSample::LightsOf(const FaceLighting& lighting) const {
+  TexelLights out;
+  std::vector<int> source;
+  out.lights = ptm::EffectiveLights(lighting.lights, lighting.response, &source);
+  for (const int k : source)
+    if (shadowing_ && k >= 0)
+      out.among_sectors.emplace_back(ptm::LightAmongSectors(
+          lighting.lights[static_cast<std::size_t>(k)].first, shadowing_->horizon.sectors));
+    else
+      out.among_sectors.emplace_back(std::nullopt);
+  return out;
+}
+
+void PtmSample::ShadowLights(const TexelLights& lights, const ReducedPlanes& reduced,
+                             const BilinearTaps& at, std::vector<ptm::EffectiveLight>& out) const {
+  out = lights.lights;
+  if (!shadowing_) return;
+  // Planes from HorizonPlanesBegin(): per sector its elevation, then its square.
+  const std::size_t begin = static_cast<std::size_t>(HorizonPlanesBegin());
+  const std::size_t sectors = static_cast<std::size_t>(shadowing_->horizon.sectors);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const std::optional<ptm::LightAmongSectors>& l = lights.among_sectors[k];
+    if (!l) continue;
+    const auto s0 = static_cast<std::size_t>(l->s0), s1 = static_cast<std::size_t>(l->s1);
+    const double mean =
+        l->Horizon(at.Of(reduced.planes[begin + s0]), at.Of(reduced.planes[begin + s1]));
+    const double mean_square = l->Horizon(at.Of(reduced.planes[begin + sectors + s0]),
+                                          at.Of(reduced.planes[begin + sectors + s1]));
+    out[k].weight *= shadowing_->CellLightFactor(l->elevation_rad, mean, mean_square - mean * mean);
+  }
+}
+
 std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighting& lighting,
                                         double gain) const {
   const int polys = ptm_.NumPolynomials();
   std::vector<cv::Mat> out(3);
   for (cv::Mat& m : out) m = cv::Mat(r.planes[0].size(), CV_32FC1);
   std::vector<float> a(static_cast<std::size_t>(polys * 6)), colour(3, 1.0f);
-  const std::vector<ptm::EffectiveLight> lights =
-      ptm::EffectiveLights(lighting.lights, lighting.response);
+  const TexelLights texel_lights = LightsOf(lighting);
+  std::vector<ptm::EffectiveLight> lights = texel_lights.lights;
   for (int y = 0; y < r.planes[0].rows; ++y) {
     for (int x = 0; x < r.planes[0].cols; ++x) {
+      if (shadowing_) ShadowLights(texel_lights, r, BilinearTaps(r.planes[0].size(), x, y), lights);
       for (int i = 0; i < polys * 6; ++i)
         a[static_cast<std::size_t>(i)] = r.planes[static_cast<std::size_t>(i)].at<float>(y, x);
       if (ptm_.format == ptm::PtmFormat::kLrgb)
@@ -275,7 +355,8 @@ std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighti
 }
 
 double PtmSample::RelitLinearSum(const FaceLighting& lighting, int cells) const {
-  const std::vector<cv::Mat> relit = Relight(Reduced(coarse_level_), lighting, 1.0);
+  const std::vector<cv::Mat> relit =
+      Relight(shadowing_ ? shadowed_sum_texels_ : Reduced(coarse_level_), lighting, 1.0);
   double sum = 0.0;
   for (int c = 0; c < 3; ++c)
     for (int j = 0; j < relit[0].rows; ++j)

@@ -4,11 +4,14 @@
 #include <map>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "mesh/triangle_frame.h"
+#include "ptm/horizon.h"
+#include "ptm/light_response.h"
 #include "ptm/ptm.h"
 #include "sfm/lights.h"
 #include "synth/triangle_parts.h"
@@ -110,12 +113,21 @@ class MaterialSample {
   mutable std::map<int, ReducedPlanes> reduced_;
 };
 
+class BilinearTaps;
+
 /// A PTM sample (paper 003): features are the orthonormal coefficients (6 LRGB,
 /// 18 RGB), turned by the frame rotation's 6 x 6 map; values (coefficients and
 /// LRGB colour) may be blended; relit in the display domain (RelightMixture).
+/// With its self-shadowing (`texlume fit --horizon`), each light's linear value is
+/// multiplied by the relief's light factor (ptm::SelfShadowing), as the renderer
+/// shades a model with horizon maps: the sample is relit with the shadows the
+/// photos show. The face frame is the sample's texel frame (patches are not turned
+/// in the sample), so a face's lights read the sample's horizon directly.
 class PtmSample : public MaterialSample {
  public:
-  explicit PtmSample(const ptm::Ptm& ptm);
+  /// `shadowing`: the sample's own (of its size), or null for none. Neither is copied:
+  /// both must outlive the sample.
+  explicit PtmSample(const ptm::Ptm& ptm, const ptm::SelfShadowing* shadowing = nullptr);
 
   std::string Name() const override { return "PTM"; }
   int Width() const override { return ptm_.width; }
@@ -139,18 +151,46 @@ class PtmSample : public MaterialSample {
   int CoefficientPlanes() const { return static_cast<int>(coefficients_.size()); }
   /// Everything a texel holds: orthonormal coefficients, then LRGB colour.
   const std::vector<cv::Mat>& Values() const { return values_; }
+  /// Whether the sample casts the relief's shadows.
+  bool CastsShadows() const { return shadowing_ != nullptr; }
+
+  /// A face lighting's lights as the sample's texels answer them
+  /// (ptm::EffectiveLights) and, when the sample casts shadows, where each falls
+  /// among the horizon's sectors (nothing for the ambient light: it casts none).
+  struct TexelLights {
+    std::vector<ptm::EffectiveLight> lights;
+    std::vector<std::optional<ptm::LightAmongSectors>> among_sectors;
+  };
+  TexelLights LightsOf(const FaceLighting& lighting) const;
+  /// `lights` with each weight times the relief's light factor at the reduced
+  /// sample's point `at` (bilinear taps of `reduced`'s size): the horizon's mean and
+  /// spread over the point's cell (SelfShadowing::CellLightFactor). Unchanged when
+  /// the sample casts no shadows.
+  void ShadowLights(const TexelLights& lights, const ReducedPlanes& reduced, const BilinearTaps& at,
+                    std::vector<ptm::EffectiveLight>& out) const;
 
  protected:
   /// Raw coefficients a0..a5 per polynomial, then LRGB colour: evaluation is
   /// linear in them, so reducing them equals reducing the relit image (up to
-  /// the clamp).
+  /// the clamp). With self-shadowing, then per sector the horizon elevation and its
+  /// square (radians): reduced, their means over a cell give the horizon's mean and
+  /// spread there.
   const std::vector<cv::Mat>& RelightPlanes() const override { return raw_; }
 
  private:
+  /// The index in RelightPlanes() of the first horizon plane.
+  int HorizonPlanesBegin() const { return ptm_.NumPolynomials() * 6 + (lrgb() ? 3 : 0); }
+  bool lrgb() const { return ptm_.format == ptm::PtmFormat::kLrgb; }
+
   const ptm::Ptm& ptm_;
+  const ptm::SelfShadowing* shadowing_ = nullptr;
   std::vector<cv::Mat> values_, coefficients_, raw_;
   cv::Mat energy_;
   int coarse_level_ = 0;  ///< the level RelitLinearSum averages at (about 16 texels a side)
+  /// With self-shadowing, what RelitLinearSum relights instead: the texels of a
+  /// grid over the sample (kShadowedSumGrid a side), each with its own horizon, since
+  /// a cell's shadow is not that of its mean horizon.
+  ReducedPlanes shadowed_sum_texels_;
 };
 
 /// Bilinear value of a CV_32FC1 plane at (x, y) (pixel centres at integers),

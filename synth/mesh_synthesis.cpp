@@ -138,9 +138,10 @@ MeshSynthesis SynthesizeMeshPtm(const mesh::TriangleMesh& mesh,
                                 const sfm::VisibilityResult& visibility,
                                 const std::vector<MeshPhoto>& photos, const ptm::Ptm& ptm,
                                 const MeshSynthesisOptions& options,
-                                const ProgressCallback& progress, const FaceRegions* regions) {
+                                const ProgressCallback& progress, const FaceRegions* regions,
+                                const ptm::SelfShadowing* sample_shadowing) {
   options.Check();
-  const PtmSample sample(ptm);
+  const PtmSample sample(ptm, sample_shadowing);
   // The photo-consistency pass and detail transfer work on LRGB luminance.
   std::unique_ptr<CoefficientCorrection> correction;
   if (options.correction_iterations > 0 && ptm.format == ptm::PtmFormat::kLrgb)

@@ -126,13 +126,16 @@ EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
 /// OptionError for bad options and InputError when the patches would not fit the
 /// sample or would exceed max_texels (with the estimate).
 /// `regions`: a distributed run (TriangleEngine::DistributeOver); on ranks other than
-/// 0 the result is only this rank's share (rank_share_only).
+/// 0 the result is only this rank's share (rank_share_only). `sample_shadowing`: the
+/// sample's self-shadowing (`--sample-horizon`), with which placement, gains and the
+/// photo-consistency pass relight the sample with the relief's shadows (PtmSample).
 MeshSynthesis SynthesizeMeshPtm(const mesh::TriangleMesh& mesh,
                                 const sfm::Reconstruction& reconstruction,
                                 const sfm::VisibilityResult& visibility,
                                 const std::vector<MeshPhoto>& photos, const ptm::Ptm& sample,
                                 const MeshSynthesisOptions& options,
                                 const ProgressCallback& progress = {},
-                                const FaceRegions* regions = nullptr);
+                                const FaceRegions* regions = nullptr,
+                                const ptm::SelfShadowing* sample_shadowing = nullptr);
 
 }  // namespace texlume::synth

@@ -265,6 +265,12 @@ TEST(Cli, SynthAndRenderRefuseBadCommandLinesAndInputs) {
             2);
   EXPECT_NE(out.find("--sample-horizon is not taken by --engine graphcut"), std::string::npos)
       << out;
+  // Shadows in the synthesis need the horizon map.
+  EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
+                    "--sample-texel-size 0.01 --out f --shadowed-synthesis",
+                    &out),
+            2);
+  EXPECT_NE(out.find("--shadowed-synthesis requires --sample-horizon"), std::string::npos) << out;
   // A photo cache that is not a size (photos on demand, docs/cli.md).
   EXPECT_EQ(Texlume("synth --model a --images b --lights c --mesh d --sample e "
                     "--sample-texel-size 0.01 --out f --photo-cache lots",

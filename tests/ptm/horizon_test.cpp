@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <vector>
 
 #include "core/errors.h"
 #include "ptm/exr_io.h"
@@ -131,6 +133,51 @@ TEST(SelfShadowingExr, RoundTripsAndRefusesFilesThatAreNotHorizons) {
   names[2] = "R";
   WriteExr(dir.path() / "other.exr", planes, names);
   EXPECT_THROW(ReadSelfShadowingExr(dir.path() / "other.exr"), InputError);
+}
+
+// A relief of bumps (texel units), 64 x 64.
+cv::Mat Bumps(double amplitude) {
+  cv::Mat h(64, 64, CV_64FC1);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      h.at<double>(y, x) = amplitude * std::sin(0.4 * x) * std::sin(0.3 * y + 0.2 * x);
+  return h;
+}
+
+// A horizon of heights times m is that of the heights with its tangents times m, so an
+// atlas integrated half as steep as its sample is given the sample's relief back.
+TEST(LowLightShadowLoss, MatchingAFlatterReliefScalesItBackToTheSamples) {
+  SelfShadowing sample, atlas;
+  sample.shadow_floor = atlas.shadow_floor = 0.3;
+  sample.penumbra_rad = atlas.penumbra_rad = 4.0 * std::numbers::pi / 180.0;
+  sample.horizon = ComputeHorizonMap(Bumps(4.0), 16, 48);
+  atlas.horizon = ComputeHorizonMap(Bumps(2.0), 16, 48);
+  const double target = LowLightShadowLoss(sample, {});
+  const double flatter = LowLightShadowLoss(atlas, {});
+  ASSERT_GT(target, 0.05);
+  ASSERT_LT(flatter, 0.8 * target);
+  EXPECT_NEAR(LowLightShadowLoss(atlas, {}, 2.0), target, 0.01 * target);
+  const double gain = MatchLowLightShadowLoss(atlas, {}, target);
+  EXPECT_NEAR(gain, 2.0, 0.05);
+  EXPECT_NEAR(atlas.height_scale, gain, 1e-12);
+  EXPECT_NEAR(LowLightShadowLoss(atlas, {}), target, 0.002);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < sample.horizon.elevation_rad.size(); ++i)
+    worst = std::max(worst, std::abs(static_cast<double>(atlas.horizon.elevation_rad[i]) -
+                                     sample.horizon.elevation_rad[i]));
+  EXPECT_LT(worst, 0.02);  // radians
+  // Only the texels counted: those behind no horizon lose nothing.
+  std::vector<char> open(sample.horizon.NumTexels(), 1);
+  for (std::size_t t = 0; t < open.size(); ++t)
+    for (int k = 0; k < 16; ++k)
+      if (sample.horizon.elevation_rad[t * 16 + static_cast<std::size_t>(k)] > 0.0f) open[t] = 0;
+  ASSERT_GT(std::count(open.begin(), open.end(), 1), 0);
+  EXPECT_EQ(LowLightShadowLoss(sample, open), 0.0);
+  // A target out of reach is met as far as the gain's range allows.
+  SelfShadowing flat = atlas;
+  flat.horizon = ComputeHorizonMap(cv::Mat::zeros(64, 64, CV_64FC1), 16, 48);
+  EXPECT_NEAR(MatchLowLightShadowLoss(flat, {}, target), 4.0, 1e-6);
+  EXPECT_EQ(LowLightShadowLoss(flat, {}), 0.0);
 }
 
 }  // namespace

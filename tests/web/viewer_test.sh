@@ -15,12 +15,13 @@ trap 'rm -rf "$tmp"' EXIT
   --texel-size 0.004 --relief 0.012 --no-btf > "$tmp/scene.log"
 capture="$tmp/scene/material/capture"
 # The sample with its horizon map: the model casts the relief's shadows, in the
-# viewer as in texlume render.
+# viewer as in texlume render (and the synthesis relights the sample with them).
 "$texlume" fit --images "$capture" --lights "$capture/lights.lp" --out "$tmp/sample.ptm" \
   --exr "$tmp/sample.exr" --horizon "$tmp/horizon.exr" > "$tmp/fit.log"
 object="$tmp/scene/object"
 "$texlume" synth --model "$object/sparse" --images "$object/images" --lights "$object/lights.json" \
   --mesh "$object/mesh.ply" --sample "$tmp/sample.exr" --sample-horizon "$tmp/horizon.exr" \
-  --sample-texel-size 0.004 --atlas-size 1024 --out "$tmp/model" > "$tmp/synth.log" 2>&1
+  --shadowed-synthesis --sample-texel-size 0.004 --atlas-size 1024 --out "$tmp/model" \
+  > "$tmp/synth.log" 2>&1
 cd "$web"
 TEXLUME="$texlume" TEXLUME_MODEL="$tmp/model" TEXLUME_PHOTOS="$object" node --test test/
