@@ -541,9 +541,17 @@ class SynthJob {
     summary_.seconds_visibility = inputs_.seconds_visibility;
   }
 
-  // The sample's self-shadowing for the synthesis to relight it with, or none.
+  // The sample's self-shadowing for the synthesis to relight it with, or none. Its
+  // elevations and their squares join the sample's relit planes (synth::PtmSample):
+  // refused up front unless they fit twice over (the reduced levels the photos ask
+  // for take about as much again).
   const ptm::SelfShadowing* ShadowsInSynthesis() const {
-    return sample_shadowing_ && options_.shadowed_synthesis ? &*sample_shadowing_ : nullptr;
+    if (!sample_shadowing_ || !options_.shadowed_synthesis) return nullptr;
+    const ptm::HorizonMap& h = sample_shadowing_->horizon;
+    RequireMemory(2.0 * h.sectors * static_cast<double>(h.NumTexels()) * 4.0 * 2.0,
+                  "the sample's horizon planes (--shadowed-synthesis)",
+                  options_.sample_horizon_file.string());
+    return &*sample_shadowing_;
   }
 
   // The relief's horizon per atlas (--sample-horizon; pipeline/sample_shadowing.h).
