@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <exception>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "ptm/horizon.h"
@@ -20,9 +22,12 @@ std::vector<char> CountedTexels(const texlume::ptm::SelfShadowing& s, const char
   std::vector<char> counted(s.horizon.NumTexels(), 1);
   if (!ptm_path) return counted;
   const texlume::ptm::Ptm ptm = texlume::ptm::ReadPtmExr(ptm_path);
+  if (ptm.width != s.horizon.width || ptm.height != s.horizon.height)
+    throw std::runtime_error(std::string(ptm_path) + " is not the horizon map's size");
   for (std::size_t t = 0; t < counted.size(); ++t) {
     bool any = false;
-    for (int m = 0; m < 6; ++m) any = any || ptm.Coefficients(t, 0)[m] != 0.0f;
+    for (int q = 0; q < ptm.NumPolynomials(); ++q)
+      for (int m = 0; m < 6; ++m) any = any || ptm.Coefficients(t, q)[m] != 0.0f;
     counted[t] = any;
   }
   return counted;

@@ -299,8 +299,11 @@ void SynthJobOptions::CheckInputsAndLayout() const {
         "--compare-regions is for one process: mpirun's manifest measures its own regions");
   if (!sample_horizon_file.empty() && LowerCaseExtension(sample_horizon_file) != ".exr")
     throw OptionError("--sample-horizon is the .exr that texlume fit --horizon writes");
-  if (atlas_relief_gain > 0.0 && (atlas_relief_gain < 0.25 || atlas_relief_gain > 4.0))
+  if (!std::isfinite(atlas_relief_gain) ||
+      (atlas_relief_gain > 0.0 && (atlas_relief_gain < 0.25 || atlas_relief_gain > 4.0)))
     throw OptionError("--atlas-relief-gain is auto or in [0.25, 4]");
+  if (sample_horizon_file.empty() && (shadowed_synthesis || atlas_relief_gain > 0.0))
+    throw OptionError("--shadowed-synthesis and --atlas-relief-gain need --sample-horizon");
   CheckWorldUnit(mm_per_world_unit);
 }
 
@@ -532,8 +535,10 @@ class SynthJob {
   void Load() {
     inputs_ = LoadSynthInputs(options_);
     sample_ = options_.sample ? Sample{*options_.sample, {}} : ReadSample(options_.sample_file);
-    if (!options_.sample_horizon_file.empty())
+    if (!options_.sample_horizon_file.empty()) {
       sample_shadowing_ = ReadSampleShadowing(options_.sample_horizon_file, sample_);
+      if (options_.shadowed_synthesis) RequireSynthesisShadowMemory();
+    }
     PrepareSynthMesh(inputs_, options_, std::min(sample_.ptm.width, sample_.ptm.height),
                      options_.synthesis.sample_texel_size, options_.synthesis.strip, progress_);
     summary_.CountInputs(inputs_);
@@ -541,17 +546,19 @@ class SynthJob {
     summary_.seconds_visibility = inputs_.seconds_visibility;
   }
 
-  // The sample's self-shadowing for the synthesis to relight it with, or none. Its
-  // elevations and their squares join the sample's relit planes (synth::PtmSample):
-  // refused up front unless they fit twice over (the reduced levels the photos ask
-  // for take about as much again).
+  // The sample's self-shadowing for the synthesis to relight it with, or none.
   const ptm::SelfShadowing* ShadowsInSynthesis() const {
-    if (!sample_shadowing_ || !options_.shadowed_synthesis) return nullptr;
+    return sample_shadowing_ && options_.shadowed_synthesis ? &*sample_shadowing_ : nullptr;
+  }
+
+  // --shadowed-synthesis: the horizon's elevations and their squares join the sample's
+  // relit planes (synth::PtmSample), kept at full size and reduced at each density level
+  // the photos ask for (about 3.4 times the full size in all, with a margin: 4.5).
+  void RequireSynthesisShadowMemory() const {
     const ptm::HorizonMap& h = sample_shadowing_->horizon;
-    RequireMemory(2.0 * h.sectors * static_cast<double>(h.NumTexels()) * 4.0 * 2.0,
+    RequireMemory(2.0 * h.sectors * static_cast<double>(h.NumTexels()) * 4.0 * 4.5,
                   "the sample's horizon planes (--shadowed-synthesis)",
                   options_.sample_horizon_file.string());
-    return &*sample_shadowing_;
   }
 
   // The relief's horizon per atlas (--sample-horizon; pipeline/sample_shadowing.h).

@@ -207,6 +207,13 @@ constexpr double kLowLightElevationsDeg[] = {10.0, 15.0, 20.0, 25.0, 30.0};
 constexpr int kTangentBins = 4096;
 constexpr double kMaxTangent = 10.0;
 
+// The tangent of a horizon elevation kept within [0, pi / 2) (a float pi / 2 is just
+// above it).
+double HorizonTangent(float elevation_rad) {
+  constexpr double kSteepest = std::numbers::pi / 2 - 1e-6;
+  return std::tan(std::clamp(static_cast<double>(elevation_rad), 0.0, kSteepest));
+}
+
 // How many (texel, sector) pairs of `counted` texels have a horizon tangent in each bin.
 std::vector<double> TangentHistogram(const HorizonMap& h, const std::vector<char>& counted) {
   std::vector<double> bins(kTangentBins, 0.0);
@@ -214,10 +221,11 @@ std::vector<double> TangentHistogram(const HorizonMap& h, const std::vector<char
   for (std::size_t t = 0; t < h.NumTexels(); ++t) {
     if (!counted.empty() && !counted[t]) continue;
     for (std::size_t s = 0; s < sectors; ++s) {
-      const double tangent = std::tan(h.elevation_rad[t * sectors + s]);
+      const double tangent =
+          std::clamp(HorizonTangent(h.elevation_rad[t * sectors + s]), 0.0, kMaxTangent);
       const int bin =
           std::min(kTangentBins - 1, static_cast<int>(tangent / kMaxTangent * kTangentBins));
-      bins[static_cast<std::size_t>(std::max(0, bin))] += 1.0;
+      bins[static_cast<std::size_t>(bin)] += 1.0;
     }
   }
   return bins;
@@ -251,6 +259,9 @@ double LowLightShadowLoss(const SelfShadowing& shadowing, const std::vector<char
 double MatchLowLightShadowLoss(SelfShadowing& shadowing, const std::vector<char>& counted,
                                double target_loss) {
   const std::vector<double> bins = TangentHistogram(shadowing.horizon, counted);
+  // Nothing to match (a flat sample, or an atlas that casts no shadow at any gain): the
+  // relief as it is.
+  if (!(target_loss > 0.0) || LossOfHistogram(bins, shadowing, 4.0) <= 0.0) return 1.0;
   // The loss rises with the gain: bisection on log m over [1/4, 4].
   double low = std::log(0.25), high = std::log(4.0);
   for (int it = 0; it < 40; ++it) {
@@ -262,7 +273,7 @@ double MatchLowLightShadowLoss(SelfShadowing& shadowing, const std::vector<char>
 
 double ScaleRelief(SelfShadowing& shadowing, double gain) {
   for (float& e : shadowing.horizon.elevation_rad)
-    e = static_cast<float>(std::atan(gain * std::tan(static_cast<double>(e))));
+    e = static_cast<float>(std::atan(gain * HorizonTangent(e)));
   shadowing.height_scale *= gain;
   return gain;
 }

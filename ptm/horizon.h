@@ -109,7 +109,8 @@ double ScaleRelief(SelfShadowing& shadowing, double gain);
 
 /// Scales the relief of `shadowing` (heights times m: horizon tangents and height_scale)
 /// so that its LowLightShadowLoss over `counted` equals `target_loss`, m in [1/4, 4]
-/// (clamped there when the target is out of reach). Returns m. A synthesised atlas's
+/// (clamped there when the target is out of reach; 1, the relief unchanged, when the
+/// target is 0 or the map casts no shadow at any gain). Returns m. A synthesised atlas's
 /// integrated normals, blended and resampled, are flatter than its sample's: matched,
 /// the model casts the sample's share of shadow.
 double MatchLowLightShadowLoss(SelfShadowing& shadowing, const std::vector<char>& counted,

@@ -390,8 +390,9 @@ class CoefficientCorrection::DetailDictionary {
     const ReducedPlanes& red = sample.Reduced(level);
     dx_ = 1.0 / red.rx, dy_ = 1.0 / red.ry;
     const cv::Size full(sample.Width(), sample.Height());
-    std::vector<cv::Mat> coarse_raw(red.planes.size());
-    for (std::size_t c = 0; c < red.planes.size(); ++c)
+    // The raw coefficients and LRGB colour (Values()' planes), not a horizon's.
+    std::vector<cv::Mat> coarse_raw(sample.Values().size());
+    for (std::size_t c = 0; c < coarse_raw.size(); ++c)
       cv::resize(red.planes[c], coarse_raw[c], full, 0, 0, cv::INTER_LINEAR);
     const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
     coarse_.assign(6, cv::Mat());

@@ -320,12 +320,15 @@ void PtmSample::ShadowLights(const TexelLights& lights, const ReducedPlanes& red
   for (std::size_t k = 0; k < out.size(); ++k) {
     const std::optional<ptm::LightAmongSectors>& l = lights.among_sectors[k];
     if (!l) continue;
+    // Each sector's mean and variance over the cell, then the two sectors' blend (a
+    // texel's own horizon, at level 0, has variance 0 in every sector).
     const auto s0 = static_cast<std::size_t>(l->s0), s1 = static_cast<std::size_t>(l->s1);
-    const double mean =
-        l->Horizon(at.Of(reduced.planes[begin + s0]), at.Of(reduced.planes[begin + s1]));
-    const double mean_square = l->Horizon(at.Of(reduced.planes[begin + sectors + s0]),
-                                          at.Of(reduced.planes[begin + sectors + s1]));
-    out[k].weight *= shadowing_->CellLightFactor(l->elevation_rad, mean, mean_square - mean * mean);
+    const double mean0 = at.Of(reduced.planes[begin + s0]);
+    const double mean1 = at.Of(reduced.planes[begin + s1]);
+    const double variance0 = at.Of(reduced.planes[begin + sectors + s0]) - mean0 * mean0;
+    const double variance1 = at.Of(reduced.planes[begin + sectors + s1]) - mean1 * mean1;
+    out[k].weight *= shadowing_->CellLightFactor(l->elevation_rad, l->Horizon(mean0, mean1),
+                                                 l->Horizon(variance0, variance1));
   }
 }
 

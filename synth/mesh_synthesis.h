@@ -127,8 +127,9 @@ EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
 /// sample or would exceed max_texels (with the estimate).
 /// `regions`: a distributed run (TriangleEngine::DistributeOver); on ranks other than
 /// 0 the result is only this rank's share (rank_share_only). `sample_shadowing`: the
-/// sample's self-shadowing (`--sample-horizon`), with which placement, gains and the
-/// photo-consistency pass relight the sample with the relief's shadows (PtmSample).
+/// sample's self-shadowing (`--shadowed-synthesis`), with which placement, gains and
+/// the photo-consistency pass (LRGB samples) relight the sample with the relief's
+/// shadows (PtmSample).
 MeshSynthesis SynthesizeMeshPtm(const mesh::TriangleMesh& mesh,
                                 const sfm::Reconstruction& reconstruction,
                                 const sfm::VisibilityResult& visibility,

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "core/errors.h"
 #include "core/memory_budget.h"
 #include "datasets_synthetic/shapes.h"
@@ -69,6 +71,21 @@ TEST(SynthJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
   o.atlas.gutter = 0;
   EXPECT_THROW(o.Check(), OptionError);
   EXPECT_THROW(pipeline::RunSynthJob(o), OptionError);
+  // The sample horizon's settings need the horizon, and a gain in [0.25, 4] or auto.
+  o = CompleteSynthJob();
+  o.shadowed_synthesis = true;
+  EXPECT_THROW(o.Check(), OptionError);
+  o.sample_horizon_file = "horizon.exr";
+  EXPECT_NO_THROW(o.Check());
+  for (const double gain : {0.1, 5.0, std::numeric_limits<double>::quiet_NaN()}) {
+    o.atlas_relief_gain = gain;
+    EXPECT_THROW(o.Check(), OptionError) << gain;
+  }
+  o.atlas_relief_gain = 1.5;
+  EXPECT_NO_THROW(o.Check());
+  o.sample_horizon_file.clear();
+  o.shadowed_synthesis = false;
+  EXPECT_THROW(o.Check(), OptionError);
 }
 
 // A graph-cut fill whose dense surface the memory limit cannot hold is refused

@@ -174,10 +174,25 @@ TEST(LowLightShadowLoss, MatchingAFlatterReliefScalesItBackToTheSamples) {
   ASSERT_GT(std::count(open.begin(), open.end(), 1), 0);
   EXPECT_EQ(LowLightShadowLoss(sample, open), 0.0);
   // A target out of reach is met as far as the gain's range allows.
+  SelfShadowing faint = sample;
+  faint.horizon = ComputeHorizonMap(Bumps(0.4), 16, 48);
+  ASSERT_GT(LowLightShadowLoss(faint, {}, 4.0), 0.0);
+  ASSERT_LT(LowLightShadowLoss(faint, {}, 4.0), target);
+  EXPECT_NEAR(MatchLowLightShadowLoss(faint, {}, target), 4.0, 1e-6);
+  // A flat map, or a target of no shadow, leaves the relief as it is.
   SelfShadowing flat = atlas;
   flat.horizon = ComputeHorizonMap(cv::Mat::zeros(64, 64, CV_64FC1), 16, 48);
-  EXPECT_NEAR(MatchLowLightShadowLoss(flat, {}, target), 4.0, 1e-6);
+  EXPECT_EQ(MatchLowLightShadowLoss(flat, {}, target), 1.0);
   EXPECT_EQ(LowLightShadowLoss(flat, {}), 0.0);
+  SelfShadowing again = sample;
+  EXPECT_EQ(MatchLowLightShadowLoss(again, {}, 0.0), 1.0);
+  EXPECT_EQ(again.horizon.elevation_rad, sample.horizon.elevation_rad);
+  // A horizon at a float's pi / 2 (the reader's largest) stays a horizon when scaled.
+  SelfShadowing steep = sample;
+  steep.horizon.elevation_rad[0] = static_cast<float>(std::numbers::pi / 2);
+  ScaleRelief(steep, 2.0);
+  EXPECT_GE(steep.horizon.elevation_rad[0], 1.5f);
+  EXPECT_LE(steep.horizon.elevation_rad[0], static_cast<float>(std::numbers::pi / 2));
 }
 
 }  // namespace

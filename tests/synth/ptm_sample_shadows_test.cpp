@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 #include "core/srgb.h"
 #include "ptm/horizon.h"
@@ -88,6 +89,28 @@ TEST(PtmSampleShadows, EachLightIsTimesTheReliefsLightFactorAndAmbientIsNot) {
   // The gains' mean relights with the same shadows.
   EXPECT_NEAR(shadowed.RelitLinearSum(low, 100), 0.25 * plain.RelitLinearSum(low, 100),
               1e-3 * plain.RelitLinearSum(low, 100));
+}
+
+// At full resolution a texel is shadowed exactly as SelfShadowing::LightFactor has it,
+// its horizon interpolated between sectors that differ.
+TEST(PtmSampleShadows, ATexelsLightFactorIsTheHorizonMapsBetweenUnlikeSectors) {
+  const ptm::Ptm ptm = GreySample();
+  ptm::SelfShadowing shadowing = Shadowing([](int) { return 0.0; });
+  for (std::size_t i = 0; i < shadowing.horizon.elevation_rad.size(); ++i)
+    shadowing.horizon.elevation_rad[i] = static_cast<float>((i % 2 ? 40.0 : 0.0) * kDeg);
+  const PtmSample plain(ptm), shadowed(ptm, &shadowing);
+  // Sectors are 45 degrees apart: between sector 0 (0) and 1 (40 degrees) the horizon
+  // rises from 0 to 40 degrees.
+  for (const auto& [elevation_deg, azimuth_deg] :
+       {std::pair{25.0, 22.5}, {15.0, 22.5}, {21.0, 22.5}, {30.0, 40.0}, {10.0, 5.0}}) {
+    const Eigen::Vector3d l = LightAt(elevation_deg, azimuth_deg);
+    const FaceLighting lighting{Eigen::Vector3d::UnitZ(), {{l, 1.0}}, {}};
+    EXPECT_NEAR(
+        MeanLinear(shadowed.Relight(shadowed.Reduced(0), lighting, 1.0)),
+        shadowing.LightFactor(0, l) * MeanLinear(plain.Relight(plain.Reduced(0), lighting, 1.0)),
+        2e-4)
+        << elevation_deg << " " << azimuth_deg;
+  }
 }
 
 // A reduced cell holding texels in shadow and texels lit is lit in proportion:
