@@ -1,6 +1,7 @@
 #include "pipeline/sample_shadowing.h"
 
 #include <algorithm>
+#include <numbers>
 
 #include "core/errors.h"
 #include "core/memory_budget.h"
@@ -54,6 +55,40 @@ std::vector<double> ShadowModelAtlases(const ptm::SelfShadowing& sample,
     model.shadowing.push_back(std::move(atlas));
   }
   return relief_gains;
+}
+
+SampleShadowingStage::SampleShadowingStage(const SynthJobOptions& options, const Sample& sample)
+    : options_(options), shadowing_(ReadSampleShadowing(options.sample_horizon_file, sample)) {
+  if (!options_.shadowed_synthesis) return;
+  // The horizon's elevations and their squares join the sample's relit planes
+  // (synth::PtmSample), kept at full size and reduced at each density level the photos
+  // ask for (about 3.4 times the full size in all, with a margin: 4.5).
+  const ptm::HorizonMap& h = shadowing_.horizon;
+  RequireMemory(2.0 * h.sectors * static_cast<double>(h.NumTexels()) * 4.0 * 4.5,
+                "the sample's horizon planes (--shadowed-synthesis)",
+                options_.sample_horizon_file.string());
+}
+
+const ptm::SelfShadowing* SampleShadowingStage::ForSynthesis() const {
+  return options_.shadowed_synthesis ? &shadowing_ : nullptr;
+}
+
+void SampleShadowingStage::ShadowAtlases(model::TexturedModel& model,
+                                         const ProgressCallback& progress) {
+  atlas_relief_gains_ = ShadowModelAtlases(shadowing_, options_.sample_horizon_file,
+                                           options_.atlas_relief_gain, model, progress);
+}
+
+nlohmann::json SampleShadowingStage::Record() const {
+  return {{"file", options_.sample_horizon_file.string()},
+          {"height_scale", shadowing_.height_scale},
+          {"shadow_floor", shadowing_.shadow_floor},
+          {"penumbra_deg", shadowing_.penumbra_rad * 180.0 / std::numbers::pi},
+          {"in_synthesis", options_.shadowed_synthesis},
+          {"atlas_relief_gain", options_.atlas_relief_gain > 0.0
+                                    ? nlohmann::json(options_.atlas_relief_gain)
+                                    : nlohmann::json("auto")},
+          {"atlas_relief_gains", atlas_relief_gains_}};
 }
 
 }  // namespace texlume::pipeline

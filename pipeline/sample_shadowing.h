@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "core/progress.h"
@@ -26,5 +27,27 @@ std::vector<double> ShadowModelAtlases(const ptm::SelfShadowing& sample,
                                        const std::filesystem::path& file, double relief_gain,
                                        model::TexturedModel& model,
                                        const ProgressCallback& progress);
+
+/// The synth job's `--sample-horizon` steps, one method each: the sample's horizon
+/// read (with the memory `--shadowed-synthesis` needs, refused up front), the
+/// shadowing the synthesis relights the sample with, the atlases' horizons, and
+/// the manifest's record of them.
+class SampleShadowingStage {
+ public:
+  /// Reads options.sample_horizon_file (ReadSampleShadowing); `options` must outlive
+  /// the stage.
+  SampleShadowingStage(const SynthJobOptions& options, const Sample& sample);
+  /// The sample's self-shadowing with --shadowed-synthesis, else null.
+  const ptm::SelfShadowing* ForSynthesis() const;
+  /// ShadowModelAtlases with the options' relief gain.
+  void ShadowAtlases(model::TexturedModel& model, const ProgressCallback& progress);
+  /// The manifest's `inputs.sample_horizon`.
+  nlohmann::json Record() const;
+
+ private:
+  const SynthJobOptions& options_;
+  ptm::SelfShadowing shadowing_;
+  std::vector<double> atlas_relief_gains_;  ///< per atlas, once ShadowAtlases ran
+};
 
 }  // namespace texlume::pipeline

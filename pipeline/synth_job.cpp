@@ -535,10 +535,7 @@ class SynthJob {
   void Load() {
     inputs_ = LoadSynthInputs(options_);
     sample_ = options_.sample ? Sample{*options_.sample, {}} : ReadSample(options_.sample_file);
-    if (!options_.sample_horizon_file.empty()) {
-      sample_shadowing_ = ReadSampleShadowing(options_.sample_horizon_file, sample_);
-      if (options_.shadowed_synthesis) RequireSynthesisShadowMemory();
-    }
+    if (!options_.sample_horizon_file.empty()) sample_shadowing_.emplace(options_, sample_);
     PrepareSynthMesh(inputs_, options_, std::min(sample_.ptm.width, sample_.ptm.height),
                      options_.synthesis.sample_texel_size, options_.synthesis.strip, progress_);
     summary_.CountInputs(inputs_);
@@ -546,27 +543,11 @@ class SynthJob {
     summary_.seconds_visibility = inputs_.seconds_visibility;
   }
 
-  // The sample's self-shadowing for the synthesis to relight it with, or none.
-  const ptm::SelfShadowing* ShadowsInSynthesis() const {
-    return sample_shadowing_ && options_.shadowed_synthesis ? &*sample_shadowing_ : nullptr;
-  }
-
-  // --shadowed-synthesis: the horizon's elevations and their squares join the sample's
-  // relit planes (synth::PtmSample), kept at full size and reduced at each density level
-  // the photos ask for (about 3.4 times the full size in all, with a margin: 4.5).
-  void RequireSynthesisShadowMemory() const {
-    const ptm::HorizonMap& h = sample_shadowing_->horizon;
-    RequireMemory(2.0 * h.sectors * static_cast<double>(h.NumTexels()) * 4.0 * 4.5,
-                  "the sample's horizon planes (--shadowed-synthesis)",
-                  options_.sample_horizon_file.string());
-  }
-
   // The relief's horizon per atlas (--sample-horizon; pipeline/sample_shadowing.h).
   void ShadowAtlases() {
     if (!sample_shadowing_) return;
     const auto t = std::chrono::steady_clock::now();
-    atlas_relief_gains_ = ShadowModelAtlases(*sample_shadowing_, options_.sample_horizon_file,
-                                             options_.atlas_relief_gain, model_, progress_);
+    sample_shadowing_->ShadowAtlases(model_, progress_);
     summary_.seconds_atlas += SecondsSince(t);
   }
 
@@ -578,9 +559,10 @@ class SynthJob {
         RegionsOfJob(options_, in, options_.synthesis);
     const synth::FaceRegions* regions_or_null = regions ? &*regions : nullptr;
     synthesis_ = sample_.colour.empty()
-                     ? synth::SynthesizeMeshPtm(in.mesh, in.reconstruction, in.visibility,
-                                                in.photos, sample_.ptm, options_.synthesis,
-                                                progress_, regions_or_null, ShadowsInSynthesis())
+                     ? synth::SynthesizeMeshPtm(
+                           in.mesh, in.reconstruction, in.visibility, in.photos, sample_.ptm,
+                           options_.synthesis, progress_, regions_or_null,
+                           sample_shadowing_ ? sample_shadowing_->ForSynthesis() : nullptr)
                      : synth::SynthesizeMeshColour(
                            in.mesh, in.reconstruction, in.visibility, in.photos, sample_.colour,
                            ColourOptions(options_.synthesis), progress_, regions_or_null);
@@ -700,17 +682,7 @@ class SynthJob {
     record["command"] = "synth";
     record["inputs"] = options_.InputsJson();
     record["inputs"]["sample"] = options_.sample_file.string();
-    if (sample_shadowing_)
-      record["inputs"]["sample_horizon"] = {
-          {"file", options_.sample_horizon_file.string()},
-          {"height_scale", sample_shadowing_->height_scale},
-          {"shadow_floor", sample_shadowing_->shadow_floor},
-          {"penumbra_deg", sample_shadowing_->penumbra_rad * 180.0 / std::numbers::pi},
-          {"in_synthesis", options_.shadowed_synthesis},
-          {"atlas_relief_gain", options_.atlas_relief_gain > 0.0
-                                    ? nlohmann::json(options_.atlas_relief_gain)
-                                    : nlohmann::json("auto")},
-          {"atlas_relief_gains", atlas_relief_gains_}};
+    if (sample_shadowing_) record["inputs"]["sample_horizon"] = sample_shadowing_->Record();
     record["settings"] = Settings();
     record["summary"] = Summary();
     record["warnings"] = summary_.warnings;
@@ -795,8 +767,7 @@ class SynthJob {
   std::optional<synth::EdgeMismatch> edge_mismatch_;  // a distributed run's
   nlohmann::json region_comparison_;                  // one process's (--compare-regions)
   model::TexturedModel model_;
-  std::optional<ptm::SelfShadowing> sample_shadowing_;  // --sample-horizon
-  std::vector<double> atlas_relief_gains_;              // per atlas (ptm::MatchLowLightShadowLoss)
+  std::optional<SampleShadowingStage> sample_shadowing_;  // --sample-horizon
   std::vector<cv::Mat> baked_;
   Eigen::Vector3f flat_albedo_ = Eigen::Vector3f::Constant(0.5f);
   std::vector<std::pair<std::string, cv::Mat>> extra_images_;
