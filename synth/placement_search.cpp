@@ -46,10 +46,28 @@ void ForEachView(std::size_t count, const PerView& view) {
 
 }  // namespace
 
+std::array<cv::Mat, 3> RelitScratch::Planes(std::size_t slot, cv::Size size) {
+  if (buffers_.size() <= slot) buffers_.resize(slot + 1);
+  std::array<cv::Mat, 3> out;
+  for (std::size_t c = 0; c < out.size(); ++c) {
+    cv::Mat& buffer = buffers_[slot][c];
+    if (buffer.cols < size.width || buffer.rows < size.height)
+      buffer.create(std::max(buffer.rows, size.height), std::max(buffer.cols, size.width),
+                    CV_32FC1);
+    out[c] = buffer(cv::Rect(cv::Point(0, 0), size));
+  }
+  return out;
+}
+
 PlacementSearch::PlacementSearch(const MaterialSample& sample,
                                  const std::vector<RectifiedView>& views,
-                                 const std::vector<double>& photo_gains, cv::Size patch_texels)
-    : sample_(sample), views_(views), photo_gains_(photo_gains), patch_(patch_texels) {
+                                 const std::vector<double>& photo_gains, cv::Size patch_texels,
+                                 RelitScratch* scratch)
+    : sample_(sample),
+      views_(views),
+      photo_gains_(photo_gains),
+      patch_(patch_texels),
+      scratch_(scratch ? scratch : &own_scratch_) {
   last_x_ = sample.Width() - patch_texels.width;
   last_y_ = sample.Height() - patch_texels.height;
 }
@@ -148,9 +166,9 @@ std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<View
 
 class PlacementSearch::RelitTiles {
  public:
-  RelitTiles(const PlacementSearch& search, const ViewAtStep& view) : search_(search), view_(view) {
+  RelitTiles(const PlacementSearch& search, const ViewAtStep& view, std::array<cv::Mat, 3> planes)
+      : search_(search), view_(view), planes_(std::move(planes)) {
     const cv::Size size = view.reduced->planes[0].size();
-    for (cv::Mat& m : planes_) m.create(size, CV_32FC1);
     tiles_x_ = (size.width + kTile - 1) / kTile;
     done_.assign(static_cast<std::size_t>(tiles_x_ * ((size.height + kTile - 1) / kTile)), 0);
   }
@@ -239,7 +257,8 @@ std::vector<ScoredPlacement> PlacementSearch::CoarseToFine(int top_k, int candid
     const int stride = Stride(views);
     std::vector<RelitTiles> relit;
     relit.reserve(views.size());
-    for (const ViewAtStep& v : views) relit.emplace_back(*this, v);
+    for (std::size_t r = 0; r < views.size(); ++r)
+      relit.emplace_back(*this, views[r], scratch_->Planes(r, views[r].reduced->planes[0].size()));
     // Every placement of this density's grid within a coarse cell of a candidate.
     std::unordered_set<long long> seen;
     std::vector<ScoredPlacement> scored;

@@ -23,9 +23,10 @@ class PlacementSearch {
  public:
   /// `views` rectified at their photo density levels (best view first), `photo_gains`
   /// per photo, `patch_texels` the patch's size in sample texels. All references must
-  /// outlive the search.
+  /// outlive the search. `scratch` (optional) lends the direct scores their buffers.
   PlacementSearch(const MaterialSample& sample, const std::vector<RectifiedView>& views,
-                  const std::vector<double>& photo_gains, cv::Size patch_texels);
+                  const std::vector<double>& photo_gains, cv::Size patch_texels,
+                  RelitScratch* scratch = nullptr);
 
   /// Paper 003: every placement scored (FFT), the top_k distinct ones at the primary
   /// view's density (a photo cell apart), best first.
@@ -78,6 +79,8 @@ class PlacementSearch {
   const std::vector<RectifiedView>& views_;
   const std::vector<double>& photo_gains_;
   cv::Size patch_;
+  RelitScratch* scratch_;
+  RelitScratch own_scratch_;     // when none is lent
   int last_x_ = 0, last_y_ = 0;  // the last placement's top-left texel
 };
 

@@ -557,7 +557,7 @@ void TriangleEngine::ScoreAndPlace(TrianglePatch& patch, const std::vector<Recti
   // photos, at the placements of the patch in the sample the search visits; of
   // its top_k, the one closest to the synthesised neighbours.
   const PlacementSearch search(sample_, views, result_.photo_gains,
-                               cv::Size(patch.width, patch.height));
+                               cv::Size(patch.width, patch.height), &relit_scratch_);
   KeepClosestToNeighbours(
       options_.search == PlacementSearchKind::kExhaustive
           ? search.Exhaustive(options_.top_k)

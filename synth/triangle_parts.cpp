@@ -22,9 +22,12 @@ Eigen::Vector3f RelightEffective(const float* coefficients, const float* colour,
   Eigen::Vector3f linear = Eigen::Vector3f::Zero();
   for (const ptm::EffectiveLight& e : lights) {
     const Eigen::Vector3d& l = e.direction;
+    // LRGB: one luminance polynomial scaled by each channel's colour.
+    const double luminance =
+        format == ptm::PtmFormat::kLrgb ? ptm::EvaluatePolynomial(coefficients, l.x(), l.y()) : 0.0;
     for (int c = 0; c < 3; ++c) {
       const double v = format == ptm::PtmFormat::kLrgb
-                           ? ptm::EvaluatePolynomial(coefficients, l.x(), l.y()) * colour[c]
+                           ? luminance * colour[c]
                            : ptm::EvaluatePolynomial(coefficients + 6 * c, l.x(), l.y());
       linear[c] += static_cast<float>(e.weight) * srgb::ToLinear(static_cast<float>(v));
     }

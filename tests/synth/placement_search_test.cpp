@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <map>
 #include <opencv2/imgproc.hpp>
@@ -123,6 +124,28 @@ TEST(PlacementSearch, RefinedScoresEqualTheExhaustiveScores) {
   const std::vector<ScoredPlacement> fallback = search.CoarseToFine(12, 16, 3, 1000);
   const std::vector<ScoredPlacement> exhaustive = search.Exhaustive(12);
   for (std::size_t n = 0; n < 12; ++n) EXPECT_EQ(fallback[n], exhaustive[n]);
+}
+
+// A lent scratch, left holding another search's relit cells of other sizes (a
+// larger sample, one view more), changes no score: each face's search relights
+// every cell it reads.
+TEST(PlacementSearch, ALentScratchScoresAsTheSearchsOwn) {
+  const Fixture f(0.05);
+  const ColourSample larger(StructuredColour(224, 11));
+  std::vector<RectifiedView> other = f.views;
+  other.push_back(f.views.front());
+  RelitScratch scratch;
+  const PlacementSearch before(larger, other, f.gains, cv::Size(kPatch + 8, kPatch), &scratch);
+  ASSERT_EQ(before.CoarseToFine(12, 16).size(), 12u);
+  const PlacementSearch lent(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch), &scratch);
+  const PlacementSearch own(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch));
+  const std::vector<ScoredPlacement> with_lent = lent.CoarseToFine(12, 16);
+  const std::vector<ScoredPlacement> with_own = own.CoarseToFine(12, 16);
+  ASSERT_EQ(with_lent.size(), 12u);
+  for (std::size_t n = 0; n < with_own.size(); ++n) EXPECT_EQ(with_lent[n], with_own[n]);
+  // The scratch grew to the larger sample's cells and still serves the smaller.
+  const std::array<cv::Mat, 3> planes = scratch.Planes(0, cv::Size(5, 7));
+  EXPECT_EQ(planes[2].size(), cv::Size(5, 7));
 }
 
 // A sample whose relighting fails under one photo's gain (as a failed allocation
