@@ -67,7 +67,7 @@ PlacementSearch::PlacementSearch(const MaterialSample& sample,
       views_(views),
       photo_gains_(photo_gains),
       patch_(patch_texels),
-      scratch_(scratch ? scratch : &own_scratch_) {
+      scratch_(scratch) {
   last_x_ = sample.Width() - patch_texels.width;
   last_y_ = sample.Height() - patch_texels.height;
 }
@@ -252,13 +252,15 @@ std::vector<ScoredPlacement> PlacementSearch::CoarseToFine(int top_k, int candid
     return Exhaustive(top_k);
   std::vector<ScoredPlacement> kept =
       KeepBest(ScoreOnGrid(views, coarse_stride), std::max(candidates, top_k));
+  RelitScratch own;  // when none is lent
+  RelitScratch& scratch = scratch_ ? *scratch_ : own;
   for (int step = steps - 1; step >= 0; --step) {
     views = ViewsAtStep(step);
     const int stride = Stride(views);
     std::vector<RelitTiles> relit;
     relit.reserve(views.size());
     for (std::size_t r = 0; r < views.size(); ++r)
-      relit.emplace_back(*this, views[r], scratch_->Planes(r, views[r].reduced->planes[0].size()));
+      relit.emplace_back(*this, views[r], scratch.Planes(r, views[r].reduced->planes[0].size()));
     // Every placement of this density's grid within a coarse cell of a candidate.
     std::unordered_set<long long> seen;
     std::vector<ScoredPlacement> scored;

@@ -23,10 +23,14 @@ class PlacementSearch {
  public:
   /// `views` rectified at their photo density levels (best view first), `photo_gains`
   /// per photo, `patch_texels` the patch's size in sample texels. All references must
-  /// outlive the search. `scratch` (optional) lends the direct scores their buffers.
+  /// outlive the search. `scratch` (optional; it must outlive the search, and serve one
+  /// search at a time) lends the direct scores their buffers; without it each
+  /// CoarseToFine allocates its own.
   PlacementSearch(const MaterialSample& sample, const std::vector<RectifiedView>& views,
                   const std::vector<double>& photo_gains, cv::Size patch_texels,
                   RelitScratch* scratch = nullptr);
+  PlacementSearch(const PlacementSearch&) = delete;
+  PlacementSearch& operator=(const PlacementSearch&) = delete;
 
   /// Paper 003: every placement scored (FFT), the top_k distinct ones at the primary
   /// view's density (a photo cell apart), best first.
@@ -79,8 +83,7 @@ class PlacementSearch {
   const std::vector<RectifiedView>& views_;
   const std::vector<double>& photo_gains_;
   cv::Size patch_;
-  RelitScratch* scratch_;
-  RelitScratch own_scratch_;     // when none is lent
+  RelitScratch* scratch_;        // lent, or null
   int last_x_ = 0, last_y_ = 0;  // the last placement's top-left texel
 };
 

@@ -135,6 +135,7 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
 void TriangleEngine::FinishFaces(const std::vector<std::size_t>& faces,
                                  const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
+  relit_scratch_.Release();  // the placements are done: their memory goes to the finish
   if (correction_) correction_->Finish(*this, faces, progress);
   result_.seconds_finish += SecondsSince(start);
 }

@@ -125,13 +125,15 @@ struct RelitWindow {
 
 /// Memory for the relit samples the direct scores read, kept from one face's search
 /// to the next: a fresh buffer per face and view costs a page fault per page it
-/// touches (issue 33: the s512 job 1.47 x less CPU with them kept). Grows to the
-/// largest size asked and never shrinks. One search at a time may use it.
+/// touches (issue 33; docs/synth.md, "Relit buffers kept from face to face"). Grows
+/// to the largest size asked until Release(). One search at a time may use it.
 class RelitScratch {
  public:
   /// View `slot`'s three planes, `size` cells each: views into buffers that may
   /// hold an earlier search's values.
   std::array<cv::Mat, 3> Planes(std::size_t slot, cv::Size size);
+  /// Frees the buffers (the next Planes() allocates again).
+  void Release() { buffers_.clear(); }
 
  private:
   std::vector<std::array<cv::Mat, 3>> buffers_;

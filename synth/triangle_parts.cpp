@@ -22,7 +22,8 @@ Eigen::Vector3f RelightEffective(const float* coefficients, const float* colour,
   Eigen::Vector3f linear = Eigen::Vector3f::Zero();
   for (const ptm::EffectiveLight& e : lights) {
     const Eigen::Vector3d& l = e.direction;
-    // LRGB: one luminance polynomial scaled by each channel's colour.
+    // LRGB: one luminance polynomial scaled by each channel's colour (Malzbender et
+    // al. 2001, eq. 2), evaluated once for the three channels.
     const double luminance =
         format == ptm::PtmFormat::kLrgb ? ptm::EvaluatePolynomial(coefficients, l.x(), l.y()) : 0.0;
     for (int c = 0; c < 3; ++c) {

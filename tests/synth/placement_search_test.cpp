@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -127,8 +128,8 @@ TEST(PlacementSearch, RefinedScoresEqualTheExhaustiveScores) {
 }
 
 // A lent scratch, left holding another search's relit cells of other sizes (a
-// larger sample, one view more), changes no score: each face's search relights
-// every cell it reads.
+// larger sample, one view more; then NaN everywhere), changes no score: each
+// face's search relights every cell it reads.
 TEST(PlacementSearch, ALentScratchScoresAsTheSearchsOwn) {
   const Fixture f(0.05);
   const ColourSample larger(StructuredColour(224, 11));
@@ -137,15 +138,20 @@ TEST(PlacementSearch, ALentScratchScoresAsTheSearchsOwn) {
   RelitScratch scratch;
   const PlacementSearch before(larger, other, f.gains, cv::Size(kPatch + 8, kPatch), &scratch);
   ASSERT_EQ(before.CoarseToFine(12, 16).size(), 12u);
+  // It refined (the direct scores took the scratch) on the larger sample's cells.
+  const std::array<cv::Mat, 3> grown = scratch.Planes(0, cv::Size(5, 7));
+  EXPECT_EQ(grown[2].size(), cv::Size(5, 7));
+  ASSERT_GE(grown[0].step[0], 224 * sizeof(float));
+  for (std::size_t slot = 0; slot < other.size(); ++slot)
+    for (cv::Mat plane : scratch.Planes(slot, cv::Size(224, 224)))  // views: the buffers
+      plane.setTo(std::numeric_limits<float>::quiet_NaN());
   const PlacementSearch lent(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch), &scratch);
   const PlacementSearch own(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch));
   const std::vector<ScoredPlacement> with_lent = lent.CoarseToFine(12, 16);
   const std::vector<ScoredPlacement> with_own = own.CoarseToFine(12, 16);
   ASSERT_EQ(with_lent.size(), 12u);
+  ASSERT_EQ(with_own.size(), 12u);
   for (std::size_t n = 0; n < with_own.size(); ++n) EXPECT_EQ(with_lent[n], with_own[n]);
-  // The scratch grew to the larger sample's cells and still serves the smaller.
-  const std::array<cv::Mat, 3> planes = scratch.Planes(0, cv::Size(5, 7));
-  EXPECT_EQ(planes[2].size(), cv::Size(5, 7));
 }
 
 // A sample whose relighting fails under one photo's gain (as a failed allocation
