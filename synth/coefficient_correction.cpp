@@ -144,9 +144,13 @@ class CoefficientCorrection::PatchPass {
     Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
     // The lights as the texel answers them (horizon fade, light response and
     // ambient, the relief's shadows), as PtmSample::Relight relights.
-    std::vector<ptm::EffectiveLight>& lights = shadowed_lights_;
-    sample_.ShadowLights(texel_lights_[view], red0_, BilinearTaps(p0.size(), sx, sy), lights);
-    for (const ptm::EffectiveLight& e : lights) {
+    const std::vector<ptm::EffectiveLight>* lights = &texel_lights_[view].lights;
+    if (sample_.CastsShadows()) {  // else the lights are the view's, unchanged
+      sample_.ShadowLights(texel_lights_[view], red0_, BilinearTaps(p0.size(), sx, sy),
+                           shadowed_lights_);
+      lights = &shadowed_lights_;
+    }
+    for (const ptm::EffectiveLight& e : *lights) {
       const Eigen::Vector3d& l = e.direction;
       const double intensity = e.weight;
       const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
