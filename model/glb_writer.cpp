@@ -176,6 +176,15 @@ class GlbBuilder {
           AddTexture(atlas.ptm_plane_pngs[j], "ptm_" + k + "_plane_" + std::to_string(j));
       ptm["planes"].push_back({{"index", plane}, {"texCoord", 0}});
     }
+    if (!atlas.horizon_pngs.empty()) {
+      ptm["horizon"] = atlas.horizon_fields;
+      ptm["horizon"]["textures"] = nlohmann::json::array();
+      for (std::size_t j = 0; j < atlas.horizon_pngs.size(); ++j) {
+        const int sectors =
+            AddTexture(atlas.horizon_pngs[j], "horizon_" + k + "_" + std::to_string(j));
+        ptm["horizon"]["textures"].push_back({{"index", sectors}, {"texCoord", 0}});
+      }
+    }
     gltf_["materials"].push_back({{"name", "atlas_" + k},
                                   {"pbrMetallicRoughness",
                                    {{"baseColorTexture", {{"index", albedo}}},

@@ -22,7 +22,11 @@ struct GlbAtlas {
   /// PNG-encoded, for TEXLUME_ptm_atlas.
   std::vector<std::vector<unsigned char>> ptm_plane_pngs;
   nlohmann::json ptm_fields;  ///< TEXLUME_ptm_atlas's other fields (scale, bias, frame...)
-  nlohmann::json extras;      ///< the material's extras
+  /// The relief's horizon when the model casts its shadows (EncodeHorizonTextures):
+  /// TEXLUME_ptm_atlas's `horizon`, its PNGs as `textures`. Empty: no horizon.
+  std::vector<std::vector<unsigned char>> horizon_pngs;
+  nlohmann::json horizon_fields;
+  nlohmann::json extras;  ///< the material's extras
 };
 
 /// glTF's frame from the model's (COLMAP's) as a 4 x 4 matrix: rows of the rotation
@@ -36,7 +40,8 @@ Eigen::Matrix4d GltfFromModel(const TexturedModel& model);
 /// primitive and material per atlas: positions, smooth normals, tangents along the
 /// atlas frame's x (so the normal map's axes are the PTM's), TEXCOORD_0 (glTF's v
 /// down); the albedo as base colour, the PTM normals as normal map, and the PTM atlas's
-/// coefficient planes under the TEXLUME_ptm_atlas extension. Throws std::runtime_error when
+/// coefficient planes (and the relief's horizon, when it has one) under the
+/// TEXLUME_ptm_atlas extension. Throws std::runtime_error when
 /// the file would exceed the 4 GiB a GLB can hold.
 void WriteGlb(const std::filesystem::path& path, const TexturedModel& model,
               const std::vector<GlbAtlas>& atlases);

@@ -16,6 +16,7 @@
 #include "core/file_util.h"
 #include "core/partial_output.h"
 #include "model/glb_writer.h"
+#include "model/web_model.h"
 #include "ptm/ptm_io.h"
 #include "synth/mesh_synthesis.h"
 
@@ -238,6 +239,9 @@ class ModelFolderWriter {
       const std::string horizon_file = "horizon_atlas_" + k + ".exr";
       ptm::WriteSelfShadowingExr(model_.shadowing[a], tmp_ / horizon_file);
       manifest_["atlases"].back()["horizon"] = horizon_file;
+      HorizonTextures horizon = EncodeHorizonTextures(model_.shadowing[a], horizon_file);
+      glb.horizon_pngs = std::move(horizon.pngs);
+      glb.horizon_fields = std::move(horizon.fields);
     }
     const nlohmann::json ptm_fields = {
         {"format", format},

@@ -125,13 +125,12 @@ QuantisedPlane QuantisePlane(const std::vector<float>& values) {
 
 namespace {
 
-// The relief's horizon (model's SelfShadowing) at kWebHorizonSectors azimuths
-// 2 pi s / 16, four sectors per RGBA PNG, byte = elevation / (pi / 2) x 255; and
-// how the light falls in shadow (docs/viewer.md, "Web model").
 constexpr int kWebHorizonSectors = 16;
 
-nlohmann::json HorizonTextures(const ptm::SelfShadowing& shadowing, const std::string& k,
-                               WebModel& web) {
+}  // namespace
+
+HorizonTextures EncodeHorizonTextures(const ptm::SelfShadowing& shadowing,
+                                      const std::string& label) {
   const ptm::HorizonMap& h = shadowing.horizon;
   constexpr double kQuarterTurn = std::numbers::pi / 2.0;
   std::vector<QuantisedPlane> planes(kWebHorizonSectors);
@@ -145,20 +144,33 @@ nlohmann::json HorizonTextures(const ptm::SelfShadowing& shadowing, const std::s
       q.bytes[t] = static_cast<unsigned char>(
           std::clamp(std::lround(h.ElevationAt(t, azimuth) / kQuarterTurn * 255.0), 0L, 255L));
   }
-  nlohmann::json files = nlohmann::json::array();
+  HorizonTextures out;
   for (int first = 0; first < kWebHorizonSectors; first += 4) {
-    const std::vector<const QuantisedPlane*> rgba = {
-        &planes[static_cast<std::size_t>(first)], &planes[static_cast<std::size_t>(first) + 1],
-        &planes[static_cast<std::size_t>(first) + 2], &planes[static_cast<std::size_t>(first) + 3]};
-    const std::string name = "horizon_" + k + "_" + std::to_string(first / 4) + ".png";
-    web.files[name] = PlanesPng(rgba, h.width, h.height, name);
+    std::vector<const QuantisedPlane*> rgba;
+    for (int s = first; s < first + 4; ++s) rgba.push_back(&planes[static_cast<std::size_t>(s)]);
+    out.pngs.push_back(PlanesPng(rgba, h.width, h.height, label));
+  }
+  out.fields = {{"sectors", kWebHorizonSectors},
+                {"elevation_scale", kQuarterTurn},
+                {"shadow_floor", shadowing.shadow_floor},
+                {"penumbra_rad", shadowing.penumbra_rad}};
+  return out;
+}
+
+namespace {
+
+// The web model's horizon files of atlas `k`, added to `web`; its scene entry.
+nlohmann::json HorizonFiles(const ptm::SelfShadowing& shadowing, const std::string& k,
+                            WebModel& web) {
+  HorizonTextures textures = EncodeHorizonTextures(shadowing, "the horizon of atlas " + k);
+  nlohmann::json files = nlohmann::json::array();
+  for (std::size_t i = 0; i < textures.pngs.size(); ++i) {
+    const std::string name = "horizon_" + k + "_" + std::to_string(i) + ".png";
+    web.files[name] = std::move(textures.pngs[i]);
     files.push_back(name);
   }
-  return {{"files", files},
-          {"sectors", kWebHorizonSectors},
-          {"elevation_scale", kQuarterTurn},
-          {"shadow_floor", shadowing.shadow_floor},
-          {"penumbra_rad", shadowing.penumbra_rad}};
+  textures.fields["files"] = files;
+  return textures.fields;
 }
 
 }  // namespace
@@ -263,7 +275,7 @@ WebModel BuildWebModel(const fs::path& model_dir) {
       textures.push_back({{"file", name}, {"scale", scale}, {"bias", bias}});
     }
     entry["textures"] = textures;
-    if (!model.shadowing.empty()) entry["horizon"] = HorizonTextures(model.shadowing[a], k, web);
+    if (!model.shadowing.empty()) entry["horizon"] = HorizonFiles(model.shadowing[a], k, web);
     if (a < entries.size() && entries[a].is_object() && entries[a].contains("base_colour")) {
       const std::string name =
           ManifestFileName(entries[a]["base_colour"], model_dir, "base_colour");

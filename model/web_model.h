@@ -35,6 +35,18 @@ QuantisedPlane QuantisePlane(const std::vector<float>& values);
 std::vector<unsigned char> PlanesPng(const std::vector<const QuantisedPlane*>& planes, int width,
                                      int height, const std::string& label);
 
+/// The relief's horizon of one atlas (its SelfShadowing) as the web model and the
+/// GLB carry it (docs/viewer.md, "The relief's shadows"): 16 azimuths 2 pi s / 16,
+/// four per RGBA PNG, byte = elevation / (pi / 2) x 255; and how the light falls in
+/// shadow (`sectors`, `elevation_scale`, `shadow_floor`, `penumbra_rad`).
+struct HorizonTextures {
+  std::vector<std::vector<unsigned char>> pngs;  ///< PNG i holds sectors 4i .. 4i + 3
+  nlohmann::json fields;
+};
+/// Throws InputError(label) when a PNG cannot be encoded.
+HorizonTextures EncodeHorizonTextures(const ptm::SelfShadowing& shadowing,
+                                      const std::string& label);
+
 /// Builds the web model of a model folder written by WriteModelFolder (reads
 /// its manifest, OBJ, EXR atlases and baked textures). Throws InputError naming
 /// the file on anything malformed.

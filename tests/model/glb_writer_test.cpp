@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <numbers>
 #include <opencv2/imgcodecs.hpp>
 
 #include "core/file_util.h"
@@ -54,10 +55,10 @@ struct Glb {
     std::memcpy(out.data(), bytes.data(), out.size() * sizeof(T));
     return out;
   }
-  cv::Mat Texture(int texture) const {
+  cv::Mat Texture(int texture, int flags = cv::IMREAD_COLOR) const {
     const int image = json["textures"][static_cast<std::size_t>(texture)]["source"].get<int>();
     const std::string png = View(json["images"][static_cast<std::size_t>(image)]["bufferView"]);
-    return cv::imdecode(std::vector<unsigned char>(png.begin(), png.end()), cv::IMREAD_COLOR);
+    return cv::imdecode(std::vector<unsigned char>(png.begin(), png.end()), flags);
   }
 };
 
@@ -159,6 +160,49 @@ TEST_F(ModelExports, TheGlbCarriesThePtmPlanesThatDequantiseToTheAtlas) {
   EXPECT_NEAR(value(4, px[1]), 0.2, 2e-3);
   EXPECT_NEAR(ptm["evaluation"]["horizon_elevation_deg"].get<double>(), ptm::kHorizonElevationDeg,
               0);
+}
+
+TEST_F(ModelExports, TheGlbHasNoHorizonWhenTheModelCastsNoShadows) {
+  EXPECT_FALSE(glb_.json["materials"][0]["extensions"][kGltfPtmExtension].contains("horizon"));
+}
+
+TEST(ModelExport, TheGlbCarriesTheReliefsHorizonAtSixteenAzimuths) {
+  TexturedModel model = TiltedSquare();
+  ptm::SelfShadowing& shadowing = model.shadowing.emplace_back();
+  ptm::HorizonMap& h = shadowing.horizon;
+  h.width = h.height = 32;
+  h.sectors = 8;  // the GLB's 16 azimuths read between them
+  h.elevation_rad.resize(h.NumTexels() * 8);
+  for (std::size_t t = 0; t < h.NumTexels(); ++t)
+    for (std::size_t s = 0; s < 8; ++s)
+      h.elevation_rad[t * 8 + s] = static_cast<float>(0.1 * s + 0.02 * static_cast<double>(t % 9));
+  shadowing.shadow_floor = 0.25;
+  shadowing.penumbra_rad = 0.07;
+  testing::TempDir tmp;
+  WriteModelFolder(tmp / "model", model, nlohmann::json::object());
+  const Glb glb = ReadGlb(tmp / "model/model.glb");
+  const nlohmann::json& horizon =
+      glb.json["materials"][0]["extensions"][kGltfPtmExtension]["horizon"];
+  ASSERT_EQ(horizon["sectors"].get<int>(), 16);
+  ASSERT_EQ(horizon["textures"].size(), 4u);
+  EXPECT_EQ(horizon["shadow_floor"].get<double>(), 0.25);
+  EXPECT_EQ(horizon["penumbra_rad"].get<double>(), 0.07);
+  const double scale = horizon["elevation_scale"].get<double>();
+  EXPECT_NEAR(scale, std::numbers::pi / 2, 1e-12);
+  // Sector s is channel s % 4 (R, G, B, A) of texture s / 4; OpenCV decodes BGRA.
+  const int bgra[4] = {2, 1, 0, 3};
+  for (int s = 0; s < 16; ++s) {
+    const cv::Mat png = glb.Texture(horizon["textures"][static_cast<std::size_t>(s / 4)]["index"],
+                                    cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(png.type(), CV_8UC4);
+    ASSERT_EQ(png.size(), cv::Size(32, 32));
+    for (const std::size_t t : {std::size_t{0}, std::size_t{37}, std::size_t{1000}}) {
+      const cv::Vec4b px = png.at<cv::Vec4b>(static_cast<int>(t / 32), static_cast<int>(t % 32));
+      EXPECT_NEAR(px[bgra[s % 4]] / 255.0 * scale, h.ElevationAt(t, 2 * std::numbers::pi * s / 16),
+                  0.5 / 255.0 * scale + 1e-9)
+          << "sector " << s << ", texel " << t;
+    }
+  }
 }
 
 TEST_F(ModelExports, TheObjHasVertexNormalsAndReadsBack) {

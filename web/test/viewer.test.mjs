@@ -201,6 +201,16 @@ test('the exported GLB passes the Khronos glTF validator with no errors and no w
               `${report.issues.numInfos} infos`);
   assert.equal(report.issues.numErrors, 0, JSON.stringify(errors, null, 1));
   assert.equal(report.issues.numWarnings, 0, JSON.stringify(errors, null, 1));
+  // The model casts the relief's shadows: every material carries its horizon's 4 textures.
+  const view = new DataView(bytes.buffer, bytes.byteOffset);
+  const gltf = JSON.parse(new TextDecoder().decode(bytes.subarray(20, 20 + view.getUint32(12, true))));
+  for (const material of gltf.materials) {
+    const horizon = material.extensions.TEXLUME_ptm_atlas.horizon;
+    assert.ok(horizon, `${material.name} has TEXLUME_ptm_atlas.horizon`);
+    assert.equal(horizon.sectors, 16);
+    assert.equal(horizon.textures.length, 4);
+    for (const t of horizon.textures) assert.ok(t.index < gltf.textures.length);
+  }
 });
 
 // COLMAP's text model: cameras (PINHOLE) and images by name.
