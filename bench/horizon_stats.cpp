@@ -19,18 +19,11 @@ namespace {
 
 // Per texel, whether it counts: every texel, or those a chart of `ptm` covers.
 std::vector<char> CountedTexels(const texlume::ptm::SelfShadowing& s, const char* ptm_path) {
-  std::vector<char> counted(s.horizon.NumTexels(), 1);
-  if (!ptm_path) return counted;
+  if (!ptm_path) return std::vector<char>(s.horizon.NumTexels(), 1);
   const texlume::ptm::Ptm ptm = texlume::ptm::ReadPtmExr(ptm_path);
   if (ptm.width != s.horizon.width || ptm.height != s.horizon.height)
     throw std::runtime_error(std::string(ptm_path) + " is not the horizon map's size");
-  for (std::size_t t = 0; t < counted.size(); ++t) {
-    bool any = false;
-    for (int q = 0; q < ptm.NumPolynomials(); ++q)
-      for (int m = 0; m < 6; ++m) any = any || ptm.Coefficients(t, q)[m] != 0.0f;
-    counted[t] = any;
-  }
-  return counted;
+  return texlume::ptm::CoveredTexels(ptm);
 }
 
 }  // namespace

@@ -8,27 +8,17 @@
 #include "ptm/shadowed_fit.h"
 
 namespace texlume::pipeline {
+namespace {
 
+// The PTM sample's self-shadowing (SampleShadowingStage's constructor).
 ptm::SelfShadowing ReadSampleShadowing(const std::filesystem::path& file, const Sample& sample) {
   if (!sample.colour.empty())
     throw InputError(file.string(), "a horizon map goes with a PTM sample, not a colour photo");
   return ptm::ReadSelfShadowingExr(file, sample.ptm.width, sample.ptm.height, "the sample");
 }
 
-namespace {
-
-// The texels a chart of `atlas` covers: any coefficient not 0.
-std::vector<char> CoveredTexels(const ptm::Ptm& atlas) {
-  std::vector<char> covered(atlas.NumTexels(), 0);
-  for (std::size_t t = 0; t < covered.size(); ++t)
-    for (int q = 0; q < atlas.NumPolynomials() && !covered[t]; ++q)
-      for (int m = 0; m < 6; ++m)
-        if (atlas.Coefficients(t, q)[m] != 0.0f) covered[t] = 1;
-  return covered;
-}
-
-}  // namespace
-
+// SampleShadowingStage::ShadowAtlases at `relief_gain` (<= 0: matched); returns each
+// atlas's relief gain.
 std::vector<double> ShadowModelAtlases(const ptm::SelfShadowing& sample,
                                        const std::filesystem::path& file, double relief_gain,
                                        model::TexturedModel& model,
@@ -48,14 +38,16 @@ std::vector<double> ShadowModelAtlases(const ptm::SelfShadowing& sample,
   for (std::size_t a = 0; a < model.atlases.size(); ++a) {
     if (progress) progress("the atlases' horizons", a, model.atlases.size());
     ptm::SelfShadowing atlas = ptm::ShadowingOfPtm(model.atlases[a], sample);
-    relief_gains.push_back(
-        relief_gain > 0.0
-            ? ptm::ScaleRelief(atlas, relief_gain)
-            : ptm::MatchLowLightShadowLoss(atlas, CoveredTexels(model.atlases[a]), sample_loss));
+    relief_gains.push_back(relief_gain > 0.0
+                               ? ptm::ScaleRelief(atlas, relief_gain)
+                               : ptm::MatchLowLightShadowLoss(
+                                     atlas, ptm::CoveredTexels(model.atlases[a]), sample_loss));
     model.shadowing.push_back(std::move(atlas));
   }
   return relief_gains;
 }
+
+}  // namespace
 
 SampleShadowingStage::SampleShadowingStage(const SynthJobOptions& options, const Sample& sample)
     : options_(options), shadowing_(ReadSampleShadowing(options.sample_horizon_file, sample)) {

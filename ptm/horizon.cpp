@@ -186,16 +186,14 @@ double HorizonVisibility(const HorizonMap& horizon, std::size_t texel, const Eig
 }
 
 double SelfShadowing::LightFactor(std::size_t texel, const Eigen::Vector3d& light) const {
-  const double v = HorizonVisibility(horizon, texel, light, penumbra_rad);
-  return v + (1.0 - v) * shadow_floor;
+  return LightFactorAt(HorizonVisibility(horizon, texel, light, penumbra_rad));
 }
 
 double SelfShadowing::CellLightFactor(double light_elevation_rad, double horizon_mean_rad,
                                       double horizon_variance) const {
   const double width =
       std::sqrt(penumbra_rad * penumbra_rad + 12.0 * std::max(0.0, horizon_variance));
-  const double v = VisibilityAboveHorizon(light_elevation_rad, horizon_mean_rad, width);
-  return v + (1.0 - v) * shadow_floor;
+  return LightFactorAt(VisibilityAboveHorizon(light_elevation_rad, horizon_mean_rad, width));
 }
 
 namespace {

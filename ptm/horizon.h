@@ -87,6 +87,10 @@ struct SelfShadowing {
 
   /// v + (1 - v) shadow_floor, v the horizon's visibility of the light (unit, texel frame).
   double LightFactor(std::size_t texel, const Eigen::Vector3d& light) const;
+  /// The light factor at a visibility v in [0, 1]: v + (1 - v) shadow_floor.
+  double LightFactorAt(double visibility) const {
+    return visibility + (1.0 - visibility) * shadow_floor;
+  }
   /// The mean light factor over a cell of texels whose horizons at the light's azimuth
   /// have this mean and variance (radians, radians^2): the horizons taken as spread
   /// evenly about their mean, so the ramp widens to sqrt(penumbra^2 + 12 variance). At

@@ -166,6 +166,15 @@ Ptm AsRgb(const Ptm& ptm) {
   return rgb;
 }
 
+std::vector<char> CoveredTexels(const Ptm& ptm) {
+  std::vector<char> covered(ptm.NumTexels(), 0);
+  for (std::size_t t = 0; t < covered.size(); ++t)
+    for (int q = 0; q < ptm.NumPolynomials() && !covered[t]; ++q)
+      for (int m = 0; m < 6; ++m)
+        if (ptm.Coefficients(t, q)[m] != 0.0f) covered[t] = 1;
+  return covered;
+}
+
 std::vector<float> NormalMap(const Ptm& ptm) {
   std::vector<float> out(ptm.NumTexels() * 3);
   for (std::size_t t = 0; t < ptm.NumTexels(); ++t) {

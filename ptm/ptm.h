@@ -97,6 +97,9 @@ struct EnhancementOptions {
 std::vector<float> Relight(const Ptm& ptm, const Eigen::Vector3d& light,
                            const EnhancementOptions& enhancement = {});
 
+/// Per texel, whether a chart of an atlas covers it: 1 where any coefficient is not 0.
+std::vector<char> CoveredTexels(const Ptm& ptm);
+
 /// Per-texel normals (row-major, 3 floats per texel) from the luminance of the PTM
 /// (for RGB: of the mean of the three polynomials).
 std::vector<float> NormalMap(const Ptm& ptm);

@@ -47,9 +47,8 @@ double ShadowFactor(const ptm::SelfShadowing& shadowing, const Eigen::Vector2d& 
             h.ElevationAt(static_cast<std::size_t>(yy) * h.width + xx, azimuth));
       },
       &horizon);
-  const double v = ptm::VisibilityAboveHorizon(std::asin(std::clamp(l.z(), -1.0, 1.0)), horizon,
-                                               shadowing.penumbra_rad);
-  return v + (1.0 - v) * shadowing.shadow_floor;
+  return shadowing.LightFactorAt(ptm::VisibilityAboveHorizon(
+      std::asin(std::clamp(l.z(), -1.0, 1.0)), horizon, shadowing.penumbra_rad));
 }
 
 // A photo's gain times its white balance (when given), per channel.

@@ -42,6 +42,19 @@ TEST(Ptm, EvaluationFollowsEquations1And2) {
   EXPECT_NEAR(EvaluatePolynomial(a, lu, lv), dot, 1e-7);
 }
 
+TEST(Ptm, CoveredTexelsAreThoseWithAnyCoefficientNotZero) {
+  Ptm rgb;
+  rgb.Resize(PtmFormat::kRgb, 3, 2);  // zero-filled
+  rgb.Coefficients(1, 2)[4] = 0.5f;   // blue's v coefficient of texel 1
+  rgb.Coefficients(4, 0)[5] = -1.0f;  // red's constant of texel 4
+  EXPECT_EQ(CoveredTexels(rgb), (std::vector<char>{0, 1, 0, 0, 1, 0}));
+  Ptm lrgb;
+  lrgb.Resize(PtmFormat::kLrgb, 2, 1);
+  lrgb.colour[0] = 0.7f;  // colour alone covers nothing
+  lrgb.Coefficients(1)[0] = 1e-6f;
+  EXPECT_EQ(CoveredTexels(lrgb), (std::vector<char>{0, 1}));
+}
+
 TEST(Ptm, NormalIsTheMaximumOfTheBiquadratic) {
   // L = 1 - |l - m|^2 peaks at m = (0.3, -0.2): a0 = a1 = -1, a3 = 2 mx, a4 = 2 my.
   const float a[6] = {-1, -1, 0, 0.6f, -0.4f, 1 - 0.13f};
