@@ -239,7 +239,8 @@ class ModelFolderWriter {
       const std::string horizon_file = "horizon_atlas_" + k + ".exr";
       ptm::WriteSelfShadowingExr(model_.shadowing[a], tmp_ / horizon_file);
       manifest_["atlases"].back()["horizon"] = horizon_file;
-      HorizonTextures horizon = EncodeHorizonTextures(model_.shadowing[a], horizon_file);
+      HorizonTextures horizon =
+          EncodeHorizonTextures(model_.shadowing[a], "the GLB's horizon of atlas " + k);
       glb.horizon_pngs = std::move(horizon.pngs);
       glb.horizon_fields = std::move(horizon.fields);
     }

@@ -25,14 +25,18 @@ std::vector<double> ShadowModelAtlases(const ptm::SelfShadowing& sample,
                                        const ProgressCallback& progress) {
   // Every atlas's horizon is kept (4 bytes a sector), and written through planes and
   // an interleaved copy (twice that again); one atlas's heights and normals at a time.
+  // The GLB keeps every atlas's 16 horizon bytes a texel as PNGs (at most that) until
+  // it is written, each made from 16 quantised bytes a texel
+  // (model::EncodeHorizonTextures).
+  constexpr double kGlbHorizonBytes = 16.0;
   double kept_texels = 0.0, largest = 0.0;
   for (const ptm::Ptm& atlas : model.atlases) {
     kept_texels += static_cast<double>(atlas.NumTexels());
     largest = std::max(largest, static_cast<double>(atlas.NumTexels()));
   }
-  RequireMemory(
-      kept_texels * 4.0 * sample.horizon.sectors + largest * (8.0 * sample.horizon.sectors + 64.0),
-      "the atlases' horizon maps", file.string());
+  RequireMemory(kept_texels * (4.0 * sample.horizon.sectors + kGlbHorizonBytes) +
+                    largest * (8.0 * sample.horizon.sectors + 64.0 + kGlbHorizonBytes),
+                "the atlases' horizon maps", file.string());
   const double sample_loss = relief_gain > 0.0 ? 0.0 : ptm::LowLightShadowLoss(sample, {});
   std::vector<double> relief_gains;
   for (std::size_t a = 0; a < model.atlases.size(); ++a) {

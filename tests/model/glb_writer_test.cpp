@@ -181,8 +181,9 @@ TEST(ModelExport, TheGlbCarriesTheReliefsHorizonAtSixteenAzimuths) {
   testing::TempDir tmp;
   WriteModelFolder(tmp / "model", model, nlohmann::json::object());
   const Glb glb = ReadGlb(tmp / "model/model.glb");
-  const nlohmann::json& horizon =
-      glb.json["materials"][0]["extensions"][kGltfPtmExtension]["horizon"];
+  const nlohmann::json& ptm = glb.json["materials"][0]["extensions"][kGltfPtmExtension];
+  ASSERT_TRUE(ptm.contains("horizon"));
+  const nlohmann::json& horizon = ptm["horizon"];
   ASSERT_EQ(horizon["sectors"].get<int>(), 16);
   ASSERT_EQ(horizon["textures"].size(), 4u);
   EXPECT_EQ(horizon["shadow_floor"].get<double>(), 0.25);

@@ -209,7 +209,10 @@ test('the exported GLB passes the Khronos glTF validator with no errors and no w
     assert.ok(horizon, `${material.name} has TEXLUME_ptm_atlas.horizon`);
     assert.equal(horizon.sectors, 16);
     assert.equal(horizon.textures.length, 4);
-    for (const t of horizon.textures) assert.ok(t.index < gltf.textures.length);
+    const planes = new Set(material.extensions.TEXLUME_ptm_atlas.planes.map((p) => p.index));
+    const indices = horizon.textures.map((t) => t.index);
+    assert.equal(new Set(indices).size, 4, 'four distinct horizon textures');
+    for (const i of indices) assert.ok(i >= 0 && i < gltf.textures.length && !planes.has(i));
   }
 });
 
