@@ -5,7 +5,7 @@
 
 #include "core/errors.h"
 #include "core/image_io.h"
-#include "model/web_model.h"
+#include "model/packed_textures.h"
 #include "ptm/exr_io.h"
 
 namespace texlume::model {

@@ -180,9 +180,9 @@ class GlbBuilder {
       ptm["horizon"] = atlas.horizon_fields;
       ptm["horizon"]["textures"] = nlohmann::json::array();
       for (std::size_t j = 0; j < atlas.horizon_pngs.size(); ++j) {
-        const int sectors =
+        const int texture =
             AddTexture(atlas.horizon_pngs[j], "horizon_" + k + "_" + std::to_string(j));
-        ptm["horizon"]["textures"].push_back({{"index", sectors}, {"texCoord", 0}});
+        ptm["horizon"]["textures"].push_back({{"index", texture}, {"texCoord", 0}});
       }
     }
     gltf_["materials"].push_back({{"name", "atlas_" + k},

@@ -16,7 +16,7 @@
 #include "core/file_util.h"
 #include "core/partial_output.h"
 #include "model/glb_writer.h"
-#include "model/web_model.h"
+#include "model/packed_textures.h"
 #include "ptm/ptm_io.h"
 #include "synth/mesh_synthesis.h"
 
