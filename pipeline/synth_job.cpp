@@ -403,7 +403,9 @@ nlohmann::json RanksJson(const synth::TriangleSynthesis& synthesis,
                      {"seconds_prepare", r.seconds_prepare},
                      {"seconds_region", r.seconds_region},
                      {"seconds_finish", r.seconds_finish},
-                     {"bytes_sent", r.bytes_sent}});
+                     {"bytes_sent", r.bytes_sent},
+                     {"patch_memory_bytes", r.patch_memory_bytes},
+                     {"peak_resident_bytes", r.peak_resident_bytes}});
   nlohmann::json record = {{"ranks", synthesis.rank_records.size()},
                            {"region_border_faces", synthesis.region_border_faces},
                            {"region_cut_edges", synthesis.region_cut_edges},
@@ -695,7 +697,8 @@ class SynthJob {
         {"atlas", s.seconds_atlas},
         {"baselines", s.seconds_baselines},
         {"synthesis_per_triangle", s.seconds_synthesis / std::max<std::size_t>(1, s.faces)}};
-    record["resources"] = {{"peak_resident_bytes", PeakResidentBytes()}};
+    record["resources"] = {{"peak_resident_bytes", PeakResidentBytes()},
+                           {"patch_memory_estimate_bytes", synthesis_.patch_memory_bytes}};
     if (const nlohmann::json d = RanksJson(synthesis_, edge_mismatch_); !d.is_null())
       record["distributed"] = d;
     if (!region_comparison_.is_null()) record["region_comparison"] = region_comparison_;

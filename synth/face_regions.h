@@ -28,12 +28,15 @@ class RankCommunicator {
 /// What one rank of a distributed synthesis did (the run's timings).
 struct RankRecord {
   int rank = 0;
-  std::uint64_t faces = 0;         ///< faces of its region, border included
-  std::uint64_t faces_placed = 0;  ///< its region's faces off the border, which it placed
-  double seconds_prepare = 0.0;    ///< set-up, frames and photometry (sent by rank 0)
-  double seconds_region = 0.0;     ///< placing and correcting them
-  double seconds_finish = 0.0;     ///< their pass after placement (detail transfer)
-  std::uint64_t bytes_sent = 0;    ///< what it sent rank 0
+  std::uint64_t faces = 0;          ///< faces of its region, border included
+  std::uint64_t faces_placed = 0;   ///< its region's faces off the border, which it placed
+  double seconds_prepare = 0.0;     ///< set-up, frames and photometry (sent by rank 0)
+  double seconds_region = 0.0;      ///< placing and correcting them
+  double seconds_finish = 0.0;      ///< their pass after placement (detail transfer)
+  std::uint64_t bytes_sent = 0;     ///< what it sent rank 0
+  double patch_memory_bytes = 0.0;  ///< the patches it holds were estimated to need
+  /// Its resident memory's peak when its region was done (rank 0: before it gathers).
+  std::uint64_t peak_resident_bytes = 0;
 };
 
 /// A distributed synthesis: the ranks and one region of faces per rank. Rank 0

@@ -192,11 +192,15 @@ void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
   }
   // The patches' feature planes, the atlases baked from them and the bake's own
   // buffers (docs/robustness.md "Memory").
-  RequireMemory(PatchMemoryBytes(geometry, sample_.NumFeatures()),
-                "the patches and atlases of " + std::to_string(geometry.total_texels) +
-                    " texels at a texel size of " + std::to_string(t) +
-                    " world units (a larger --sample-texel-size needs fewer)",
-                "mesh");
+  const std::string what = "the patches and atlases of " + std::to_string(geometry.total_texels) +
+                           " texels at a texel size of " + std::to_string(t) +
+                           " world units (a larger --sample-texel-size needs fewer)";
+  if (regions_) {
+    RequirePatchMemoryOnEveryMachine(geometry, what);
+  } else {
+    result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures());
+    RequireMemory(result_.patch_memory_bytes, what, "mesh");
+  }
   if (patches_in_sample_ &&
       (geometry.widest > sample_.Width() || geometry.tallest > sample_.Height())) {
     throw InputError(

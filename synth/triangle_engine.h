@@ -180,6 +180,9 @@ struct TriangleSynthesis {
   /// run's rank 0: over its own and the border faces).
   double seconds_finish = 0.0;
   double seconds_prepare = 0.0;  ///< set-up, frames and photometry
+  /// The patches' and atlases' memory this process was estimated to need
+  /// (PatchMemoryBytes; a rank of a distributed run: of the faces it holds).
+  double patch_memory_bytes = 0.0;
 };
 
 class TriangleEngine;
@@ -343,6 +346,10 @@ class TriangleEngine {
   // Throws InputError on a rank whose faces, photos, patches or regions differ
   // from rank 0's (every rank reads its own inputs).
   void RequireSameInputsAsRankZero() const;
+  // The patches' memory (PatchMemoryBytes) of the faces this rank holds, against the
+  // memory of the ranks on its machine together: every rank refuses, with the same
+  // message, when any machine's ranks need more than their limits' sum.
+  void RequirePatchMemoryOnEveryMachine(const PatchGeometry& geometry, const std::string& what);
   // Placed faces (patches, the correction's state), and their reading: each
   // face read must be `expected` and not placed yet (else `what` is broken).
   void WriteFaces(const std::vector<int>& faces, ByteWriter& out) const;

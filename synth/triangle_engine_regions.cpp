@@ -1,9 +1,12 @@
 // The distributed run of the per-triangle engine (issue 33, synth/face_regions.h):
 // photometry and the region borders placed at rank 0 and sent to the others, then
 // each region placed by its rank, growing from the borders.
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <map>
 #include <string>
 #include <tuple>
 #include <type_traits>
@@ -11,6 +14,7 @@
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/memory_budget.h"
 #include "core/timing.h"
 #include "synth/face_order.h"
 #include "synth/triangle_engine.h"
@@ -67,6 +71,79 @@ void TriangleEngine::RequireSameInputsAsRankZero() const {
                      "the same input files and settings");
 }
 
+namespace {
+
+// The name of the machine this rank runs on (ranks on one machine share its memory).
+std::string ThisMachine() {
+  char name[256] = {};
+  if (gethostname(name, sizeof name - 1) != 0) return "this machine";
+  return name;
+}
+
+// What the ranks on one machine need and may use together, bytes.
+struct MachineMemory {
+  double needed = 0.0, limit = 0.0, rank_zero = 0.0;
+  int ranks = 0;
+};
+
+// Empty when every machine's ranks fit within their limits together; else why not.
+std::string MemoryRefusal(const std::map<std::string, MachineMemory>& machines,
+                          const std::string& what) {
+  for (const auto& [name, m] : machines) {
+    if (m.needed <= m.limit) continue;
+    return what + " need about " + MemorySizeText(m.needed) + " on the " + std::to_string(m.ranks) +
+           " ranks of " + name + " together (" +
+           (m.rank_zero > 0.0 ? "rank 0, which gathers every face, " + MemorySizeText(m.rank_zero)
+                              : std::string("no rank 0")) +
+           "), more than their memory limits together, " + MemorySizeText(m.limit) +
+           " (--memory-limit, each rank's)";
+  }
+  return "";
+}
+
+}  // namespace
+
+void TriangleEngine::RequirePatchMemoryOnEveryMachine(const PatchGeometry& geometry,
+                                                      const std::string& what) {
+  RankCommunicator& ranks = *regions_->ranks;
+  const mesh::FacePartition& partition = regions_->partition;
+  // Rank 0 holds every face (it gathers them and bakes the atlases); another rank
+  // its own region's faces and the region borders, which rank 0 sends every rank.
+  std::vector<char> held(mesh_.faces.size(), 1);
+  if (ranks.Rank() != 0)
+    for (std::size_t f = 0; f < held.size(); ++f)
+      held[f] = partition.region_of_face[f] == ranks.Rank() || partition.on_border[f];
+  result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures(), held);
+  const std::string machine = ThisMachine();
+  std::map<std::string, MachineMemory> machines;
+  const auto add = [&machines](const std::string& name, double needed, double limit, int rank) {
+    MachineMemory& m = machines[name];
+    m.needed += needed, m.limit += limit, ++m.ranks;
+    if (rank == 0) m.rank_zero = needed;
+  };
+  ByteWriter mine;
+  mine.Put(result_.patch_memory_bytes);
+  mine.Put(static_cast<double>(MemoryLimitBytes()));
+  mine.PutVector(std::vector<char>(machine.begin(), machine.end()));
+  if (ranks.Rank() == 0)
+    add(machine, result_.patch_memory_bytes, static_cast<double>(MemoryLimitBytes()), 0);
+  ranks.GatherToRoot(mine.bytes(), [&](int rank, std::vector<char>&& from_rank) {
+    ByteReader in(from_rank);
+    const auto needed = in.Get<double>();
+    const auto limit = in.Get<double>();
+    const std::vector<char> name = in.GetVector<char>();
+    add(std::string(name.begin(), name.end()), needed, limit, rank);
+  });
+  ByteWriter verdict;
+  if (ranks.Rank() == 0) {
+    const std::string refusal = MemoryRefusal(machines, what);
+    verdict.PutVector(std::vector<char>(refusal.begin(), refusal.end()));
+  }
+  ranks.Broadcast(verdict.bytes());
+  const std::vector<char> refusal = ByteReader(verdict.bytes()).GetVector<char>();
+  if (!refusal.empty()) throw InputError("mesh", std::string(refusal.begin(), refusal.end()));
+}
+
 void TriangleEngine::PlaceRegions(const std::vector<int>& order,
                                   const std::vector<std::array<int, 3>>& neighbours,
                                   const ProgressCallback& progress) {
@@ -94,6 +171,8 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order,
   record.seconds_prepare = result_.seconds_prepare;
   record.seconds_region = placing;
   record.seconds_finish = result_.seconds_finish;
+  record.patch_memory_bytes = result_.patch_memory_bytes;
+  record.peak_resident_bytes = PeakResidentBytes();
   const auto gather = std::chrono::steady_clock::now();
   if (rank != 0) {
     ByteWriter message;

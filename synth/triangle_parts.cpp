@@ -242,10 +242,37 @@ void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& can
   patch.overlap_error = error;
 }
 
+namespace {
+
+// A triangle's own area in texels of side `t` (its corners in its patch frame).
+double TriangleTexels(const TrianglePatch& patch, double t) {
+  const Eigen::Vector2d e1 = patch.corners_in_frame[1] - patch.corners_in_frame[0];
+  const Eigen::Vector2d e2 = patch.corners_in_frame[2] - patch.corners_in_frame[0];
+  return 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x()) / (t * t);
+}
+
+double PatchMemoryBytes(double patch_texels, double surface_texels, int feature_planes) {
+  const double like_triangles = std::min(patch_texels, 4.0 * surface_texels);
+  return feature_planes * (20.0 * like_triangles + 3.0 * (patch_texels - like_triangles));
+}
+
+}  // namespace
+
 double PatchMemoryBytes(const PatchGeometry& geometry, int feature_planes) {
-  const double patch = static_cast<double>(geometry.total_texels);
-  const double like_triangles = std::min(patch, 4.0 * geometry.surface_texels);
-  return feature_planes * (20.0 * like_triangles + 3.0 * (patch - like_triangles));
+  return PatchMemoryBytes(static_cast<double>(geometry.total_texels), geometry.surface_texels,
+                          feature_planes);
+}
+
+double PatchMemoryBytes(const PatchGeometry& geometry, int feature_planes,
+                        const std::vector<char>& held) {
+  double patch_texels = 0.0, surface_texels = 0.0;
+  for (std::size_t f = 0; f < geometry.patches.size(); ++f) {
+    if (!held[f]) continue;
+    const TrianglePatch& p = geometry.patches[f];
+    patch_texels += static_cast<double>(p.width) * p.height;
+    surface_texels += TriangleTexels(p, geometry.texel_size);
+  }
+  return PatchMemoryBytes(patch_texels, surface_texels, feature_planes);
 }
 
 PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double t, int strip,
@@ -274,6 +301,7 @@ PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double t, int st
                                 const std::vector<Eigen::Vector3d>& tangents_in_world) {
   const std::size_t num_faces = mesh.faces.size();
   PatchGeometry result;
+  result.texel_size = t;
   std::int64_t& total_texels = result.total_texels;
   int& widest = result.widest;
   int& tallest = result.tallest;
@@ -303,9 +331,7 @@ PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double t, int st
     widest = std::max(widest, patch.width);
     tallest = std::max(tallest, patch.height);
     total_texels += static_cast<std::int64_t>(patch.width) * patch.height;
-    const Eigen::Vector2d e1 = patch.corners_in_frame[1] - patch.corners_in_frame[0];
-    const Eigen::Vector2d e2 = patch.corners_in_frame[2] - patch.corners_in_frame[0];
-    result.surface_texels += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x()) / (t * t);
+    result.surface_texels += TriangleTexels(patch, t);
   }
   // Unfoldings across every shared edge.
   const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(mesh);

@@ -112,6 +112,7 @@ struct PatchGeometry {
   std::int64_t total_texels = 0;  ///< of the patch rectangles (strips included)
   double surface_texels = 0.0;    ///< of the triangles themselves: their area / texel size^2
   int widest = 0, tallest = 0;    ///< largest patch sides, texels
+  double texel_size = 0.0;        ///< world units
 };
 
 /// What the patches and the atlases baked from them take, bytes (issue 33): 20
@@ -122,6 +123,10 @@ struct PatchGeometry {
 /// only as correction grids at the photos' density (measured: 17 bytes a texel
 /// with 6 planes, columns of 99280 and 300144 faces; docs/robustness.md).
 double PatchMemoryBytes(const PatchGeometry& geometry, int feature_planes);
+/// The same for the faces `held` marks (one flag a face): what one rank of a
+/// distributed run holds (its region and the region borders).
+double PatchMemoryBytes(const PatchGeometry& geometry, int feature_planes,
+                        const std::vector<char>& held);
 PatchGeometry MakePatchGeometry(const mesh::TriangleMesh& mesh, double texel_size, int strip,
                                 TangentFrame tangent_frame,
                                 const Eigen::Vector3d& field_direction_in_world);

@@ -231,5 +231,19 @@ TEST(PatchMemoryBytes, SmallTrianglesStripsCostLessThanTheirTexels) {
   }
 }
 
+TEST(PatchMemoryBytes, OfHeldFacesCountsOnlyThem) {
+  // A rank's share (its region and the borders): every face is the whole; the
+  // first half of 2 x 50^2 equal triangles is half of it; none is nothing.
+  const PatchGeometry g = FirstEdgeGeometry(datasets::MakeGridPlane(50, 2.0));
+  const std::size_t faces = g.patches.size();
+  EXPECT_NEAR(PatchMemoryBytes(g, 6, std::vector<char>(faces, 1)), PatchMemoryBytes(g, 6),
+              1e-9 * PatchMemoryBytes(g, 6));
+  std::vector<char> half(faces, 0);
+  std::fill(half.begin(), half.begin() + static_cast<std::ptrdiff_t>(faces / 2), 1);
+  EXPECT_NEAR(PatchMemoryBytes(g, 6, half), 0.5 * PatchMemoryBytes(g, 6),
+              0.02 * PatchMemoryBytes(g, 6));
+  EXPECT_EQ(PatchMemoryBytes(g, 6, std::vector<char>(faces, 0)), 0.0);
+}
+
 }  // namespace
 }  // namespace texlume::synth
