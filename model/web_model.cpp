@@ -2,10 +2,12 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <numeric>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <unordered_map>
 
 #include "core/errors.h"
@@ -93,6 +95,24 @@ std::vector<int> ChartsOfModel(const TexturedModel& model) {
     chart[f] = it->second;
   }
   return chart;
+}
+
+std::vector<cv::Mat> AtlasChartRegions(const TexturedModel& model) {
+  const std::vector<int> chart = ChartsOfModel(model);
+  std::vector<cv::Mat> regions;
+  for (const ptm::Ptm& a : model.atlases) regions.emplace_back(a.height, a.width, CV_32SC1, -1);
+  constexpr int kShift = 4;  // sub-texel corners
+  for (std::size_t f = 0; f < model.corner_px.size(); ++f) {
+    const auto a = static_cast<std::size_t>(model.face_atlas[f]);
+    if (a >= regions.size()) continue;
+    cv::Point corners[3];
+    for (std::size_t k = 0; k < 3; ++k)  // texel (x, y) is the face's when its centre is inside
+      corners[k] = cv::Point(
+          static_cast<int>(std::lround((model.corner_px[f][k].x() - 0.5f) * (1 << kShift))),
+          static_cast<int>(std::lround((model.corner_px[f][k].y() - 0.5f) * (1 << kShift))));
+    cv::fillConvexPoly(regions[a], corners, 3, cv::Scalar(chart[f]), cv::LINE_8, kShift);
+  }
+  return regions;
 }
 
 namespace {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <numbers>
 #include <stdexcept>
@@ -78,13 +79,19 @@ double Bilinear(const cv::Mat& map, double column, double row) {
 
 // The largest elevation of the relief seen from texel (row, column) along the
 // image-space direction (d_column, d_row), up to `max_distance` texels.
-double HorizonAlong(const cv::Mat& height_texels, int row, int column, double d_column,
-                    double d_row, int max_distance) {
+// `regions` (CV_32SC1 or empty): the ray stops where the nearest texel's region is
+// not its origin's (an origin in region < 0 goes on everywhere).
+double HorizonAlong(const cv::Mat& height_texels, const cv::Mat& regions, int row, int column,
+                    double d_column, double d_row, int max_distance) {
   const double h0 = height_texels.at<double>(row, column);
+  const int region = regions.empty() ? -1 : regions.at<std::int32_t>(row, column);
   double best_slope = 0.0;
   for (int t = 1; t <= max_distance; ++t) {
     const double c = column + t * d_column, r = row + t * d_row;
     if (c < 0 || r < 0 || c > height_texels.cols - 1 || r > height_texels.rows - 1) break;
+    if (region >= 0 && regions.at<std::int32_t>(static_cast<int>(std::lround(r)),
+                                                static_cast<int>(std::lround(c))) != region)
+      break;
     best_slope = std::max(best_slope, (Bilinear(height_texels, c, r) - h0) / t);
   }
   return std::atan(best_slope);
@@ -144,7 +151,8 @@ LightAmongSectors::LightAmongSectors(const Eigen::Vector3d& light, int sectors)
   SectorsOfAzimuth(std::atan2(light.y(), light.x()), sectors, s0, s1, f);
 }
 
-HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_distance_texels) {
+HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_distance_texels,
+                             const cv::Mat& regions) {
   if (sectors < 4 || sectors > 64)
     throw std::invalid_argument("ComputeHorizonMap: sectors " + std::to_string(sectors) +
                                 " outside [4, 64]");
@@ -154,6 +162,8 @@ HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_
   if (height_texels.type() != CV_64FC1 || height_texels.cols < 2 || height_texels.rows < 2)
     throw std::invalid_argument(
         "ComputeHorizonMap: expects a CV_64FC1 height map of 2 x 2 or more");
+  if (!regions.empty() && (regions.type() != CV_32SC1 || regions.size() != height_texels.size()))
+    throw std::invalid_argument("ComputeHorizonMap: regions must be CV_32SC1 of the map's size");
   HorizonMap horizon;
   horizon.width = height_texels.cols;
   horizon.height = height_texels.rows;
@@ -167,8 +177,8 @@ HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_
         // Texel frame (cos phi, sin phi) is image (column +cos, row -sin).
         horizon.elevation_rad[(static_cast<std::size_t>(r) * horizon.width + c) * sectors +
                               static_cast<std::size_t>(s)] =
-            static_cast<float>(HorizonAlong(height_texels, r, c, std::cos(phi), -std::sin(phi),
-                                            max_distance_texels));
+            static_cast<float>(HorizonAlong(height_texels, regions, r, c, std::cos(phi),
+                                            -std::sin(phi), max_distance_texels));
       }
   return horizon;
 }

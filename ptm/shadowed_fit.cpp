@@ -275,14 +275,15 @@ ShadowedPtm FitShadowedPtm(const std::vector<cv::Mat>& images,
   return fit.RefitLitSamples();
 }
 
-SelfShadowing ShadowingOfPtm(const Ptm& ptm, const SelfShadowing& sample, int reach_texels) {
+SelfShadowing ShadowingOfPtm(const Ptm& ptm, const SelfShadowing& sample, int reach_texels,
+                             const cv::Mat& charts) {
   SelfShadowing out;
   out.height_scale = sample.height_scale;
   out.shadow_floor = sample.shadow_floor;
   out.penumbra_rad = sample.penumbra_rad;
   const cv::Mat heights_texels = HeightFromNormals(NormalMap(ptm), ptm.width, ptm.height);
-  out.horizon =
-      ComputeHorizonMap(heights_texels * sample.height_scale, sample.horizon.sectors, reach_texels);
+  out.horizon = ComputeHorizonMap(heights_texels * sample.height_scale, sample.horizon.sectors,
+                                  reach_texels, charts);
   return out;
 }
 

@@ -68,8 +68,11 @@ std::vector<float> RelightShadowed(const ShadowedPtm& shadowed, const Eigen::Vec
 /// (a synthesised atlas): its own normals integrated (HeightFromNormals) at the
 /// sample's height scale, with the sample's sectors, shadow floor and penumbra. On
 /// the fitted sample itself it gives back the fit's horizon. The horizon sees no
-/// relief beyond the map; in an atlas its rays may cross a chart's gutter into the
-/// next chart's relief (one integration over the whole atlas).
-SelfShadowing ShadowingOfPtm(const Ptm& ptm, const SelfShadowing& sample, int reach_texels = 48);
+/// relief beyond the map, nor, given an atlas's `charts` (CV_32SC1, the chart of each
+/// texel, -1 in gutters; model::AtlasChartRegions), beyond its texel's chart
+/// (ComputeHorizonMap's regions): without them its rays cross a chart's gutter into
+/// the next chart's relief.
+SelfShadowing ShadowingOfPtm(const Ptm& ptm, const SelfShadowing& sample, int reach_texels = 48,
+                             const cv::Mat& charts = cv::Mat());
 
 }  // namespace texlume::ptm

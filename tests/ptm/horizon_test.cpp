@@ -87,6 +87,26 @@ TEST(HorizonMap, AWallsHorizonAndShadowFollowItsGeometry) {
   EXPECT_EQ(HorizonVisibility(horizon, texel, light(10, 180), penumbra), 1.0);
 }
 
+TEST(HorizonMap, ARaySeesNothingBeyondItsRegion) {
+  // The wall of the test above, 10 texels away: in another region it casts no
+  // horizon, in the texel's own region (or for a texel of region -1) the same 45
+  // degrees as without regions.
+  cv::Mat h = cv::Mat::zeros(8, 40, CV_64FC1);
+  h(cv::Rect(20, 0, 20, 8)).setTo(10.0);
+  cv::Mat regions(h.size(), CV_32SC1, cv::Scalar(0));
+  regions(cv::Rect(15, 0, 25, 8)).setTo(1);
+  const std::size_t texel = 4 * 40 + 10;
+  EXPECT_NEAR(ComputeHorizonMap(h, 8, 32, regions).ElevationAt(texel, 0.0), 0.0, 1e-9);
+  regions(cv::Rect(0, 0, 40, 8)).setTo(1);
+  EXPECT_NEAR(ComputeHorizonMap(h, 8, 32, regions).ElevationAt(texel, 0.0), 45.0 * kDegree, 1e-6);
+  regions(cv::Rect(0, 0, 15, 8)).setTo(-1);
+  EXPECT_NEAR(ComputeHorizonMap(h, 8, 32, regions).ElevationAt(texel, 0.0), 45.0 * kDegree, 1e-6);
+  EXPECT_THROW(ComputeHorizonMap(h, 8, 32, cv::Mat(4, 4, CV_32SC1, cv::Scalar(0))),
+               std::invalid_argument);
+  EXPECT_THROW(ComputeHorizonMap(h, 8, 32, cv::Mat(h.size(), CV_8UC1, cv::Scalar(0))),
+               std::invalid_argument);
+}
+
 TEST(HorizonMap, RefusesSettingsOutOfRange) {
   const cv::Mat h = cv::Mat::zeros(4, 4, CV_64FC1);
   EXPECT_THROW(ComputeHorizonMap(h, 3, 8), std::invalid_argument);
