@@ -163,7 +163,8 @@ int RunTexlume(int argc, const char* const* argv, std::ostream& out, std::ostrea
     SetMemoryLimitBytes(memory_limit.empty() ? 0 : ParseMemorySize(memory_limit));
     // Ranks on one machine share its memory: each takes its share of the default.
     if (memory_limit.empty() && LaunchedAsSeveralRanks() && RanksOnThisMachine() > 1)
-      SetMemoryLimitBytes(MemoryLimitBytes() / static_cast<std::uint64_t>(RanksOnThisMachine()));
+      SetSharedMemoryLimitBytes(MemoryLimitBytes() /
+                                static_cast<std::uint64_t>(RanksOnThisMachine()));
     RefuseSeveralRanksUnlessSynth(*sub);
     return run.at(sub)(out, err);
   } catch (const CLI::CallForHelp& e) {

@@ -10,8 +10,10 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <iterator>
 #include <numbers>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -29,9 +31,10 @@ constexpr int kAzimuths = 16;
 constexpr int kReachTexels = 48;  // ShadowingOfPtm's default
 // Bins of the distance to the chart's edge, texels: [edge[b], edge[b + 1]).
 constexpr double kBinEdges[] = {0.0, 2.0, 8.0, 24.0, 48.0, 1e9};
-constexpr int kBins = 5;
+constexpr int kBins = static_cast<int>(std::size(kBinEdges)) - 1;
 
-// Per texel of a chart, its distance (texels) to the nearest texel of another region.
+// Per texel, its distance (texels) to the nearest edge texel: a texel with a 4-neighbour
+// of another region (0 on the chart's own outer row; the atlas's border is no edge).
 cv::Mat DistanceToChartEdge(const cv::Mat& charts) {
   cv::Mat inner(charts.size(), CV_8UC1, cv::Scalar(255));
   for (int r = 0; r < charts.rows; ++r)
@@ -58,7 +61,7 @@ struct BinnedLight {
       for (int c = 0; c < charts.cols; ++c) {
         if (charts.at<int>(r, c) < 0) continue;
         int b = 0;
-        while (distance.at<float>(r, c) >= kBinEdges[b + 1]) ++b;
+        while (b + 1 < kBins && distance.at<float>(r, c) >= kBinEdges[b + 1]) ++b;
         texels[static_cast<std::size_t>(b)] += 1.0;
         const auto t = static_cast<std::size_t>(r) * static_cast<std::size_t>(charts.cols) +
                        static_cast<std::size_t>(c);

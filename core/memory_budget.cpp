@@ -15,6 +15,7 @@ namespace texlume {
 namespace {
 
 std::atomic<std::uint64_t> g_limit_bytes{0};  // 0: the default
+std::atomic<bool> g_limit_is_users{false};    // set by --memory-limit
 
 // Three quarters of MemTotal, or 8 GiB when /proc/meminfo cannot be read.
 std::uint64_t DefaultLimitBytes() {
@@ -36,14 +37,27 @@ std::uint64_t PeakResidentBytes() {
   return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024u;  // ru_maxrss is in KiB on Linux
 }
 
-std::uint64_t MemoryLimitBytes() {
-  const std::uint64_t set = g_limit_bytes.load();
-  if (set != 0) return set;
+std::uint64_t DefaultMemoryLimitBytes() {
   static const std::uint64_t default_limit = DefaultLimitBytes();
   return default_limit;
 }
 
-void SetMemoryLimitBytes(std::uint64_t bytes) { g_limit_bytes.store(bytes); }
+std::uint64_t MemoryLimitBytes() {
+  const std::uint64_t set = g_limit_bytes.load();
+  return set != 0 ? set : DefaultMemoryLimitBytes();
+}
+
+void SetMemoryLimitBytes(std::uint64_t bytes) {
+  g_limit_bytes.store(bytes);
+  g_limit_is_users.store(bytes != 0);
+}
+
+void SetSharedMemoryLimitBytes(std::uint64_t bytes) {
+  g_limit_bytes.store(bytes);
+  g_limit_is_users.store(false);
+}
+
+bool MemoryLimitIsUsers() { return g_limit_is_users.load(); }
 
 std::uint64_t ParseMemorySize(const std::string& text) {
   const auto refuse = [&] {

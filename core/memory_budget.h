@@ -9,8 +9,16 @@ namespace texlume {
 /// `--memory-limit`, or by default three quarters of the machine's physical memory
 /// (MemTotal in /proc/meminfo; 8 GiB where that cannot be read).
 std::uint64_t MemoryLimitBytes();
-/// Sets the limit; 0 restores the default.
+/// Sets the limit the user asked for (`--memory-limit`); 0 restores the default.
 void SetMemoryLimitBytes(std::uint64_t bytes);
+/// The default limit of this machine (three quarters of its memory), whatever is set.
+std::uint64_t DefaultMemoryLimitBytes();
+/// Sets this process's share of the machine's default limit (ranks of one job on
+/// one machine share it; docs/robustness.md "Memory"): not the user's limit.
+void SetSharedMemoryLimitBytes(std::uint64_t bytes);
+/// Whether the limit is the user's (SetMemoryLimitBytes, not 0), not the default or
+/// a share of it.
+bool MemoryLimitIsUsers();
 
 /// Parses a memory size: bytes ("2000000000") or a number with a binary unit
 /// ("512M", "1.5G", "2T"; K, M, G, T are powers of 1024, a trailing "B" or "iB" is

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 #include <unordered_map>
 
+#include "core/check.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "synth/mesh_synthesis.h"
@@ -99,14 +100,18 @@ std::vector<int> ChartsOfModel(const TexturedModel& model) {
 
 std::vector<cv::Mat> AtlasChartRegions(const TexturedModel& model) {
   const std::vector<int> chart = ChartsOfModel(model);
+  TEXLUME_CHECK(model.corner_px.size() == model.mesh.faces.size() &&
+                    model.face_atlas.size() == model.mesh.faces.size(),
+                "texture coordinates and an atlas per face");
   std::vector<cv::Mat> regions;
   for (const ptm::Ptm& a : model.atlases) regions.emplace_back(a.height, a.width, CV_32SC1, -1);
   constexpr int kShift = 4;  // sub-texel corners
   for (std::size_t f = 0; f < model.corner_px.size(); ++f) {
+    if (model.face_atlas[f] < 0) continue;
     const auto a = static_cast<std::size_t>(model.face_atlas[f]);
     if (a >= regions.size()) continue;
     cv::Point corners[3];
-    for (std::size_t k = 0; k < 3; ++k)  // texel (x, y) is the face's when its centre is inside
+    for (std::size_t k = 0; k < 3; ++k)  // texel centres at +0.5, as report::AtlasOccupancies
       corners[k] = cv::Point(
           static_cast<int>(std::lround((model.corner_px[f][k].x() - 0.5f) * (1 << kShift))),
           static_cast<int>(std::lround((model.corner_px[f][k].y() - 0.5f) * (1 << kShift))));

@@ -24,8 +24,9 @@ struct WebModel {
 /// texels) in the same atlas. Returns the chart id of every face (0-based).
 std::vector<int> ChartsOfModel(const TexturedModel& model);
 
-/// Per atlas (CV_32SC1, its size), the chart (ChartsOfModel) of each texel whose
-/// centre a face of that chart covers; -1 elsewhere (gutters, empty space).
+/// Per atlas (CV_32SC1, its size), the chart (ChartsOfModel) of each texel a face of
+/// that chart covers (its texel centres rasterised with their edges, as the report's
+/// occupancy counts them); -1 elsewhere (gutters, empty space).
 std::vector<cv::Mat> AtlasChartRegions(const TexturedModel& model);
 
 /// Builds the web model of a model folder written by WriteModelFolder (reads

@@ -44,8 +44,8 @@ struct HorizonMap {
 /// `max_distance_texels` away, read bilinearly along the ray; 0 where nothing rises
 /// above the texel. The ray leaving the map sees nothing beyond its edge.
 /// `regions` (optional, CV_32SC1 of the map's size; an atlas's charts): a ray from
-/// a texel of region >= 0 sees nothing beyond the first texel of another region, as
-/// beyond the map's edge (texels of region < 0, gutters, see everything).
+/// a texel of region >= 0 stops at its first step whose nearest texel is of another
+/// region, as at the map's edge (texels of region < 0, gutters, see everything).
 /// Throws std::invalid_argument for sectors outside [4, 64], a distance outside
 /// [1, 4096] or regions of another size or type.
 HorizonMap ComputeHorizonMap(const cv::Mat& height_texels, int sectors, int max_distance_texels,

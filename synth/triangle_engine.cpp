@@ -196,6 +196,7 @@ void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
                            " texels at a texel size of " + std::to_string(t) +
                            " world units (a larger --sample-texel-size needs fewer)";
   if (regions_) {
+    RequireSameInputsAsRankZero(geometry.patches);  // before anything a rank reads from rank 0
     RequirePatchMemoryOnEveryMachine(geometry, what);
   } else {
     result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures());

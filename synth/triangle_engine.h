@@ -343,12 +343,13 @@ class TriangleEngine {
   std::vector<int> RegionOrder(const std::vector<int>& order, const std::vector<int>& border_faces,
                                const std::vector<char>& interior,
                                const std::vector<std::array<int, 3>>& neighbours) const;
-  // Throws InputError on a rank whose faces, photos, patches or regions differ
-  // from rank 0's (every rank reads its own inputs).
-  void RequireSameInputsAsRankZero() const;
-  // The patches' memory (PatchMemoryBytes) of the faces this rank holds, against the
-  // memory of the ranks on its machine together: every rank refuses, with the same
-  // message, when any machine's ranks need more than their limits' sum.
+  // Throws InputError on a rank whose faces, photos, `patches` (their rectangles)
+  // or regions differ from rank 0's (every rank reads its own inputs).
+  void RequireSameInputsAsRankZero(const std::vector<TrianglePatch>& patches) const;
+  // The patches' memory (PatchMemoryBytes) of the faces this rank holds: under the
+  // default limit, against the memory the ranks on its machine share (rank 0, which
+  // holds every face, may then use what the others do not need); under the user's
+  // --memory-limit, against each rank's own. Every rank refuses with the same message.
   void RequirePatchMemoryOnEveryMachine(const PatchGeometry& geometry, const std::string& what);
   // Placed faces (patches, the correction's state), and their reading: each
   // face read must be `expected` and not placed yet (else `what` is broken).

@@ -31,7 +31,6 @@ void TriangleEngine::DistributeOver(FaceRegions regions) {
 
 void TriangleEngine::EstimateOrReceivePhotometry(const ProgressCallback& progress) {
   if (!regions_) return EstimatePhotometry(progress);
-  RequireSameInputsAsRankZero();  // before anything a rank reads from rank 0
   RankCommunicator& ranks = *regions_->ranks;
   ByteWriter out;
   if (ranks.Rank() == 0) {
@@ -51,15 +50,15 @@ void TriangleEngine::EstimateOrReceivePhotometry(const ProgressCallback& progres
   TEXLUME_CHECK(result_.photo_gains.size() == photos_.size(), "rank 0 has the same photos");
 }
 
-void TriangleEngine::RequireSameInputsAsRankZero() const {
+void TriangleEngine::RequireSameInputsAsRankZero(const std::vector<TrianglePatch>& patches) const {
   // FNV-1a over what every rank must agree on: faces, photos, patch rectangles, regions.
   std::uint64_t hash = 0xcbf29ce484222325ull;
   const auto mix = [&hash](std::uint64_t value) { hash = (hash ^ value) * 0x100000001b3ull; };
   mix(mesh_.faces.size());
   for (const MeshPhoto& photo : photos_) mix(photo.image_id.value);
-  for (std::size_t f = 0; f < result_.patches.size(); ++f) {
-    mix(static_cast<std::uint64_t>(result_.patches[f].width));
-    mix(static_cast<std::uint64_t>(result_.patches[f].height));
+  for (std::size_t f = 0; f < patches.size(); ++f) {
+    mix(static_cast<std::uint64_t>(patches[f].width));
+    mix(static_cast<std::uint64_t>(patches[f].height));
     mix(static_cast<std::uint64_t>(regions_->partition.region_of_face[f]));
   }
   ByteWriter rank_zero;
@@ -80,25 +79,76 @@ std::string ThisMachine() {
   return name;
 }
 
-// What the ranks on one machine need and may use together, bytes.
-struct MachineMemory {
-  double needed = 0.0, limit = 0.0, rank_zero = 0.0;
-  int ranks = 0;
+// One rank's patches' estimate and memory limit, as rank 0 gathers them.
+struct RankMemory {
+  int rank = 0;
+  double needed_bytes = 0.0, limit_bytes = 0.0;
+  double machine_default_bytes = 0.0;  // DefaultMemoryLimitBytes() of its machine
+  bool users_limit = false;            // --memory-limit: the rank's own, not shared
+  std::string machine;
+
+  void Write(ByteWriter& out) const {
+    out.Put(rank), out.Put(needed_bytes), out.Put(limit_bytes);
+    out.Put(machine_default_bytes), out.Put(static_cast<char>(users_limit));
+    out.PutVector(std::vector<char>(machine.begin(), machine.end()));
+  }
+  static RankMemory Read(ByteReader& in) {
+    RankMemory m;
+    m.rank = in.Get<int>(), m.needed_bytes = in.Get<double>(), m.limit_bytes = in.Get<double>();
+    m.machine_default_bytes = in.Get<double>(), m.users_limit = in.Get<char>() != 0;
+    const std::vector<char> name = in.GetVector<char>();
+    m.machine.assign(name.begin(), name.end());
+    TEXLUME_CHECK(in.Remaining() == 0, "a rank's memory message is read whole");
+    return m;
+  }
 };
 
-// Empty when every machine's ranks fit within their limits together; else why not.
-std::string MemoryRefusal(const std::map<std::string, MachineMemory>& machines,
+// What the ranks of one machine may use together under the default limit: their
+// shares, at most the machine's default (a launcher that tells no rank how many share
+// the machine leaves each the whole default).
+double SharedBytes(const std::vector<RankMemory>& on_machine) {
+  double shares = 0.0;
+  for (const RankMemory& m : on_machine) shares += m.limit_bytes;
+  return std::min(shares, on_machine.front().machine_default_bytes);
+}
+
+// Empty when every machine's ranks fit; else why not (`what` the patches' description).
+std::string MemoryRefusal(const std::map<std::string, std::vector<RankMemory>>& machines,
                           const std::string& what) {
-  for (const auto& [name, m] : machines) {
-    if (m.needed <= m.limit) continue;
-    return what + " need about " + MemorySizeText(m.needed) + " on the " + std::to_string(m.ranks) +
-           " ranks of " + name + " together (" +
-           (m.rank_zero > 0.0 ? "rank 0, which gathers every face, " + MemorySizeText(m.rank_zero)
-                              : std::string("no rank 0")) +
-           "), more than their memory limits together, " + MemorySizeText(m.limit) +
-           " (--memory-limit, each rank's)";
+  for (const auto& [name, ranks] : machines) {
+    double needed_bytes = 0.0;
+    bool users_limit = false;
+    for (const RankMemory& m : ranks) {
+      needed_bytes += m.needed_bytes;
+      users_limit = users_limit || m.users_limit;
+    }
+    if (users_limit) {  // each rank within its own --memory-limit
+      for (const RankMemory& m : ranks)
+        if (!(m.needed_bytes <= m.limit_bytes))
+          return what + " need about " + MemorySizeText(m.needed_bytes) + " on rank " +
+                 std::to_string(m.rank) + " (" + name + "), more than its memory limit of " +
+                 MemorySizeText(m.limit_bytes) + " (--memory-limit)";
+      continue;
+    }
+    const double shared_bytes = SharedBytes(ranks);
+    if (!(needed_bytes <= shared_bytes))
+      return what + " need about " + MemorySizeText(needed_bytes) + " on the " +
+             std::to_string(ranks.size()) + " ranks of " + name +
+             " together, more than the memory they share, " + MemorySizeText(shared_bytes) +
+             " (--memory-limit)";
   }
   return "";
+}
+
+// Under the default limit, what rank 0 may use once the other ranks of its machine
+// have their estimates: the shared memory less theirs (0 under --memory-limit).
+double RankZeroBytes(const std::vector<RankMemory>& on_machine) {
+  double others_bytes = 0.0;
+  for (const RankMemory& m : on_machine) {
+    if (m.users_limit) return 0.0;
+    if (m.rank != 0) others_bytes += m.needed_bytes;
+  }
+  return SharedBytes(on_machine) - others_bytes;
 }
 
 }  // namespace
@@ -114,34 +164,39 @@ void TriangleEngine::RequirePatchMemoryOnEveryMachine(const PatchGeometry& geome
     for (std::size_t f = 0; f < held.size(); ++f)
       held[f] = partition.region_of_face[f] == ranks.Rank() || partition.on_border[f];
   result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures(), held);
-  const std::string machine = ThisMachine();
-  std::map<std::string, MachineMemory> machines;
-  const auto add = [&machines](const std::string& name, double needed, double limit, int rank) {
-    MachineMemory& m = machines[name];
-    m.needed += needed, m.limit += limit, ++m.ranks;
-    if (rank == 0) m.rank_zero = needed;
-  };
-  ByteWriter mine;
-  mine.Put(result_.patch_memory_bytes);
-  mine.Put(static_cast<double>(MemoryLimitBytes()));
-  mine.PutVector(std::vector<char>(machine.begin(), machine.end()));
-  if (ranks.Rank() == 0)
-    add(machine, result_.patch_memory_bytes, static_cast<double>(MemoryLimitBytes()), 0);
-  ranks.GatherToRoot(mine.bytes(), [&](int rank, std::vector<char>&& from_rank) {
+  const RankMemory mine{ranks.Rank(),
+                        result_.patch_memory_bytes,
+                        static_cast<double>(MemoryLimitBytes()),
+                        static_cast<double>(DefaultMemoryLimitBytes()),
+                        MemoryLimitIsUsers(),
+                        ThisMachine()};
+  ByteWriter message;
+  mine.Write(message);
+  std::map<std::string, std::vector<RankMemory>> machines;
+  if (ranks.Rank() == 0) machines[mine.machine].push_back(mine);
+  ranks.GatherToRoot(message.bytes(), [&machines](int, std::vector<char>&& from_rank) {
     ByteReader in(from_rank);
-    const auto needed = in.Get<double>();
-    const auto limit = in.Get<double>();
-    const std::vector<char> name = in.GetVector<char>();
-    add(std::string(name.begin(), name.end()), needed, limit, rank);
+    RankMemory m = RankMemory::Read(in);
+    machines[m.machine].push_back(std::move(m));
   });
   ByteWriter verdict;
+  std::string refusal;
   if (ranks.Rank() == 0) {
-    const std::string refusal = MemoryRefusal(machines, what);
+    refusal = MemoryRefusal(machines, what);
     verdict.PutVector(std::vector<char>(refusal.begin(), refusal.end()));
   }
   ranks.Broadcast(verdict.bytes());
-  const std::vector<char> refusal = ByteReader(verdict.bytes()).GetVector<char>();
-  if (!refusal.empty()) throw InputError("mesh", std::string(refusal.begin(), refusal.end()));
+  ByteReader in(verdict.bytes());
+  const std::vector<char> text = in.GetVector<char>();
+  TEXLUME_CHECK(in.Remaining() == 0, "rank 0's memory verdict is read whole");
+  if (!text.empty()) throw InputError("mesh", std::string(text.begin(), text.end()));
+  // Rank 0's later stages (the gather, the atlases, their horizons) may use what the
+  // other ranks of its machine do not need.
+  if (ranks.Rank() == 0) {
+    const double rank_zero_bytes = RankZeroBytes(machines.at(mine.machine));
+    if (rank_zero_bytes > static_cast<double>(MemoryLimitBytes()))
+      SetSharedMemoryLimitBytes(static_cast<std::uint64_t>(rank_zero_bytes));
+  }
 }
 
 void TriangleEngine::PlaceRegions(const std::vector<int>& order,

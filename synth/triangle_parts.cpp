@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <string>
 
+#include "core/check.h"
 #include "core/errors.h"
 #include "core/srgb.h"
 #include "ptm/coefficient_space.h"
@@ -265,6 +266,8 @@ double PatchMemoryBytes(const PatchGeometry& geometry, int feature_planes) {
 
 double PatchMemoryBytes(const PatchGeometry& geometry, int feature_planes,
                         const std::vector<char>& held) {
+  TEXLUME_CHECK(held.size() == geometry.patches.size() && geometry.texel_size > 0.0,
+                "a flag per patch of a geometry MakePatchGeometry made");
   double patch_texels = 0.0, surface_texels = 0.0;
   for (std::size_t f = 0; f < geometry.patches.size(); ++f) {
     if (!held[f]) continue;

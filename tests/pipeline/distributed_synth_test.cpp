@@ -205,17 +205,22 @@ TEST_F(DistributedSynthTest, ARankWithOtherInputsStopsWithAnErrorNamingIt) {
   EXPECT_FALSE(fs::exists(tmp_->path() / "differ" / "manifest.json"));
 }
 
+// The default memory limit again however a block ends.
+struct DefaultMemoryLimitAtEnd {
+  ~DefaultMemoryLimitAtEnd() { SetMemoryLimitBytes(0); }
+};
+
 TEST_F(DistributedSynthTest, RanksOnOneMachineShareItsMemoryRankZeroHoldingEveryFace) {
+  const DefaultMemoryLimitAtEnd restore;
   const double one_process =
       Manifest("one")["resources"]["patch_memory_estimate_bytes"].get<double>();
   ASSERT_GT(one_process, 0.0);
-  // Two ranks whose limits are each below one process's need run together (an
-  // equal split of the machine would refuse rank 0)...
-  SetMemoryLimitBytes(static_cast<std::uint64_t>(0.9 * one_process));
+  // Two ranks whose shares of the machine are each below one process's need run
+  // together (an equal split would refuse rank 0)...
+  SetSharedMemoryLimitBytes(static_cast<std::uint64_t>(0.9 * one_process));
   EXPECT_NO_THROW(RunOnThreadRanks(Job("share2"), 2));
-  SetMemoryLimitBytes(0);
   // ...since rank 0 gathers and bakes every face, as one process, and the other
-  // holds its region and the borders.
+  // holds its region and the borders; rank 0 then takes what rank 1 does not need.
   const nlohmann::json per_rank = Manifest("share2")["distributed"]["per_rank"];
   ASSERT_EQ(per_rank.size(), 2u);
   const double rank_zero = per_rank[0]["patch_memory_bytes"].get<double>();
@@ -223,17 +228,25 @@ TEST_F(DistributedSynthTest, RanksOnOneMachineShareItsMemoryRankZeroHoldingEvery
   EXPECT_DOUBLE_EQ(rank_zero, one_process);
   EXPECT_GT(rank_one, 0.2 * one_process);
   EXPECT_LT(rank_one, 0.8 * one_process);
-  EXPECT_GT(per_rank[1]["peak_resident_bytes"].get<double>(), 0.0);
+  EXPECT_NEAR(static_cast<double>(MemoryLimitBytes()), 1.8 * one_process - rank_one, 2.0);
+  EXPECT_FALSE(MemoryLimitIsUsers());
   // A little less than their need together refuses on every rank, with the same message.
-  SetMemoryLimitBytes(static_cast<std::uint64_t>(0.49 * (rank_zero + rank_one)));
+  SetSharedMemoryLimitBytes(static_cast<std::uint64_t>(0.49 * (rank_zero + rank_one)));
   std::vector<std::string> messages;
   EXPECT_ANY_THROW(RunOnThreadRanks(Job("share2_refused"), 2, {}, &messages));
-  SetMemoryLimitBytes(0);
   ASSERT_EQ(messages.size(), 2u);
   EXPECT_EQ(messages[0], messages[1]);
   EXPECT_NE(messages[0].find("on the 2 ranks of"), std::string::npos) << messages[0];
-  EXPECT_NE(messages[0].find("--memory-limit"), std::string::npos) << messages[0];
   EXPECT_FALSE(fs::exists(tmp_->path() / "share2_refused" / "manifest.json"));
+  // The user's --memory-limit stays each rank's own: rank 0 is refused at 0.9 of its need.
+  SetMemoryLimitBytes(static_cast<std::uint64_t>(0.9 * one_process));
+  messages.clear();
+  EXPECT_ANY_THROW(RunOnThreadRanks(Job("share2_users"), 2, {}, &messages));
+  ASSERT_EQ(messages.size(), 2u);
+  EXPECT_EQ(messages[0], messages[1]);
+  EXPECT_NE(messages[0].find("on rank 0"), std::string::npos) << messages[0];
+  EXPECT_NE(messages[0].find("--memory-limit"), std::string::npos) << messages[0];
+  EXPECT_FALSE(fs::exists(tmp_->path() / "share2_users" / "manifest.json"));
 }
 
 TEST_F(DistributedSynthTest, MpirunWithTwoAndThreeRanksTakesTheSameCommandLine) {
