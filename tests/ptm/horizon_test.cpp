@@ -101,6 +101,20 @@ TEST(HorizonMap, ARaySeesNothingBeyondItsRegion) {
   EXPECT_NEAR(ComputeHorizonMap(h, 8, 32, regions).ElevationAt(texel, 0.0), 45.0 * kDegree, 1e-6);
   regions(cv::Rect(0, 0, 15, 8)).setTo(-1);
   EXPECT_NEAR(ComputeHorizonMap(h, 8, 32, regions).ElevationAt(texel, 0.0), 45.0 * kDegree, 1e-6);
+  // A gutter (-1) between the texel and the wall, the wall in the texel's own region
+  // again: the ray stops at the gutter, as at another chart.
+  regions.setTo(0);
+  regions(cv::Rect(14, 0, 2, 8)).setTo(-1);
+  EXPECT_NEAR(ComputeHorizonMap(h, 8, 32, regions).ElevationAt(texel, 0.0), 0.0, 1e-9);
+  // Diagonally (sector 1, 45 degrees up the image) a ray stops likewise at the region's edge.
+  cv::Mat hill = cv::Mat::zeros(40, 40, CV_64FC1);
+  hill(cv::Rect(20, 0, 20, 20)).setTo(10.0);
+  cv::Mat quadrants(hill.size(), CV_32SC1, cv::Scalar(0));
+  const std::size_t corner = 30 * 40 + 10;  // row 30, column 10: the hill up and right
+  EXPECT_GT(ComputeHorizonMap(hill, 8, 32, quadrants).ElevationAt(corner, 45.0 * kDegree), 0.1);
+  quadrants(cv::Rect(20, 0, 20, 20)).setTo(1);
+  EXPECT_NEAR(ComputeHorizonMap(hill, 8, 32, quadrants).ElevationAt(corner, 45.0 * kDegree), 0.0,
+              1e-9);
   EXPECT_THROW(ComputeHorizonMap(h, 8, 32, cv::Mat(4, 4, CV_32SC1, cv::Scalar(0))),
                std::invalid_argument);
   EXPECT_THROW(ComputeHorizonMap(h, 8, 32, cv::Mat(h.size(), CV_8UC1, cv::Scalar(0))),
