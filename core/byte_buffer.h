@@ -28,6 +28,9 @@ class ByteWriter {
     Append(values.data(), values.size() * sizeof(T));
   }
   /// A matrix's type, size and elements (empty matrices included).
+  void PutString(const std::string& text) {
+    PutVector(std::vector<char>(text.begin(), text.end()));
+  }
   void PutMat(const cv::Mat& mat) {
     Put<std::int32_t>(mat.type());
     Put<std::int32_t>(mat.rows);
@@ -74,6 +77,10 @@ class ByteReader {
     std::vector<T> values(static_cast<std::size_t>(n));
     if (n) std::memcpy(values.data(), Take(values.size() * sizeof(T)), values.size() * sizeof(T));
     return values;
+  }
+  std::string GetString() {
+    const std::vector<char> text = GetVector<char>();
+    return {text.begin(), text.end()};
   }
   cv::Mat GetMat() {
     const auto type = Get<std::int32_t>();

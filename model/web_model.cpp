@@ -111,7 +111,7 @@ std::vector<cv::Mat> AtlasChartRegions(const TexturedModel& model) {
     const auto a = static_cast<std::size_t>(model.face_atlas[f]);
     if (a >= regions.size()) continue;
     cv::Point corners[3];
-    for (std::size_t k = 0; k < 3; ++k)  // texel centres at +0.5, as report::AtlasOccupancies
+    for (std::size_t k = 0; k < 3; ++k)  // texel centres at +0.5
       corners[k] = cv::Point(
           static_cast<int>(std::lround((model.corner_px[f][k].x() - 0.5f) * (1 << kShift))),
           static_cast<int>(std::lround((model.corner_px[f][k].y() - 0.5f) * (1 << kShift))));

@@ -25,7 +25,7 @@ struct WebModel {
 std::vector<int> ChartsOfModel(const TexturedModel& model);
 
 /// Per atlas (CV_32SC1, its size), the chart (ChartsOfModel) of each texel a face of
-/// that chart covers (its texel centres rasterised with their edges, as the report's
+/// that chart covers (its texel centres rasterised with their edges; the report's
 /// occupancy counts them); -1 elsewhere (gutters, empty space).
 std::vector<cv::Mat> AtlasChartRegions(const TexturedModel& model);
 

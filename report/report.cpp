@@ -20,6 +20,7 @@
 #include "core/provenance.h"
 #include "core/timing.h"
 #include "core/units.h"
+#include "model/web_model.h"
 
 namespace texlume::report {
 namespace fs = std::filesystem;
@@ -145,26 +146,11 @@ std::string HtmlEscape(const std::string& text) {
 }
 
 std::vector<double> AtlasOccupancies(const model::TexturedModel& model) {
-  std::vector<cv::Mat> inside;
-  for (const ptm::Ptm& a : model.atlases) inside.emplace_back(a.height, a.width, CV_8UC1, 0);
-  constexpr int kShift = 4;  // sub-texel vertex positions
-  for (std::size_t f = 0; f < model.corner_px.size(); ++f) {
-    const std::size_t a = static_cast<std::size_t>(model.face_atlas[f]);
-    if (a >= inside.size()) continue;
-    cv::Point corners[3];
-    for (int k = 0; k < 3; ++k) {
-      // Texel centres at +0.5: texel (x, y) is inside when its centre is.
-      corners[k] = cv::Point(
-          static_cast<int>(std::lround((model.corner_px[f][k].x() - 0.5f) * (1 << kShift))),
-          static_cast<int>(std::lround((model.corner_px[f][k].y() - 0.5f) * (1 << kShift))));
-    }
-    cv::fillConvexPoly(inside[a], corners, 3, cv::Scalar(255), cv::LINE_8, kShift);
-  }
   std::vector<double> occupancy;
-  for (const cv::Mat& m : inside)
-    occupancy.push_back(m.total() ? static_cast<double>(cv::countNonZero(m)) /
-                                        static_cast<double>(m.total())
-                                  : 0.0);
+  for (const cv::Mat& charts : model::AtlasChartRegions(model))
+    occupancy.push_back(charts.total() ? static_cast<double>(cv::countNonZero(charts >= 0)) /
+                                             static_cast<double>(charts.total())
+                                       : 0.0);
   return occupancy;
 }
 

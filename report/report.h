@@ -110,7 +110,8 @@ ReportSummary WriteReport(const std::filesystem::path& dir, const ReportInputs& 
                           const ProgressCallback& progress = {});
 
 /// Texels inside the model's triangles over the atlas's texels, per atlas
-/// (triangles rasterised at their texture coordinates).
+/// (triangles rasterised at their texture coordinates: the texels of
+/// model::AtlasChartRegions' charts).
 std::vector<double> AtlasOccupancies(const model::TexturedModel& model);
 
 /// Escapes text for HTML (& < > " ').

@@ -90,14 +90,13 @@ struct RankMemory {
   void Write(ByteWriter& out) const {
     out.Put(rank), out.Put(needed_bytes), out.Put(limit_bytes);
     out.Put(machine_default_bytes), out.Put(static_cast<char>(users_limit));
-    out.PutVector(std::vector<char>(machine.begin(), machine.end()));
+    out.PutString(machine);
   }
   static RankMemory Read(ByteReader& in) {
     RankMemory m;
     m.rank = in.Get<int>(), m.needed_bytes = in.Get<double>(), m.limit_bytes = in.Get<double>();
     m.machine_default_bytes = in.Get<double>(), m.users_limit = in.Get<char>() != 0;
-    const std::vector<char> name = in.GetVector<char>();
-    m.machine.assign(name.begin(), name.end());
+    m.machine = in.GetString();
     TEXLUME_CHECK(in.Remaining() == 0, "a rank's memory message is read whole");
     return m;
   }
@@ -180,16 +179,12 @@ void TriangleEngine::RequirePatchMemoryOnEveryMachine(const PatchGeometry& geome
     machines[m.machine].push_back(std::move(m));
   });
   ByteWriter verdict;
-  std::string refusal;
-  if (ranks.Rank() == 0) {
-    refusal = MemoryRefusal(machines, what);
-    verdict.PutVector(std::vector<char>(refusal.begin(), refusal.end()));
-  }
+  if (ranks.Rank() == 0) verdict.PutString(MemoryRefusal(machines, what));
   ranks.Broadcast(verdict.bytes());
   ByteReader in(verdict.bytes());
-  const std::vector<char> text = in.GetVector<char>();
+  const std::string refusal = in.GetString();
   TEXLUME_CHECK(in.Remaining() == 0, "rank 0's memory verdict is read whole");
-  if (!text.empty()) throw InputError("mesh", std::string(text.begin(), text.end()));
+  if (!refusal.empty()) throw InputError("mesh", refusal);
   // Rank 0's later stages (the gather, the atlases, their horizons) may use what the
   // other ranks of its machine do not need.
   if (ranks.Rank() == 0) {
