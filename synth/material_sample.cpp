@@ -188,6 +188,8 @@ void AddCorrection(const TrianglePatch& patch, const GridPoint& g, float* out) {
 }  // namespace
 
 const ReducedPlanes& MaterialSample::Reduced(int level) const {
+  // Several threads search faces at once; a map's elements stay where they are.
+  const std::lock_guard lock(reduced_mutex_);
   auto it = reduced_.find(level);
   if (it != reduced_.end()) return it->second;
   return reduced_.emplace(level, ReduceToDensityLevel(RelightPlanes(), level)).first->second;

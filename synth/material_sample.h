@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -92,7 +93,7 @@ class MaterialSample {
   virtual PhotoDomain Domain() const = 0;
 
   /// What Relight reads, reduced to a photo density level (r = 2^(-level/4)
-  /// photo pixels per texel; ReduceToDensityLevel), cached.
+  /// photo pixels per texel; ReduceToDensityLevel), cached; safe on several threads.
   const ReducedPlanes& Reduced(int level) const;
   /// How many planes Reduced() reduces (each of the sample's size at level 0).
   int NumRelightPlanes() const { return static_cast<int>(RelightPlanes().size()); }
@@ -110,6 +111,7 @@ class MaterialSample {
   virtual const std::vector<cv::Mat>& RelightPlanes() const = 0;
 
  private:
+  mutable std::mutex reduced_mutex_;
   mutable std::map<int, ReducedPlanes> reduced_;
 };
 

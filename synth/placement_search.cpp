@@ -1,5 +1,7 @@
 #include "synth/placement_search.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -27,12 +29,13 @@ std::vector<ScoredPlacement> KeepBest(std::vector<ScoredPlacement> scored, int k
   return scored;
 }
 
-// Runs view(r) for every r in [0, count) on every core. An exception must not
-// leave an OpenMP loop: each view's is kept and the first view's rethrown after it.
+// Runs view(r) for every r in [0, count) on every core, unless the search itself
+// runs on one of several threads (the engine's faces searched ahead). An exception
+// must not leave an OpenMP loop: each view's is kept and the first view's rethrown.
 template <typename PerView>
 void ForEachView(std::size_t count, const PerView& view) {
   std::vector<std::exception_ptr> errors(count);
-#pragma omp parallel for schedule(dynamic, 1) if (count > 1)
+#pragma omp parallel for schedule(dynamic, 1) if (count > 1 && !omp_in_parallel())
   for (std::size_t r = 0; r < count; ++r) {
     try {
       view(r);

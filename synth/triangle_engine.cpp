@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "core/image_io.h"
 #include "core/memory_budget.h"
+#include "core/ordered_pipeline.h"
 #include "core/timing.h"
 #include "synth/face_order.h"
 #include "synth/photo_blur.h"
@@ -22,6 +23,11 @@
 
 namespace texlume::synth {
 namespace {
+
+// Faces searched ahead of their placement, per thread (PlaceFaces): enough that a
+// thread rarely waits for the face to be placed next, few enough that their
+// rectified views stay small.
+constexpr std::size_t kFacesSearchedAheadPerThread = 4;
 
 // The mean of a view's R, G and B planes.
 cv::Mat PhotoLuminance(const RectifiedView& r) {
@@ -135,7 +141,7 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
 void TriangleEngine::FinishFaces(const std::vector<std::size_t>& faces,
                                  const ProgressCallback& progress) {
   const auto start = std::chrono::steady_clock::now();
-  relit_scratch_.Release();  // the placements are done: their memory goes to the finish
+  relit_scratch_.clear();  // the placements are done: their memory goes to the finish
   if (correction_) correction_->Finish(*this, faces, progress);
   result_.seconds_finish += SecondsSince(start);
 }
@@ -145,13 +151,43 @@ void TriangleEngine::PlaceFaces(const std::vector<int>& faces, std::uint32_t see
                                 const ProgressCallback& progress) {
   std::mt19937_64 rng(seed);
   std::size_t processed = done_before;
-  for (const int face : faces) {
-    SynthesizeFace(static_cast<std::size_t>(face), rng);
-    done_[static_cast<std::size_t>(face)] = 1;
+  const std::size_t workers = RunAheadWorkers();
+  const std::size_t ahead = kFacesSearchedAheadPerThread * workers;
+  const bool search_ahead = workers > 1 && PhotosHoldFacesInFlight(ahead + 1);
+  const std::size_t window = search_ahead ? ahead : 1;
+  relit_scratch_.resize(std::max(relit_scratch_.size(), workers));
+  std::vector<FaceSearch> found(window);  // slot n % window: face faces[n]'s search
+  const auto search = [&](std::size_t n, std::size_t worker) {
+    found[n % window] = SearchFace(static_cast<std::size_t>(faces[n]), relit_scratch_[worker]);
+  };
+  const auto place = [&](std::size_t n) {
+    const auto face = static_cast<std::size_t>(faces[n]);
+    SynthesizeFace(face, std::move(found[n % window]), rng);
+    done_[face] = 1;
     ++processed;
     if (progress && (processed % 64 == 0 || processed == total))
       progress("synthesis", processed, total);
+  };
+  if (search_ahead) {
+    RunAhead(faces.size(), window, search, place);
+  } else {  // each face's views scored on every thread instead (PlacementSearch)
+    for (std::size_t n = 0; n < faces.size(); ++n) search(n, 0), place(n);
   }
+}
+
+bool TriangleEngine::PhotosHoldFacesInFlight(std::size_t faces) const {
+  if (PhotosHeldTogether(photos_)) return true;
+  // Each face in flight holds up to max_views photos while it is rectified.
+  for (const MeshPhoto& photo : photos_) {
+    const std::shared_ptr<PhotoCache>& cache = photo.pixels.cache();
+    if (!cache || cache->NumPhotos() == 0) continue;
+    const double mean_photo_bytes =
+        static_cast<double>(cache->TotalBytes()) / static_cast<double>(cache->NumPhotos());
+    if (static_cast<double>(faces) * options_.max_views * mean_photo_bytes >
+        static_cast<double>(cache->budget_bytes()))
+      return false;
+  }
+  return true;
 }
 
 const TriangleSynthesis& TriangleEngine::Prepare(const ProgressCallback& progress) {
@@ -557,21 +593,34 @@ TriangleEngine::OverlapTargets TriangleEngine::CollectOverlapTargets(std::size_t
   return overlap;
 }
 
-void TriangleEngine::ScoreAndPlace(TrianglePatch& patch, const std::vector<RectifiedView>& views,
-                                   const OverlapTargets& overlap, std::vector<RelitWindow>& relit) {
+TriangleEngine::FaceSearch TriangleEngine::SearchFace(std::size_t f, RelitScratch& scratch) const {
   // Eq. 3 of paper 003 per photo (RMS at the photo's density), summed over the
-  // photos, at the placements of the patch in the sample the search visits; of
-  // its top_k, the one closest to the synthesised neighbours.
-  const PlacementSearch search(sample_, views, result_.photo_gains,
-                               cv::Size(patch.width, patch.height), &relit_scratch_);
+  // photos, at the placements of the patch in the sample the search visits.
+  FaceSearch found;
+  found.views = RectifiedViews(f, correction_ && correction_->WideMaskMargin() >= 0.0);
+  if (found.views.empty()) return found;
+  const TrianglePatch& patch = result_.patches[f];
+  const PlacementSearch search(sample_, found.views, result_.photo_gains,
+                               cv::Size(patch.width, patch.height), &scratch);
+  found.candidates = options_.search == PlacementSearchKind::kExhaustive
+                         ? search.Exhaustive(options_.top_k)
+                         : search.CoarseToFine(options_.top_k, options_.search_candidates);
+  return found;
+}
+
+void TriangleEngine::PlaceAmongCandidates(TrianglePatch& patch, const FaceSearch& found,
+                                          const OverlapTargets& overlap,
+                                          std::vector<RelitWindow>& relit) {
+  // Of the top_k, the one closest to the synthesised neighbours (Algorithm 2).
   KeepClosestToNeighbours(
-      options_.search == PlacementSearchKind::kExhaustive
-          ? search.Exhaustive(options_.top_k)
-          : search.CoarseToFine(options_.top_k, options_.search_candidates),
-      [&](int sx, int sy) { return overlap.Error(sample_, patch.width, sx, sy); }, patch);
+      found.candidates, [&](int sx, int sy) { return overlap.Error(sample_, patch.width, sx, sy); },
+      patch);
+  const std::vector<RectifiedView>& views = found.views;
   if (!correction_ || correction_->RelitMarginCells(views.front()) < 0) return;
   std::vector<int> margins;
   for (const RectifiedView& r : views) margins.push_back(correction_->RelitMarginCells(r));
+  const PlacementSearch search(sample_, views, result_.photo_gains,
+                               cv::Size(patch.width, patch.height));
   relit = search.RelitAround(cv::Point(patch.sample_x, patch.sample_y), margins);
 }
 
@@ -596,18 +645,16 @@ void TriangleEngine::PlaceByNeighbours(TrianglePatch& patch, const OverlapTarget
   patch.overlap_error = errors.at<float>(p.y, p.x) / static_cast<double>(overlap.texels.size());
 }
 
-void TriangleEngine::SynthesizeFace(std::size_t f, std::mt19937_64& rng) {
+void TriangleEngine::SynthesizeFace(std::size_t f, FaceSearch found, std::mt19937_64& rng) {
   TrianglePatch& patch = result_.patches[f];
   const OverlapTargets overlap = CollectOverlapTargets(f);
-  std::vector<RectifiedView> views =
-      RectifiedViews(f, correction_ && correction_->WideMaskMargin() >= 0.0);
-  if (!views.empty()) {
+  if (!found.views.empty()) {
     std::vector<RelitWindow> relit;  // per view: the sample relit around the placed patch
-    ScoreAndPlace(patch, views, overlap, relit);
+    PlaceAmongCandidates(patch, found, overlap, relit);
     patch.source = PatchSource::kPhotos;
-    patch.views_used = static_cast<int>(views.size());
+    patch.views_used = static_cast<int>(found.views.size());
     ++result_.num_from_photos;
-    if (correction_) correction_->Correct(*this, f, views, relit);
+    if (correction_) correction_->Correct(*this, f, found.views, relit);
   } else if (!overlap.texels.empty()) {
     PlaceByNeighbours(patch, overlap, rng);
     patch.source = PatchSource::kNeighbours;

@@ -322,9 +322,24 @@ class TriangleEngine {
   void EstimateOrReceivePhotometry(const ProgressCallback& progress);
   // Stage 2b: `faces` in their order, each placed and corrected (SynthesizeFace);
   // progress counts from `done_before` of `total`.
+  // The faces ahead are searched on every thread (SearchFace, which reads no
+  // placed face) while this thread places them in their order (core/ordered_pipeline.h).
   void PlaceFaces(const std::vector<int>& faces, std::uint32_t seed, std::size_t done_before,
                   std::size_t total, const ProgressCallback& progress);
-  void SynthesizeFace(std::size_t face, std::mt19937_64& rng);
+  // Whether the photo cache holds the photos of `faces` faces at once (each
+  // face's up to max_views), so that searching them together does not make the
+  // faces take turns decoding them.
+  bool PhotosHoldFacesInFlight(std::size_t faces) const;
+  // A face's rectified views and its top_k placements by eq. 3 alone (the image
+  // constraint, paper 003), which no other face's placement changes.
+  struct FaceSearch {
+    std::vector<RectifiedView> views;
+    std::vector<std::pair<float, cv::Point>> candidates;  // ScoredPlacement, best first
+  };
+  FaceSearch SearchFace(std::size_t face, RelitScratch& scratch) const;
+  // Places (of `found`'s candidates, the one closest to the placed neighbours)
+  // and corrects a face, or places it by its neighbours when no photo sees it.
+  void SynthesizeFace(std::size_t face, FaceSearch found, std::mt19937_64& rng);
   // The correction's pass after placement (PhotoCorrection::Finish) over `faces`.
   void FinishFaces(const std::vector<std::size_t>& faces, const ProgressCallback& progress);
   // Stage 2b distributed: the border faces placed at rank 0 and sent to every
@@ -372,10 +387,10 @@ class TriangleEngine {
     double Error(const MaterialSample& sample, int width, int sx, int sy) const;
   };
   OverlapTargets CollectOverlapTargets(std::size_t face) const;
-  // Score (eq. 3 summed over the views) and place (top_k, then the neighbours).
-  // `relit`: around the placed patch, when the correction reads it.
-  void ScoreAndPlace(TrianglePatch& patch, const std::vector<RectifiedView>& views,
-                     const OverlapTargets& overlap, std::vector<RelitWindow>& relit);
+  // Of the candidates (eq. 3 summed over the views, top_k), the one closest to the
+  // neighbours. `relit`: around the placed patch, when the correction reads it.
+  void PlaceAmongCandidates(TrianglePatch& patch, const FaceSearch& found,
+                            const OverlapTargets& overlap, std::vector<RelitWindow>& relit);
   // Unseen faces: the overlap constraint over every placement (FFT).
   void PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap, std::mt19937_64& rng);
 
@@ -399,8 +414,9 @@ class TriangleEngine {
   std::optional<FaceRegions> regions_;  // a distributed run (DistributeOver)
   // The sample's feature planes transformed once, for the faces no photo sees.
   std::optional<ImageSpectra> feature_spectra_;
-  // The placement search's relit buffers, lent to each face's search in turn.
-  RelitScratch relit_scratch_;
+  // The placement search's relit buffers, one per thread searching
+  // (RunAheadWorkers), lent to each face's search in turn.
+  std::vector<RelitScratch> relit_scratch_;
   TriangleSynthesis result_;
 };
 

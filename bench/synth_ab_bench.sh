@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Two builds of texlume timed on the same synth job, alternating in one script
+# (this machine's speed drifts by 10-20 % between runs and more between days, so
+# a change is measured against its baseline run beside it). The scene folders
+# are bench/triangle_time_bench.sh's (WORK/s512, WORK/sphere: run it once first).
+# Each row: a build's run, its CPU seconds (user + system), wall seconds and
+# synthesis seconds (its manifest); after each pair, whether the two PTM atlases
+# are the same bytes.
+# Usage: bench/synth_ab_bench.sh BASE_BUILD NEW_BUILD WORK [SCENES (s512 sphere)] [RUNS (2)]
+set -euo pipefail
+base=$(realpath "$1") new=$(realpath "$2") work=$(realpath "$3")
+scenes=${4:-s512 sphere} runs=${5:-2}
+echo "| scene | build | run | CPU s | wall s | synthesis s |"
+echo "|---|---|---|---|---|---|"
+for name in $scenes; do
+  case "$name" in
+    s512) texel=0.00390625 ;;
+    sphere) texel=0.002 ;;
+    *) echo "synth_ab_bench: unknown scene $name (s512 or sphere)" >&2; exit 2 ;;
+  esac
+  dir="$work/$name" object="$work/$name/object"
+  [ -f "$dir/sample.ptm" ] || { echo "synth_ab_bench: no $dir/sample.ptm (run bench/triangle_time_bench.sh)" >&2; exit 2; }
+  for run in $(seq "$runs"); do
+    for side in base new; do
+      build=$base
+      [ "$side" = new ] && build=$new
+      model="$dir/ab_$side"
+      rm -rf "$model"
+      TIMEFORMAT="%U %S %R"
+      times=$({ time "$build/apps/texlume" synth --model "$object/sparse" --images "$object/images" \
+        --lights "$object/lights.json" --mesh "$object/mesh.ply" --no-report \
+        --sample "$dir/sample.ptm" --sample-texel-size "$texel" --out "$model" > /dev/null 2>&1; } 2>&1 | tail -1)
+      python3 - "$model/manifest.json" "$name" "$side" "$run" $times <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+name, side, run, user, system, wall = sys.argv[2], sys.argv[3], sys.argv[4], *map(float, sys.argv[5:8])
+print(f"| {name} | {side} | {run} | {user + system:.1f} | {wall:.1f} | {m['timings_s']['synthesis']:.1f} |")
+PY
+    done
+    if cmp -s "$dir/ab_base/ptm_atlas_0.ptm" "$dir/ab_new/ptm_atlas_0.ptm"; then
+      echo "atlases: the same bytes" >&2
+    else
+      echo "atlases: different" >&2
+    fi
+  done
+done
