@@ -48,6 +48,15 @@ struct FaceRegions {
   mesh::FacePartition partition;
 };
 
+/// The faces rank 0 places before the regions (BordersPlacedFirst): the region borders
+/// (partition.on_border) and the faces with an edge neighbour on one. Placed together,
+/// breadth first as one process places any face, the borders' own edges and the edges
+/// next to them are as seamless as one process's; each region then grows from this
+/// band. (The borders alone, a region's first faces each fitted to one border face,
+/// left the edges next to the borders 19 % above one process's on 4 ranks.)
+std::vector<char> BordersPlacedFirst(const mesh::FacePartition& partition,
+                                     const std::vector<std::array<int, 3>>& neighbours);
+
 /// The faces divided into `num_regions` regions of equal face counts
 /// (mesh::PartitionFaces). Every face weighs the same: measured by
 /// bench/mpi_bench.sh on a 20328-face column, a face's work (placement and detail

@@ -342,10 +342,11 @@ class TriangleEngine {
   void SynthesizeFace(std::size_t face, FaceSearch found, std::mt19937_64& rng);
   // The correction's pass after placement (PhotoCorrection::Finish) over `faces`.
   void FinishFaces(const std::vector<std::size_t>& faces, const ProgressCallback& progress);
-  // Stage 2b distributed: the border faces placed at rank 0 and sent to every
-  // rank, then this rank's region off the border placed from them and finished,
-  // gathered at rank 0, which finishes the border faces; the other ranks'
-  // results are their share (rank_share_only). `neighbours`: mesh::FaceNeighbours.
+  // Stage 2b distributed: the border faces and those next to them (placed_first_,
+  // "the border faces" below) placed at rank 0 and sent to every rank, then this
+  // rank's region off them placed from them and finished, gathered at rank 0, which
+  // finishes the border faces; the other ranks' results are their share
+  // (rank_share_only). `neighbours`: mesh::FaceNeighbours.
   void PlaceRegions(const std::vector<int>& order,
                     const std::vector<std::array<int, 3>>& neighbours,
                     const ProgressCallback& progress);
@@ -412,6 +413,7 @@ class TriangleEngine {
   /// The faces in the order the passes over the photos visit them (FacesByPhoto).
   std::vector<std::size_t> photo_visit_order_;
   std::optional<FaceRegions> regions_;  // a distributed run (DistributeOver)
+  std::vector<char> placed_first_;      // its BordersPlacedFirst
   // The sample's feature planes transformed once, for the faces no photo sees.
   std::optional<ImageSpectra> feature_spectra_;
   // The placement search's relit buffers, one per thread searching

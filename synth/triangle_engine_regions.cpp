@@ -27,6 +27,7 @@ void TriangleEngine::DistributeOver(FaceRegions regions) {
   TEXLUME_CHECK(regions.partition.region_of_face.size() == mesh_.faces.size(),
                 "the partition is of the engine's mesh");
   regions_ = std::move(regions);
+  placed_first_ = BordersPlacedFirst(regions_->partition, mesh::FaceNeighbours(mesh_));
 }
 
 void TriangleEngine::EstimateOrReceivePhotometry(const ProgressCallback& progress) {
@@ -157,11 +158,11 @@ void TriangleEngine::RequirePatchMemoryOnEveryMachine(const PatchGeometry& geome
   RankCommunicator& ranks = *regions_->ranks;
   const mesh::FacePartition& partition = regions_->partition;
   // Rank 0 holds every face (it gathers them and bakes the atlases); another rank
-  // its own region's faces and the region borders, which rank 0 sends every rank.
+  // its own region's faces and the band rank 0 places first and sends every rank.
   std::vector<char> held(mesh_.faces.size(), 1);
   if (ranks.Rank() != 0)
     for (std::size_t f = 0; f < held.size(); ++f)
-      held[f] = partition.region_of_face[f] == ranks.Rank() || partition.on_border[f];
+      held[f] = partition.region_of_face[f] == ranks.Rank() || placed_first_[f];
   result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures(), held);
   const RankMemory mine{ranks.Rank(),
                         result_.patch_memory_bytes,
@@ -202,11 +203,12 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order,
   const int rank = ranks.Rank();
   std::vector<char> interior(mesh_.faces.size(), 0);
   for (std::size_t f = 0; f < interior.size(); ++f)
-    interior[f] = partition.region_of_face[f] == rank && !partition.on_border[f];
-  // The border faces first, breadth first along the borders as in one process;
-  // each region then grows from them, so no two separately placed regions meet.
+    interior[f] = partition.region_of_face[f] == rank && !placed_first_[f];
+  // The borders and the faces next to them first, breadth first along the borders
+  // as in one process (BordersPlacedFirst); each region then grows from them, so no
+  // two separately placed regions meet.
   const std::vector<int> border_faces =
-      mesh::BreadthFirstFaceOrderWithin(order, partition.on_border, neighbours);
+      mesh::BreadthFirstFaceOrderWithin(order, placed_first_, neighbours);
   PlaceBorders(border_faces, progress);
   const std::vector<int> region_faces = RegionOrder(order, border_faces, interior, neighbours);
   const auto start = std::chrono::steady_clock::now();
@@ -269,7 +271,7 @@ void TriangleEngine::PlaceBorders(const std::vector<int>& border_faces,
   if (ranks.Rank() != 0) {
     ByteReader in(out.bytes());
     ReadFaces(
-        in, [this](std::size_t f) { return regions_->partition.on_border[f] != 0; },
+        in, [this](std::size_t f) { return placed_first_[f] != 0; },
         "rank 0 sends the border faces, once");
     TEXLUME_CHECK(in.Remaining() == 0, "the border faces' message is read whole");
   }
@@ -372,7 +374,7 @@ void TriangleEngine::ReadRegion(const std::vector<char>& message) {
   ReadFaces(
       in,
       [&](std::size_t f) {
-        return partition.region_of_face[f] == record.rank && !partition.on_border[f];
+        return partition.region_of_face[f] == record.rank && !placed_first_[f];
       },
       "a rank sends its own region's faces off the border, once");
   if (correction_) correction_->AddSums(in);

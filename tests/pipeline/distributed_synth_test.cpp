@@ -166,9 +166,9 @@ TEST_F(DistributedSynthTest, ThreeRanksPlaceEveryFaceAndRankZeroWritesTheModel) 
   }
   EXPECT_EQ(placed, three.faces);  // every face placed once, by one rank
   EXPECT_FALSE(Manifest("threads3").contains("region_comparison"));  // not asked for
-  // Borders placed first, each region grown from them: the borders and the edges
-  // next to them agree no worse than other edges do (with a margin for a few
-  // dozen border edges).
+  // The borders and the faces next to them placed first, each region grown from them: the borders
+  // and the edges next to them agree no worse than other edges do (with a margin for a few dozen
+  // border edges).
   const nlohmann::json& e = d["edge_mismatch"];
   EXPECT_GT(e["region_borders"]["edges"].get<int>(), 10);
   EXPECT_LT(e["region_borders"]["mean"].get<double>(), 1.5 * e["elsewhere"]["mean"].get<double>());

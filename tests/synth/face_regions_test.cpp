@@ -124,5 +124,32 @@ TEST(FaceRegions, RegionsForRanksHoldEqualFaceCounts) {
   EXPECT_EQ(p.region_of_face, RegionsForRanks(neighbours, 3, 1).region_of_face);
 }
 
+// The band rank 0 places first: every border face and every face with an edge
+// neighbour on a border, nothing else (a grid cut into 3 regions).
+TEST(FaceRegions, TheBandPlacedFirstHoldsTheBordersAndTheFacesNextToThem) {
+  const std::vector<std::array<int, 3>> neighbours =
+      mesh::FaceNeighbours(datasets::MakeGridPlane(30, 1.0));
+  const mesh::FacePartition p = RegionsForRanks(neighbours, 3, 1);
+  const std::vector<char> band = BordersPlacedFirst(p, neighbours);
+  ASSERT_EQ(band.size(), neighbours.size());
+  std::size_t borders = 0, next_to = 0;
+  for (std::size_t f = 0; f < band.size(); ++f) {
+    bool touches_border = false, touches_other_region = false;
+    for (const int g : neighbours[f]) {
+      if (g < 0) continue;
+      touches_border |= p.on_border[static_cast<std::size_t>(g)] != 0;
+      touches_other_region |= p.region_of_face[static_cast<std::size_t>(g)] != p.region_of_face[f];
+    }
+    EXPECT_EQ(p.on_border[f] != 0, touches_other_region) << f;
+    EXPECT_EQ(band[f] != 0, p.on_border[f] || touches_border) << f;
+    borders += p.on_border[f] ? 1 : 0;
+    next_to += band[f] && !p.on_border[f] ? 1 : 0;
+  }
+  // A band a few faces wide along the cuts: more than the borders, far from everything.
+  EXPECT_GT(borders, 0u);
+  EXPECT_GT(next_to, borders / 2);
+  EXPECT_LT(borders + next_to, neighbours.size() / 2);
+}
+
 }  // namespace
 }  // namespace texlume::synth
