@@ -97,7 +97,7 @@ print("|---|" + "---|" * len(names))
 mismatch = [manifest(names[0])["region_comparison"][0]["edge_mismatch"],
             mn["distributed"]["edge_mismatch"],
             manifest(names[2])["region_comparison"][0]["edge_mismatch"]]
-for edges in ("region_borders", "next_to_borders", "elsewhere"):
+for edges in ("region_borders", "next_to_borders", "next_to_band", "elsewhere"):
     cells = [f"{m[edges]['mean']:.5f} +- {m[edges]['standard_error']:.5f}" for m in mismatch]
     print(f"| {edges.replace('_', ' ')} ({mismatch[1][edges]['edges']}) | " + " | ".join(cells) + " |")
 print()
@@ -105,8 +105,8 @@ for r in dist["per_rank"]:
     print(f"rank {r['rank']}: {r['faces']} faces, placed {r['faces_placed']} in "
           f"{r['seconds_region']:.1f} s, detail transfer {r['seconds_finish']:.1f} s (prepare "
           f"{r['seconds_prepare']:.1f} s), sent {r['bytes_sent']} B")
-print(f"rank 0: gather {dist['seconds_gather']:.2f} s, {dist['region_border_faces']} border faces "
-      f"placed and finished in {dist['seconds_region_borders']:.1f} s")
+print(f"rank 0: gather {dist['seconds_gather']:.2f} s, {dist['region_band_faces']} faces of the band along "
+      f"the borders placed and finished in {dist['seconds_region_borders']:.1f} s")
 
 # The model (docs/synth.md "Across machines") of this job on N ranks of one thread, from the
 # measured parts of the RANKS run:
@@ -120,8 +120,8 @@ work = [r["seconds_region"] + r["seconds_finish"] for r in dist["per_rank"]]
 placed = sum(r["faces_placed"] for r in dist["per_rank"])
 region_work = sum(work)
 imbalance = max(work) / (region_work / n)
-t_border = dist["seconds_region_borders"] / max(1, dist["region_border_faces"])
-beta = dist["region_border_faces"] / math.sqrt(n * faces)
+t_border = dist["seconds_region_borders"] / max(1, dist["region_band_faces"])
+beta = dist["region_band_faces"] / math.sqrt(n * faces)
 sent = [r for r in dist["per_rank"] if r["rank"] != 0]
 volume = sum(r["bytes_sent"] for r in sent) / max(1, sum(r["faces_placed"] for r in sent)) * placed
 prepare = dist["per_rank"][0]["seconds_prepare"]

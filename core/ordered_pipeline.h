@@ -21,9 +21,11 @@ std::size_t RunAheadWorkers();
 /// has returned, so the caller may keep what prepare leaves for consume in
 /// `window` slots (slot i % window). The calling thread prepares too while the item
 /// it needs next is not prepared yet. With one thread (or one item), prepare(i)
-/// then consume(i), in turn. The first exception thrown by either stops the run:
-/// no later item starts, and it is rethrown on the calling thread once every
-/// thread has stopped. prepare must be safe to run on several threads at once.
+/// then consume(i), in turn. An exception ends the run as in that turn: the one of
+/// the first failure in the order prepare(0), consume(0), prepare(1), ... is
+/// rethrown on the calling thread once every thread has stopped, whichever thread
+/// met its failure first, and no item past a failed one starts. prepare must be
+/// safe to run on several threads at once.
 /// `window` >= 1.
 void RunAhead(std::size_t count, std::size_t window,
               const std::function<void(std::size_t item, std::size_t worker)>& prepare,

@@ -377,6 +377,7 @@ nlohmann::json EdgeMismatchJson(const synth::EdgeMismatch& mismatch) {
   };
   return {{"region_borders", tally(mismatch.region_borders)},
           {"next_to_borders", tally(mismatch.next_to_borders)},
+          {"next_to_band", tally(mismatch.next_to_band)},
           {"elsewhere", tally(mismatch.elsewhere)}};
 }
 
@@ -408,6 +409,7 @@ nlohmann::json RanksJson(const synth::TriangleSynthesis& synthesis,
                      {"peak_resident_bytes", r.peak_resident_bytes}});
   nlohmann::json record = {{"ranks", synthesis.rank_records.size()},
                            {"region_border_faces", synthesis.region_border_faces},
+                           {"region_band_faces", synthesis.region_band_faces},
                            {"region_cut_edges", synthesis.region_cut_edges},
                            {"seconds_gather", synthesis.seconds_gather},
                            {"seconds_region_borders", synthesis.seconds_region_borders},

@@ -577,7 +577,7 @@ void CoefficientCorrection::Finish(TriangleEngine& engine, const std::vector<std
   if (!options_.detail_transfer) return;
   std::vector<TrianglePatch>& patches = engine.result().patches;
   // The dictionaries of the levels any face used (their detail bands serve every
-  // face), in parallel (their reductions first: the sample's cache is not thread-safe).
+  // face), in parallel (their reductions first, so that no thread waits on another's).
   std::vector<int> levels;
   for (const int level : correction_level_) {
     if (level < 0 || dictionaries_.count(level)) continue;

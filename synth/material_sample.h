@@ -52,7 +52,7 @@ FaceLighting LightingInFrame(const mesh::TriangleFrame& frame,
 /// samples"). An engine never looks inside a sample: it compares feature
 /// planes, turns them with the face frames, relights the sample for the image
 /// constraint and asks whether values may be blended. Reductions are cached on
-/// first use (not thread-safe; build the levels before parallel sections).
+/// first use (Reduced, safe on several threads).
 class MaterialSample {
  public:
   virtual ~MaterialSample() = default;

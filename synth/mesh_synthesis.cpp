@@ -115,6 +115,10 @@ EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
   for (std::size_t f = 0; f < num_faces; ++f)
     for (const Unfolding& u : synthesis.unfoldings[f])
       if (u.face >= 0 && region(f) != region(static_cast<std::size_t>(u.face))) on_border[f] = 1;
+  std::vector<char> in_band = on_border;  // BordersPlacedFirst: the borders and their neighbours
+  for (std::size_t f = 0; f < num_faces; ++f)
+    for (const Unfolding& u : synthesis.unfoldings[f])
+      if (u.face >= 0 && on_border[static_cast<std::size_t>(u.face)]) in_band[f] = 1;
   EdgeMismatch m;
   const double planes = std::max(1, synthesis.CoefficientPlanes());
   for (std::size_t f = 0; f < num_faces; ++f)
@@ -129,6 +133,7 @@ EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
       }
       m.elsewhere.Add(sum / planes, points);
       if (on_border[f] != on_border[other]) m.next_to_borders.Add(sum / planes, points);
+      if (in_band[f] != in_band[other]) m.next_to_band.Add(sum / planes, points);
     }
   return m;
 }

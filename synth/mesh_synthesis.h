@@ -110,12 +110,14 @@ class EdgeTally {
 /// between edges whose faces lie in different regions of a distributed run and
 /// the others: the mean squared difference of the blended coefficient planes
 /// (orthonormal space, the neighbour's turned by the unfolding) between the two
-/// faces' patches at points one texel apart along each edge. `next_to_borders`
-/// is the part of `elsewhere` between a face on a region border and a face of
-/// its own region off it (the one placed by rank 0's border pass, the other by
-/// its region's rank).
+/// faces' patches at points one texel apart along each edge. Two parts of
+/// `elsewhere`: `next_to_borders`, between a face on a region border and a face of
+/// its own region off it (both placed by rank 0 with the band, BordersPlacedFirst);
+/// `next_to_band`, between a face of that band and a face of its own region off it
+/// (the one placed by rank 0, the other by its region's rank: where the ranks' work
+/// meets rank 0's).
 struct EdgeMismatch {
-  EdgeTally region_borders, next_to_borders, elsewhere;
+  EdgeTally region_borders, next_to_borders, next_to_band, elsewhere;
 };
 EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
                                  const std::vector<int>& region_of_face);

@@ -148,7 +148,7 @@ std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<View
   std::vector<ScoredPlacement> scored;
   for (int sy = 0; sy <= last_y_; sy += stride)
     for (int sx = 0; sx <= last_x_; sx += stride) scored.emplace_back(0.0f, cv::Point(sx, sy));
-  // The views' relit samples and SSD maps on both cores, summed in view order.
+  // The views' relit samples and SSD maps on every core (ForEachView), summed in view order.
   std::vector<cv::Mat> ssd(views.size());
   ForEachView(views.size(), [&](std::size_t r) {
     const ViewAtStep& v = views[r];
@@ -202,7 +202,7 @@ class PlacementSearch::RelitTiles {
 std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views,
                                             const std::vector<cv::Point>& texels,
                                             std::vector<RelitTiles>& relit) const {
-  // Each view (its own relit tiles) on both cores; the scores summed in view order.
+  // Each view (its own relit tiles) on every core (ForEachView); the scores summed in view order.
   std::vector<std::vector<double>> per_view(views.size(), std::vector<double>(texels.size()));
   ForEachView(views.size(), [&](std::size_t r) {
     const ViewAtStep& v = views[r];

@@ -171,7 +171,10 @@ void TriangleEngine::PlaceFaces(const std::vector<int>& faces, std::uint32_t see
   if (search_ahead) {
     RunAhead(faces.size(), window, search, place);
   } else {  // each face's views scored on every thread instead (PlacementSearch)
-    for (std::size_t n = 0; n < faces.size(); ++n) search(n, 0), place(n);
+    for (std::size_t n = 0; n < faces.size(); ++n) {
+      search(n, 0);
+      place(n);
+    }
   }
 }
 

@@ -168,11 +168,12 @@ struct TriangleSynthesis {
   /// its faces went to rank 0, which holds the result; this one holds only the
   /// set-up, the photometry and this rank's own faces.
   bool rank_share_only = false;
-  /// A distributed run, at rank 0: what every rank did, by rank, and the faces
-  /// on region borders (placed by rank 0 first) and the edges between regions.
+  /// A distributed run, at rank 0: what every rank did, by rank, the faces on
+  /// region borders, the band rank 0 placed first (the borders and the faces
+  /// next to them, BordersPlacedFirst) and the edges between regions.
   std::vector<RankRecord> rank_records;
   std::vector<int> region_of_face;  ///< the partition (mesh::FacePartition)
-  std::size_t region_border_faces = 0, region_cut_edges = 0;
+  std::size_t region_border_faces = 0, region_band_faces = 0, region_cut_edges = 0;
   /// Rank 0 of a distributed run: waiting for and reading the other ranks'
   /// faces; placing, sending and finishing the border faces.
   double seconds_gather = 0.0, seconds_region_borders = 0.0;
@@ -243,9 +244,9 @@ class TriangleEngine {
                  PhotoCorrection* correction);
 
   /// Makes Run distributed over `regions.ranks` (synth/face_regions.h): rank 0
-  /// places the border faces and sends them to every rank, each rank grows its
-  /// region's faces off the border from them, rank 0 gathers them and finishes
-  /// (the border faces' detail transfer). Set-up and frames run on every rank;
+  /// places the band along the region borders (BordersPlacedFirst) and sends it to
+  /// every rank, each rank grows its region's faces off the band from it, rank 0
+  /// gathers them and finishes (the band's detail transfer). Set-up and frames run on every rank;
   /// the photometry on rank 0, which sends it to the others. Call on every rank
   /// with the same partition.
   void DistributeOver(FaceRegions regions);

@@ -1,6 +1,6 @@
 // The distributed run of the per-triangle engine (issue 33, synth/face_regions.h):
-// photometry and the region borders placed at rank 0 and sent to the others, then
-// each region placed by its rank, growing from the borders.
+// photometry and the band along the region borders placed at rank 0 and sent to the
+// others, then each region placed by its rank, growing from the band.
 #include <unistd.h>
 
 #include <algorithm>
@@ -245,7 +245,9 @@ void TriangleEngine::PlaceRegions(const std::vector<int>& order,
   result_.seconds_region_borders += SecondsSince(finish);
   for (std::size_t f = 0; f < done_.size(); ++f)
     TEXLUME_CHECK(done_[f], "every face is placed by a rank or at the borders");
-  result_.region_border_faces = border_faces.size();
+  result_.region_band_faces = border_faces.size();
+  result_.region_border_faces = static_cast<std::size_t>(
+      std::count(partition.on_border.begin(), partition.on_border.end(), 1));
   result_.region_cut_edges = partition.cut_edges;
   result_.region_of_face = partition.region_of_face;
   CountSources();

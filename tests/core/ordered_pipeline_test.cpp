@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -117,6 +118,37 @@ TEST(RunAhead, TheFirstExceptionStopsTheRunAndReachesTheCaller) {
       EXPECT_THROW(RunRecorded(r, 100, 4, static_cast<std::size_t>(-1), 50), std::invalid_argument);
       EXPECT_EQ(r.order.size(), 50u);
       for (std::size_t i = 50 + 4; i < 100; ++i) EXPECT_EQ(r.prepared[i], 0) << i;
+    }
+  }
+}
+
+// Of several failures, the one first in item order is reported, as running the
+// items in turn would, whichever thread meets its failure first.
+TEST(RunAhead, ReportsTheFailureFirstInItemOrder) {
+  for (const int threads : {1, 2, 4}) {
+    const Threads scope(threads);
+    for (const bool consume_fails : {false, true}) {
+      std::string message;
+      try {
+        RunAhead(
+            60, 12,
+            [&](std::size_t i, std::size_t) {
+              if (i == 30 && !consume_fails) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(20));
+                throw std::runtime_error("item 30");
+              }
+              if (i == 33 || i == 35) throw std::runtime_error("item " + std::to_string(i));
+            },
+            [&](std::size_t i) {
+              if (i == 30 && consume_fails) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(20));
+                throw std::runtime_error("consuming 30");
+              }
+            });
+      } catch (const std::runtime_error& e) {
+        message = e.what();
+      }
+      EXPECT_EQ(message, consume_fails ? "consuming 30" : "item 30") << threads << " threads";
     }
   }
 }

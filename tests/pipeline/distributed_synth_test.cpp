@@ -156,7 +156,8 @@ TEST_F(DistributedSynthTest, ThreeRanksPlaceEveryFaceAndRankZeroWritesTheModel) 
   const nlohmann::json d = Manifest("threads3")["distributed"];
   ASSERT_TRUE(d.is_object());
   EXPECT_EQ(d["ranks"], 3);
-  std::size_t placed = d["region_border_faces"];
+  std::size_t placed = d["region_band_faces"];
+  EXPECT_GT(placed, d["region_border_faces"].get<std::size_t>());  // the borders and beyond
   for (const auto& rank : d["per_rank"]) {
     placed += rank["faces_placed"].get<std::size_t>();
     EXPECT_GT(rank["faces_placed"].get<std::size_t>(), three.faces / 6);  // regions balanced
@@ -173,6 +174,9 @@ TEST_F(DistributedSynthTest, ThreeRanksPlaceEveryFaceAndRankZeroWritesTheModel) 
   EXPECT_GT(e["region_borders"]["edges"].get<int>(), 10);
   EXPECT_LT(e["region_borders"]["mean"].get<double>(), 1.5 * e["elsewhere"]["mean"].get<double>());
   EXPECT_LT(e["next_to_borders"]["mean"].get<double>(), 1.5 * e["elsewhere"]["mean"].get<double>());
+  // Where each region's own faces meet the band rank 0 placed.
+  EXPECT_GT(e["next_to_band"]["edges"].get<int>(), e["region_borders"]["edges"].get<int>());
+  EXPECT_LT(e["next_to_band"]["mean"].get<double>(), 1.5 * e["elsewhere"]["mean"].get<double>());
   EXPECT_GT(e["region_borders"]["standard_error"].get<double>(), 0.0);
   EXPECT_GT(e["next_to_borders"]["edges"].get<int>(), e["region_borders"]["edges"].get<int>());
   EXPECT_LT(e["next_to_borders"]["edges"].get<int>(), e["elsewhere"]["edges"].get<int>());
@@ -187,7 +191,7 @@ TEST_F(DistributedSynthTest, ThreeRanksPlaceEveryFaceAndRankZeroWritesTheModel) 
   // Two regions have fewer edges between them than three.
   EXPECT_LT(one["region_comparison"][0]["edge_mismatch"]["region_borders"]["edges"].get<int>(),
             c["edge_mismatch"]["region_borders"]["edges"].get<int>());
-  for (const char* edges : {"region_borders", "next_to_borders", "elsewhere"}) {
+  for (const char* edges : {"region_borders", "next_to_borders", "next_to_band", "elsewhere"}) {
     EXPECT_EQ(c["edge_mismatch"][edges]["edges"], e[edges]["edges"]) << edges;
     EXPECT_GT(c["edge_mismatch"][edges]["mean"].get<double>(), 0.0) << edges;
   }
