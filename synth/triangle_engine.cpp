@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
@@ -152,8 +153,10 @@ void TriangleEngine::PlaceFaces(const std::vector<int>& faces, std::uint32_t see
   std::mt19937_64 rng(seed);
   std::size_t processed = done_before;
   const std::size_t workers = RunAheadWorkers();
-  const std::size_t ahead = kFacesSearchedAheadPerThread * workers;
-  const bool search_ahead = workers > 1 && PhotosHoldFacesInFlight(ahead + 1);
+  // As many faces in flight as the photo cache holds the photos of (a face's
+  // search takes its turn decoding them otherwise).
+  const std::size_t ahead = std::min(kFacesSearchedAheadPerThread * workers, FacesPhotosHold());
+  const bool search_ahead = workers > 1 && ahead >= 2;
   const std::size_t window = search_ahead ? ahead : 1;
   relit_scratch_.resize(std::max(relit_scratch_.size(), workers));
   std::vector<FaceSearch> found(window);  // slot n % window: face faces[n]'s search
@@ -178,19 +181,21 @@ void TriangleEngine::PlaceFaces(const std::vector<int>& faces, std::uint32_t see
   }
 }
 
-bool TriangleEngine::PhotosHoldFacesInFlight(std::size_t faces) const {
-  if (PhotosHeldTogether(photos_)) return true;
+std::size_t TriangleEngine::FacesPhotosHold() const {
+  std::size_t faces = std::numeric_limits<std::size_t>::max();
+  if (PhotosHeldTogether(photos_)) return faces;
   // Each face in flight holds up to max_views photos while it is rectified.
+  const PhotoCache* checked = nullptr;
   for (const MeshPhoto& photo : photos_) {
-    const std::shared_ptr<PhotoCache>& cache = photo.pixels.cache();
-    if (!cache || cache->NumPhotos() == 0) continue;
+    const PhotoCache* cache = photo.pixels.cache().get();
+    if (!cache || cache == checked || cache->NumPhotos() == 0) continue;
+    checked = cache;
     const double mean_photo_bytes =
         static_cast<double>(cache->TotalBytes()) / static_cast<double>(cache->NumPhotos());
-    if (static_cast<double>(faces) * options_.max_views * mean_photo_bytes >
-        static_cast<double>(cache->budget_bytes()))
-      return false;
+    faces = std::min(faces, static_cast<std::size_t>(static_cast<double>(cache->budget_bytes()) /
+                                                     (options_.max_views * mean_photo_bytes)));
   }
-  return true;
+  return faces;
 }
 
 const TriangleSynthesis& TriangleEngine::Prepare(const ProgressCallback& progress) {

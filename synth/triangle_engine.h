@@ -327,10 +327,10 @@ class TriangleEngine {
   // placed face) while this thread places them in their order (core/ordered_pipeline.h).
   void PlaceFaces(const std::vector<int>& faces, std::uint32_t seed, std::size_t done_before,
                   std::size_t total, const ProgressCallback& progress);
-  // Whether the photo cache holds the photos of `faces` faces at once (each
-  // face's up to max_views), so that searching them together does not make the
-  // faces take turns decoding them.
-  bool PhotosHoldFacesInFlight(std::size_t faces) const;
+  // How many faces' photos (each face's up to max_views) the photo cache holds at
+  // once (SIZE_MAX when it holds every photo): the most faces PlaceFaces searches
+  // together, so that they do not take turns decoding their photos.
+  std::size_t FacesPhotosHold() const;
   // A face's rectified views and its top_k placements by eq. 3 alone (the image
   // constraint, paper 003), which no other face's placement changes.
   struct FaceSearch {

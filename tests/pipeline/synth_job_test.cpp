@@ -693,6 +693,21 @@ TEST_F(MeshPipelineTest, PhotosOnDemandStayWithinTheirCacheAndKeepTheModel) {
               full.mean_psnr, full.mean_ssim, small.mean_psnr, small.mean_ssim);
   EXPECT_NEAR(small.mean_psnr, full.mean_psnr, 0.3);
   EXPECT_NEAR(small.mean_ssim, full.mean_ssim, 0.02);
+  // A cache of two faces' photos (not all of them): two threads search two faces at
+  // once (each face's photos held while it is searched), without taking turns decoding.
+  j.photo_cache_bytes = 2 * static_cast<std::uint64_t>(j.synthesis.max_views) * photo_bytes;
+  ASSERT_LT(j.photo_cache_bytes, inputs.photo_cache->TotalBytes());
+  j.out_dir = tmp_->path() / "model_two_faces_cache";
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(2);
+  const pipeline::SynthJobSummary two = pipeline::RunSynthJob(j);
+  omp_set_num_threads(threads);
+  const auto two_decodes = nlohmann::json::parse(testing::ReadText(
+      j.out_dir / "manifest.json"))["summary"]["photo_cache"]["decodes"]
+                               .get<std::size_t>();
+  std::printf("photos on demand, two faces' photos: %zu decodes\n", two_decodes);
+  EXPECT_LT(two_decodes, faces / 2);
+  EXPECT_EQ(two.from_photos, summary_->from_photos);
   // A cache too small for one face's photos is refused before anything is read.
   j.photo_cache_bytes = photo_bytes;
   j.out_dir = tmp_->path() / "model_too_small";
