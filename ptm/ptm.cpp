@@ -38,10 +38,6 @@ Eigen::Matrix<double, Eigen::Dynamic, 6> PtmLightMatrix(
   return a;
 }
 
-double EvaluatePolynomial(const float* a, double lu, double lv) {
-  return a[0] * lu * lu + a[1] * lv * lv + a[2] * lu * lv + a[3] * lu + a[4] * lv + a[5];
-}
-
 Eigen::Vector3f Ptm::Evaluate(std::size_t texel, double lu, double lv) const {
   if (format == PtmFormat::kLrgb) {
     const float l = static_cast<float>(EvaluatePolynomial(Coefficients(texel), lu, lv));

@@ -69,7 +69,10 @@ std::array<double, 6> PtmBasis(double lu, double lv);
 /// row k is PtmBasis of light k.
 Eigen::Matrix<double, Eigen::Dynamic, 6> PtmLightMatrix(const std::vector<Eigen::Vector3d>& lights);
 /// L(lu, lv) = a0 lu^2 + a1 lv^2 + a2 lu lv + a3 lu + a4 lv + a5 (paper 003 eq. 1).
-double EvaluatePolynomial(const float* a, double lu, double lv);
+/// Inline: the relighting loops (synth/) evaluate it per texel and light.
+inline double EvaluatePolynomial(const float* a, double lu, double lv) {
+  return a[0] * lu * lu + a[1] * lv * lv + a[2] * lu * lv + a[3] * lu + a[4] * lv + a[5];
+}
 
 /// The surface normal of a texel from its (luminance) coefficients: the light
 /// direction of the biquadratic's maximum (Malzbender et al. 2001, eq. 16),

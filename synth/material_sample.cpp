@@ -339,21 +339,22 @@ std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighti
   const int polys = ptm_.NumPolynomials();
   std::vector<cv::Mat> out(3);
   for (cv::Mat& m : out) m = cv::Mat(r.planes[0].size(), CV_32FC1);
-  std::vector<float> a(static_cast<std::size_t>(polys * 6)), colour(3, 1.0f);
+  const bool lrgb = ptm_.format == ptm::PtmFormat::kLrgb;
+  const std::size_t read = static_cast<std::size_t>(polys * 6 + (lrgb ? 3 : 0));
+  std::vector<float> a(read), colour(3, 1.0f);
   const TexelLights texel_lights = LightsOf(lighting);
   std::vector<ptm::EffectiveLight> lights = texel_lights.lights;
+  std::vector<const float*> in(read);  // the planes' rows
   for (int y = 0; y < r.planes[0].rows; ++y) {
+    for (std::size_t i = 0; i < read; ++i) in[i] = r.planes[i].ptr<float>(y);
+    std::array<float*, 3> row{};
+    for (std::size_t c = 0; c < row.size(); ++c) row[c] = out[c].ptr<float>(y);
     for (int x = 0; x < r.planes[0].cols; ++x) {
       if (shadowing_) ShadowLights(texel_lights, r, BilinearTaps(r.planes[0].size(), x, y), lights);
-      for (int i = 0; i < polys * 6; ++i)
-        a[static_cast<std::size_t>(i)] = r.planes[static_cast<std::size_t>(i)].at<float>(y, x);
-      if (ptm_.format == ptm::PtmFormat::kLrgb)
-        for (int c = 0; c < 3; ++c)
-          colour[static_cast<std::size_t>(c)] =
-              r.planes[static_cast<std::size_t>(6 + c)].at<float>(y, x);
-      const Eigen::Vector3f v =
-          RelightEffective(a.data(), colour.data(), ptm_.format, lights, gain);
-      for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(c)].at<float>(y, x) = v[c];
+      for (std::size_t i = 0; i < read; ++i) a[i] = in[i][x];
+      const Eigen::Vector3f v = RelightEffective(
+          a.data(), lrgb ? a.data() + polys * 6 : colour.data(), ptm_.format, lights, gain);
+      for (std::size_t c = 0; c < row.size(); ++c) row[c][x] = v[static_cast<Eigen::Index>(c)];
     }
   }
   return out;

@@ -17,28 +17,6 @@ namespace texlume::synth {
 
 using LightList = std::vector<std::pair<Eigen::Vector3d, double>>;  // (tangent-frame dir, I)
 
-Eigen::Vector3f RelightEffective(const float* coefficients, const float* colour,
-                                 ptm::PtmFormat format,
-                                 const std::vector<ptm::EffectiveLight>& lights, double gain) {
-  Eigen::Vector3f linear = Eigen::Vector3f::Zero();
-  for (const ptm::EffectiveLight& e : lights) {
-    const Eigen::Vector3d& l = e.direction;
-    // LRGB: one luminance polynomial scaled by each channel's colour (Malzbender et
-    // al. 2001, eq. 2), evaluated once for the three channels.
-    const double luminance =
-        format == ptm::PtmFormat::kLrgb ? ptm::EvaluatePolynomial(coefficients, l.x(), l.y()) : 0.0;
-    for (int c = 0; c < 3; ++c) {
-      const double v = format == ptm::PtmFormat::kLrgb
-                           ? luminance * colour[c]
-                           : ptm::EvaluatePolynomial(coefficients + 6 * c, l.x(), l.y());
-      linear[c] += static_cast<float>(e.weight) * srgb::ToLinear(static_cast<float>(v));
-    }
-  }
-  Eigen::Vector3f out;
-  for (int c = 0; c < 3; ++c) out[c] = srgb::FromLinear(static_cast<float>(gain) * linear[c]);
-  return out;
-}
-
 Eigen::Vector3f RelightMixture(const float* coefficients, const float* colour,
                                ptm::PtmFormat format, const LightList& lights, double gain,
                                const ptm::LightResponse& response) {

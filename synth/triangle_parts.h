@@ -11,6 +11,7 @@
 
 #include "core/image_io.h"
 #include "core/photo_cache.h"
+#include "core/srgb.h"
 #include "mesh/mesh.h"
 #include "mesh/triangle_frame.h"
 #include "ptm/ptm.h"
@@ -212,9 +213,28 @@ Eigen::Vector3f RelightMixture(const float* coefficients_or_l, const float* colo
                                const std::vector<std::pair<Eigen::Vector3d, double>>& lights,
                                double gain, const ptm::LightResponse& response = {});
 /// RelightMixture with the lights already as the texel answers them
-/// (ptm::EffectiveLights): for many texels under one lighting.
-Eigen::Vector3f RelightEffective(const float* coefficients_or_l, const float* colour,
-                                 ptm::PtmFormat format,
-                                 const std::vector<ptm::EffectiveLight>& lights, double gain);
+/// (ptm::EffectiveLights): for many texels under one lighting. Inline: the
+/// sample's relighting (MaterialSample::Relight) calls it per cell.
+inline Eigen::Vector3f RelightEffective(const float* coefficients_or_l, const float* colour,
+                                        ptm::PtmFormat format,
+                                        const std::vector<ptm::EffectiveLight>& lights,
+                                        double gain) {
+  const bool lrgb = format == ptm::PtmFormat::kLrgb;
+  Eigen::Vector3f linear = Eigen::Vector3f::Zero();
+  for (const ptm::EffectiveLight& e : lights) {
+    const Eigen::Vector3d& l = e.direction;
+    // LRGB: one luminance polynomial scaled by each channel's colour (Malzbender et
+    // al. 2001, eq. 2), evaluated once for the three channels.
+    const double luminance = lrgb ? ptm::EvaluatePolynomial(coefficients_or_l, l.x(), l.y()) : 0.0;
+    for (int c = 0; c < 3; ++c) {
+      const double v = lrgb ? luminance * colour[c]
+                            : ptm::EvaluatePolynomial(coefficients_or_l + 6 * c, l.x(), l.y());
+      linear[c] += static_cast<float>(e.weight) * srgb::ToLinear(static_cast<float>(v));
+    }
+  }
+  Eigen::Vector3f out;
+  for (int c = 0; c < 3; ++c) out[c] = srgb::FromLinear(static_cast<float>(gain) * linear[c]);
+  return out;
+}
 
 }  // namespace texlume::synth
