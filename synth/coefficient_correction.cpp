@@ -6,11 +6,12 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 
 #include "core/image_io.h"
 #include "ptm/coefficient_space.h"
-#include "synth/nearest_windows.h"
+#include "synth/detail_transfer.h"
 #include "synth/photo_blur.h"
 
 namespace texlume::synth {
@@ -18,26 +19,6 @@ namespace {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Row6d = Eigen::Matrix<double, 1, 6>;
-
-// Detail transfer: a window of 3 x 3 points (dx, dy) texels apart around
-// (x, y), 6 orthonormal luminance coefficients each (5 x 5 matched worse on the
-// demo: SSIM 0.536 against 0.538).
-constexpr int kDetailWindowRadius = 1;
-constexpr int kDetailWindowLength =
-    (2 * kDetailWindowRadius + 1) * (2 * kDetailWindowRadius + 1) * 6;
-// At most this many sample points per dictionary (2^16 windows take 14 MiB;
-// a 256 x 256 sample has about 62 000).
-constexpr std::size_t kDetailMaxPoints = std::size_t{1} << 16;
-
-void CoarseWindow(const std::vector<cv::Mat>& coarse, double x, double y, double dx, double dy,
-                  float* window) {
-  for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
-    for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a) {
-      const BilinearTaps at(coarse[0].size(), x + a * dx, y + b * dy);
-      for (int m = 0; m < 6; ++m)
-        *window++ = static_cast<float>(at.Of(coarse[static_cast<std::size_t>(m)]));
-    }
-}
 
 }  // namespace
 
@@ -381,133 +362,6 @@ class CoefficientCorrection::PatchPass {
   mutable std::vector<ptm::EffectiveLight> shadowed_lights_;  // Predict's, at one cell
   cv::Mat known_;                                             // CV_8UC1: cells with a change
 };
-
-// Detail transfer's dictionary at one density level: the sample's coarse
-// luminance coefficients brought back to full size (orthonormal), and the
-// window of them around every sample point, 3 x 3 points one photo cell apart,
-// indexed for nearest-neighbour search. Its detail band (planes minus coarse)
-// is what the transferred patches read.
-class CoefficientCorrection::DetailDictionary {
- public:
-  // Touches no shared state, so levels can be built in parallel.
-  DetailDictionary(const PtmSample& sample, int level, std::vector<cv::Mat>& band) {
-    const ReducedPlanes& red = sample.Reduced(level);
-    dx_ = 1.0 / red.rx, dy_ = 1.0 / red.ry;
-    const cv::Size full(sample.Width(), sample.Height());
-    // The raw coefficients and LRGB colour (Values()' planes), not a horizon's.
-    std::vector<cv::Mat> coarse_raw(sample.Values().size());
-    for (std::size_t c = 0; c < coarse_raw.size(); ++c)
-      cv::resize(red.planes[c], coarse_raw[c], full, 0, 0, cv::INTER_LINEAR);
-    const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
-    coarse_.assign(6, cv::Mat());
-    for (cv::Mat& m : coarse_) m = cv::Mat::zeros(full, CV_32FC1);
-    for (int y = 0; y < full.height; ++y)
-      for (int x = 0; x < full.width; ++x)
-        for (int m = 0; m < 6; ++m) {
-          double v = 0.0;
-          for (int k = 0; k < 6; ++k)
-            v += to(m, k) * coarse_raw[static_cast<std::size_t>(k)].at<float>(y, x);
-          coarse_[static_cast<std::size_t>(m)].at<float>(y, x) = static_cast<float>(v);
-        }
-    const std::vector<cv::Mat>& values = sample.Values();
-    band.resize(values.size());
-    for (std::size_t c = 0; c < band.size(); ++c)
-      band[c] = values[c] - (c < 6 ? coarse_[c] : coarse_raw[c]);
-    IndexWindows(full);
-  }
-
-  bool Usable() const { return nearest_ != nullptr; }
-
-  // Matches for every cell of a corrected patch (its correction grid).
-  void Transfer(TrianglePatch& patch, int level) const;
-
- private:
-  void IndexWindows(cv::Size full) {
-    const int bx = static_cast<int>(std::ceil(kDetailWindowRadius * dx_)),
-              by = static_cast<int>(std::ceil(kDetailWindowRadius * dy_));
-    const int nx = full.width - 2 * bx, ny = full.height - 2 * by;
-    if (nx < 4 || ny < 4) return;  // windows wider than the sample: no transfer
-    // Large samples: points on a coarser grid, so a dictionary stays under
-    // kDetailMaxPoints windows.
-    const int stride = static_cast<int>(
-        std::ceil(std::sqrt(static_cast<double>(nx) * ny / static_cast<double>(kDetailMaxPoints))));
-    for (int y = by; y < full.height - by; y += stride)
-      for (int x = bx; x < full.width - bx; x += stride) points_.emplace_back(x, y);
-    cv::Mat windows(static_cast<int>(points_.size()), kDetailWindowLength, CV_32FC1);
-    for (std::size_t n = 0; n < points_.size(); ++n)
-      CoarseWindow(coarse_, points_[n].x, points_[n].y, dx_, dy_,
-                   windows.ptr<float>(static_cast<int>(n)));
-    nearest_ = std::make_unique<NearestWindows>(std::move(windows), NearestWindows::Options{});
-  }
-
-  double dx_ = 1.0, dy_ = 1.0;     // texels per photo cell
-  std::vector<cv::Mat> coarse_;    // 6 orthonormal luminance planes, full size
-  std::vector<cv::Point> points_;  // window centres, texels
-  std::unique_ptr<NearestWindows> nearest_;
-};
-
-void CoefficientCorrection::DetailDictionary::Transfer(TrianglePatch& patch, int level) const {
-  const int gw = patch.correction[0].cols, gh = patch.correction[0].rows;
-  std::vector<cv::Mat> corrected(6);
-  for (cv::Mat& m : corrected) m = cv::Mat(gh, gw, CV_32FC1);
-  for (int j = 0; j < gh; ++j)
-    for (int i = 0; i < gw; ++i) {
-      const BilinearTaps at(coarse_[0].size(), patch.sample_x + (i + 0.5) * dx_ - 0.5,
-                            patch.sample_y + (j + 0.5) * dy_ - 0.5);
-      for (std::size_t m = 0; m < 6; ++m)
-        corrected[m].at<float>(j, i) =
-            static_cast<float>(at.Of(coarse_[m]) + patch.correction[m].at<float>(j, i));
-    }
-  cv::Mat queries(gh * gw, kDetailWindowLength, CV_32FC1);
-  for (int j = 0; j < gh; ++j)
-    for (int i = 0; i < gw; ++i) {
-      float* q = queries.ptr<float>(j * gw + i);
-      for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
-        for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a)
-          for (std::size_t m = 0; m < 6; ++m)
-            *q++ =
-                corrected[m].at<float>(std::clamp(j + b, 0, gh - 1), std::clamp(i + a, 0, gw - 1));
-    }
-  std::vector<int> indices;
-  std::vector<float> distances;
-  nearest_->Nearest(queries, indices, distances);
-  patch.detail_source = cv::Mat(gh, gw, CV_32FC2);
-  cv::Mat best(gh, gw, CV_32FC1);
-  for (int j = 0; j < gh; ++j)
-    for (int i = 0; i < gw; ++i) {
-      const std::size_t n = static_cast<std::size_t>(j * gw + i);
-      const cv::Point p = points_[static_cast<std::size_t>(indices[n])];
-      patch.detail_source.at<cv::Vec2f>(j, i) =
-          cv::Vec2f(static_cast<float>(p.x), static_cast<float>(p.y));
-      best.at<float>(j, i) = distances[n];
-    }
-  // Coherent matches keep the detail whole where their bands are blended: a
-  // neighbour cell's match moved by one cell wherever it is nearer.
-  const int sample_width = coarse_[0].cols, sample_height = coarse_[0].rows;
-  const double x_lo = kDetailWindowRadius * dx_, x_hi = sample_width - 1 - x_lo;
-  const double y_lo = kDetailWindowRadius * dy_, y_hi = sample_height - 1 - y_lo;
-  std::array<float, kDetailWindowLength> window;
-  auto try_shift = [&](int i, int j, int ni, int nj) {
-    if (ni < 0 || nj < 0 || ni >= gw || nj >= gh) return;
-    const cv::Vec2f n = patch.detail_source.at<cv::Vec2f>(nj, ni);
-    const double x = n[0] + (i - ni) * dx_, y = n[1] + (j - nj) * dy_;
-    if (x < x_lo || x > x_hi || y < y_lo || y > y_hi) return;
-    CoarseWindow(coarse_, x, y, dx_, dy_, window.data());
-    const float* q = queries.ptr<float>(j * gw + i);
-    double e = 0.0;
-    for (int k = 0; k < kDetailWindowLength; ++k) e += (window[k] - q[k]) * (window[k] - q[k]);
-    if (e < best.at<float>(j, i)) {
-      best.at<float>(j, i) = static_cast<float>(e);
-      patch.detail_source.at<cv::Vec2f>(j, i) =
-          cv::Vec2f(static_cast<float>(x), static_cast<float>(y));
-    }
-  };
-  for (int j = 0; j < gh; ++j)
-    for (int i = 0; i < gw; ++i) try_shift(i, j, i - 1, j), try_shift(i, j, i, j - 1);
-  for (int j = gh - 1; j >= 0; --j)
-    for (int i = gw - 1; i >= 0; --i) try_shift(i, j, i + 1, j), try_shift(i, j, i, j + 1);
-  patch.detail_level = level;
-}
 
 CoefficientCorrection::CoefficientCorrection(const PtmSample& sample,
                                              const MeshSynthesisOptions& options)

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "synth/detail_transfer.h"
 #include "synth/material_sample.h"
 #include "synth/mesh_synthesis.h"
 #include "synth/triangle_engine.h"
@@ -27,10 +28,9 @@ namespace texlume::synth {
 /// the photos' chromaticity. Cells outside the triangle take their
 /// neighbours' change.
 ///
-/// Finish (detail transfer): per cell of each corrected patch's grid, the
-/// sample point whose coarse window (3 x 3 cells) is nearest the corrected
-/// coarse values (k-d tree per density level), then two passes that take a
-/// neighbour cell's match moved by one cell wherever it is nearer.
+/// Finish (detail transfer, synth/detail_transfer.h): per density level a face
+/// was corrected at, the sample's DetailDictionary; each corrected patch's cells
+/// matched to the sample points whose coarse windows are nearest.
 class CoefficientCorrection : public PhotoCorrection {
  public:
   CoefficientCorrection(const PtmSample& sample, const MeshSynthesisOptions& options);
@@ -57,7 +57,6 @@ class CoefficientCorrection : public PhotoCorrection {
 
  private:
   class PatchPass;
-  class DetailDictionary;
   const CoefficientPrior& PriorAt(int level);
   void TransferDetail(TrianglePatch& patch, int level) const;
 

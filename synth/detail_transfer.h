@@ -1,0 +1,69 @@
+#pragma once
+
+#include <limits>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "synth/material_sample.h"
+#include "synth/nearest_windows.h"
+#include "synth/triangle_engine.h"
+
+// Detail transfer (beyond paper 003, the photo-consistency pass's last step,
+// synth/coefficient_correction.h): a corrected patch's coarse luminance
+// coefficients matched, cell by cell, to the sample point whose coarse window is
+// nearest, whose detail band the patch then carries.
+namespace texlume::synth {
+
+/// Detail transfer's dictionary at one density level: the sample's coarse
+/// luminance coefficients brought back to full size (orthonormal), and the
+/// window of them around every sample point, 3 x 3 points one photo cell apart,
+/// indexed for nearest-neighbour search. Its detail band (planes minus coarse)
+/// is what the transferred patches read.
+class DetailDictionary {
+ public:
+  /// The dictionary of `sample` reduced to density `level`; `band` receives the
+  /// detail band (per plane of sample.Values()). Touches no shared state, so
+  /// levels can be built in parallel.
+  DetailDictionary(const PtmSample& sample, int level, std::vector<cv::Mat>& band);
+
+  /// False when the windows are wider than the sample: no transfer.
+  bool Usable() const { return nearest_ != nullptr; }
+
+  /// Per cell of a corrected patch's grid (patch.correction, at `level`'s density),
+  /// the sample point its detail comes from (patch.detail_source, texels): the
+  /// index is asked at the cells of one colour of a checkerboard (issue 33: half
+  /// the queries); passes then take a neighbour cell's match moved by one cell
+  /// wherever it is nearer (the other cells' only matches, unless they lie beyond
+  /// the neighbours' reach and ask the index themselves).
+  void Transfer(TrianglePatch& patch, int level) const;
+
+ private:
+  // Per cell of a patch's grid (row-major): the sample point its detail comes from
+  // (texels) and the squared window distance (infinite: none yet).
+  struct Matches {
+    Matches(int w, int h)
+        : width(w),
+          source(static_cast<std::size_t>(w * h)),
+          distance(static_cast<std::size_t>(w * h), std::numeric_limits<float>::infinity()) {}
+    bool Found(std::size_t c) const { return distance[c] < std::numeric_limits<float>::infinity(); }
+    int width;
+    std::vector<cv::Vec2f> source;
+    std::vector<float> distance;
+  };
+  void IndexWindows(cv::Size full);
+  // Per cell, the window of the corrected coarse coefficients (a row each).
+  cv::Mat CorrectedWindows(const TrianglePatch& patch) const;
+  // The nearest windows of the index for `cells` (row-major indices).
+  void MatchByIndex(const cv::Mat& windows, const std::vector<int>& cells, Matches& matches) const;
+  // One pass over the grid (forward: from the left and above; else from the right
+  // and below) taking a neighbour's match moved by one cell wherever it is nearer.
+  void Propagate(const cv::Mat& windows, bool forward, Matches& matches) const;
+
+  double dx_ = 1.0, dy_ = 1.0;     // texels per photo cell
+  std::vector<cv::Mat> coarse_;    // 6 orthonormal luminance planes, full size
+  std::vector<cv::Point> points_;  // window centres, texels
+  std::unique_ptr<NearestWindows> nearest_;
+};
+
+}  // namespace texlume::synth
