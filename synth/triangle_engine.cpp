@@ -181,6 +181,10 @@ void TriangleEngine::PlaceFaces(const std::vector<int>& faces, std::uint32_t see
   }
 }
 
+double TriangleEngine::RelitBytesAtMost() const {
+  return RelitScratch::BytesAtMost(options_.max_views, cv::Size(sample_.Width(), sample_.Height()));
+}
+
 std::size_t TriangleEngine::FacesPhotosHold() const {
   std::size_t faces = std::numeric_limits<std::size_t>::max();
   if (PhotosHeldTogether(photos_)) return faces;
@@ -235,15 +239,20 @@ void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
                                  "; use a larger texel size or a finer mesh");
   }
   // The patches' feature planes, the atlases baked from them and the bake's own
-  // buffers (docs/robustness.md "Memory").
+  // buffers, and the relit buffers each searching thread keeps (docs/robustness.md
+  // "Memory").
+  const std::size_t threads = RunAheadWorkers();
   const std::string what = "the patches and atlases of " + std::to_string(geometry.total_texels) +
                            " texels at a texel size of " + std::to_string(t) +
-                           " world units (a larger --sample-texel-size needs fewer)";
+                           " world units (a larger --sample-texel-size needs fewer), and the "
+                           "relit sample buffers of " +
+                           std::to_string(threads) + " searching threads (OMP_NUM_THREADS)";
   if (regions_) {
     RequireSameInputsAsRankZero(geometry.patches);  // before anything a rank reads from rank 0
     RequirePatchMemoryOnEveryMachine(geometry, what);
   } else {
-    result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures());
+    result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures()) +
+                                 static_cast<double>(threads) * RelitBytesAtMost();
     RequireMemory(result_.patch_memory_bytes, what, "mesh");
   }
   if (patches_in_sample_ &&

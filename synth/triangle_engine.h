@@ -134,6 +134,11 @@ class RelitScratch {
   std::array<cv::Mat, 3> Planes(std::size_t slot, cv::Size size);
   /// Frees the buffers (the next Planes() allocates again).
   void Release() { buffers_.clear(); }
+  /// The most the buffers of a search over `views` views of a sample of `sample`
+  /// texels can grow to: three float planes per view at the sample's full density.
+  static double BytesAtMost(int views, cv::Size sample) {
+    return 3.0 * sizeof(float) * views * static_cast<double>(sample.area());
+  }
 
  private:
   std::vector<std::array<cv::Mat, 3>> buffers_;
@@ -331,6 +336,8 @@ class TriangleEngine {
   // once (SIZE_MAX when it holds every photo): the most faces PlaceFaces searches
   // together, so that they do not take turns decoding their photos.
   std::size_t FacesPhotosHold() const;
+  // The most one searching thread's relit buffers can grow to (RelitScratch).
+  double RelitBytesAtMost() const;
   // A face's rectified views and its top_k placements by eq. 3 alone (the image
   // constraint, paper 003), which no other face's placement changes.
   struct FaceSearch {

@@ -15,6 +15,7 @@
 #include "core/check.h"
 #include "core/errors.h"
 #include "core/memory_budget.h"
+#include "core/ordered_pipeline.h"
 #include "core/timing.h"
 #include "synth/face_order.h"
 #include "synth/triangle_engine.h"
@@ -163,7 +164,8 @@ void TriangleEngine::RequirePatchMemoryOnEveryMachine(const PatchGeometry& geome
   if (ranks.Rank() != 0)
     for (std::size_t f = 0; f < held.size(); ++f)
       held[f] = partition.region_of_face[f] == ranks.Rank() || placed_first_[f];
-  result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures(), held);
+  result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures(), held) +
+                               static_cast<double>(RunAheadWorkers()) * RelitBytesAtMost();
   const RankMemory mine{ranks.Rank(),
                         result_.patch_memory_bytes,
                         static_cast<double>(MemoryLimitBytes()),

@@ -232,7 +232,8 @@ TEST_F(DistributedSynthTest, RanksOnOneMachineShareItsMemoryRankZeroHoldingEvery
   EXPECT_DOUBLE_EQ(rank_zero, one_process);
   EXPECT_GT(rank_one, 0.2 * one_process);
   EXPECT_LT(rank_one, 0.8 * one_process);
-  EXPECT_NEAR(static_cast<double>(MemoryLimitBytes()), 1.8 * one_process - rank_one, 2.0);
+  // (Within the bytes the shares are truncated to, once when set and once when split.)
+  EXPECT_NEAR(static_cast<double>(MemoryLimitBytes()), 1.8 * one_process - rank_one, 4.0);
   EXPECT_FALSE(MemoryLimitIsUsers());
   // A little less than their need together refuses on every rank, with the same message.
   SetSharedMemoryLimitBytes(static_cast<std::uint64_t>(0.49 * (rank_zero + rank_one)));

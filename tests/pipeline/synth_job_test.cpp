@@ -18,6 +18,7 @@
 
 #include "atlas/atlas.h"
 #include "core/errors.h"
+#include "core/image_io.h"
 #include "core/memory_budget.h"
 #include "datasets_synthetic/scene.h"
 #include "datasets_synthetic/shapes.h"
@@ -651,6 +652,18 @@ TEST_F(MeshPipelineTest, OutputsAreTheSameOnOneThreadAndOnTwo) {
     const fs::path relative = name.get<std::string>();
     EXPECT_TRUE(WithoutTimings(one / relative) == WithoutTimings(two / relative)) << relative;
   }
+  // The memory estimate counts each searching thread's relit buffers (RelitScratch).
+  const auto estimate = [](const fs::path& dir) {
+    return nlohmann::json::parse(
+               testing::ReadText(dir / "manifest.json"))["resources"]["patch_memory_estimate_bytes"]
+        .get<double>();
+  };
+  // The fixture's model on two threads, this one on one.
+  const ImageReader sample(job_->sample_file);
+  EXPECT_NEAR(estimate(two) - estimate(one),
+              RelitScratch::BytesAtMost(job_->synthesis.max_views,
+                                        cv::Size(sample.width(), sample.height())),
+              1.0);
 }
 
 // Photos on demand (issue 33): with a cache of the fewest photos a face needs (its
