@@ -7,6 +7,7 @@
 
 #include "core/errors.h"
 #include "synth/coefficient_correction.h"
+#include "synth/face_regions.h"
 
 namespace texlume::synth {
 
@@ -110,15 +111,21 @@ double EdgeTally::StandardError() const {
 EdgeMismatch MeasureEdgeMismatch(const MeshSynthesis& synthesis,
                                  const std::vector<int>& region_of_face) {
   const std::size_t num_faces = synthesis.patches.size();
-  const auto region = [&](std::size_t f) { return region_of_face.empty() ? 0 : region_of_face[f]; };
-  std::vector<char> on_border(num_faces, 0);
+  if (num_faces == 0) return {};
+  // The regions' borders and the band rank 0 places first, from the unfoldings'
+  // edge neighbours, as the distributed run computes them.
+  std::vector<std::array<int, 3>> neighbours(num_faces);
   for (std::size_t f = 0; f < num_faces; ++f)
-    for (const Unfolding& u : synthesis.unfoldings[f])
-      if (u.face >= 0 && region(f) != region(static_cast<std::size_t>(u.face))) on_border[f] = 1;
-  std::vector<char> in_band = on_border;  // BordersPlacedFirst: the borders and their neighbours
-  for (std::size_t f = 0; f < num_faces; ++f)
-    for (const Unfolding& u : synthesis.unfoldings[f])
-      if (u.face >= 0 && on_border[static_cast<std::size_t>(u.face)]) in_band[f] = 1;
+    for (std::size_t k = 0; k < 3; ++k) neighbours[f][k] = synthesis.unfoldings[f][k].face;
+  mesh::FacePartition partition;
+  partition.region_of_face =
+      region_of_face.empty() ? std::vector<int>(num_faces, 0) : region_of_face;
+  partition.num_regions =
+      1 + *std::max_element(partition.region_of_face.begin(), partition.region_of_face.end());
+  mesh::CountRegionBorders(neighbours, partition);
+  const std::vector<char>& on_border = partition.on_border;
+  const std::vector<char> in_band = BordersPlacedFirst(partition, neighbours);
+  const auto region = [&](std::size_t f) { return partition.region_of_face[f]; };
   EdgeMismatch m;
   const double planes = std::max(1, synthesis.CoefficientPlanes());
   for (std::size_t f = 0; f < num_faces; ++f)

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <functional>
 #include <map>
@@ -53,10 +54,14 @@ void TriangleEngine::EstimateOrReceivePhotometry(const ProgressCallback& progres
 }
 
 void TriangleEngine::RequireSameInputsAsRankZero(const std::vector<TrianglePatch>& patches) const {
-  // FNV-1a over what every rank must agree on: faces, photos, patch rectangles, regions.
+  // FNV-1a over what every rank must agree on: faces (their vertices, hence the
+  // face neighbours the band and the regions' order follow), photos, patch
+  // rectangles, regions.
   std::uint64_t hash = 0xcbf29ce484222325ull;
   const auto mix = [&hash](std::uint64_t value) { hash = (hash ^ value) * 0x100000001b3ull; };
   mix(mesh_.faces.size());
+  for (const std::array<int, 3>& face : mesh_.faces)
+    for (const int v : face) mix(static_cast<std::uint64_t>(static_cast<std::uint32_t>(v)));
   for (const MeshPhoto& photo : photos_) mix(photo.image_id.value);
   for (std::size_t f = 0; f < patches.size(); ++f) {
     mix(static_cast<std::uint64_t>(patches[f].width));
