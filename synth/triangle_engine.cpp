@@ -109,6 +109,7 @@ TriangleEngine::TriangleEngine(const mesh::TriangleMesh& mesh,
       correction_(correction) {
   for (std::size_t n = 0; n < photos.size(); ++n) photo_index_[photos[n].image_id] = n;
   vertex_normals_ = mesh::VertexNormals(mesh);
+  face_neighbours_ = mesh::FaceNeighbours(mesh);
 }
 
 TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
@@ -119,7 +120,7 @@ TriangleSynthesis TriangleEngine::Run(const ProgressCallback& progress) {
 
   // Breadth first from the best-seen face (Algorithm 2, step 2); photo by photo
   // when the photos do not all fit in memory (synth/face_order.h).
-  const std::vector<std::array<int, 3>> neighbours = mesh::FaceNeighbours(mesh_);
+  const std::vector<std::array<int, 3>>& neighbours = face_neighbours_;
   const std::vector<int> order =
       PhotosHeldTogether(photos_)
           ? mesh::BreadthFirstFaceOrder(mesh_, neighbours, BestSeenFace(visibility_))

@@ -412,7 +412,8 @@ class TriangleEngine {
   PhotoCorrection* correction_;
   std::map<sfm::ImageId, std::size_t> photo_index_;
   std::vector<char> done_;
-  std::vector<Eigen::Vector3d> vertex_normals_;  // mesh::VertexNormals, for ShadingTurns
+  std::vector<Eigen::Vector3d> vertex_normals_;      // mesh::VertexNormals, for ShadingTurns
+  std::vector<std::array<int, 3>> face_neighbours_;  // mesh::FaceNeighbours, once
   /// Cells the score reads beyond the triangle (world units): W_e / 2 for a
   /// blended sample (its blending zone, so that a blend mixes two
   /// photo-corrected patches), none for a sample that is cut.

@@ -29,7 +29,7 @@ void TriangleEngine::DistributeOver(FaceRegions regions) {
   TEXLUME_CHECK(regions.partition.region_of_face.size() == mesh_.faces.size(),
                 "the partition is of the engine's mesh");
   regions_ = std::move(regions);
-  placed_first_ = BordersPlacedFirst(regions_->partition, mesh::FaceNeighbours(mesh_));
+  placed_first_ = BordersPlacedFirst(regions_->partition, face_neighbours_);
 }
 
 void TriangleEngine::EstimateOrReceivePhotometry(const ProgressCallback& progress) {
