@@ -8,17 +8,15 @@
 # are the same bytes.
 # Usage: bench/synth_ab_bench.sh BASE_BUILD NEW_BUILD WORK [SCENES (s512 sphere)] [RUNS (2)]
 set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+source "$root/bench/lib/synth_scenes.sh"
 base=$(realpath "$1") new=$(realpath "$2") work=$(realpath "$3")
 scenes=${4:-s512 sphere} runs=${5:-2}
 echo "| scene | build | run | CPU s | wall s | synthesis s |"
 echo "|---|---|---|---|---|---|"
 for name in $scenes; do
-  case "$name" in
-    s512) texel=0.00390625 ;;
-    sphere) texel=0.002 ;;
-    *) echo "synth_ab_bench: unknown scene $name (s512 or sphere)" >&2; exit 2 ;;
-  esac
-  dir="$work/$name" object="$work/$name/object"
+  synth_scene_settings "$name"
+  dir="$work/$name"
   [ -f "$dir/sample.ptm" ] || { echo "synth_ab_bench: no $dir/sample.ptm (run bench/triangle_time_bench.sh)" >&2; exit 2; }
   for run in $(seq "$runs"); do
     for side in base new; do
@@ -26,10 +24,7 @@ for name in $scenes; do
       [ "$side" = new ] && build=$new
       model="$dir/ab_$side"
       rm -rf "$model"
-      TIMEFORMAT="%U %S %R"
-      times=$({ time "$build/apps/texlume" synth --model "$object/sparse" --images "$object/images" \
-        --lights "$object/lights.json" --mesh "$object/mesh.ply" --no-report \
-        --sample "$dir/sample.ptm" --sample-texel-size "$texel" --out "$model" > /dev/null 2>&1; } 2>&1 | tail -1)
+      times=$(timed_synth "$build/apps/texlume" "$dir" "$texel" "$model")
       python3 - "$model/manifest.json" "$name" "$side" "$run" $times <<'PY'
 import json, sys
 m = json.load(open(sys.argv[1]))
@@ -37,7 +32,14 @@ name, side, run, user, system, wall = sys.argv[2], sys.argv[3], sys.argv[4], *ma
 print(f"| {name} | {side} | {run} | {user + system:.1f} | {wall:.1f} | {m['timings_s']['synthesis']:.1f} |")
 PY
     done
-    if cmp -s "$dir/ab_base/ptm_atlas_0.ptm" "$dir/ab_new/ptm_atlas_0.ptm"; then
+    # Every atlas either model wrote (PTM atlases and the pictures baked beside them).
+    same=1
+    for atlas in "$dir"/ab_base/*_[0-9]*.* "$dir"/ab_new/*_[0-9]*.*; do
+      other="$dir/ab_base/$(basename "$atlas")"
+      [ "$other" = "$atlas" ] && other="$dir/ab_new/$(basename "$atlas")"
+      cmp -s "$atlas" "$other" || same=0
+    done
+    if [ "$same" = 1 ]; then
       echo "atlases: the same bytes" >&2
     else
       echo "atlases: different" >&2

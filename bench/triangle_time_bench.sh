@@ -2,12 +2,8 @@
 # Time per triangle of the main job's placement search (issue 33): `texlume synth`
 # with `--search exhaustive` (paper 003: every placement of the sample scored by
 # FFT for every face) and `--search coarse-to-fine` (the default) on the same
-# scenes, in the same run. Scenes (SCENES, both by default):
-# - s512: the issue's stone sphere, a 512 x 512 RTI capture at 256 texels per world
-#   unit (texlume scene --capture-size 512 --texel-size 0.00390625), photos of
-#   640 x 480 at about 200 px per world unit;
-# - sphere: bench/fidelity_bench.sh's realistic sphere (256 x 256 capture at 500
-#   texels per world unit, held-out views at twice the photos' resolution).
+# scenes, in the same run. Scenes (SCENES, both by default): s512 and sphere
+# (bench/lib/synth_scenes.sh).
 # Each row: the job's CPU seconds (user + system) and per triangle of the mesh it
 # synthesised, its synthesis seconds (its manifest) and whole-job wall seconds, and the
 # held-out PSNR / SSIM at full resolution and reduced 4 x 4 (texlume render
@@ -16,6 +12,7 @@
 # Usage: bench/triangle_time_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [SCENES (s512 sphere)]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+source "$root/bench/lib/synth_scenes.sh"
 build=$(realpath "${1:-$root/build}")
 texlume="$build/apps/texlume"
 work=${2:-$(mktemp -d)}
@@ -25,11 +22,7 @@ echo "| scene | search | CPU s | CPU ms per triangle | synthesis s | job s | hel
 echo "|---|---|---|---|---|---|---|---|---|"
 for name in $scenes; do
   dir="$work/$name"
-  case "$name" in
-    s512) texel=0.00390625 scene_args=(--capture-size 512 --texel-size 0.00390625) ;;
-    sphere) texel=0.002 scene_args=(--kind sphere --held-out-scale 2) ;;
-    *) echo "triangle_time_bench: unknown scene $name (s512 or sphere)" >&2; exit 2 ;;
-  esac
+  synth_scene_settings "$name"
   if [ ! -f "$dir/scene.json" ]; then
     echo "triangle_time_bench: scene $name" >&2
     "$texlume" scene --out "$dir" --no-btf "${scene_args[@]}" > /dev/null
@@ -41,11 +34,7 @@ for name in $scenes; do
   for search in exhaustive coarse-to-fine; do
     model="$dir/model_$search"
     rm -rf "$model" "$dir/render_$search"
-    TIMEFORMAT="%U %S %R"
-    times=$({ time "$texlume" synth --model "$object/sparse" --images "$object/images" \
-      --lights "$object/lights.json" --mesh "$object/mesh.ply" --no-report \
-      --sample "$dir/sample.ptm" --sample-texel-size "$texel" --search "$search" \
-      --out "$model" > /dev/null; } 2>&1 | tail -1)
+    times=$(timed_synth "$texlume" "$dir" "$texel" "$model" --search "$search")
     cpu=$(echo "$times" | awk '{print $1 + $2}') wall=$(echo "$times" | awk '{print $3}')
     "$texlume" render --model "$model" --cameras "$held/sparse" --lights "$held/lights.json" \
       --truth "$held/images" --truth-masks "$held/masks" --reduced-factor 4 \
