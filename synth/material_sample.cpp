@@ -188,11 +188,16 @@ void AddCorrection(const TrianglePatch& patch, const GridPoint& g, float* out) {
 }  // namespace
 
 const ReducedPlanes& MaterialSample::Reduced(int level) const {
-  // Several threads search faces at once; a map's elements stay where they are.
-  const std::lock_guard lock(reduced_mutex_);
-  auto it = reduced_.find(level);
-  if (it != reduced_.end()) return it->second;
-  return reduced_.emplace(level, ReduceToDensityLevel(RelightPlanes(), level)).first->second;
+  // Several threads search faces at once; a map's elements stay where they are, and
+  // a level being reduced holds up only the threads that ask for it.
+  ReducedLevel* entry = nullptr;
+  {
+    const std::lock_guard lock(reduced_mutex_);
+    entry = &reduced_.try_emplace(level).first->second;
+  }
+  std::call_once(entry->once,
+                 [&] { entry->planes = ReduceToDensityLevel(RelightPlanes(), level); });
+  return entry->planes;
 }
 
 bool MaterialSample::PatchFeatures(const TrianglePatch& patch, double t, const Eigen::Vector2d& p,

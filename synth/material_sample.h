@@ -111,8 +111,14 @@ class MaterialSample {
   virtual const std::vector<cv::Mat>& RelightPlanes() const = 0;
 
  private:
-  mutable std::mutex reduced_mutex_;
-  mutable std::map<int, ReducedPlanes> reduced_;
+  // A level's planes, reduced once by the first thread that asks for them; the
+  // others wait for that level only.
+  struct ReducedLevel {
+    std::once_flag once;
+    ReducedPlanes planes;
+  };
+  mutable std::mutex reduced_mutex_;  // guards the map, not the levels' reductions
+  mutable std::map<int, ReducedLevel> reduced_;
 };
 
 class BilinearTaps;

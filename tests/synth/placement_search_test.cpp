@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <stdexcept>
+#include <thread>
 
 #include "synth/colour_sample.h"
 
@@ -202,6 +203,34 @@ TEST(PlacementSearch, RelitWindowsAreTheRelitSamplesCells) {
                            whole[static_cast<std::size_t>(c)](window), cv::NORM_INF),
                   0.0);
     }
+  }
+}
+
+// Faces searched on several threads ask for the sample's levels at once: each
+// level is reduced once, every thread gets the same planes, and they are the
+// planes reduced on one thread.
+TEST(MaterialSample, LevelsAskedOnSeveralThreadsAreReducedOnce) {
+  const ColourSample sample(StructuredColour(96, 5));
+  constexpr int kLevels = 6, kThreads = 4;
+  std::vector<std::array<const ReducedPlanes*, kLevels>> got(kThreads);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      for (int n = 0; n < kLevels; ++n) {
+        const int level = (n + t) % kLevels;  // each thread in another order
+        got[static_cast<std::size_t>(t)][static_cast<std::size_t>(level)] = &sample.Reduced(level);
+      }
+    });
+  for (std::thread& thread : threads) thread.join();
+  const ColourSample alone(StructuredColour(96, 5));
+  for (int level = 0; level < kLevels; ++level) {
+    const auto l = static_cast<std::size_t>(level);
+    for (int t = 1; t < kThreads; ++t) EXPECT_EQ(got[static_cast<std::size_t>(t)][l], got[0][l]);
+    const ReducedPlanes& expected = alone.Reduced(level);
+    ASSERT_EQ(got[0][l]->planes.size(), expected.planes.size());
+    EXPECT_EQ(got[0][l]->rx, expected.rx);
+    for (std::size_t c = 0; c < expected.planes.size(); ++c)
+      EXPECT_EQ(cv::norm(got[0][l]->planes[c], expected.planes[c], cv::NORM_INF), 0.0);
   }
 }
 
