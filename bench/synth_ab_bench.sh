@@ -4,8 +4,8 @@
 # a change is measured against its baseline run beside it). The scene folders
 # are bench/triangle_time_bench.sh's (WORK/s512, WORK/sphere: run it once first).
 # Each row: a build's run, its CPU seconds (user + system), wall seconds and
-# synthesis seconds (its manifest); after each pair, whether the two PTM atlases
-# are the same bytes.
+# synthesis seconds (its manifest); after each pair, whether every atlas file the
+# two models wrote (ptm_atlas_0.ptm, albedo_0.png, ...) is the same bytes.
 # Usage: bench/synth_ab_bench.sh BASE_BUILD NEW_BUILD WORK [SCENES (s512 sphere)] [RUNS (2)]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)

@@ -27,7 +27,7 @@ for name in $scenes; do
     echo "triangle_time_bench: scene $name" >&2
     "$texlume" scene --out "$dir" --no-btf "${scene_args[@]}" > /dev/null
   fi
-  object="$dir/object" capture="$dir/material/capture" held="$dir/object/held_out"
+  capture="$dir/material/capture" held="$dir/object/held_out"
   [ -f "$dir/sample.ptm" ] ||
     "$texlume" fit --images "$capture" --lights "$capture/lights.lp" --out "$dir/sample.ptm" > /dev/null
   baseline_cpu=""

@@ -6,7 +6,6 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <opencv2/imgproc.hpp>
 
 #include "core/image_io.h"
@@ -431,13 +430,12 @@ void CoefficientCorrection::Finish(TriangleEngine& engine, const std::vector<std
   if (!options_.detail_transfer) return;
   std::vector<TrianglePatch>& patches = engine.result().patches;
   // The dictionaries of the levels any face used (their detail bands serve every
-  // face), in parallel (their reductions first, so that no thread waits on another's).
+  // face), in parallel (each level is reduced once, by the thread that asks first).
   std::vector<int> levels;
   for (const int level : correction_level_) {
     if (level < 0 || dictionaries_.count(level)) continue;
     dictionaries_[level];
     detail_bands_[level];
-    sample_.Reduced(level);
     levels.push_back(level);
   }
 #pragma omp parallel for schedule(dynamic, 1)

@@ -58,7 +58,6 @@ class CoefficientCorrection : public PhotoCorrection {
  private:
   class PatchPass;
   const CoefficientPrior& PriorAt(int level);
-  void TransferDetail(TrianglePatch& patch, int level) const;
 
   const PtmSample& sample_;
   const MeshSynthesisOptions& options_;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "core/check.h"
 #include "ptm/coefficient_space.h"
 
 namespace texlume::synth {
@@ -152,6 +153,7 @@ void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, Matches& 
 
 void DetailDictionary::Transfer(TrianglePatch& patch, int level) const {
   const int gw = patch.correction[0].cols, gh = patch.correction[0].rows;
+  TEXLUME_CHECK(gw > 0 && gh > 0, "detail transfer needs a correction grid");
   const cv::Mat windows = CorrectedWindows(patch);
   Matches matches(gw, gh);
   // The index is asked at the cells of one colour of a checkerboard (issue 33:
@@ -165,9 +167,12 @@ void DetailDictionary::Transfer(TrianglePatch& patch, int level) const {
   cells.clear();
   for (int c = 0; c < gw * gh; ++c)
     if (!matches.Found(static_cast<std::size_t>(c))) cells.push_back(c);
-  MatchByIndex(windows, cells, matches);
-  // Coherent matches keep the detail whole where their bands are blended.
-  Propagate(windows, true, matches);
+  // Coherent matches keep the detail whole where their bands are blended (a
+  // second forward pass changes nothing unless the index matched more cells).
+  if (!cells.empty()) {
+    MatchByIndex(windows, cells, matches);
+    Propagate(windows, true, matches);
+  }
   Propagate(windows, false, matches);
   patch.detail_source = cv::Mat(gh, gw, CV_32FC2);
   for (int c = 0; c < gw * gh; ++c)

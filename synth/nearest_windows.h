@@ -4,7 +4,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-// Nearest-window search for detail transfer (synth/coefficient_correction.h): of a
+// Nearest-window search for detail transfer (synth/detail_transfer.h): of a
 // set of windows of equal length (a float row each), the one nearest a query in the
 // L2 sense. The windows of a sample's coarse coefficients are smooth, so a few
 // principal components carry most of their variance: a kd-tree (nanoflann)

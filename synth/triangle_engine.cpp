@@ -154,11 +154,8 @@ void TriangleEngine::PlaceFaces(const std::vector<int>& faces, std::uint32_t see
   std::mt19937_64 rng(seed);
   std::size_t processed = done_before;
   const std::size_t workers = RunAheadWorkers();
-  // As many faces in flight as the photo cache holds the photos of (a face's
-  // search takes its turn decoding them otherwise).
-  const std::size_t ahead = std::min(kFacesSearchedAheadPerThread * workers, FacesPhotosHold());
-  const bool search_ahead = workers > 1 && ahead >= 2;
-  const std::size_t window = search_ahead ? ahead : 1;
+  const std::size_t window = FacesSearchedTogether();
+  const bool search_ahead = window > 1;
   relit_scratch_.resize(std::max(relit_scratch_.size(), workers));
   std::vector<FaceSearch> found(window);  // slot n % window: face faces[n]'s search
   const auto search = [&](std::size_t n, std::size_t worker) {
@@ -182,8 +179,20 @@ void TriangleEngine::PlaceFaces(const std::vector<int>& faces, std::uint32_t see
   }
 }
 
+std::size_t TriangleEngine::FacesSearchedTogether() const {
+  // As many faces in flight as the photo cache holds the photos of (a face's
+  // search takes its turn decoding them otherwise).
+  const std::size_t workers = RunAheadWorkers();
+  const std::size_t ahead = std::min(kFacesSearchedAheadPerThread * workers, FacesPhotosHold());
+  return workers > 1 && ahead >= 2 ? ahead : 1;
+}
+
 double TriangleEngine::RelitBytesAtMost() const {
-  return RelitScratch::BytesAtMost(options_.max_views, cv::Size(sample_.Width(), sample_.Height()));
+  // One set of buffers per thread searching faces ahead, else the one the face
+  // being placed lends its search.
+  const std::size_t sets = FacesSearchedTogether() > 1 ? RunAheadWorkers() : 1;
+  return static_cast<double>(sets) *
+         RelitScratch::BytesAtMost(options_.max_views, cv::Size(sample_.Width(), sample_.Height()));
 }
 
 std::size_t TriangleEngine::FacesPhotosHold() const {
@@ -242,18 +251,19 @@ void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
   // The patches' feature planes, the atlases baked from them and the bake's own
   // buffers, and the relit buffers each searching thread keeps (docs/robustness.md
   // "Memory").
-  const std::size_t threads = RunAheadWorkers();
-  const std::string what = "the patches and atlases of " + std::to_string(geometry.total_texels) +
-                           " texels at a texel size of " + std::to_string(t) +
-                           " world units (a larger --sample-texel-size needs fewer), and the "
-                           "relit sample buffers of " +
-                           std::to_string(threads) + " searching threads (OMP_NUM_THREADS)";
+  const std::size_t threads = FacesSearchedTogether() > 1 ? RunAheadWorkers() : 1;
+  const std::string what =
+      "the patches and atlases of " + std::to_string(geometry.total_texels) +
+      " texels at a texel size of " + std::to_string(t) +
+      " world units (a larger --sample-texel-size needs fewer), and the relit sample buffers " +
+      (threads > 1 ? "of " + std::to_string(threads) + " threads searching faces (OMP_NUM_THREADS)"
+                   : std::string("of the search"));
   if (regions_) {
     RequireSameInputsAsRankZero(geometry.patches);  // before anything a rank reads from rank 0
     RequirePatchMemoryOnEveryMachine(geometry, what);
   } else {
-    result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures()) +
-                                 static_cast<double>(threads) * RelitBytesAtMost();
+    result_.patch_memory_bytes =
+        PatchMemoryBytes(geometry, sample_.NumFeatures()) + RelitBytesAtMost();
     RequireMemory(result_.patch_memory_bytes, what, "mesh");
   }
   if (patches_in_sample_ &&

@@ -137,7 +137,7 @@ class RelitScratch {
   /// The most the buffers of a search over `views` views of a sample of `sample`
   /// texels can grow to: three float planes per view at the sample's full density.
   static double BytesAtMost(int views, cv::Size sample) {
-    return 3.0 * sizeof(float) * views * static_cast<double>(sample.area());
+    return 3.0 * sizeof(float) * views * static_cast<double>(sample.width) * sample.height;
   }
 
  private:
@@ -336,7 +336,11 @@ class TriangleEngine {
   // once (SIZE_MAX when it holds every photo): the most faces PlaceFaces searches
   // together, so that they do not take turns decoding their photos.
   std::size_t FacesPhotosHold() const;
-  // The most one searching thread's relit buffers can grow to (RelitScratch).
+  // How many faces PlaceFaces searches at once: FacesPhotosHold's, at most
+  // kFacesSearchedAheadPerThread a thread, with more than one thread; else 1.
+  std::size_t FacesSearchedTogether() const;
+  // The most the searches' relit buffers can grow to (RelitScratch): one set per
+  // thread when faces are searched ahead, else one.
   double RelitBytesAtMost() const;
   // A face's rectified views and its top_k placements by eq. 3 alone (the image
   // constraint, paper 003), which no other face's placement changes.

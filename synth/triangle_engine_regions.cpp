@@ -169,8 +169,8 @@ void TriangleEngine::RequirePatchMemoryOnEveryMachine(const PatchGeometry& geome
   if (ranks.Rank() != 0)
     for (std::size_t f = 0; f < held.size(); ++f)
       held[f] = partition.region_of_face[f] == ranks.Rank() || placed_first_[f];
-  result_.patch_memory_bytes = PatchMemoryBytes(geometry, sample_.NumFeatures(), held) +
-                               static_cast<double>(RunAheadWorkers()) * RelitBytesAtMost();
+  result_.patch_memory_bytes =
+      PatchMemoryBytes(geometry, sample_.NumFeatures(), held) + RelitBytesAtMost();
   const RankMemory mine{ranks.Rank(),
                         result_.patch_memory_bytes,
                         static_cast<double>(MemoryLimitBytes()),

@@ -17,14 +17,18 @@ synth_scene_settings() {
 
 # Times `TEXLUME synth` on scene folder DIR (its object and sample.ptm) at texel
 # size TEXEL into model folder OUT, with any further synth options; prints
-# "user system wall" seconds.
+# "user system wall" seconds. The job's messages go to OUT.log, shown when it fails.
 timed_synth() {
   local texlume=$1 dir=$2 texel=$3 out=$4
   shift 4
-  local object="$dir/object"
-  TIMEFORMAT="%U %S %R"
-  { time "$texlume" synth --model "$object/sparse" --images "$object/images" \
+  local object="$dir/object" TIMEFORMAT="%U %S %R"
+  if ! { time "$texlume" synth --model "$object/sparse" --images "$object/images" \
     --lights "$object/lights.json" --mesh "$object/mesh.ply" --no-report \
-    --sample "$dir/sample.ptm" --sample-texel-size "$texel" --out "$out" "$@" > /dev/null 2>&1; } 2>&1 |
-    tail -1
+    --sample "$dir/sample.ptm" --sample-texel-size "$texel" --out "$out" "$@" \
+    > "$out.log" 2>&1; } 2> "$out.time"; then
+    echo "$(basename "$0"): texlume synth failed; its messages ($out.log):" >&2
+    tail -20 "$out.log" >&2
+    exit 1
+  fi
+  tail -1 "$out.time"
 }

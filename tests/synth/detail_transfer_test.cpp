@@ -97,6 +97,39 @@ TEST(DetailTransfer, ACorrectedPatchTakesTheDetailOfThePlaceItWasCorrectedToward
   }
 }
 
+// Every cell of a patch's grid has a window centre of the sample ([1, 46] x [1, 46]
+// for a 48 x 48 sample) as its source.
+void ExpectSourcesAreWindowCentres(const TrianglePatch& patch) {
+  for (int j = 0; j < patch.detail_source.rows; ++j)
+    for (int i = 0; i < patch.detail_source.cols; ++i) {
+      const cv::Vec2f s = patch.detail_source.at<cv::Vec2f>(j, i);
+      EXPECT_GE(s[0], 1.0f) << i << ", " << j;
+      EXPECT_LE(s[0], 46.0f) << i << ", " << j;
+      EXPECT_GE(s[1], 1.0f) << i << ", " << j;
+      EXPECT_LE(s[1], 46.0f) << i << ", " << j;
+    }
+}
+
+// Patches against the sample's right and bottom edges: cells there lie beyond every
+// window's centre. In a patch one cell high, the last cell is not asked (the
+// checkerboard) and no neighbour's match moved by a cell reaches it, so it asks the
+// index itself.
+TEST(DetailTransfer, CellsBeyondTheWindowsReachStillFindAMatch) {
+  const ptm::Ptm p = SmoothPtm(48, 9);
+  const PtmSample sample(p);
+  std::vector<cv::Mat> band;
+  const DetailDictionary dictionary(sample, 0, band);
+  TrianglePatch square = PatchCorrectedToward(p, cv::Size(12, 12), {36, 36}, {36, 36});
+  dictionary.Transfer(square, 0);
+  ExpectSourcesFrom(square, {36, 36});
+  ExpectSourcesAreWindowCentres(square);
+  // The last column's cells sit at x = 47: their best window centre is at x = 46.
+  EXPECT_NEAR(square.detail_source.at<cv::Vec2f>(5, 11)[0], 46.0f, 1e-3);
+  TrianglePatch row = PatchCorrectedToward(p, cv::Size(12, 1), {36, 20}, {36, 20});
+  dictionary.Transfer(row, 0);
+  ExpectSourcesAreWindowCentres(row);
+}
+
 // A sample narrower than a window's reach has no dictionary to transfer from.
 TEST(DetailTransfer, ASampleNarrowerThanAWindowIsNotUsable) {
   const ptm::Ptm p = SmoothPtm(4, 7);

@@ -3,9 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <stdexcept>
@@ -232,6 +236,50 @@ TEST(MaterialSample, LevelsAskedOnSeveralThreadsAreReducedOnce) {
     for (std::size_t c = 0; c < expected.planes.size(); ++c)
       EXPECT_EQ(cv::norm(got[0][l]->planes[c], expected.planes[c], cv::NORM_INF), 0.0);
   }
+}
+
+// A colour sample whose first reduction waits (up to 10 s) until another level was
+// returned to another thread; it counts the reductions.
+class FirstReductionWaits : public ColourSample {
+ public:
+  using ColourSample::ColourSample;
+  void OtherLevelReturned() const {
+    {
+      const std::lock_guard lock(mutex_);
+      other_returned_ = true;
+    }
+    changed_.notify_all();
+  }
+  mutable std::atomic<int> reductions{0};
+  mutable bool waited_for_other = false;
+
+ protected:
+  const std::vector<cv::Mat>& RelightPlanes() const override {
+    if (reductions++ == 0) {
+      std::unique_lock lock(mutex_);
+      waited_for_other =
+          changed_.wait_for(lock, std::chrono::seconds(10), [&] { return other_returned_; });
+    }
+    return ColourSample::RelightPlanes();
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::condition_variable changed_;
+  mutable bool other_returned_ = false;
+};
+
+// A level being reduced holds up only the threads that ask for that level.
+TEST(MaterialSample, ALevelBeingReducedDoesNotHoldUpAnother) {
+  const FirstReductionWaits sample(StructuredColour(64, 3));
+  std::thread first([&] { sample.Reduced(0); });
+  while (sample.reductions.load() == 0) std::this_thread::yield();
+  sample.Reduced(4);  // while level 0 is being reduced
+  sample.OtherLevelReturned();
+  first.join();
+  EXPECT_TRUE(sample.waited_for_other);
+  sample.Reduced(0), sample.Reduced(4);
+  EXPECT_EQ(sample.reductions.load(), 2);
 }
 
 }  // namespace
