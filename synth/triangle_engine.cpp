@@ -187,11 +187,14 @@ std::size_t TriangleEngine::FacesSearchedTogether() const {
   return workers > 1 && ahead >= 2 ? ahead : 1;
 }
 
+std::size_t TriangleEngine::RelitBufferSets() const {
+  // One set per thread searching faces ahead, else the one the face being placed
+  // lends its search.
+  return FacesSearchedTogether() > 1 ? RunAheadWorkers() : 1;
+}
+
 double TriangleEngine::RelitBytesAtMost() const {
-  // One set of buffers per thread searching faces ahead, else the one the face
-  // being placed lends its search.
-  const std::size_t sets = FacesSearchedTogether() > 1 ? RunAheadWorkers() : 1;
-  return static_cast<double>(sets) *
+  return static_cast<double>(RelitBufferSets()) *
          RelitScratch::BytesAtMost(options_.max_views, cv::Size(sample_.Width(), sample_.Height()));
 }
 
@@ -251,7 +254,7 @@ void TriangleEngine::SetUpPatches(PatchGeometry geometry) {
   // The patches' feature planes, the atlases baked from them and the bake's own
   // buffers, and the relit buffers each searching thread keeps (docs/robustness.md
   // "Memory").
-  const std::size_t threads = FacesSearchedTogether() > 1 ? RunAheadWorkers() : 1;
+  const std::size_t threads = RelitBufferSets();
   const std::string what =
       "the patches and atlases of " + std::to_string(geometry.total_texels) +
       " texels at a texel size of " + std::to_string(t) +

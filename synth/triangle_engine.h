@@ -339,8 +339,9 @@ class TriangleEngine {
   // How many faces PlaceFaces searches at once: FacesPhotosHold's, at most
   // kFacesSearchedAheadPerThread a thread, with more than one thread; else 1.
   std::size_t FacesSearchedTogether() const;
-  // The most the searches' relit buffers can grow to (RelitScratch): one set per
-  // thread when faces are searched ahead, else one.
+  // The sets of relit buffers the searches keep (RelitScratch): one per thread
+  // when faces are searched ahead, else one; and the most they can grow to.
+  std::size_t RelitBufferSets() const;
   double RelitBytesAtMost() const;
   // A face's rectified views and its top_k placements by eq. 3 alone (the image
   // constraint, paper 003), which no other face's placement changes.
