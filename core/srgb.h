@@ -28,6 +28,9 @@ class Tables {
   }
   float Decode(float v) const { return Interpolate(decode_, v); }
   float Encode(float v) const { return Interpolate(encode_, std::sqrt(v)); }
+  /// The tables themselves (kIntervals + 1 values each), for the row kernels (srgb_rows.h).
+  const float* DecodeTable() const { return decode_.data(); }
+  const float* EncodeTable() const { return encode_.data(); }
 
  private:
   static float Interpolate(const std::array<float, kIntervals + 1>& table, float x) {
@@ -41,21 +44,30 @@ class Tables {
   std::array<float, kIntervals + 1> decode_, encode_;
 };
 
+/// The curves' linear segments: display values up to kDisplayLinearUpTo (linear
+/// values up to kLinearUpTo) are proportional, with slope kLinearSlope.
+inline constexpr float kDisplayLinearUpTo = 0.04045f;
+inline constexpr float kLinearUpTo = 0.0031308f;
+inline constexpr float kLinearSlope = 12.92f;
+
 inline const Tables& TheTables() {
   static const Tables tables;
   return tables;
 }
 
-/// sRGB display value in [0, 1] (clamped; NaN: 0) to linear.
-inline float ToLinear(float v) {
+/// sRGB display value in [0, 1] (clamped; NaN: 0) to linear, with the tables given
+/// (a loop that takes them once checks no initialisation guard per value).
+inline float ToLinear(float v, const Tables& tables) {
   v = v > 0.0f ? std::min(v, 1.0f) : 0.0f;
-  return v <= 0.04045f ? v / 12.92f : TheTables().Decode(v);
+  return v <= kDisplayLinearUpTo ? v / kLinearSlope : tables.Decode(v);
 }
+inline float ToLinear(float v) { return ToLinear(v, TheTables()); }
 
-/// Linear value in [0, 1] (clamped; NaN: 0) to sRGB display.
-inline float FromLinear(float v) {
+/// Linear value in [0, 1] (clamped; NaN: 0) to sRGB display, with the tables given.
+inline float FromLinear(float v, const Tables& tables) {
   v = v > 0.0f ? std::min(v, 1.0f) : 0.0f;
-  return v <= 0.0031308f ? v * 12.92f : TheTables().Encode(v);
+  return v <= kLinearUpTo ? v * kLinearSlope : tables.Encode(v);
 }
+inline float FromLinear(float v) { return FromLinear(v, TheTables()); }
 
 }  // namespace texlume::srgb

@@ -70,8 +70,12 @@ std::array<double, 6> PtmBasis(double lu, double lv);
 Eigen::Matrix<double, Eigen::Dynamic, 6> PtmLightMatrix(const std::vector<Eigen::Vector3d>& lights);
 /// L(lu, lv) = a0 lu^2 + a1 lv^2 + a2 lu lv + a3 lu + a4 lv + a5 (paper 003 eq. 1).
 /// Inline: the relighting loops (synth/) evaluate it per texel and light.
+inline double EvaluatePolynomial(float a0, float a1, float a2, float a3, float a4, float a5,
+                                 double lu, double lv) {
+  return a0 * lu * lu + a1 * lv * lv + a2 * lu * lv + a3 * lu + a4 * lv + a5;
+}
 inline double EvaluatePolynomial(const float* a, double lu, double lv) {
-  return a[0] * lu * lu + a[1] * lv * lv + a[2] * lu * lv + a[3] * lu + a[4] * lv + a[5];
+  return EvaluatePolynomial(a[0], a[1], a[2], a[3], a[4], a[5], lu, lv);
 }
 
 /// The surface normal of a texel from its (luminance) coefficients: the light

@@ -9,6 +9,7 @@
 #include "core/srgb.h"
 #include "ptm/coefficient_space.h"
 #include "synth/planar_synthesis.h"
+#include "synth/relight_rows.h"
 #include "synth/template_match.h"
 
 namespace texlume::synth {
@@ -349,13 +350,18 @@ std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighti
   std::vector<float> a(read), colour(3, 1.0f);
   const TexelLights texel_lights = LightsOf(lighting);
   std::vector<ptm::EffectiveLight> lights = texel_lights.lights;
-  std::vector<const float*> in(read);  // the planes' rows
+  PtmRowRelighter rows(ptm_.format, lights, gain);  // without shadows, the same lights everywhere
+  std::vector<const float*> in(read);               // the planes' rows
   for (int y = 0; y < r.planes[0].rows; ++y) {
     for (std::size_t i = 0; i < read; ++i) in[i] = r.planes[i].ptr<float>(y);
     std::array<float*, 3> row{};
     for (std::size_t c = 0; c < row.size(); ++c) row[c] = out[c].ptr<float>(y);
+    if (!shadowing_) {
+      rows.Relight(in.data(), r.planes[0].cols, row);
+      continue;
+    }
     for (int x = 0; x < r.planes[0].cols; ++x) {
-      if (shadowing_) ShadowLights(texel_lights, r, BilinearTaps(r.planes[0].size(), x, y), lights);
+      ShadowLights(texel_lights, r, BilinearTaps(r.planes[0].size(), x, y), lights);
       for (std::size_t i = 0; i < read; ++i) a[i] = in[i][x];
       const Eigen::Vector3f v = RelightEffective(
           a.data(), lrgb ? a.data() + polys * 6 : colour.data(), ptm_.format, lights, gain);

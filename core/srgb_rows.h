@@ -1,0 +1,18 @@
+#pragma once
+
+namespace texlume::srgb {
+
+/// The sRGB conversions of srgb.h over a row of values, eight at a time with AVX2
+/// where the processor has it (the tables read by gathers), one at a time otherwise;
+/// the values are those of ToLinear and FromLinear, to the bit, either way.
+
+/// linear[i] += weight * ToLinear(display[i]) for i < n.
+void AddWeightedLinear(const float* display, float weight, int n, float* linear);
+
+/// display[i] = FromLinear(scale * linear[i]) for i < n.
+void ScaledFromLinear(const float* linear, float scale, int n, float* display);
+
+/// Whether the processor runs the eight-at-a-time kernels.
+bool RowsUseAvx2();
+
+}  // namespace texlume::srgb

@@ -1,0 +1,104 @@
+#include "synth/relight_rows.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+
+#include "synth/material_sample.h"
+#include "synth/triangle_parts.h"
+
+namespace texlume::synth {
+namespace {
+
+// Raw coefficient planes (then LRGB colour planes) of random values, seeded, wide
+// enough that relit values fall below 0, in both linear segments and above 1.
+std::vector<cv::Mat> RandomRawPlanes(ptm::PtmFormat format, cv::Size size, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> a(-0.6f, 0.6f), colour(0.0f, 1.2f);
+  const bool lrgb = format == ptm::PtmFormat::kLrgb;
+  std::vector<cv::Mat> planes(lrgb ? 9 : 18);
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    planes[i] = cv::Mat(size, CV_32FC1);
+    for (float& v : cv::Mat_<float>(planes[i])) v = (lrgb && i >= 6) ? colour(rng) : a(rng);
+  }
+  return planes;
+}
+
+std::vector<ptm::EffectiveLight> Lights() {
+  return {{Eigen::Vector3d(0.5, -0.3, 0.81).normalized(), 0.8},
+          {Eigen::Vector3d(-0.9, 0.2, 0.2).normalized(), 1.7},
+          {Eigen::Vector3d::UnitZ(), 0.15}};  // an ambient light, as EffectiveLights adds it
+}
+
+// The relit cells, bit for bit, against RelightEffective cell by cell.
+void ExpectSameAsPerCell(ptm::PtmFormat format, const std::vector<cv::Mat>& planes,
+                         const std::array<cv::Mat, 3>& relit,
+                         const std::vector<ptm::EffectiveLight>& lights, double gain) {
+  const bool lrgb = format == ptm::PtmFormat::kLrgb;
+  std::vector<float> texel(planes.size());
+  const float ones[3] = {1.0f, 1.0f, 1.0f};
+  int compared = 0;
+  for (int y = 0; y < planes[0].rows; ++y)
+    for (int x = 0; x < planes[0].cols; ++x) {
+      for (std::size_t i = 0; i < planes.size(); ++i) texel[i] = planes[i].at<float>(y, x);
+      const Eigen::Vector3f expected =
+          RelightEffective(texel.data(), lrgb ? texel.data() + 6 : ones, format, lights, gain);
+      for (int c = 0; c < 3; ++c) {
+        const float got = relit[static_cast<std::size_t>(c)].at<float>(y, x);
+        ASSERT_EQ(std::memcmp(&got, &expected[c], sizeof(float)), 0)
+            << "cell (" << x << ", " << y << ") channel " << c << ": " << got << " against "
+            << expected[c];
+        ++compared;
+      }
+    }
+  EXPECT_EQ(compared, 3 * planes[0].rows * planes[0].cols);
+}
+
+// Rows of 1 to 37 cells (whole vector steps and the rest), both PTM formats.
+TEST(PtmRowRelighter, IsRelightEffectiveToTheBit) {
+  for (const ptm::PtmFormat format : {ptm::PtmFormat::kLrgb, ptm::PtmFormat::kRgb})
+    for (const int cols : {1, 7, 8, 9, 16, 37}) {
+      SCOPED_TRACE(cols);
+      const std::vector<cv::Mat> planes = RandomRawPlanes(format, cv::Size(cols, 3), 11);
+      std::array<cv::Mat, 3> relit;
+      for (cv::Mat& m : relit) m = cv::Mat(3, cols, CV_32FC1);
+      PtmRowRelighter rows(format, Lights(), 1.4);
+      std::vector<const float*> in(planes.size());
+      for (int y = 0; y < 3; ++y) {
+        for (std::size_t i = 0; i < planes.size(); ++i) in[i] = planes[i].ptr<float>(y);
+        rows.Relight(in.data(), cols,
+                     {relit[0].ptr<float>(y), relit[1].ptr<float>(y), relit[2].ptr<float>(y)});
+      }
+      ExpectSameAsPerCell(format, planes, relit, Lights(), 1.4);
+    }
+}
+
+// A PtmSample relights through the rows: its reduced planes relit, cell by cell, as
+// RelightMixture relights them under the face's lights and response.
+TEST(PtmRowRelighter, IsWhatAPtmSampleRelightsWith) {
+  for (const ptm::PtmFormat format : {ptm::PtmFormat::kLrgb, ptm::PtmFormat::kRgb}) {
+    ptm::Ptm p;
+    p.Resize(format, 21, 13);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> a(-0.4f, 0.6f), colour(0.1f, 1.0f);
+    for (float& v : p.coefficients) v = a(rng);
+    for (float& v : p.colour) v = colour(rng);
+    const PtmSample sample(p);
+    FaceLighting lighting{
+        Eigen::Vector3d::UnitZ(),
+        {{Eigen::Vector3d(0.3, 0.4, 0.866), 1.1}, {Eigen::Vector3d(-0.8, 0.5, 0.33), 0.6}},
+        {}};
+    lighting.response.ambient = 0.12;
+    lighting.response.elevation_factor[2] = 0.7;
+    const ReducedPlanes& reduced = sample.Reduced(2);
+    const std::vector<cv::Mat> relit = sample.Relight(reduced, lighting, 0.9);
+    const std::vector<ptm::EffectiveLight> lights =
+        ptm::EffectiveLights(lighting.lights, lighting.response);
+    ASSERT_EQ(lights.size(), 3u);
+    ExpectSameAsPerCell(format, reduced.planes, {relit[0], relit[1], relit[2]}, lights, 0.9);
+  }
+}
+
+}  // namespace
+}  // namespace texlume::synth
