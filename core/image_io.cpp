@@ -15,14 +15,9 @@
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/memory_budget.h"
-#include "core/srgb.h"
 
 namespace texlume {
 namespace fs = std::filesystem;
-
-float SrgbToLinear(float v) { return srgb::ToLinear(v); }
-
-float LinearToSrgb(float v) { return srgb::FromLinear(v); }
 
 namespace {
 

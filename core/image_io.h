@@ -8,14 +8,17 @@
 #include <string_view>
 #include <vector>
 
+#include "core/srgb.h"
+
 namespace texlume {
 
 /// sRGB decoding and encoding of display values in [0, 1] (IEC 61966-2-1);
 /// inputs outside [0, 1] are clamped, NaN is 0. Within 1e-7 of the curves
-/// (tabulated: core/image_io.cpp). Photos and PTMs hold display values;
-/// light mixtures are summed in the linear domain (DESIGN.md, "Frames, units").
-float SrgbToLinear(float v);
-float LinearToSrgb(float v);
+/// (tabulated: core/srgb.h; inline, as the loops over texels call them). Photos
+/// and PTMs hold display values; light mixtures are summed in the linear domain
+/// (DESIGN.md, "Frames, units").
+inline float SrgbToLinear(float v) { return srgb::ToLinear(v); }
+inline float LinearToSrgb(float v) { return srgb::FromLinear(v); }
 
 /// texlume's one image reader (OpenImageIO: PNG, JPEG, TIFF, EXR, ...), with
 /// one orientation policy: pixels are taken in the order the file stores them

@@ -21,14 +21,37 @@ constexpr int kDetailWindowLength =
 // a 256 x 256 sample has about 62 000).
 constexpr std::size_t kDetailMaxPoints = std::size_t{1} << 16;
 
-void CoarseWindow(const std::vector<cv::Mat>& coarse, double x, double y, double dx, double dy,
-                  float* window) {
+// The coarse coefficients of the window of 3 x 3 points (dx, dy) texels apart
+// around (x, y), point by point, 6 each: visit(k, value) for k = 0, 1, ... until
+// it returns false.
+template <typename Visit>
+void VisitCoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy,
+                       Visit visit) {
+  std::array<double, 6> at_point;
+  int k = 0;
   for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
     for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a) {
-      const BilinearTaps at(coarse[0].size(), x + a * dx, y + b * dy);
-      for (int m = 0; m < 6; ++m)
-        *window++ = static_cast<float>(at.Of(coarse[static_cast<std::size_t>(m)]));
+      BilinearTaps(coarse.size(), x + a * dx, y + b * dy).OfChannels(coarse, at_point.data());
+      for (const double v : at_point)
+        if (!visit(k++, static_cast<float>(v))) return;
     }
+}
+
+void CoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy, float* window) {
+  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, float v) { return window[k] = v, true; });
+}
+
+// The squared distance from `query` to the coarse window at (x, y), or a partial
+// sum of it of at least `bound` (the sum only grows: the comparison with the bound
+// is the same).
+double CoarseWindowDistance(const cv::Mat& coarse, double x, double y, double dx, double dy,
+                            const float* query, double bound) {
+  double e = 0.0;
+  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, float v) {
+    e += (v - query[k]) * (v - query[k]);
+    return e < bound;
+  });
+  return e;
 }
 
 }  // namespace
@@ -42,20 +65,22 @@ DetailDictionary::DetailDictionary(const PtmSample& sample, int level, std::vect
   for (std::size_t c = 0; c < coarse_raw.size(); ++c)
     cv::resize(red.planes[c], coarse_raw[c], full, 0, 0, cv::INTER_LINEAR);
   const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
-  coarse_.assign(6, cv::Mat());
-  for (cv::Mat& m : coarse_) m = cv::Mat::zeros(full, CV_32FC1);
+  coarse_ = cv::Mat(full, CV_32FC(6));
   for (int y = 0; y < full.height; ++y)
     for (int x = 0; x < full.width; ++x)
       for (int m = 0; m < 6; ++m) {
         double v = 0.0;
         for (int k = 0; k < 6; ++k)
           v += to(m, k) * coarse_raw[static_cast<std::size_t>(k)].at<float>(y, x);
-        coarse_[static_cast<std::size_t>(m)].at<float>(y, x) = static_cast<float>(v);
+        coarse_.ptr<float>(y)[x * 6 + m] = static_cast<float>(v);
       }
   const std::vector<cv::Mat>& values = sample.Values();
   band.resize(values.size());
-  for (std::size_t c = 0; c < band.size(); ++c)
-    band[c] = values[c] - (c < 6 ? coarse_[c] : coarse_raw[c]);
+  cv::Mat coarse_plane;
+  for (std::size_t c = 0; c < band.size(); ++c) {
+    if (c < 6) cv::extractChannel(coarse_, coarse_plane, static_cast<int>(c));
+    band[c] = values[c] - (c < 6 ? coarse_plane : coarse_raw[c]);
+  }
   IndexWindows(full);
 }
 
@@ -84,11 +109,13 @@ cv::Mat DetailDictionary::CorrectedWindows(const TrianglePatch& patch) const {
   for (cv::Mat& m : corrected) m = cv::Mat(gh, gw, CV_32FC1);
   for (int j = 0; j < gh; ++j)
     for (int i = 0; i < gw; ++i) {
-      const BilinearTaps at(coarse_[0].size(), patch.sample_x + (i + 0.5) * dx_ - 0.5,
-                            patch.sample_y + (j + 0.5) * dy_ - 0.5);
+      std::array<double, 6> coarse;
+      BilinearTaps(coarse_.size(), patch.sample_x + (i + 0.5) * dx_ - 0.5,
+                   patch.sample_y + (j + 0.5) * dy_ - 0.5)
+          .OfChannels(coarse_, coarse.data());
       for (std::size_t m = 0; m < 6; ++m)
         corrected[m].at<float>(j, i) =
-            static_cast<float>(at.Of(coarse_[m]) + patch.correction[m].at<float>(j, i));
+            static_cast<float>(coarse[m] + patch.correction[m].at<float>(j, i));
     }
   // Each cell's window of them (clamped at the grid's edges).
   cv::Mat windows(gh * gw, kDetailWindowLength, CV_32FC1);
@@ -124,9 +151,8 @@ void DetailDictionary::MatchByIndex(const cv::Mat& windows, const std::vector<in
 void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, Matches& matches) const {
   // A neighbour cell's match moved by one cell, wherever it is nearer.
   const int gw = matches.width, gh = static_cast<int>(matches.source.size()) / gw;
-  const double x_lo = kDetailWindowRadius * dx_, x_hi = coarse_[0].cols - 1 - x_lo;
-  const double y_lo = kDetailWindowRadius * dy_, y_hi = coarse_[0].rows - 1 - y_lo;
-  std::array<float, kDetailWindowLength> window;
+  const double x_lo = kDetailWindowRadius * dx_, x_hi = coarse_.cols - 1 - x_lo;
+  const double y_lo = kDetailWindowRadius * dy_, y_hi = coarse_.rows - 1 - y_lo;
   const auto try_shift = [&](int i, int j, int ni, int nj) {
     if (ni < 0 || nj < 0 || ni >= gw || nj >= gh) return;
     const auto c = static_cast<std::size_t>(j * gw + i), n = static_cast<std::size_t>(nj * gw + ni);
@@ -134,10 +160,8 @@ void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, Matches& 
     const double x = matches.source[n][0] + (i - ni) * dx_;
     const double y = matches.source[n][1] + (j - nj) * dy_;
     if (x < x_lo || x > x_hi || y < y_lo || y > y_hi) return;
-    CoarseWindow(coarse_, x, y, dx_, dy_, window.data());
-    const float* q = windows.ptr<float>(j * gw + i);
-    double e = 0.0;
-    for (int k = 0; k < kDetailWindowLength; ++k) e += (window[k] - q[k]) * (window[k] - q[k]);
+    const double e = CoarseWindowDistance(coarse_, x, y, dx_, dy_, windows.ptr<float>(j * gw + i),
+                                          matches.distance[c]);
     if (e < matches.distance[c])
       matches.distance[c] = static_cast<float>(e),
       matches.source[c] = cv::Vec2f(static_cast<float>(x), static_cast<float>(y));

@@ -61,7 +61,7 @@ class DetailDictionary {
   void Propagate(const cv::Mat& windows, bool forward, Matches& matches) const;
 
   double dx_ = 1.0, dy_ = 1.0;     // texels per photo cell
-  std::vector<cv::Mat> coarse_;    // 6 orthonormal luminance planes, full size
+  cv::Mat coarse_;                 // the 6 orthonormal luminance planes interleaved, full size
   std::vector<cv::Point> points_;  // window centres, texels
   std::unique_ptr<NearestWindows> nearest_;
 };

@@ -214,11 +214,23 @@ class BilinearTaps {
   double Of(const cv::Mat& plane) const {
     const float* r0 = plane.ptr<float>(y0_);
     const float* r1 = plane.ptr<float>(y1_);
-    return (1 - fy_) * ((1 - fx_) * r0[x0_] + fx_ * r0[x1_]) +
-           fy_ * ((1 - fx_) * r1[x0_] + fx_ * r1[x1_]);
+    return Blend(r0[x0_], r0[x1_], r1[x0_], r1[x1_]);
+  }
+  /// Of() of each channel of a CV_32FC(n) plane of the size given, into out[0..n)
+  /// (the values of Of() on each channel split out; one read of the row pair).
+  void OfChannels(const cv::Mat& interleaved, double* out) const {
+    const int n = interleaved.channels();
+    const float* r0 = interleaved.ptr<float>(y0_);
+    const float* r1 = interleaved.ptr<float>(y1_);
+    for (int m = 0; m < n; ++m)
+      out[m] = Blend(r0[x0_ * n + m], r0[x1_ * n + m], r1[x0_ * n + m], r1[x1_ * n + m]);
   }
 
  private:
+  double Blend(float v00, float v10, float v01, float v11) const {
+    return (1 - fy_) * ((1 - fx_) * v00 + fx_ * v10) + fy_ * ((1 - fx_) * v01 + fx_ * v11);
+  }
+
   int x0_ = 0, x1_ = 0, y0_ = 0, y1_ = 0;
   double fx_ = 0.0, fy_ = 0.0;
 };

@@ -68,7 +68,14 @@ NearestWindows::NearestWindows(cv::Mat windows, Options options)
 NearestWindows::~NearestWindows() = default;
 
 cv::Mat NearestWindows::Project(const cv::Mat& rows) const {
-  cv::Mat centred = rows - cv::repeat(mean_, rows.rows, 1);
+  // Each row less the mean (no repeated copy of the mean: the same values).
+  cv::Mat centred(rows.size(), CV_32FC1);
+  const float* mean = mean_.ptr<float>();
+  for (int r = 0; r < rows.rows; ++r) {
+    const float* in = rows.ptr<float>(r);
+    float* out = centred.ptr<float>(r);
+    for (int i = 0; i < rows.cols; ++i) out[i] = in[i] - mean[i];
+  }
   cv::Mat out;
   cv::gemm(centred, components_, 1.0, cv::noArray(), 0.0, out, cv::GEMM_2_T);
   return out;
