@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "apps/cli.h"
+#include "core/memory_budget.h"
 #include "core/partial_output.h"
 #ifdef TEXLUME_MPI
 #include "distributed/mpi_ranks.h"
@@ -10,6 +11,7 @@
 int main(int argc, char** argv) {
   // Before any thread starts: SIGINT and SIGTERM remove partial outputs, then exit.
   texlume::InstallInterruptCleanup();
+  texlume::KeepFreedMemoryForReuse();
 #ifdef TEXLUME_MPI
   // `mpirun -np N texlume synth ...`: MPI for the whole run; a rank that fails ends
   // them all, so none waits for it.

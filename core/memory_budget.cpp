@@ -1,6 +1,9 @@
 #include "core/memory_budget.h"
 
 #include <sys/resource.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include <atomic>
 #include <cctype>
@@ -110,6 +113,14 @@ void RequireMemory(double estimated_bytes, const std::string& what, const std::s
                                 ", more than the memory limit of " + MemorySizeText(limit) +
                                 " (--memory-limit)");
   }
+}
+
+void KeepFreedMemoryForReuse() {
+#ifdef __GLIBC__
+  // A fixed threshold also stops glibc's own adjustment of it.
+  mallopt(M_MMAP_THRESHOLD, kLargestArenaBlock);
+  mallopt(M_TRIM_THRESHOLD, kFreedBytesKept);
+#endif
 }
 
 }  // namespace texlume

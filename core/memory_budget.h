@@ -29,6 +29,16 @@ std::uint64_t ParseMemorySize(const std::string& text);
 /// ru_maxrss): what a run's manifest records as its peak.
 std::uint64_t PeakResidentBytes();
 
+/// Called once at the start of the program: the allocator (glibc's) keeps up to
+/// kFreedBytesKept freed at the top of each arena and serves blocks up to
+/// kLargestArenaBlock from its arenas, instead of giving each large buffer back to
+/// the system when it is freed and faulting its pages in again when the next face
+/// asks for one (issue 33: half the page faults and 7 % of the CPU of the s512
+/// job; docs/robustness.md, "Memory").
+void KeepFreedMemoryForReuse();
+inline constexpr int kFreedBytesKept = 64 << 20;
+inline constexpr int kLargestArenaBlock = 32 << 20;
+
 /// "1.50 GiB", "512 MiB", ...
 std::string MemorySizeText(double bytes);
 

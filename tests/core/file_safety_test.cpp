@@ -2,8 +2,11 @@
 // files are read within a limit (ReadFileBytes), and outputs are written under a
 // partial name that is renamed when complete or removed (PartialOutput).
 #include <gtest/gtest.h>
+#include <malloc.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <cstdlib>
 
 #include "core/errors.h"
 #include "core/file_util.h"
@@ -143,6 +146,36 @@ TEST(MemoryBudget, RefusesAnEstimateOverTheLimitNamingTheFile) {
             "of 1.00 MiB (--memory-limit)");
   EXPECT_GT(MemoryLimitBytes(), std::uint64_t{1} << 28);  // the machine's: far more than 256 MiB
 }
+
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
+// In a child process (the settings stay there): a 16 MiB buffer then comes from the
+// arena and stays there when freed, and one over kLargestArenaBlock is still mapped
+// on its own.
+TEST(MemoryBudget, FreedBuffersAreKeptForTheNextFace) {
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    KeepFreedMemoryForReuse();
+    const struct mallinfo2 before = mallinfo2();
+    // Used through volatile pointers, or the compiler drops the pairs.
+    char* volatile block = static_cast<char*>(std::malloc(16 << 20));
+    block[0] = 1;
+    const bool from_arena = mallinfo2().hblks == before.hblks;
+    std::free(block);
+    const bool kept = mallinfo2().fordblks >= before.fordblks + (16 << 20);
+    char* volatile large =
+        static_cast<char*>(std::malloc(std::size_t{kLargestArenaBlock} + (16 << 20)));
+    large[0] = 1;
+    const bool mapped = mallinfo2().hblks == before.hblks + 1;
+    std::free(large);
+    _exit((from_arena ? 0 : 1) | (kept ? 0 : 2) | (mapped ? 0 : 4));
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "1: not from the arena, 2: not kept, 4: not mapped";
+}
+#endif
 
 }  // namespace
 }  // namespace texlume
