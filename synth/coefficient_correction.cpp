@@ -44,6 +44,7 @@ class CoefficientCorrection::PatchPass {
     for (cv::Mat& m : patch.channel_gain) m = cv::Mat::ones(gh_, gw_, CV_32FC1);
     ComputeWayToMean();
     for (const RectifiedView& r : views_) texel_lights_.push_back(sample_.LightsOf(r.lighting));
+    ComputeLightRows();
   }
 
   void Run() {
@@ -92,6 +93,20 @@ class CoefficientCorrection::PatchPass {
       }
   }
 
+  // Per view and light, the polynomial's basis at the light in orthonormal
+  // coefficients (d luminance / d q): the same at every cell, so once.
+  void ComputeLightRows() {
+    const Eigen::Matrix<double, 6, 6>& from_orthonormal =
+        ptm::OrthonormalBasis::Hemisphere().FromOrthonormal();
+    for (const PtmSample::TexelLights& view : texel_lights_) {
+      std::vector<Row6d>& rows = light_rows_.emplace_back();
+      for (const ptm::EffectiveLight& e : view.lights) {
+        const std::array<double, 6> phi = ptm::PtmBasis(e.direction.x(), e.direction.y());
+        rows.push_back(Eigen::Map<const Row6d>(phi.data()) * from_orthonormal);
+      }
+    }
+  }
+
   // Prediction (displayed luminance) and luminance Jacobian of view `view` at cell
   // (i, j), with the change q_delta (orthonormal) added to the patch's
   // coefficients; the linear value per channel into `channel_linear`.
@@ -130,12 +145,11 @@ class CoefficientCorrection::PatchPass {
                            shadowed_lights_);
       lights = &shadowed_lights_;
     }
-    for (const ptm::EffectiveLight& e : *lights) {
-      const Eigen::Vector3d& l = e.direction;
-      const double intensity = e.weight;
+    for (std::size_t k = 0; k < lights->size(); ++k) {
+      const Eigen::Vector3d& l = (*lights)[k].direction;
+      const double intensity = (*lights)[k].weight;
       const double lum = ptm::EvaluatePolynomial(a, l.x(), l.y());
-      const std::array<double, 6> phi = ptm::PtmBasis(l.x(), l.y());
-      const Row6d row = Eigen::Map<const Row6d>(phi.data()) * from_orthonormal;
+      const Row6d& row = light_rows_[view][k];
       for (int c = 0; c < 3; ++c) {
         const double v = lum * colour[c];
         if (v <= 0.0 || v >= 1.0) continue;  // clamped: no derivative
@@ -358,6 +372,7 @@ class CoefficientCorrection::PatchPass {
   std::vector<Vector6d> to_mean_of_cell_;
   // Per view, the lights as the texel answers them (PtmSample::LightsOf), once.
   std::vector<PtmSample::TexelLights> texel_lights_;
+  std::vector<std::vector<Row6d>> light_rows_;  // per view and light: ComputeLightRows
   mutable std::vector<ptm::EffectiveLight> shadowed_lights_;  // Predict's, at one cell
   cv::Mat known_;                                             // CV_8UC1: cells with a change
 };
