@@ -147,7 +147,16 @@ TEST(MemoryBudget, RefusesAnEstimateOverTheLimitNamingTheFile) {
   EXPECT_GT(MemoryLimitBytes(), std::uint64_t{1} << 28);  // the machine's: far more than 256 MiB
 }
 
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
+// AddressSanitizer brings its own allocator (GCC and clang say so differently).
+#if defined(__SANITIZE_ADDRESS__)
+#define TEXLUME_OWN_ALLOCATOR 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define TEXLUME_OWN_ALLOCATOR 1
+#endif
+#endif
+
+#if defined(__GLIBC__) && !defined(TEXLUME_OWN_ALLOCATOR)
 // In a child process (the settings stay there): a 16 MiB buffer then comes from the
 // arena and stays there when freed, and one over kLargestArenaBlock is still mapped
 // on its own.
