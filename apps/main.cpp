@@ -9,9 +9,10 @@
 #endif
 
 int main(int argc, char** argv) {
-  // Before any thread starts: SIGINT and SIGTERM remove partial outputs, then exit.
-  texlume::InstallInterruptCleanup();
+  // Before any thread starts: the allocator's settings, then SIGINT and SIGTERM
+  // remove partial outputs, then exit.
   texlume::KeepFreedMemoryForReuse();
+  texlume::InstallInterruptCleanup();
 #ifdef TEXLUME_MPI
   // `mpirun -np N texlume synth ...`: MPI for the whole run; a rank that fails ends
   // them all, so none waits for it.

@@ -117,9 +117,10 @@ void RequireMemory(double estimated_bytes, const std::string& what, const std::s
 
 void KeepFreedMemoryForReuse() {
 #ifdef __GLIBC__
-  // A fixed threshold also stops glibc's own adjustment of it.
-  mallopt(M_MMAP_THRESHOLD, kLargestArenaBlock);
-  mallopt(M_TRIM_THRESHOLD, kFreedBytesKept);
+  // A fixed threshold also stops glibc's own adjustment of it. A refusal (a value
+  // glibc does not take) leaves its defaults, which are correct, only slower.
+  static_cast<void>(mallopt(M_MMAP_THRESHOLD, kLargestArenaBlock));
+  static_cast<void>(mallopt(M_TRIM_THRESHOLD, kFreedBytesKept));
 #endif
 }
 

@@ -29,15 +29,18 @@ std::uint64_t ParseMemorySize(const std::string& text);
 /// ru_maxrss): what a run's manifest records as its peak.
 std::uint64_t PeakResidentBytes();
 
-/// Called once at the start of the program: the allocator (glibc's) keeps up to
-/// kFreedBytesKept freed at the top of each arena and serves blocks up to
+/// The most freed memory glibc's allocator keeps at the top of an arena, in bytes.
+inline constexpr int kFreedBytesKept = 64 << 20;
+/// The largest block it serves from its arenas (larger ones are mapped on their own):
+/// 32 MiB, the most glibc accepts on a 64-bit system.
+inline constexpr int kLargestArenaBlock = 32 << 20;
+/// Called once at the start of the program, before any thread: the allocator keeps
+/// up to kFreedBytesKept freed at the top of each arena and serves blocks up to
 /// kLargestArenaBlock from its arenas, instead of giving each large buffer back to
 /// the system when it is freed and faulting its pages in again when the next face
-/// asks for one (issue 33: half the page faults and 7 % of the CPU of the s512
-/// job; docs/robustness.md, "Memory").
+/// asks for one (issue 33: half the page faults and 10 % of the CPU of the s512
+/// job; docs/robustness.md, "Memory"). Elsewhere than glibc, nothing.
 void KeepFreedMemoryForReuse();
-inline constexpr int kFreedBytesKept = 64 << 20;
-inline constexpr int kLargestArenaBlock = 32 << 20;
 
 /// "1.50 GiB", "512 MiB", ...
 std::string MemorySizeText(double bytes);

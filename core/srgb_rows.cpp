@@ -2,7 +2,10 @@
 
 #include "core/srgb.h"
 
-#if defined(__x86_64__) && defined(__GNUC__)
+// A build for processors with fused multiply-add (-march=native, x86-64-v3) may fuse
+// the scalar conversions' products and sums, which separate AVX2 steps do not: the
+// rows then take the scalar path too, so that they keep the scalar values.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__FMA__)
 #include <immintrin.h>
 #define TEXLUME_SRGB_AVX2 1
 #endif
@@ -13,7 +16,8 @@ namespace texlume::srgb {
 namespace {
 
 // Each step below is the scalar code's expression in its order, so that the lanes
-// round as ToLinear and FromLinear do (AVX2 alone has no fused multiply-add).
+// round as ToLinear and FromLinear do (AVX2 alone has no fused multiply-add, and the
+// scalar code is not fused either: above).
 #define TEXLUME_AVX2 __attribute__((target("avx2")))
 
 // Tables::Interpolate: table[i] + f (table[i + 1] - table[i]) at x kIntervals = i + f.
@@ -97,3 +101,6 @@ void ScaledFromLinear(const float* linear, float scale, int n, float* display) {
 }
 
 }  // namespace texlume::srgb
+
+#undef TEXLUME_AVX2
+#undef TEXLUME_SRGB_AVX2

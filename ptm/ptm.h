@@ -74,6 +74,7 @@ inline double EvaluatePolynomial(float a0, float a1, float a2, float a3, float a
                                  double lu, double lv) {
   return a0 * lu * lu + a1 * lv * lv + a2 * lu * lv + a3 * lu + a4 * lv + a5;
 }
+/// The same of a texel's coefficients a0..a5 in a row.
 inline double EvaluatePolynomial(const float* a, double lu, double lv) {
   return EvaluatePolynomial(a[0], a[1], a[2], a[3], a[4], a[5], lu, lv);
 }

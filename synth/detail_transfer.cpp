@@ -31,14 +31,17 @@ void VisitCoarseWindow(const cv::Mat& coarse, double x, double y, double dx, dou
   int k = 0;
   for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
     for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a) {
-      BilinearTaps(coarse.size(), x + a * dx, y + b * dy).OfChannels(coarse, at_point.data());
+      BilinearTaps(coarse.size(), x + a * dx, y + b * dy).OfChannels(coarse, at_point);
       for (const double v : at_point)
         if (!visit(k++, static_cast<float>(v))) return;
     }
 }
 
 void CoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy, float* window) {
-  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, float v) { return window[k] = v, true; });
+  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, float v) {
+    window[k] = v;
+    return true;
+  });
 }
 
 // The squared distance from `query` to the coarse window at (x, y), or a partial
@@ -112,7 +115,7 @@ cv::Mat DetailDictionary::CorrectedWindows(const TrianglePatch& patch) const {
       std::array<double, 6> coarse;
       BilinearTaps(coarse_.size(), patch.sample_x + (i + 0.5) * dx_ - 0.5,
                    patch.sample_y + (j + 0.5) * dy_ - 0.5)
-          .OfChannels(coarse_, coarse.data());
+          .OfChannels(coarse_, coarse);
       for (std::size_t m = 0; m < 6; ++m)
         corrected[m].at<float>(j, i) =
             static_cast<float>(coarse[m] + patch.correction[m].at<float>(j, i));

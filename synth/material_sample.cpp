@@ -350,14 +350,16 @@ std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighti
   std::vector<float> a(read), colour(3, 1.0f);
   const TexelLights texel_lights = LightsOf(lighting);
   std::vector<ptm::EffectiveLight> lights = texel_lights.lights;
-  PtmRowRelighter rows(ptm_.format, lights, gain);  // without shadows, the same lights everywhere
-  std::vector<const float*> in(read);               // the planes' rows
+  // Without shadows, the same lights everywhere: a row at a time.
+  std::optional<PtmRowRelighter> rows;
+  if (!shadowing_) rows.emplace(ptm_.format, lights, gain);
+  std::vector<const float*> in(read);  // the planes' rows
   for (int y = 0; y < r.planes[0].rows; ++y) {
     for (std::size_t i = 0; i < read; ++i) in[i] = r.planes[i].ptr<float>(y);
     std::array<float*, 3> row{};
     for (std::size_t c = 0; c < row.size(); ++c) row[c] = out[c].ptr<float>(y);
-    if (!shadowing_) {
-      rows.Relight(in.data(), r.planes[0].cols, row);
+    if (rows) {
+      rows->Relight(in.data(), r.planes[0].cols, row);
       continue;
     }
     for (int x = 0; x < r.planes[0].cols; ++x) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -216,14 +217,17 @@ class BilinearTaps {
     const float* r1 = plane.ptr<float>(y1_);
     return Blend(r0[x0_], r0[x1_], r1[x0_], r1[x1_]);
   }
-  /// Of() of each channel of a CV_32FC(n) plane of the size given, into out[0..n)
-  /// (the values of Of() on each channel split out; one read of the row pair).
-  void OfChannels(const cv::Mat& interleaved, double* out) const {
-    const int n = interleaved.channels();
+  /// Of() of each channel of a CV_32FC(N) plane of the size given (the values of
+  /// Of() on each channel split out; one read of the row pair).
+  template <std::size_t N>
+  void OfChannels(const cv::Mat& interleaved, std::array<double, N>& out) const {
+    CV_DbgAssert(interleaved.type() == CV_32FC(static_cast<int>(N)));
+    constexpr int n = static_cast<int>(N);
     const float* r0 = interleaved.ptr<float>(y0_);
     const float* r1 = interleaved.ptr<float>(y1_);
     for (int m = 0; m < n; ++m)
-      out[m] = Blend(r0[x0_ * n + m], r0[x1_ * n + m], r1[x0_ * n + m], r1[x1_ * n + m]);
+      out[static_cast<std::size_t>(m)] =
+          Blend(r0[x0_ * n + m], r0[x1_ * n + m], r1[x0_ * n + m], r1[x1_ * n + m]);
   }
 
  private:

@@ -56,7 +56,12 @@ std::vector<std::size_t> Lengths() {
   return n;
 }
 
+// Without AVX2 the rows are the scalar conversions themselves: nothing to compare.
+#define SKIP_WITHOUT_AVX2() \
+  if (!RowsUseAvx2()) GTEST_SKIP() << "this processor (or build) takes the scalar path"
+
 TEST(SrgbRows, AddWeightedLinearIsToLinearToTheBit) {
+  SKIP_WITHOUT_AVX2();
   const std::vector<float> in = Values();
   for (const std::size_t n : Lengths()) {
     const std::vector<float> row(in.begin(), in.begin() + static_cast<std::ptrdiff_t>(n));
@@ -68,29 +73,33 @@ TEST(SrgbRows, AddWeightedLinearIsToLinearToTheBit) {
   }
 }
 
+// At scale 1 the values' segment ends are FromLinear's own; at 1.3 other values.
 TEST(SrgbRows, ScaledFromLinearIsFromLinearToTheBit) {
+  SKIP_WITHOUT_AVX2();
   const std::vector<float> in = Values();
-  for (const std::size_t n : Lengths()) {
-    const std::vector<float> row(in.begin(), in.begin() + static_cast<std::ptrdiff_t>(n));
-    std::vector<float> got(n), expected(n);
-    ScaledFromLinear(row.data(), 1.3f, static_cast<int>(n), got.data());
-    for (std::size_t i = 0; i < n; ++i) expected[i] = FromLinear(1.3f * row[i]);
-    ExpectSameBits(got, expected, row);
-  }
+  for (const float scale : {1.0f, 1.3f})
+    for (const std::size_t n : Lengths()) {
+      const std::vector<float> row(in.begin(), in.begin() + static_cast<std::ptrdiff_t>(n));
+      std::vector<float> got(n), expected(n);
+      ScaledFromLinear(row.data(), scale, static_cast<int>(n), got.data());
+      for (std::size_t i = 0; i < n; ++i) expected[i] = FromLinear(scale * row[i]);
+      ExpectSameBits(got, expected, row);
+    }
 }
 
-// The conversions themselves, at known values: 0 and 1 are fixed points, the
-// linear segments are proportional, and a mid grey decodes to about 0.214.
+// The conversions themselves, at known values (in a row of 8: one vector step where
+// there is AVX2): 0 and 1 are fixed points, the linear segment is proportional, a mid
+// grey decodes to about 0.214, and a round trip returns the display values.
 TEST(SrgbRows, KnownValues) {
-  const std::vector<float> display{0.0f, 1.0f, 0.02f, 0.5f};
+  const std::vector<float> display{0.0f, 1.0f, 0.02f, 0.5f, 0.25f, 0.75f, 0.9f, 0.1f};
   std::vector<float> linear(display.size(), 0.0f);
-  AddWeightedLinear(display.data(), 1.0f, 4, linear.data());
+  AddWeightedLinear(display.data(), 1.0f, 8, linear.data());
   EXPECT_EQ(linear[0], 0.0f);
   EXPECT_NEAR(linear[1], 1.0f, 1e-6f);
   EXPECT_FLOAT_EQ(linear[2], 0.02f / 12.92f);
   EXPECT_NEAR(linear[3], 0.2140411f, 1e-6f);
   std::vector<float> back(display.size());
-  ScaledFromLinear(linear.data(), 1.0f, 4, back.data());
+  ScaledFromLinear(linear.data(), 1.0f, 8, back.data());
   for (std::size_t i = 0; i < display.size(); ++i) EXPECT_NEAR(back[i], display[i], 1e-5f);
 }
 
