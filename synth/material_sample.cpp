@@ -186,6 +186,51 @@ void AddCorrection(const TrianglePatch& patch, const GridPoint& g, float* out) {
   }
 }
 
+// Any sample's windows relit by its Relight, then copied into place.
+class WindowByRelight : public WindowRelighter {
+ public:
+  WindowByRelight(const MaterialSample& sample, const ReducedPlanes& reduced, FaceLighting lighting,
+                  double gain)
+      : sample_(sample), reduced_(reduced), lighting_(std::move(lighting)), gain_(gain) {}
+  void Relight(cv::Rect cells, std::array<cv::Mat, 3>& out) override {
+    ReducedPlanes window{{}, reduced_.rx, reduced_.ry};
+    for (const cv::Mat& plane : reduced_.planes) window.planes.push_back(plane(cells));
+    const std::vector<cv::Mat> relit = sample_.Relight(window, lighting_, gain_);
+    for (std::size_t c = 0; c < out.size(); ++c) relit[c].copyTo(out[c](cells));
+  }
+
+ private:
+  const MaterialSample& sample_;
+  const ReducedPlanes& reduced_;
+  FaceLighting lighting_;
+  double gain_;
+};
+
+// A PTM sample without relief shadows: each window's rows relit in place, one light
+// over the row (PtmRowRelighter), the lights worked out once.
+class PtmWindowRelighter : public WindowRelighter {
+ public:
+  PtmWindowRelighter(const ReducedPlanes& reduced, ptm::PtmFormat format, int planes,
+                     std::vector<ptm::EffectiveLight> lights, double gain)
+      : reduced_(reduced),
+        rows_(format, std::move(lights), gain),
+        in_(static_cast<std::size_t>(planes)) {}
+  void Relight(cv::Rect cells, std::array<cv::Mat, 3>& out) override {
+    for (int y = cells.y; y < cells.br().y; ++y) {
+      for (std::size_t i = 0; i < in_.size(); ++i)
+        in_[i] = reduced_.planes[i].ptr<float>(y) + cells.x;
+      std::array<float*, 3> row{};
+      for (std::size_t c = 0; c < row.size(); ++c) row[c] = out[c].ptr<float>(y) + cells.x;
+      rows_.Relight(in_.data(), cells.width, row);
+    }
+  }
+
+ private:
+  const ReducedPlanes& reduced_;
+  PtmRowRelighter rows_;
+  std::vector<const float*> in_;  // the planes' rows at the window
+};
+
 }  // namespace
 
 const ReducedPlanes& MaterialSample::Reduced(int level) const {
@@ -199,6 +244,12 @@ const ReducedPlanes& MaterialSample::Reduced(int level) const {
   std::call_once(entry->once,
                  [&] { entry->planes = ReduceToDensityLevel(RelightPlanes(), level); });
   return entry->planes;
+}
+
+std::unique_ptr<WindowRelighter> MaterialSample::RelighterOf(const ReducedPlanes& reduced,
+                                                             const FaceLighting& lighting,
+                                                             double gain) const {
+  return std::make_unique<WindowByRelight>(*this, reduced, lighting, gain);
 }
 
 bool MaterialSample::PatchFeatures(const TrianglePatch& patch, double t, const Eigen::Vector2d& p,
@@ -371,6 +422,15 @@ std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighti
     }
   }
   return out;
+}
+
+std::unique_ptr<WindowRelighter> PtmSample::RelighterOf(const ReducedPlanes& reduced,
+                                                        const FaceLighting& lighting,
+                                                        double gain) const {
+  if (shadowing_) return MaterialSample::RelighterOf(reduced, lighting, gain);
+  const int planes = ptm_.NumPolynomials() * 6 + (lrgb() ? 3 : 0);
+  return std::make_unique<PtmWindowRelighter>(reduced, ptm_.format, planes,
+                                              LightsOf(lighting).lights, gain);
 }
 
 double PtmSample::RelitLinearSum(const FaceLighting& lighting, int cells) const {

@@ -49,6 +49,17 @@ FaceLighting LightingInFrame(const mesh::TriangleFrame& frame,
                              const std::vector<sfm::ObjectLight>& lights,
                              const ptm::LightResponse& response);
 
+/// Relights windows of one reduced sample under one face lighting into planes the
+/// caller holds, with Relight's values at every cell: for a search that relights the
+/// cells its placements ask for, one window after another (synth/placement_search.h).
+class WindowRelighter {
+ public:
+  virtual ~WindowRelighter() = default;
+  /// Writes Relight(the reduced sample's window `cells`) into `out` (R, G, B planes
+  /// of the reduced size) at `cells`.
+  virtual void Relight(cv::Rect cells, std::array<cv::Mat, 3>& out) = 0;
+};
+
 /// A material sample as the synthesis engines see it (DESIGN.md, "Engines and
 /// samples"). An engine never looks inside a sample: it compares feature
 /// planes, turns them with the face frames, relights the sample for the image
@@ -102,6 +113,11 @@ class MaterialSample {
   /// (R, G, B) of the reduced size, in Domain().
   virtual std::vector<cv::Mat> Relight(const ReducedPlanes& reduced, const FaceLighting& lighting,
                                        double gain) const = 0;
+  /// Relight's values window by window, set up once for `reduced` (which must outlive
+  /// it) under `lighting` and `gain`. By default each window is relit by Relight.
+  virtual std::unique_ptr<WindowRelighter> RelighterOf(const ReducedPlanes& reduced,
+                                                       const FaceLighting& lighting,
+                                                       double gain) const;
   /// What `cells` texels of the sample sum to on average under a face's
   /// lighting, over R, G and B, in the linear domain (the photo gains compare
   /// it with the photo's sum over as many cells).
@@ -152,6 +168,10 @@ class PtmSample : public MaterialSample {
   PhotoDomain Domain() const override { return PhotoDomain::kDisplay; }
   std::vector<cv::Mat> Relight(const ReducedPlanes& reduced, const FaceLighting& lighting,
                                double gain) const override;
+  /// Without relief shadows, the rows of each window relit in place (PtmRowRelighter).
+  std::unique_ptr<WindowRelighter> RelighterOf(const ReducedPlanes& reduced,
+                                               const FaceLighting& lighting,
+                                               double gain) const override;
   double RelitLinearSum(const FaceLighting& lighting, int cells) const override;
 
   const ptm::Ptm& ptm() const { return ptm_; }

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <opencv2/imgproc.hpp>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "synth/template_match.h"
@@ -167,64 +169,94 @@ std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<View
   return scored;
 }
 
-class PlacementSearch::RelitTiles {
+class PlacementSearch::RelitView {
  public:
-  RelitTiles(const PlacementSearch& search, const ViewAtStep& view, std::array<cv::Mat, 3> planes)
-      : search_(search), view_(view), planes_(std::move(planes)) {
-    const cv::Size size = view.reduced->planes[0].size();
-    tiles_x_ = (size.width + kTile - 1) / kTile;
-    done_.assign(static_cast<std::size_t>(tiles_x_ * ((size.height + kTile - 1) / kTile)), 0);
+  RelitView(const PlacementSearch& search, const ViewAtStep& view, std::array<cv::Mat, 3> planes)
+      : relighter_(search.sample_.RelighterOf(*view.reduced, view.view->lighting,
+                                              search.photo_gains_[view.view->photo])),
+        planes_(std::move(planes)) {
+    covered_ = cv::Mat::zeros(planes_[0].size(), CV_8UC1);
   }
-  // Relights the tiles `cells` touches that are not relit yet.
+  // Relights the cells of `cells` that are not relit yet: rows whose uncovered cells
+  // span the same columns are relit together, one rectangle each.
   void Cover(cv::Rect cells) {
-    const cv::Rect all(cv::Point(0, 0), planes_[0].size());
-    for (int ty = cells.y / kTile; ty <= (cells.br().y - 1) / kTile; ++ty)
-      for (int tx = cells.x / kTile; tx <= (cells.br().x - 1) / kTile; ++tx) {
-        char& done = done_[static_cast<std::size_t>(ty * tiles_x_ + tx)];
-        if (done) continue;
-        const cv::Rect tile = cv::Rect(tx * kTile, ty * kTile, kTile, kTile) & all;
-        const std::vector<cv::Mat> relit = search_.RelitCells(view_, tile);
-        for (std::size_t c = 0; c < planes_.size(); ++c) relit[c].copyTo(planes_[c](tile));
-        done = 1;
-      }
+    cells &= cv::Rect(cv::Point(0, 0), planes_[0].size());
+    std::vector<std::pair<int, int>> spans(static_cast<std::size_t>(cells.height));
+    for (int j = 0; j < cells.height; ++j) spans[static_cast<std::size_t>(j)] = Uncovered(cells, j);
+    for (int j = 0; j < cells.height;) {
+      const std::pair<int, int> span = spans[static_cast<std::size_t>(j)];
+      int end = j + 1;
+      while (end < cells.height && spans[static_cast<std::size_t>(end)] == span) ++end;
+      if (span.first < span.second)
+        Relight(cv::Rect(span.first, cells.y + j, span.second - span.first, end - j));
+      j = end;
+    }
   }
+  // The view's eq. 3 by placement cell (row-major), as scored so far.
+  std::unordered_map<long long, double>& scores() { return scores_; }
   const std::array<cv::Mat, 3>& planes() const { return planes_; }
 
  private:
-  static constexpr int kTile = 16;
-  const PlacementSearch& search_;
-  const ViewAtStep& view_;
+  // Row j of `cells`: the columns [first, second) from its first to its last cell not
+  // relit yet (empty when all are), widened to whole groups of kColumns columns.
+  std::pair<int, int> Uncovered(cv::Rect cells, int j) const {
+    const unsigned char* row = covered_.ptr<unsigned char>(cells.y + j);
+    const auto n = static_cast<std::size_t>(cells.width);
+    const auto* first = static_cast<const unsigned char*>(std::memchr(row + cells.x, 0, n));
+    if (!first) return {0, 0};
+    const auto* last = static_cast<const unsigned char*>(memrchr(row + cells.x, 0, n));
+    const int lo = static_cast<int>(first - row) / kColumns * kColumns;
+    const int hi = (static_cast<int>(last - row) / kColumns + 1) * kColumns;
+    return {lo, std::min(hi, covered_.cols)};
+  }
+  void Relight(cv::Rect area) {
+    relighter_->Relight(area, planes_);
+    covered_(area).setTo(1);
+  }
+
+  // Windows start and end on multiples of this many columns (but at the sample's
+  // right edge): the relighting's vectors run over whole rows of 8.
+  static constexpr int kColumns = 8;
+  std::unique_ptr<WindowRelighter> relighter_;
   std::array<cv::Mat, 3> planes_;
-  int tiles_x_ = 0;
-  std::vector<char> done_;
+  cv::Mat covered_;  // CV_8UC1: 1 where relit
+  std::unordered_map<long long, double> scores_;
 };
+
+double PlacementSearch::CellScore(const ViewAtStep& v, cv::Point at, RelitView& relit) const {
+  relit.Cover(cv::Rect(at, v.mask.size()));
+  double ssd = 0.0;
+  for (int j = 0; j < v.mask.rows; ++j) {
+    const float* m = v.mask.ptr<float>(j);
+    float row = 0.0f;  // a row's sum in floats, rows in doubles
+    for (std::size_t c = 0; c < v.photo.size(); ++c) {
+      const float* s = relit.planes()[c].ptr<float>(at.y + j) + at.x;
+      const float* p = v.photo[c].ptr<float>(j);
+      for (int i = 0; i < v.mask.cols; ++i) {
+        const float d = s[i] - p[i];
+        row += m[i] * d * d;
+      }
+    }
+    ssd += row;
+  }
+  // Eq. 3: the RMS difference at the photo's density (as AddImageScore).
+  return std::sqrt(std::max(ssd, 0.0) / (3.0 * v.count));
+}
 
 std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views,
                                             const std::vector<cv::Point>& texels,
-                                            std::vector<RelitTiles>& relit) const {
-  // Each view (its own relit tiles) on every core (ForEachView); the scores summed in view order.
+                                            std::vector<RelitView>& relit) const {
+  // Each view (its own relit cells) on every core (ForEachView); the scores summed in view order.
   std::vector<std::vector<double>> per_view(views.size(), std::vector<double>(texels.size()));
   ForEachView(views.size(), [&](std::size_t r) {
     const ViewAtStep& v = views[r];
     for (std::size_t n = 0; n < texels.size(); ++n) {
+      // Placements in one cell of this view score alike: each cell scored once.
       const cv::Point at = v.Cell(texels[n]);
-      relit[r].Cover(cv::Rect(at, v.mask.size()));
-      double ssd = 0.0;
-      for (int j = 0; j < v.mask.rows; ++j) {
-        const float* m = v.mask.ptr<float>(j);
-        float row = 0.0f;  // a row's sum in floats (it vectorises), rows in doubles
-        for (std::size_t c = 0; c < v.photo.size(); ++c) {
-          const float* s = relit[r].planes()[c].ptr<float>(at.y + j) + at.x;
-          const float* p = v.photo[c].ptr<float>(j);
-          for (int i = 0; i < v.mask.cols; ++i) {
-            const float d = s[i] - p[i];
-            row += m[i] * d * d;
-          }
-        }
-        ssd += row;
-      }
-      // Eq. 3: the RMS difference at the photo's density (as AddImageScore).
-      per_view[r][n] = std::sqrt(std::max(ssd, 0.0) / (3.0 * v.count));
+      const auto [it, fresh] =
+          relit[r].scores().try_emplace(static_cast<long long>(at.y) * v.placements_x + at.x, 0.0);
+      if (fresh) it->second = CellScore(v, at, relit[r]);
+      per_view[r][n] = it->second;
     }
   });
   std::vector<double> total(texels.size(), 0.0);
@@ -260,7 +292,7 @@ std::vector<ScoredPlacement> PlacementSearch::CoarseToFine(int top_k, int candid
   for (int step = steps - 1; step >= 0; --step) {
     views = ViewsAtStep(step);
     const int stride = Stride(views);
-    std::vector<RelitTiles> relit;
+    std::vector<RelitView> relit;
     relit.reserve(views.size());
     for (std::size_t r = 0; r < views.size(); ++r)
       relit.emplace_back(*this, views[r], scratch.Planes(r, views[r].reduced->planes[0].size()));

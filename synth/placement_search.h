@@ -68,14 +68,16 @@ class PlacementSearch {
   static int Stride(const std::vector<ViewAtStep>& views);
   // Eq. 3 at every placement (FFT), at the placements `stride` texels apart.
   std::vector<ScoredPlacement> ScoreOnGrid(const std::vector<ViewAtStep>& views, int stride) const;
-  // The sample relit under a view at a step, tile by tile as placements ask, so
-  // that no cell is relit twice however the placements overlap.
-  class RelitTiles;
+  // The sample relit under a view at a step, as placements ask, so that no cell is
+  // relit twice however the placements overlap; and the view's scores by cell.
+  class RelitView;
   // Eq. 3 at the given placements (sample texels), computed directly; `relit`
   // per view.
   std::vector<float> ScoreAt(const std::vector<ViewAtStep>& views,
                              const std::vector<cv::Point>& texels,
-                             std::vector<RelitTiles>& relit) const;
+                             std::vector<RelitView>& relit) const;
+  // Eq. 3 of view `v` alone at its cell `at` (the placement's top left).
+  double CellScore(const ViewAtStep& v, cv::Point at, RelitView& relit) const;
   // The sample relit under `v`'s lighting over `cells` of its reduced sample.
   std::vector<cv::Mat> RelitCells(const ViewAtStep& v, cv::Rect cells) const;
 

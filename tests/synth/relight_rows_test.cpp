@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <memory>
 #include <random>
 
 #include "synth/material_sample.h"
@@ -29,6 +30,17 @@ std::vector<ptm::EffectiveLight> Lights() {
   return {{Eigen::Vector3d(0.5, -0.3, 0.81).normalized(), 0.8},
           {Eigen::Vector3d(-0.9, 0.2, 0.2).normalized(), 1.7},
           {Eigen::Vector3d::UnitZ(), 0.15}};  // an ambient light, as EffectiveLights adds it
+}
+
+// Two lights, an ambient light and an elevation factor.
+FaceLighting TwoLightsWithResponse() {
+  FaceLighting lighting{
+      Eigen::Vector3d::UnitZ(),
+      {{Eigen::Vector3d(0.3, 0.4, 0.866), 1.1}, {Eigen::Vector3d(-0.8, 0.5, 0.33), 0.6}},
+      {}};
+  lighting.response.ambient = 0.12;
+  lighting.response.elevation_factor[2] = 0.7;
+  return lighting;
 }
 
 // The relit cells, bit for bit, against RelightEffective cell by cell.
@@ -85,12 +97,7 @@ TEST(PtmRowRelighter, IsWhatAPtmSampleRelightsWith) {
     for (float& v : p.coefficients) v = a(rng);
     for (float& v : p.colour) v = colour(rng);
     const PtmSample sample(p);
-    FaceLighting lighting{
-        Eigen::Vector3d::UnitZ(),
-        {{Eigen::Vector3d(0.3, 0.4, 0.866), 1.1}, {Eigen::Vector3d(-0.8, 0.5, 0.33), 0.6}},
-        {}};
-    lighting.response.ambient = 0.12;
-    lighting.response.elevation_factor[2] = 0.7;
+    const FaceLighting lighting = TwoLightsWithResponse();
     const ReducedPlanes& reduced = sample.Reduced(2);
     const std::vector<cv::Mat> relit = sample.Relight(reduced, lighting, 0.9);
     const std::vector<ptm::EffectiveLight> lights =
@@ -98,6 +105,67 @@ TEST(PtmRowRelighter, IsWhatAPtmSampleRelightsWith) {
     ASSERT_EQ(lights.size(), 3u);
     ExpectSameAsPerCell(format, reduced.planes, {relit[0], relit[1], relit[2]}, lights, 0.9);
   }
+}
+
+// A sample's window relighter writes, at each window, the cells Relight gives for
+// the whole reduced sample, bit for bit, and leaves every other cell alone.
+void ExpectWindowsAsTheWhole(const MaterialSample& sample, const ReducedPlanes& reduced,
+                             const FaceLighting& lighting, double gain) {
+  const std::vector<cv::Mat> whole = sample.Relight(reduced, lighting, gain);
+  const cv::Size size = reduced.planes[0].size();
+  std::array<cv::Mat, 3> out;
+  for (cv::Mat& m : out) m = cv::Mat(size, CV_32FC1, cv::Scalar(-7.0f));
+  const std::unique_ptr<WindowRelighter> relighter = sample.RelighterOf(reduced, lighting, gain);
+  // Overlapping windows, one cell wide, and at the bottom right corner.
+  const std::vector<cv::Rect> windows = {
+      {0, 0, 5, 3}, {3, 2, 9, 4}, {7, 1, 1, 6}, {size.width - 7, size.height - 2, 7, 2}};
+  cv::Mat inside = cv::Mat::zeros(size, CV_8UC1);
+  for (const cv::Rect& w : windows) {
+    relighter->Relight(w, out);
+    inside(w).setTo(1);
+  }
+  for (int c = 0; c < 3; ++c)
+    for (int y = 0; y < size.height; ++y)
+      for (int x = 0; x < size.width; ++x) {
+        const float got = out[static_cast<std::size_t>(c)].at<float>(y, x);
+        const float expected = inside.at<unsigned char>(y, x)
+                                   ? whole[static_cast<std::size_t>(c)].at<float>(y, x)
+                                   : -7.0f;
+        ASSERT_EQ(std::memcmp(&got, &expected, sizeof(float)), 0)
+            << "cell (" << x << ", " << y << ") channel " << c << ": " << got << " against "
+            << expected;
+      }
+}
+
+TEST(WindowRelighter, PtmWindowsAreTheWholeRelitSample) {
+  for (const ptm::PtmFormat format : {ptm::PtmFormat::kLrgb, ptm::PtmFormat::kRgb}) {
+    ptm::Ptm p;
+    p.Resize(format, 37, 23);
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> a(-0.4f, 0.6f), colour(0.1f, 1.0f);
+    for (float& v : p.coefficients) v = a(rng);
+    for (float& v : p.colour) v = colour(rng);
+    const PtmSample sample(p);
+    ExpectWindowsAsTheWhole(sample, sample.Reduced(1), TwoLightsWithResponse(), 0.9);
+  }
+}
+
+// With the relief's shadows each cell has its own lights: the windows are relit by
+// Relight itself, and still read the horizon at their own cells.
+TEST(WindowRelighter, ShadowedPtmWindowsAreTheWholeRelitSample) {
+  ptm::Ptm p;
+  p.Resize(ptm::PtmFormat::kLrgb, 24, 20);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> a(-0.3f, 0.6f), colour(0.1f, 1.0f), horizon(0.0f, 0.9f);
+  for (float& v : p.coefficients) v = a(rng);
+  for (float& v : p.colour) v = colour(rng);
+  ptm::SelfShadowing shadowing;
+  shadowing.horizon = {24, 20, 8, std::vector<float>(24 * 20 * 8)};
+  for (float& e : shadowing.horizon.elevation_rad) e = horizon(rng);
+  shadowing.shadow_floor = 0.25;
+  shadowing.penumbra_rad = 0.07;
+  const PtmSample sample(p, &shadowing);
+  ExpectWindowsAsTheWhole(sample, sample.Reduced(0), TwoLightsWithResponse(), 1.1);
 }
 
 }  // namespace
