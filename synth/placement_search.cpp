@@ -175,12 +175,16 @@ class PlacementSearch::RelitView {
       : relighter_(search.sample_.RelighterOf(*view.reduced, view.view->lighting,
                                               search.photo_gains_[view.view->photo])),
         planes_(std::move(planes)) {
-    covered_ = cv::Mat::zeros(planes_[0].size(), CV_8UC1);
+    // The planes are kLanes - 1 columns wider than the reduced sample: lanes past its
+    // last placement read zeros there (their scores are not kept).
+    for (cv::Mat& plane : planes_)
+      plane.colRange(plane.cols - (kLanes - 1), plane.cols).setTo(0.0f);
+    covered_ = cv::Mat::zeros(view.reduced->planes[0].size(), CV_8UC1);
   }
   // Relights the cells of `cells` that are not relit yet: rows whose uncovered cells
   // span the same columns are relit together, one rectangle each.
   void Cover(cv::Rect cells) {
-    cells &= cv::Rect(cv::Point(0, 0), planes_[0].size());
+    cells &= cv::Rect(cv::Point(0, 0), covered_.size());
     std::vector<std::pair<int, int>> spans(static_cast<std::size_t>(cells.height));
     for (int j = 0; j < cells.height; ++j) spans[static_cast<std::size_t>(j)] = Uncovered(cells, j);
     for (int j = 0; j < cells.height;) {
@@ -223,24 +227,32 @@ class PlacementSearch::RelitView {
   std::unordered_map<long long, double> scores_;
 };
 
-double PlacementSearch::CellScore(const ViewAtStep& v, cv::Point at, RelitView& relit) const {
-  relit.Cover(cv::Rect(at, v.mask.size()));
-  double ssd = 0.0;
+std::array<double, PlacementSearch::kLanes> PlacementSearch::RowOfCellScores(
+    const ViewAtStep& v, cv::Point at, RelitView& relit) const {
+  relit.Cover(cv::Rect(at, v.mask.size() + cv::Size(kLanes - 1, 0)));
+  // Each lane (placement) sums as one placement alone would: a row's sum in floats
+  // over the channels and the row's cells in order, rows in doubles. The lanes are
+  // independent: one vector of four (SSE2, every x86-64) holds them.
+  using Lanes = float __attribute__((vector_size(kLanes * sizeof(float))));
+  std::array<double, kLanes> ssd{};
   for (int j = 0; j < v.mask.rows; ++j) {
     const float* m = v.mask.ptr<float>(j);
-    float row = 0.0f;  // a row's sum in floats, rows in doubles
+    Lanes row = {};
     for (std::size_t c = 0; c < v.photo.size(); ++c) {
       const float* s = relit.planes()[c].ptr<float>(at.y + j) + at.x;
       const float* p = v.photo[c].ptr<float>(j);
       for (int i = 0; i < v.mask.cols; ++i) {
-        const float d = s[i] - p[i];
+        Lanes relit_i;  // cell i of each lane's placement
+        std::memcpy(&relit_i, s + i, sizeof(Lanes));
+        const Lanes d = relit_i - p[i];
         row += m[i] * d * d;
       }
     }
-    ssd += row;
+    for (int k = 0; k < kLanes; ++k) ssd[static_cast<std::size_t>(k)] += row[k];
   }
   // Eq. 3: the RMS difference at the photo's density (as AddImageScore).
-  return std::sqrt(std::max(ssd, 0.0) / (3.0 * v.count));
+  for (double& e : ssd) e = std::sqrt(std::max(e, 0.0) / (3.0 * v.count));
+  return ssd;
 }
 
 std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views,
@@ -253,10 +265,14 @@ std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views
     for (std::size_t n = 0; n < texels.size(); ++n) {
       // Placements in one cell of this view score alike: each cell scored once.
       const cv::Point at = v.Cell(texels[n]);
-      const auto [it, fresh] =
-          relit[r].scores().try_emplace(static_cast<long long>(at.y) * v.placements_x + at.x, 0.0);
-      if (fresh) it->second = CellScore(v, at, relit[r]);
-      per_view[r][n] = it->second;
+      std::unordered_map<long long, double>& scores = relit[r].scores();
+      const long long key = static_cast<long long>(at.y) * v.placements_x + at.x;
+      if (!scores.count(key)) {  // this cell and the next kLanes - 1 in its row
+        const std::array<double, kLanes> row = RowOfCellScores(v, at, relit[r]);
+        for (int k = 0; k < kLanes && at.x + k < v.placements_x; ++k)
+          scores.emplace(key + k, row[k]);
+      }
+      per_view[r][n] = scores.at(key);
     }
   });
   std::vector<double> total(texels.size(), 0.0);
@@ -295,7 +311,9 @@ std::vector<ScoredPlacement> PlacementSearch::CoarseToFine(int top_k, int candid
     std::vector<RelitView> relit;
     relit.reserve(views.size());
     for (std::size_t r = 0; r < views.size(); ++r)
-      relit.emplace_back(*this, views[r], scratch.Planes(r, views[r].reduced->planes[0].size()));
+      relit.emplace_back(
+          *this, views[r],
+          scratch.Planes(r, views[r].reduced->planes[0].size() + cv::Size(kLanes - 1, 0)));
     // Every placement of this density's grid within a coarse cell of a candidate.
     std::unordered_set<long long> seen;
     std::vector<ScoredPlacement> scored;

@@ -76,8 +76,12 @@ class PlacementSearch {
   std::vector<float> ScoreAt(const std::vector<ViewAtStep>& views,
                              const std::vector<cv::Point>& texels,
                              std::vector<RelitView>& relit) const;
-  // Eq. 3 of view `v` alone at its cell `at` (the placement's top left).
-  double CellScore(const ViewAtStep& v, cv::Point at, RelitView& relit) const;
+  // Placements scored side by side: a view's cells at (at.x + k, at.y), k < kLanes.
+  static constexpr int kLanes = 4;
+  // Eq. 3 of view `v` alone at those cells (placements' top left); a lane past the
+  // view's last placement holds nothing of use.
+  std::array<double, kLanes> RowOfCellScores(const ViewAtStep& v, cv::Point at,
+                                             RelitView& relit) const;
   // The sample relit under `v`'s lighting over `cells` of its reduced sample.
   std::vector<cv::Mat> RelitCells(const ViewAtStep& v, cv::Rect cells) const;
 

@@ -132,6 +132,43 @@ TEST(PlacementSearch, RefinedScoresEqualTheExhaustiveScores) {
   for (std::size_t n = 0; n < 12; ++n) EXPECT_EQ(fallback[n], exhaustive[n]);
 }
 
+// Eq. 3 at a placement summed as the search's direct scores sum it, one placement
+// alone: per view, a row's masked squared differences in floats (channels, then
+// cells, in order), the rows in doubles; the views' RMS differences summed in order.
+float PlacementAlone(const Fixture& f, cv::Point texel) {
+  double total = 0.0;
+  for (const RectifiedView& v : f.views) {
+    const ReducedPlanes& r = f.sample.Reduced(v.level);
+    const std::vector<cv::Mat> relit = f.sample.Relight(r, v.lighting, f.gains[v.photo]);
+    const cv::Point at(
+        std::min(static_cast<int>(std::lround(texel.x * r.rx)), relit[0].cols - v.mask.cols),
+        std::min(static_cast<int>(std::lround(texel.y * r.ry)), relit[0].rows - v.mask.rows));
+    double ssd = 0.0;
+    for (int j = 0; j < v.mask.rows; ++j) {
+      float row = 0.0f;
+      for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < v.mask.cols; ++i) {
+          const float d = relit[static_cast<std::size_t>(c)].at<float>(at.y + j, at.x + i) -
+                          v.planes[static_cast<std::size_t>(c)].at<float>(j, i);
+          row += v.mask.at<float>(j, i) * d * d;
+        }
+      ssd += row;
+    }
+    total += std::sqrt(std::max(ssd, 0.0) / (3.0 * v.count));
+  }
+  return static_cast<float>(total);
+}
+
+// The direct scores are computed for several neighbouring placements side by side;
+// each is still its own placement's sum, to the bit.
+TEST(PlacementSearch, PlacementsScoredSideBySideScoreAsAlone) {
+  const Fixture f(0.05);
+  const PlacementSearch search(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch));
+  const std::vector<ScoredPlacement> refined = search.CoarseToFine(12, 16);
+  ASSERT_EQ(refined.size(), 12u);
+  for (const auto& [score, at] : refined) EXPECT_EQ(score, PlacementAlone(f, at)) << at;
+}
+
 // A lent scratch, left holding another search's relit cells of other sizes (a
 // larger sample, one view more; then NaN everywhere), changes no score: each
 // face's search relights every cell it reads.

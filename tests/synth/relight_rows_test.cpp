@@ -6,6 +6,7 @@
 #include <memory>
 #include <random>
 
+#include "synth/colour_sample.h"
 #include "synth/material_sample.h"
 #include "synth/triangle_parts.h"
 
@@ -148,6 +149,14 @@ TEST(WindowRelighter, PtmWindowsAreTheWholeRelitSample) {
     const PtmSample sample(p);
     ExpectWindowsAsTheWhole(sample, sample.Reduced(1), TwoLightsWithResponse(), 0.9);
   }
+}
+
+// A colour sample's windows (Relight per window) are its whole relit sample too.
+TEST(WindowRelighter, ColourWindowsAreTheWholeRelitSample) {
+  cv::Mat display(20, 29, CV_32FC3);
+  cv::randu(display, cv::Scalar::all(0.0), cv::Scalar::all(1.0));
+  const ColourSample sample(display);
+  ExpectWindowsAsTheWhole(sample, sample.Reduced(0), TwoLightsWithResponse(), 0.83);
 }
 
 // With the relief's shadows each cell has its own lights: the windows are relit by
