@@ -51,9 +51,12 @@ TEST(NearestWindows, FewComponentsFindTheWindowsThemselves) {
     EXPECT_EQ(distance[static_cast<std::size_t>(q)], 0.0f) << q;
 }
 
-TEST(NearestWindows, NoisyQueriesFindNearlyTheExactNearestAtTheirFullDistance) {
+// Noisy copies of windows: how often the nearest found is the exact nearest, and
+// how far the found are on average (their full distance over the exact nearest's).
+void ExpectNearlyTheExactNearest(NearestWindows::Options options, double exact_share,
+                                 double mean_ratio) {
   const cv::Mat windows = SmoothWindows(120, 5);
-  const NearestWindows nearest(windows.clone(), NearestWindows::Options{});
+  const NearestWindows nearest(windows.clone(), options);
   std::mt19937 rng(9);
   std::normal_distribution<float> noise(0.0f, 0.05f);
   cv::Mat queries;
@@ -79,8 +82,19 @@ TEST(NearestWindows, NoisyQueriesFindNearlyTheExactNearestAtTheirFullDistance) {
     exact += distance[n] <= best * (1.0f + 1e-5f);
     ratio_sum += distance[n] / best;
   }
-  EXPECT_GE(exact, queries.rows * 9 / 10) << exact << " of " << queries.rows;
-  EXPECT_LT(ratio_sum / queries.rows, 1.05);
+  EXPECT_GE(exact, exact_share * queries.rows) << exact << " of " << queries.rows;
+  EXPECT_LT(ratio_sum / queries.rows, mean_ratio);
+}
+
+// Four candidates at eps 4: nearly always the exact nearest.
+TEST(NearestWindows, NoisyQueriesFindNearlyTheExactNearestAtTheirFullDistance) {
+  ExpectNearlyTheExactNearest(NearestWindows::Options{8, 4, 4.0f}, 0.9, 1.05);
+}
+
+// The defaults (one candidate at eps 8) seed detail transfer's propagation: mostly
+// the exact nearest, and near it otherwise (218 of 254 and 1.13 when written).
+TEST(NearestWindows, TheDefaultsFindMostlyTheExactNearest) {
+  ExpectNearlyTheExactNearest(NearestWindows::Options{}, 0.8, 1.2);
 }
 
 TEST(NearestWindows, TheSameWindowsGiveTheSameMatches) {
