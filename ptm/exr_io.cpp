@@ -64,7 +64,9 @@ void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& pla
   } cleanup{tmp};
   OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
   spec.channelnames = channel_names;
-  spec.attribute("compression", "zip");
+  // PIZ (wavelet + Huffman), lossless: on float PTM atlases it wrote 15 % fewer bytes
+  // than ZIP in about a third of ZIP's CPU time (docs/ptm_format.md, "Lossless EXR").
+  spec.attribute("compression", "piz");
   // No capture date: the same data must give the same bytes.
   spec.attribute("DateTime", "");
   for (const auto& [name, value] : float_attributes) spec.attribute(name, value);

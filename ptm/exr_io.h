@@ -10,7 +10,7 @@
 namespace texlume::ptm {
 
 /// Writes a float image (CV_32FC1..CV_32FC4, or a vector of CV_32FC1 planes) as a
-/// lossless (ZIP-compressed) OpenEXR file with the given channel names, through
+/// lossless (PIZ-compressed) OpenEXR file with the given channel names, through
 /// OpenImageIO, atomically. Throws std::runtime_error naming the file on failure.
 /// `float_attributes` go into the header as float attributes (names "texlume:...").
 void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& planes,
