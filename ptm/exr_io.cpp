@@ -64,8 +64,8 @@ void WriteExr(const std::filesystem::path& path, const std::vector<cv::Mat>& pla
   } cleanup{tmp};
   OIIO::ImageSpec spec(width, height, channels, OIIO::TypeDesc::FLOAT);
   spec.channelnames = channel_names;
-  // PIZ (wavelet + Huffman), lossless: on float PTM atlases it wrote 15 % fewer bytes
-  // than ZIP in about a third of ZIP's CPU time (docs/ptm_format.md, "Lossless EXR").
+  // PIZ (wavelet + Huffman), lossless: on a float PTM atlas it wrote 15 % fewer bytes
+  // than ZIP in about half of ZIP's CPU time (docs/ptm_format.md, "Lossless EXR").
   spec.attribute("compression", "piz");
   // No capture date: the same data must give the same bytes.
   spec.attribute("DateTime", "");

@@ -83,15 +83,15 @@ double ColourSample::LambertFactor(const FaceLighting& lighting) {
 std::vector<cv::Mat> ColourSample::Relight(const ReducedPlanes& reduced,
                                            const FaceLighting& lighting, double gain) const {
   const double scale = gain * LambertFactor(lighting);
-  // Cell by cell in one expression, so that a window of the sample is relit as the
-  // whole is (OpenCV's scaling rounds its vector steps and its tail differently).
+  // Cell by cell, as OpenCV's scaling multiplies (in floats, by the factor as a
+  // float), so that any window of the sample is relit as the whole is.
   std::vector<cv::Mat> out(3);
   for (std::size_t c = 0; c < 3; ++c) {
     out[c] = cv::Mat(reduced.planes[c].size(), CV_32FC1);
     for (int y = 0; y < out[c].rows; ++y) {
       const float* in = reduced.planes[c].ptr<float>(y);
       float* relit = out[c].ptr<float>(y);
-      for (int x = 0; x < out[c].cols; ++x) relit[x] = static_cast<float>(in[x] * scale);
+      for (int x = 0; x < out[c].cols; ++x) relit[x] = in[x] * static_cast<float>(scale);
     }
   }
   return out;

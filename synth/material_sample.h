@@ -56,7 +56,7 @@ class WindowRelighter {
  public:
   virtual ~WindowRelighter() = default;
   /// Writes Relight(the reduced sample's window `cells`) into `out` (R, G, B planes
-  /// of the reduced size) at `cells`.
+  /// of at least the reduced size) at `cells`.
   virtual void Relight(cv::Rect cells, std::array<cv::Mat, 3>& out) = 0;
 };
 

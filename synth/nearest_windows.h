@@ -21,7 +21,7 @@ class NearestWindows {
   /// (docs/synth.md, "Where the time per triangle goes" and "A coarser seed for
   /// propagation"): 8 components match as well as 12 (6 lose 0.0009 SSIM); one
   /// candidate at eps 8 seeds detail transfer's propagation within 0.0004 SSIM of
-  /// four at eps 4, for about 40 % less of the tree's time.
+  /// four at eps 4, for about 20 % less of detail transfer's matching time.
   struct Options {
     int components = 8;  ///< principal components the tree searches
     int candidates = 1;  ///< nearest in the components, ranked by full distance

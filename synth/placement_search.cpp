@@ -208,9 +208,10 @@ class PlacementSearch::RelitView {
     const auto n = static_cast<std::size_t>(cells.width);
     const auto* first = static_cast<const unsigned char*>(std::memchr(row + cells.x, 0, n));
     if (!first) return {0, 0};
-    const auto* last = static_cast<const unsigned char*>(memrchr(row + cells.x, 0, n));
+    int last = cells.x + cells.width - 1;
+    while (row[last]) --last;  // stops at `first` at the latest
     const int lo = static_cast<int>(first - row) / kColumns * kColumns;
-    const int hi = (static_cast<int>(last - row) / kColumns + 1) * kColumns;
+    const int hi = (last / kColumns + 1) * kColumns;
     return {lo, std::min(hi, covered_.cols)};
   }
   void Relight(cv::Rect area) {

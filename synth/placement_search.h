@@ -77,7 +77,7 @@ class PlacementSearch {
                              const std::vector<cv::Point>& texels,
                              std::vector<RelitView>& relit) const;
   // Placements scored side by side: a view's cells at (at.x + k, at.y), k < kLanes.
-  static constexpr int kLanes = 4;
+  static constexpr int kLanes = RelitScratch::kPastTheSample + 1;
   // Eq. 3 of view `v` alone at those cells (placements' top left); a lane past the
   // view's last placement holds nothing of use.
   std::array<double, kLanes> RowOfCellScores(const ViewAtStep& v, cv::Point at,

@@ -134,10 +134,14 @@ class RelitScratch {
   std::array<cv::Mat, 3> Planes(std::size_t slot, cv::Size size);
   /// Frees the buffers (the next Planes() allocates again).
   void Release() { buffers_.clear(); }
+  /// Columns the search's planes hold past the reduced sample's: the placements it
+  /// scores side by side past the last one read there (synth/placement_search.h).
+  static constexpr int kPastTheSample = 3;
   /// The most the buffers of a search over `views` views of a sample of `sample`
   /// texels can grow to: three float planes per view at the sample's full density.
   static double BytesAtMost(int views, cv::Size sample) {
-    return 3.0 * sizeof(float) * views * static_cast<double>(sample.width) * sample.height;
+    return 3.0 * sizeof(float) * views * static_cast<double>(sample.width + kPastTheSample) *
+           sample.height;
   }
 
  private:

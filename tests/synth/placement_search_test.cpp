@@ -80,11 +80,14 @@ RectifiedView PlantedView(const ColourSample& sample, int level, cv::Point at,
 }
 
 struct Fixture {
-  ColourSample sample{StructuredColour(160, 7)};
+  ColourSample sample;
   std::vector<double> gains{1.0, 0.8};
-  cv::Point planted{73, 41};  // off every coarse grid
+  cv::Point planted;
   std::vector<RectifiedView> views;
-  Fixture(double noise) {
+  // By default a 160 x 160 sample, planted off every coarse grid.
+  explicit Fixture(double noise, const cv::Mat& colour = StructuredColour(160, 7),
+                   cv::Point planted_at = {73, 41})
+      : sample(colour), planted(planted_at) {
     const FaceLighting zenith{Eigen::Vector3d::UnitZ(), {{Eigen::Vector3d::UnitZ(), 1.0}}, {}};
     const FaceLighting slanted{
         Eigen::Vector3d::UnitZ(), {{Eigen::Vector3d(0.6, 0.0, 0.8), 1.5}}, {}};
@@ -159,6 +162,19 @@ float PlacementAlone(const Fixture& f, cv::Point texel) {
   return static_cast<float>(total);
 }
 
+// Each refined score against PlacementAlone: to the bit, unless the library was built
+// to fuse multiplies and adds (-march=native with FMA; these tests are built at -O1,
+// where GCC fuses none).
+void ExpectScoresAsAlone(const Fixture& f, const std::vector<ScoredPlacement>& refined) {
+  for (const auto& [score, at] : refined) {
+#ifdef __FMA__
+    EXPECT_NEAR(score, PlacementAlone(f, at), 1e-6f * (1.0f + score)) << at;
+#else
+    EXPECT_EQ(score, PlacementAlone(f, at)) << at;
+#endif
+  }
+}
+
 // The direct scores are computed for several neighbouring placements side by side;
 // each is still its own placement's sum, to the bit.
 TEST(PlacementSearch, PlacementsScoredSideBySideScoreAsAlone) {
@@ -166,7 +182,21 @@ TEST(PlacementSearch, PlacementsScoredSideBySideScoreAsAlone) {
   const PlacementSearch search(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch));
   const std::vector<ScoredPlacement> refined = search.CoarseToFine(12, 16);
   ASSERT_EQ(refined.size(), 12u);
-  for (const auto& [score, at] : refined) EXPECT_EQ(score, PlacementAlone(f, at)) << at;
+  ExpectScoresAsAlone(f, refined);
+}
+
+// A sample barely wider than a patch (a few placements a row, fewer than the lanes
+// past some of them): the candidates' neighbourhoods span whole rows, and a lane past
+// a row's last placement must not stand for the next row's first.
+TEST(PlacementSearch, PlacementsScoredSideBySideAtTheSamplesEdges) {
+  const Fixture f(0.05, StructuredColour(640, 7).colRange(0, kPatch + 6).clone(), {3, 301});
+  const PlacementSearch search(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch));
+  // One coarser step: with more, refining would cost more than the exhaustive search.
+  ASSERT_GE(search.CoarseSteps(1, 6), 1);
+  const std::vector<ScoredPlacement> refined = search.CoarseToFine(40, 40, 1, 6);
+  ASSERT_EQ(refined.size(), 40u);
+  EXPECT_EQ(refined[0].second, f.planted);
+  ExpectScoresAsAlone(f, refined);
 }
 
 // A lent scratch, left holding another search's relit cells of other sizes (a
