@@ -11,6 +11,8 @@ namespace {
 
 // The principal components are estimated on at most this many windows.
 constexpr int kMaxComponentRows = 8192;
+// Rows projected at a time.
+constexpr int kProjectedBlockRows = 4096;
 // Points per leaf of the kd-tree.
 constexpr int kLeafSize = 16;
 
@@ -25,8 +27,8 @@ nanoflann::SearchParams SearchEps(float eps) { return nanoflann::SearchParams(0,
 // (rows, CV_32F, by decreasing variance), from every step-th window.
 void PrincipalComponents(const cv::Mat& windows, int count, cv::Mat& mean, cv::Mat& directions) {
   const int step = std::max(1, (windows.rows + kMaxComponentRows - 1) / kMaxComponentRows);
-  cv::Mat rows;
-  for (int r = 0; r < windows.rows; r += step) rows.push_back(windows.row(r));
+  cv::Mat rows((windows.rows + step - 1) / step, windows.cols, CV_32FC1);
+  for (int r = 0; r < windows.rows; r += step) windows.row(r).copyTo(rows.row(r / step));
   cv::Mat covariance, mean64, variances, all;
   cv::calcCovarMatrix(rows, covariance, mean64, cv::COVAR_NORMAL | cv::COVAR_ROWS | cv::COVAR_SCALE,
                       CV_64F);
@@ -68,16 +70,22 @@ NearestWindows::NearestWindows(cv::Mat windows, Options options)
 NearestWindows::~NearestWindows() = default;
 
 cv::Mat NearestWindows::Project(const cv::Mat& rows) const {
-  // Each row less the mean (no repeated copy of the mean: the same values).
-  cv::Mat centred(rows.size(), CV_32FC1);
+  // Each row less the mean, a block of rows at a time (no copy of every window at
+  // once), then its components.
+  cv::Mat out(rows.rows, components_.rows, CV_32FC1);
+  cv::Mat centred;
   const float* mean = mean_.ptr<float>();
-  for (int r = 0; r < rows.rows; ++r) {
-    const float* in = rows.ptr<float>(r);
-    float* out = centred.ptr<float>(r);
-    for (int i = 0; i < rows.cols; ++i) out[i] = in[i] - mean[i];
+  for (int first = 0; first < rows.rows; first += kProjectedBlockRows) {
+    const int count = std::min(kProjectedBlockRows, rows.rows - first);
+    centred.create(count, rows.cols, CV_32FC1);
+    for (int r = 0; r < count; ++r) {
+      const float* in = rows.ptr<float>(first + r);
+      float* c = centred.ptr<float>(r);
+      for (int i = 0; i < rows.cols; ++i) c[i] = in[i] - mean[i];
+    }
+    cv::Mat block = out.rowRange(first, first + count);
+    cv::gemm(centred, components_, 1.0, cv::noArray(), 0.0, block, cv::GEMM_2_T);
   }
-  cv::Mat out;
-  cv::gemm(centred, components_, 1.0, cv::noArray(), 0.0, out, cv::GEMM_2_T);
   return out;
 }
 
