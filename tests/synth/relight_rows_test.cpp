@@ -33,6 +33,17 @@ std::vector<ptm::EffectiveLight> Lights() {
           {Eigen::Vector3d::UnitZ(), 0.15}};  // an ambient light, as EffectiveLights adds it
 }
 
+// A PTM of random coefficients in [-0.4, 0.6] and colour in [0.1, 1], seeded.
+ptm::Ptm RandomPtm(ptm::PtmFormat format, int width, int height, unsigned seed) {
+  ptm::Ptm p;
+  p.Resize(format, width, height);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> a(-0.4f, 0.6f), colour(0.1f, 1.0f);
+  for (float& v : p.coefficients) v = a(rng);
+  for (float& v : p.colour) v = colour(rng);
+  return p;
+}
+
 // Two lights, an ambient light and an elevation factor.
 FaceLighting TwoLightsWithResponse() {
   FaceLighting lighting{
@@ -91,12 +102,7 @@ TEST(PtmRowRelighter, IsRelightEffectiveToTheBit) {
 // RelightMixture relights them under the face's lights and response.
 TEST(PtmRowRelighter, IsWhatAPtmSampleRelightsWith) {
   for (const ptm::PtmFormat format : {ptm::PtmFormat::kLrgb, ptm::PtmFormat::kRgb}) {
-    ptm::Ptm p;
-    p.Resize(format, 21, 13);
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<float> a(-0.4f, 0.6f), colour(0.1f, 1.0f);
-    for (float& v : p.coefficients) v = a(rng);
-    for (float& v : p.colour) v = colour(rng);
+    const ptm::Ptm p = RandomPtm(format, 21, 13, 5);
     const PtmSample sample(p);
     const FaceLighting lighting = TwoLightsWithResponse();
     const ReducedPlanes& reduced = sample.Reduced(2);
@@ -140,12 +146,7 @@ void ExpectWindowsAsTheWhole(const MaterialSample& sample, const ReducedPlanes& 
 
 TEST(WindowRelighter, PtmWindowsAreTheWholeRelitSample) {
   for (const ptm::PtmFormat format : {ptm::PtmFormat::kLrgb, ptm::PtmFormat::kRgb}) {
-    ptm::Ptm p;
-    p.Resize(format, 37, 23);
-    std::mt19937 rng(9);
-    std::uniform_real_distribution<float> a(-0.4f, 0.6f), colour(0.1f, 1.0f);
-    for (float& v : p.coefficients) v = a(rng);
-    for (float& v : p.colour) v = colour(rng);
+    const ptm::Ptm p = RandomPtm(format, 37, 23, 9);
     const PtmSample sample(p);
     ExpectWindowsAsTheWhole(sample, sample.Reduced(1), TwoLightsWithResponse(), 0.9);
   }
