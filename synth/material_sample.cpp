@@ -193,9 +193,7 @@ class WindowByRelight : public WindowRelighter {
                   double gain)
       : sample_(sample), reduced_(reduced), lighting_(std::move(lighting)), gain_(gain) {}
   void Relight(cv::Rect cells, std::array<cv::Mat, 3>& out) override {
-    ReducedPlanes window{{}, reduced_.rx, reduced_.ry};
-    for (const cv::Mat& plane : reduced_.planes) window.planes.push_back(plane(cells));
-    const std::vector<cv::Mat> relit = sample_.Relight(window, lighting_, gain_);
+    const std::vector<cv::Mat> relit = sample_.Relight(reduced_.Window(cells), lighting_, gain_);
     for (std::size_t c = 0; c < out.size(); ++c) relit[c].copyTo(out[c](cells));
   }
 
@@ -393,26 +391,24 @@ void PtmSample::ShadowLights(const TexelLights& lights, const ReducedPlanes& red
 
 std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighting& lighting,
                                         double gain) const {
-  const int polys = ptm_.NumPolynomials();
-  std::vector<cv::Mat> out(3);
+  std::array<cv::Mat, 3> out;
   for (cv::Mat& m : out) m = cv::Mat(r.planes[0].size(), CV_32FC1);
+  // Without shadows, the same lights everywhere: the whole sample as one window.
+  if (!shadowing_) {
+    RelighterOf(r, lighting, gain)->Relight(cv::Rect(cv::Point(0, 0), r.planes[0].size()), out);
+    return {out.begin(), out.end()};
+  }
+  const int polys = ptm_.NumPolynomials();
   const bool lrgb = ptm_.format == ptm::PtmFormat::kLrgb;
-  const std::size_t read = static_cast<std::size_t>(polys * 6 + (lrgb ? 3 : 0));
+  const auto read = static_cast<std::size_t>(HorizonPlanesBegin());
   std::vector<float> a(read), colour(3, 1.0f);
   const TexelLights texel_lights = LightsOf(lighting);
   std::vector<ptm::EffectiveLight> lights = texel_lights.lights;
-  // Without shadows, the same lights everywhere: a row at a time.
-  std::optional<PtmRowRelighter> rows;
-  if (!shadowing_) rows.emplace(ptm_.format, lights, gain);
   std::vector<const float*> in(read);  // the planes' rows
   for (int y = 0; y < r.planes[0].rows; ++y) {
     for (std::size_t i = 0; i < read; ++i) in[i] = r.planes[i].ptr<float>(y);
     std::array<float*, 3> row{};
     for (std::size_t c = 0; c < row.size(); ++c) row[c] = out[c].ptr<float>(y);
-    if (rows) {
-      rows->Relight(in.data(), r.planes[0].cols, row);
-      continue;
-    }
     for (int x = 0; x < r.planes[0].cols; ++x) {
       ShadowLights(texel_lights, r, BilinearTaps(r.planes[0].size(), x, y), lights);
       for (std::size_t i = 0; i < read; ++i) a[i] = in[i][x];
@@ -421,15 +417,14 @@ std::vector<cv::Mat> PtmSample::Relight(const ReducedPlanes& r, const FaceLighti
       for (std::size_t c = 0; c < row.size(); ++c) row[c][x] = v[static_cast<Eigen::Index>(c)];
     }
   }
-  return out;
+  return {out.begin(), out.end()};
 }
 
 std::unique_ptr<WindowRelighter> PtmSample::RelighterOf(const ReducedPlanes& reduced,
                                                         const FaceLighting& lighting,
                                                         double gain) const {
   if (shadowing_) return MaterialSample::RelighterOf(reduced, lighting, gain);
-  const int planes = ptm_.NumPolynomials() * 6 + (lrgb() ? 3 : 0);
-  return std::make_unique<PtmWindowRelighter>(reduced, ptm_.format, planes,
+  return std::make_unique<PtmWindowRelighter>(reduced, ptm_.format, HorizonPlanesBegin(),
                                               LightsOf(lighting).lights, gain);
 }
 

@@ -138,9 +138,7 @@ int PlacementSearch::Stride(const std::vector<ViewAtStep>& views) {
 }
 
 std::vector<cv::Mat> PlacementSearch::RelitCells(const ViewAtStep& v, cv::Rect cells) const {
-  ReducedPlanes window{{}, v.reduced->rx, v.reduced->ry};
-  for (const cv::Mat& plane : v.reduced->planes) window.planes.push_back(plane(cells));
-  return sample_.Relight(window, v.view->lighting, photo_gains_[v.view->photo]);
+  return sample_.Relight(v.reduced->Window(cells), v.view->lighting, photo_gains_[v.view->photo]);
 }
 
 std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<ViewAtStep>& views,
@@ -185,12 +183,10 @@ class PlacementSearch::RelitView {
   // span the same columns are relit together, one rectangle each.
   void Cover(cv::Rect cells) {
     cells &= cv::Rect(cv::Point(0, 0), covered_.size());
-    std::vector<std::pair<int, int>> spans(static_cast<std::size_t>(cells.height));
-    for (int j = 0; j < cells.height; ++j) spans[static_cast<std::size_t>(j)] = Uncovered(cells, j);
     for (int j = 0; j < cells.height;) {
-      const std::pair<int, int> span = spans[static_cast<std::size_t>(j)];
+      const std::pair<int, int> span = Uncovered(cells, j);
       int end = j + 1;
-      while (end < cells.height && spans[static_cast<std::size_t>(end)] == span) ++end;
+      while (end < cells.height && Uncovered(cells, end) == span) ++end;
       if (span.first < span.second)
         Relight(cv::Rect(span.first, cells.y + j, span.second - span.first, end - j));
       j = end;
@@ -268,12 +264,14 @@ std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views
       const cv::Point at = v.Cell(texels[n]);
       std::unordered_map<long long, double>& scores = relit[r].scores();
       const long long key = static_cast<long long>(at.y) * v.placements_x + at.x;
-      if (!scores.count(key)) {  // this cell and the next kLanes - 1 in its row
-        const std::array<double, kLanes> row = RowOfCellScores(v, at, relit[r]);
-        for (int k = 0; k < kLanes && at.x + k < v.placements_x; ++k)
-          scores.emplace(key + k, row[k]);
+      if (const auto it = scores.find(key); it != scores.end()) {
+        per_view[r][n] = it->second;
+        continue;
       }
-      per_view[r][n] = scores.at(key);
+      // This cell and the next kLanes - 1 in its row.
+      const std::array<double, kLanes> row = RowOfCellScores(v, at, relit[r]);
+      for (int k = 0; k < kLanes && at.x + k < v.placements_x; ++k) scores.emplace(key + k, row[k]);
+      per_view[r][n] = row[0];
     }
   });
   std::vector<double> total(texels.size(), 0.0);

@@ -523,10 +523,8 @@ cv::Mat TriangleEngine::SampleWindowLuminance(std::size_t face, const RectifiedV
       static_cast<int>(hash % static_cast<std::uint64_t>(reduced.planes[0].cols - size.width + 1));
   const int y = static_cast<int>(
       (hash >> 32) % static_cast<std::uint64_t>(reduced.planes[0].rows - size.height + 1));
-  ReducedPlanes window{{}, reduced.rx, reduced.ry};
-  for (const cv::Mat& plane : reduced.planes)
-    window.planes.push_back(plane(cv::Rect(cv::Point(x, y), size)));
-  const std::vector<cv::Mat> relit = sample_.Relight(window, rect.lighting, 1.0);
+  const std::vector<cv::Mat> relit =
+      sample_.Relight(reduced.Window(cv::Rect(cv::Point(x, y), size)), rect.lighting, 1.0);
   return (relit[0] + relit[1] + relit[2]) / 3.0;
 }
 

@@ -154,6 +154,12 @@ int PhotoDensityLevel(const TrianglePatch& patch, const sfm::TriangleView& view,
 struct ReducedPlanes {
   std::vector<cv::Mat> planes;
   double rx = 1.0, ry = 1.0;
+  /// The window `cells` of every plane (views, not copies), at the same density.
+  ReducedPlanes Window(cv::Rect cells) const {
+    ReducedPlanes window{{}, rx, ry};
+    for (const cv::Mat& plane : planes) window.planes.push_back(plane(cells));
+    return window;
+  }
 };
 ReducedPlanes ReduceToDensityLevel(const std::vector<cv::Mat>& planes, int level);
 /// cv::remap maps that rectify a photo into the patch grid of `grid` cells at

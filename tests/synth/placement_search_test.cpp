@@ -58,9 +58,7 @@ RectifiedView PlantedView(const ColourSample& sample, int level, cv::Point at,
   const cv::Rect cells(cv::Point(static_cast<int>(std::lround(at.x * r.rx)),
                                  static_cast<int>(std::lround(at.y * r.ry))),
                        grid);
-  ReducedPlanes window{{}, r.rx, r.ry};
-  for (const cv::Mat& plane : r.planes) window.planes.push_back(plane(cells));
-  v.planes = sample.Relight(window, lighting, gain);
+  v.planes = sample.Relight(r.Window(cells), lighting, gain);
   std::mt19937 rng(seed);
   std::normal_distribution<float> n(0.0f, static_cast<float>(noise));
   for (cv::Mat& plane : v.planes) {
