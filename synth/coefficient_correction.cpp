@@ -19,6 +19,13 @@ namespace {
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Row6d = Eigen::Matrix<double, 1, 6>;
 
+// A cell's coefficients as a prediction reads them: the patch's luminance
+// coefficients (raw PTM) and LRGB colour there.
+struct CellCoefficients {
+  float a[6];
+  float colour[3];
+};
+
 }  // namespace
 
 // One patch's photo-consistency pass: the state the Gauss-Newton rounds share.
@@ -43,6 +50,7 @@ class CoefficientCorrection::PatchPass {
     patch.channel_gain.assign(3, cv::Mat());
     for (cv::Mat& m : patch.channel_gain) m = cv::Mat::ones(gh_, gw_, CV_32FC1);
     ComputeWayToMean();
+    ComputeCellsAtPatch();
     for (const RectifiedView& r : views_) texel_lights_.push_back(sample_.LightsOf(r.lighting));
     ComputeLightRows();
   }
@@ -72,6 +80,59 @@ class CoefficientCorrection::PatchPass {
   }
   const Vector6d& ToMean(int i, int j) const {
     return to_mean_of_cell_[static_cast<std::size_t>(j * gw_ + i)];
+  }
+  std::size_t Cell(int i, int j) const { return static_cast<std::size_t>(j * gw_ + i); }
+
+  // Cell (i, j)'s centre in the reduced sample's pixel coordinates (centres at
+  // integers), (sample_x + (i + 0.5) / rx) rx - 0.5, clamped to the planes.
+  cv::Point2d SamplePoint(int i, int j) const {
+    const cv::Mat& p0 = red0_.planes[0];
+    return {std::clamp(patch_.sample_x * red0_.rx + i, 0.0, p0.cols - 1.0),
+            std::clamp(patch_.sample_y * red0_.ry + j, 0.0, p0.rows - 1.0)};
+  }
+
+  // The patch's luminance coefficients and colour at every cell, bilinear in the
+  // reduced sample (the patch is fixed during the pass, so once).
+  void ComputeCellsAtPatch() {
+    const cv::Mat& p0 = red0_.planes[0];
+    cells_at_patch_.resize(static_cast<std::size_t>(gw_ * gh_));
+    for (int j = 0; j < gh_; ++j)
+      for (int i = 0; i < gw_; ++i) {
+        const cv::Point2d s = SamplePoint(i, j);
+        const int x0 = static_cast<int>(s.x), y0 = static_cast<int>(s.y);
+        const int x1 = std::min(x0 + 1, p0.cols - 1), y1 = std::min(y0 + 1, p0.rows - 1);
+        const float fx = static_cast<float>(s.x - x0), fy = static_cast<float>(s.y - y0);
+        const auto sample_at = [&](std::size_t m) {
+          const cv::Mat& plane = red0_.planes[m];
+          return (1 - fy) * ((1 - fx) * plane.at<float>(y0, x0) + fx * plane.at<float>(y0, x1)) +
+                 fy * ((1 - fx) * plane.at<float>(y1, x0) + fx * plane.at<float>(y1, x1));
+        };
+        CellCoefficients& cell = cells_at_patch_[Cell(i, j)];
+        for (std::size_t m = 0; m < 6; ++m) cell.a[m] = sample_at(m);
+        for (std::size_t c = 0; c < 3; ++c) cell.colour[c] = sample_at(6 + c);
+      }
+  }
+
+  // Cell (i, j)'s coefficients as the pass has them now: with its change (q,
+  // orthonormal) added and its colour times the channel factors found so far, so
+  // that each round's factors answer what the last left.
+  CellCoefficients CellNow(int i, int j) const {
+    const Eigen::Matrix<double, 6, 6>& from_orthonormal =
+        ptm::OrthonormalBasis::Hemisphere().FromOrthonormal();
+    const Vector6d a_delta = from_orthonormal * CorrectionAt(i, j);
+    const CellCoefficients& at_patch = cells_at_patch_[Cell(i, j)];
+    CellCoefficients now;
+    for (std::size_t m = 0; m < 6; ++m)
+      now.a[m] = at_patch.a[m] + static_cast<float>(a_delta[static_cast<Eigen::Index>(m)]);
+    for (std::size_t c = 0; c < 3; ++c)
+      now.colour[c] = at_patch.colour[c] * patch_.channel_gain[c].at<float>(j, i);
+    return now;
+  }
+  std::vector<CellCoefficients> CellsNow() const {
+    std::vector<CellCoefficients> cells(static_cast<std::size_t>(gw_ * gh_));
+    for (int j = 0; j < gh_; ++j)
+      for (int i = 0; i < gw_; ++i) cells[Cell(i, j)] = CellNow(i, j);
+    return cells;
   }
 
   // The way from the patch's coefficients to the prior's mean, per cell (the
@@ -108,41 +169,21 @@ class CoefficientCorrection::PatchPass {
   }
 
   // Prediction (displayed luminance) and luminance Jacobian of view `view` at cell
-  // (i, j), with the change q_delta (orthonormal) added to the patch's
-  // coefficients; the linear value per channel into `channel_linear`.
-  double Predict(std::size_t view, int i, int j, const Vector6d& q_delta, Row6d& jac,
+  // (i, j), whose coefficients are `cell` (CellNow); the linear value per channel
+  // into `channel_linear`.
+  double Predict(std::size_t view, int i, int j, const CellCoefficients& cell, Row6d& jac,
                  Eigen::Vector3d* channel_linear = nullptr) const {
-    // Cell (i, j)'s centre in the reduced sample's pixel coordinates (centres
-    // at integers): (sample_x + (i + 0.5) / rx) rx - 0.5; bilinear there.
-    const cv::Mat& p0 = red0_.planes[0];
-    const double sx = std::clamp(patch_.sample_x * red0_.rx + i, 0.0, p0.cols - 1.0);
-    const double sy = std::clamp(patch_.sample_y * red0_.ry + j, 0.0, p0.rows - 1.0);
-    const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
-    const int x1 = std::min(x0 + 1, p0.cols - 1), y1 = std::min(y0 + 1, p0.rows - 1);
-    const float fx = static_cast<float>(sx - x0), fy = static_cast<float>(sy - y0);
-    auto sample_at = [&](const cv::Mat& m) {
-      return (1 - fy) * ((1 - fx) * m.at<float>(y0, x0) + fx * m.at<float>(y0, x1)) +
-             fy * ((1 - fx) * m.at<float>(y1, x0) + fx * m.at<float>(y1, x1));
-    };
-    const Eigen::Matrix<double, 6, 6>& from_orthonormal =
-        ptm::OrthonormalBasis::Hemisphere().FromOrthonormal();
-    const Vector6d a_delta = from_orthonormal * q_delta;
-    float a[6], colour[3];
-    for (int m = 0; m < 6; ++m)
-      a[m] = sample_at(red0_.planes[static_cast<std::size_t>(m)]) + static_cast<float>(a_delta[m]);
-    // The colour as the channel factors found so far have it, so that each
-    // round's factors answer what the last left.
-    for (int c = 0; c < 3; ++c)
-      colour[c] = sample_at(red0_.planes[static_cast<std::size_t>(6 + c)]) *
-                  patch_.channel_gain[static_cast<std::size_t>(c)].at<float>(j, i);
+    const float* a = cell.a;
+    const float* colour = cell.colour;
     Eigen::Vector3d linear = Eigen::Vector3d::Zero();
     Eigen::Matrix<double, 3, 6> dlinear = Eigen::Matrix<double, 3, 6>::Zero();
     // The lights as the texel answers them (horizon fade, light response and
     // ambient, the relief's shadows), as PtmSample::Relight relights.
     const std::vector<ptm::EffectiveLight>* lights = &texel_lights_[view].lights;
     if (sample_.CastsShadows()) {  // else the lights are the view's, unchanged
-      sample_.ShadowLights(texel_lights_[view], red0_, BilinearTaps(p0.size(), sx, sy),
-                           shadowed_lights_);
+      const cv::Point2d s = SamplePoint(i, j);
+      sample_.ShadowLights(texel_lights_[view], red0_,
+                           BilinearTaps(red0_.planes[0].size(), s.x, s.y), shadowed_lights_);
       lights = &shadowed_lights_;
     }
     for (std::size_t k = 0; k < lights->size(); ++k) {
@@ -189,6 +230,7 @@ class CoefficientCorrection::PatchPass {
     if (options_.correction_prior_shrink >= 0.0) return options_.correction_prior_shrink;
     double photo_dot_patch = 0.0, patch_dot_patch = 0.0;
     Row6d jac;
+    const std::vector<CellCoefficients> cells = CellsNow();  // the patch's own
     for (std::size_t v = 0; v < views_.size(); ++v) {
       const RectifiedView& r = views_[v];
       // The prediction at the patch and the patch's departure, per cell, both
@@ -199,7 +241,7 @@ class CoefficientCorrection::PatchPass {
       for (int j = 0; j < gh_; ++j)
         for (int i = 0; i < gw_; ++i) {
           if (!Seen(r, i, j)) continue;
-          at_patch.at<float>(j, i) = static_cast<float>(Predict(v, i, j, Vector6d::Zero(), jac));
+          at_patch.at<float>(j, i) = static_cast<float>(Predict(v, i, j, cells[Cell(i, j)], jac));
           departure.at<float>(j, i) = static_cast<float>(-(jac * ToMean(i, j))(0));
           seen.at<float>(j, i) = 1.0f;
         }
@@ -217,32 +259,44 @@ class CoefficientCorrection::PatchPass {
     return 1.0 - std::clamp(rho, 0.0, 1.0);
   }
 
+  // Per cell and channel, the photos' linear values summed over the views that
+  // see it (the same every round, so once); marks those cells known.
+  void SumPhotosLinear() {
+    photo_linear_sum_.assign(3, cv::Mat());
+    for (cv::Mat& m : photo_linear_sum_) m = cv::Mat::zeros(gh_, gw_, CV_32FC1);
+    for (int j = 0; j < gh_; ++j)
+      for (int i = 0; i < gw_; ++i)
+        for (const RectifiedView& r : views_) {
+          if (!Seen(r, i, j)) continue;
+          for (std::size_t c = 0; c < 3; ++c)
+            photo_linear_sum_[c].at<float>(j, i) += SrgbToLinear(r.planes[c].at<float>(j, i));
+          known_.at<std::uint8_t>(j, i) = 1;
+        }
+  }
+
   // Per-channel factors at low frequency (stains, colour): photo over
   // prediction in the linear domain, summed over the views and smoothed over a
   // few photo pixels (normalised convolution), taken back to display values
   // (x^(1/2.2)), chromaticity only. Finer detail stays the sample's.
   void UpdateChannelFactors() {
-    std::vector<cv::Mat> photo_sum(3), model_sum(3);
-    for (int c = 0; c < 3; ++c)
-      photo_sum[static_cast<std::size_t>(c)] = cv::Mat::zeros(gh_, gw_, CV_32FC1),
-      model_sum[static_cast<std::size_t>(c)] = cv::Mat::zeros(gh_, gw_, CV_32FC1);
+    if (photo_linear_sum_.empty()) SumPhotosLinear();
+    std::vector<cv::Mat> model_sum(3);
+    for (cv::Mat& m : model_sum) m = cv::Mat::zeros(gh_, gw_, CV_32FC1);
     for (int j = 0; j < gh_; ++j) {
       for (int i = 0; i < gw_; ++i) {
+        if (!known_.at<std::uint8_t>(j, i)) continue;  // seen by no view
+        const CellCoefficients cell = CellNow(i, j);
         for (std::size_t v = 0; v < views_.size(); ++v) {
-          const RectifiedView& r = views_[v];
-          if (!Seen(r, i, j)) continue;
+          if (!Seen(views_[v], i, j)) continue;
           Row6d row;
           Eigen::Vector3d lin;
-          Predict(v, i, j, CorrectionAt(i, j), row, &lin);
-          for (int c = 0; c < 3; ++c) {
-            photo_sum[static_cast<std::size_t>(c)].at<float>(j, i) +=
-                SrgbToLinear(r.planes[static_cast<std::size_t>(c)].at<float>(j, i));
-            model_sum[static_cast<std::size_t>(c)].at<float>(j, i) += static_cast<float>(lin[c]);
-          }
-          known_.at<std::uint8_t>(j, i) = 1;
+          Predict(v, i, j, cell, row, &lin);
+          for (std::size_t c = 0; c < 3; ++c)
+            model_sum[c].at<float>(j, i) += static_cast<float>(lin[static_cast<Eigen::Index>(c)]);
         }
       }
     }
+    const std::vector<cv::Mat>& photo_sum = photo_linear_sum_;
     std::vector<cv::Mat> pb(3), mb(3);
     for (std::size_t c = 0; c < 3; ++c) {
       cv::GaussianBlur(photo_sum[c], pb[c], cv::Size(0, 0), options_.correction_sigma);
@@ -276,7 +330,8 @@ class CoefficientCorrection::PatchPass {
     cv::Mat seen_by_photo;  // CV_32FC1
     std::vector<Row6d> jacobian;
   };
-  ViewPrediction PredictThroughBlur(std::size_t v) const {
+  ViewPrediction PredictThroughBlur(std::size_t v,
+                                    const std::vector<CellCoefficients>& cells) const {
     const RectifiedView& r = views_[v];
     ViewPrediction p{cv::Mat::zeros(gh_, gw_, CV_32FC1),
                      std::vector<Row6d>(static_cast<std::size_t>(gw_ * gh_), Row6d::Zero())};
@@ -284,8 +339,8 @@ class CoefficientCorrection::PatchPass {
     for (int j = 0; j < gh_; ++j)
       for (int i = 0; i < gw_; ++i) {
         if (!Seen(r, i, j)) continue;
-        p.seen_by_photo.at<float>(j, i) = static_cast<float>(Predict(
-            v, i, j, CorrectionAt(i, j), p.jacobian[static_cast<std::size_t>(j * gw_ + i)]));
+        p.seen_by_photo.at<float>(j, i) =
+            static_cast<float>(Predict(v, i, j, cells[Cell(i, j)], p.jacobian[Cell(i, j)]));
         seen.at<float>(j, i) = 1.0f;
       }
     p.seen_by_photo = MaskedGaussian(p.seen_by_photo, seen, r.blur_cells);
@@ -299,8 +354,10 @@ class CoefficientCorrection::PatchPass {
   // prediction through the photo's blur: detail the photo blurs away is no
   // error, so the change does not take it out.
   void UpdateAdditiveChange(double shrink) {
+    const std::vector<CellCoefficients> cells = CellsNow();
     std::vector<ViewPrediction> predicted;
-    for (std::size_t v = 0; v < views_.size(); ++v) predicted.push_back(PredictThroughBlur(v));
+    for (std::size_t v = 0; v < views_.size(); ++v)
+      predicted.push_back(PredictThroughBlur(v, cells));
     for (int j = 0; j < gh_; ++j) {
       for (int i = 0; i < gw_; ++i) {
         Eigen::Matrix<double, Eigen::Dynamic, 6> jac(static_cast<int>(views_.size()), 6);
@@ -370,6 +427,8 @@ class CoefficientCorrection::PatchPass {
   const MeshSynthesisOptions& options_;
   int gw_, gh_;
   std::vector<Vector6d> to_mean_of_cell_;
+  std::vector<CellCoefficients> cells_at_patch_;  // ComputeCellsAtPatch
+  std::vector<cv::Mat> photo_linear_sum_;         // SumPhotosLinear, per channel
   // Per view, the lights as the texel answers them (PtmSample::LightsOf), once.
   std::vector<PtmSample::TexelLights> texel_lights_;
   std::vector<std::vector<Row6d>> light_rows_;  // per view and light: ComputeLightRows

@@ -15,49 +15,106 @@ namespace {
 // (x, y), 6 orthonormal luminance coefficients each (5 x 5 matched worse on the
 // demo: SSIM 0.536 against 0.538).
 constexpr int kDetailWindowRadius = 1;
-constexpr int kDetailWindowLength =
-    (2 * kDetailWindowRadius + 1) * (2 * kDetailWindowRadius + 1) * 6;
-// At most this many sample points per dictionary (2^16 windows take 14 MiB;
-// a 256 x 256 sample has about 62 000).
+constexpr int kDetailWindowSide = 2 * kDetailWindowRadius + 1;
+constexpr int kCoefficients = 6;
+// A point's coefficients padded to 8 floats (two SSE vectors: the window
+// distance's loops vectorise); the pads are 0 in the sample's planes and in
+// every window.
+constexpr int kPointFloats = 8;
+constexpr int kDetailWindowLength = kDetailWindowSide * kDetailWindowSide * kPointFloats;
+// At most this many sample points per dictionary (a 256 x 256 sample has about
+// 62 000; the index holds their 8 principal components, 2 MiB).
 constexpr std::size_t kDetailMaxPoints = std::size_t{1} << 16;
 
-// The coarse coefficients of the window of 3 x 3 points (dx, dy) texels apart
-// around (x, y), point by point, 6 each: visit(k, value) for k = 0, 1, ... until
-// it returns false.
+// Bilinear taps along one axis of the coarse planes at the window's points
+// centre + k step, k = -radius..radius (clamped as BilinearTaps clamps).
+struct WindowAxis {
+  WindowAxis(int size, double centre, double step) {
+    for (int k = 0; k < kDetailWindowSide; ++k) {
+      const double t = std::clamp(centre + (k - kDetailWindowRadius) * step, 0.0, size - 1.0);
+      lo[k] = std::min(static_cast<int>(t), std::max(size - 2, 0));
+      hi[k] = std::min(lo[k] + 1, size - 1);
+      f[k] = static_cast<float>(t - lo[k]);
+    }
+  }
+  int lo[kDetailWindowSide], hi[kDetailWindowSide];
+  float f[kDetailWindowSide];
+};
+
+// The coarse coefficients (kPointFloats per point, CV_32FC(kPointFloats) planes) of
+// the window of 3 x 3 points (dx, dy) texels apart around (x, y), bilinear in
+// floats: visit(k, point) for points k = 0, 1, ... until it returns false.
 template <typename Visit>
 void VisitCoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy,
                        Visit visit) {
-  std::array<double, 6> at_point;
+  const WindowAxis along_x(coarse.cols, x, dx), along_y(coarse.rows, y, dy);
+  alignas(32) float point[kPointFloats];
   int k = 0;
-  for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
-    for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a) {
-      BilinearTaps(coarse.size(), x + a * dx, y + b * dy).OfChannels(coarse, at_point);
-      for (const double v : at_point)
-        if (!visit(k++, static_cast<float>(v))) return;
+  for (int b = 0; b < kDetailWindowSide; ++b) {
+    const float* r0 = coarse.ptr<float>(along_y.lo[b]);
+    const float* r1 = coarse.ptr<float>(along_y.hi[b]);
+    const float fy = along_y.f[b];
+    for (int a = 0; a < kDetailWindowSide; ++a) {
+      const float fx = along_x.f[a];
+      const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy,
+                  w11 = fx * fy;
+      const float* v00 = r0 + along_x.lo[a] * kPointFloats;
+      const float* v10 = r0 + along_x.hi[a] * kPointFloats;
+      const float* v01 = r1 + along_x.lo[a] * kPointFloats;
+      const float* v11 = r1 + along_x.hi[a] * kPointFloats;
+      for (int m = 0; m < kPointFloats; ++m)
+        point[m] = w00 * v00[m] + w10 * v10[m] + w01 * v01[m] + w11 * v11[m];
+      if (!visit(k++, point)) return;
     }
+  }
 }
 
 void CoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy, float* window) {
-  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, float v) {
-    window[k] = v;
+  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const float* point) {
+    std::copy(point, point + kPointFloats, window + k * kPointFloats);
     return true;
   });
 }
 
 // The squared distance from `query` to the coarse window at (x, y), or a partial
-// sum of it of at least `bound` (the sum only grows: the comparison with the bound
-// is the same).
-double CoarseWindowDistance(const cv::Mat& coarse, double x, double y, double dx, double dy,
-                            const float* query, double bound) {
-  double e = 0.0;
-  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, float v) {
-    e += (v - query[k]) * (v - query[k]);
+// sum of it (whole points) of at least `bound` (the sum only grows: the
+// comparison with the bound is the same).
+float CoarseWindowDistance(const cv::Mat& coarse, double x, double y, double dx, double dy,
+                           const float* query, float bound) {
+  float e = 0.0f;
+  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const float* point) {
+    const float* q = query + k * kPointFloats;
+    float point_e[kPointFloats];
+    for (int m = 0; m < kPointFloats; ++m) point_e[m] = (point[m] - q[m]) * (point[m] - q[m]);
+    for (int m = 0; m < kPointFloats; ++m) e += point_e[m];
     return e < bound;
   });
   return e;
 }
 
 }  // namespace
+
+class DetailDictionary::PointWindows : public NearestWindows::Windows {
+ public:
+  explicit PointWindows(const DetailDictionary& d) : d_(d) {}
+  int Count() const override { return static_cast<int>(d_.points_.size()); }
+  int Length() const override { return kDetailWindowLength; }
+  void Rows(int first, cv::Mat& block) const override {
+    for (int r = 0; r < block.rows; ++r) {
+      const cv::Point p = d_.points_[static_cast<std::size_t>(first + r)];
+      CoarseWindow(d_.coarse_, p.x, p.y, d_.dx_, d_.dy_, block.ptr<float>(r));
+    }
+  }
+  float SquaredDistance(const float* query, int window, float bound) const override {
+    const cv::Point p = d_.points_[static_cast<std::size_t>(window)];
+    return CoarseWindowDistance(d_.coarse_, p.x, p.y, d_.dx_, d_.dy_, query, bound);
+  }
+
+ private:
+  const DetailDictionary& d_;
+};
+
+DetailDictionary::~DetailDictionary() = default;
 
 DetailDictionary::DetailDictionary(const PtmSample& sample, int level, std::vector<cv::Mat>& band) {
   const ReducedPlanes& red = sample.Reduced(level);
@@ -68,21 +125,22 @@ DetailDictionary::DetailDictionary(const PtmSample& sample, int level, std::vect
   for (std::size_t c = 0; c < coarse_raw.size(); ++c)
     cv::resize(red.planes[c], coarse_raw[c], full, 0, 0, cv::INTER_LINEAR);
   const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
-  coarse_ = cv::Mat(full, CV_32FC(6));
+  coarse_ = cv::Mat::zeros(full, CV_32FC(kPointFloats));
   for (int y = 0; y < full.height; ++y)
     for (int x = 0; x < full.width; ++x)
-      for (int m = 0; m < 6; ++m) {
+      for (int m = 0; m < kCoefficients; ++m) {
         double v = 0.0;
-        for (int k = 0; k < 6; ++k)
+        for (int k = 0; k < kCoefficients; ++k)
           v += to(m, k) * coarse_raw[static_cast<std::size_t>(k)].at<float>(y, x);
-        coarse_.ptr<float>(y)[x * 6 + m] = static_cast<float>(v);
+        coarse_.ptr<float>(y)[x * kPointFloats + m] = static_cast<float>(v);
       }
   const std::vector<cv::Mat>& values = sample.Values();
   band.resize(values.size());
   cv::Mat coarse_plane;
   for (std::size_t c = 0; c < band.size(); ++c) {
-    if (c < 6) cv::extractChannel(coarse_, coarse_plane, static_cast<int>(c));
-    band[c] = values[c] - (c < 6 ? coarse_plane : coarse_raw[c]);
+    const bool luminance = c < static_cast<std::size_t>(kCoefficients);
+    if (luminance) cv::extractChannel(coarse_, coarse_plane, static_cast<int>(c));
+    band[c] = values[c] - (luminance ? coarse_plane : coarse_raw[c]);
   }
   IndexWindows(full);
 }
@@ -98,27 +156,23 @@ void DetailDictionary::IndexWindows(cv::Size full) {
       std::ceil(std::sqrt(static_cast<double>(nx) * ny / static_cast<double>(kDetailMaxPoints))));
   for (int y = by; y < full.height - by; y += stride)
     for (int x = bx; x < full.width - bx; x += stride) points_.emplace_back(x, y);
-  cv::Mat windows(static_cast<int>(points_.size()), kDetailWindowLength, CV_32FC1);
-  for (std::size_t n = 0; n < points_.size(); ++n)
-    CoarseWindow(coarse_, points_[n].x, points_[n].y, dx_, dy_,
-                 windows.ptr<float>(static_cast<int>(n)));
-  nearest_ = std::make_unique<NearestWindows>(std::move(windows), NearestWindows::Options{});
+  windows_ = std::make_unique<PointWindows>(*this);
+  nearest_ = std::make_unique<NearestWindows>(*windows_, NearestWindows::Options{});
 }
 
 cv::Mat DetailDictionary::CorrectedWindows(const TrianglePatch& patch) const {
   // The coarse coefficients under each cell plus the cell's correction.
   const int gw = patch.correction[0].cols, gh = patch.correction[0].rows;
-  std::vector<cv::Mat> corrected(6);
-  for (cv::Mat& m : corrected) m = cv::Mat(gh, gw, CV_32FC1);
+  cv::Mat corrected = cv::Mat::zeros(gh, gw, CV_32FC(kPointFloats));
   for (int j = 0; j < gh; ++j)
     for (int i = 0; i < gw; ++i) {
-      std::array<double, 6> coarse;
+      std::array<double, kPointFloats> coarse;
       BilinearTaps(coarse_.size(), patch.sample_x + (i + 0.5) * dx_ - 0.5,
                    patch.sample_y + (j + 0.5) * dy_ - 0.5)
           .OfChannels(coarse_, coarse);
-      for (std::size_t m = 0; m < 6; ++m)
-        corrected[m].at<float>(j, i) =
-            static_cast<float>(coarse[m] + patch.correction[m].at<float>(j, i));
+      float* point = corrected.ptr<float>(j) + i * kPointFloats;
+      for (std::size_t m = 0; m < kCoefficients; ++m)
+        point[m] = static_cast<float>(coarse[m] + patch.correction[m].at<float>(j, i));
     }
   // Each cell's window of them (clamped at the grid's edges).
   cv::Mat windows(gh * gw, kDetailWindowLength, CV_32FC1);
@@ -126,10 +180,11 @@ cv::Mat DetailDictionary::CorrectedWindows(const TrianglePatch& patch) const {
     for (int i = 0; i < gw; ++i) {
       float* q = windows.ptr<float>(j * gw + i);
       for (int b = -kDetailWindowRadius; b <= kDetailWindowRadius; ++b)
-        for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a)
-          for (std::size_t m = 0; m < 6; ++m)
-            *q++ =
-                corrected[m].at<float>(std::clamp(j + b, 0, gh - 1), std::clamp(i + a, 0, gw - 1));
+        for (int a = -kDetailWindowRadius; a <= kDetailWindowRadius; ++a) {
+          const float* point = corrected.ptr<float>(std::clamp(j + b, 0, gh - 1)) +
+                               std::clamp(i + a, 0, gw - 1) * kPointFloats;
+          q = std::copy(point, point + kPointFloats, q);
+        }
     }
   return windows;
 }
@@ -163,10 +218,10 @@ void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, Matches& 
     const double x = matches.source[n][0] + (i - ni) * dx_;
     const double y = matches.source[n][1] + (j - nj) * dy_;
     if (x < x_lo || x > x_hi || y < y_lo || y > y_hi) return;
-    const double e = CoarseWindowDistance(coarse_, x, y, dx_, dy_, windows.ptr<float>(j * gw + i),
-                                          matches.distance[c]);
+    const float e = CoarseWindowDistance(coarse_, x, y, dx_, dy_, windows.ptr<float>(j * gw + i),
+                                         matches.distance[c]);
     if (e < matches.distance[c])
-      matches.distance[c] = static_cast<float>(e),
+      matches.distance[c] = e,
       matches.source[c] = cv::Vec2f(static_cast<float>(x), static_cast<float>(y));
   };
   if (forward) {

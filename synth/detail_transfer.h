@@ -26,6 +26,9 @@ class DetailDictionary {
   /// detail band (per plane of sample.Values()). Touches no shared state, so
   /// levels can be built in parallel.
   DetailDictionary(const PtmSample& sample, int level, std::vector<cv::Mat>& band);
+  ~DetailDictionary();
+  DetailDictionary(const DetailDictionary&) = delete;
+  DetailDictionary& operator=(const DetailDictionary&) = delete;
 
   /// False when the windows are wider than the sample: no transfer.
   bool Usable() const { return nearest_ != nullptr; }
@@ -60,9 +63,13 @@ class DetailDictionary {
   // and below) taking a neighbour's match moved by one cell wherever it is nearer.
   void Propagate(const cv::Mat& windows, bool forward, Matches& matches) const;
 
-  double dx_ = 1.0, dy_ = 1.0;     // texels per photo cell
-  cv::Mat coarse_;                 // the 6 orthonormal luminance planes interleaved, full size
+  // The windows around points_, read from coarse_ as the index asks (none held).
+  class PointWindows;
+
+  double dx_ = 1.0, dy_ = 1.0;  // texels per photo cell
+  cv::Mat coarse_;  // the 6 orthonormal luminance planes interleaved (8 floats a point), full size
   std::vector<cv::Point> points_;  // window centres, texels
+  std::unique_ptr<PointWindows> windows_;
   std::unique_ptr<NearestWindows> nearest_;
 };
 

@@ -25,10 +25,14 @@ nanoflann::SearchParams SearchEps(float eps) { return nanoflann::SearchParams(0,
 
 // The mean (1 x length, CV_32F) and the `count` leading principal directions
 // (rows, CV_32F, by decreasing variance), from every step-th window.
-void PrincipalComponents(const cv::Mat& windows, int count, cv::Mat& mean, cv::Mat& directions) {
-  const int step = std::max(1, (windows.rows + kMaxComponentRows - 1) / kMaxComponentRows);
-  cv::Mat rows((windows.rows + step - 1) / step, windows.cols, CV_32FC1);
-  for (int r = 0; r < windows.rows; r += step) windows.row(r).copyTo(rows.row(r / step));
+void PrincipalComponents(const NearestWindows::Windows& windows, int count, cv::Mat& mean,
+                         cv::Mat& directions) {
+  const int step = std::max(1, (windows.Count() + kMaxComponentRows - 1) / kMaxComponentRows);
+  cv::Mat rows((windows.Count() + step - 1) / step, windows.Length(), CV_32FC1);
+  for (int r = 0; r < windows.Count(); r += step) {
+    cv::Mat row = rows.row(r / step);
+    windows.Rows(r, row);
+  }
   cv::Mat covariance, mean64, variances, all;
   cv::calcCovarMatrix(rows, covariance, mean64, cv::COVAR_NORMAL | cv::COVAR_ROWS | cv::COVAR_SCALE,
                       CV_64F);
@@ -39,12 +43,13 @@ void PrincipalComponents(const cv::Mat& windows, int count, cv::Mat& mean, cv::M
 
 }  // namespace
 
-// nanoflann's dataset adaptor over the projected windows (a row each).
+// nanoflann's dataset adaptor over the projected windows (a row each, contiguous).
 struct NearestWindows::Tree {
   cv::Mat projected;
+  const float* points = nullptr;  // projected's rows
   std::size_t kdtree_get_point_count() const { return static_cast<std::size_t>(projected.rows); }
   float kdtree_get_pt(std::size_t i, std::size_t d) const {
-    return projected.ptr<float>(static_cast<int>(i))[d];
+    return points[i * static_cast<std::size_t>(projected.cols) + d];
   }
   template <class Box>
   bool kdtree_get_bbox(Box& /*box*/) const {
@@ -53,47 +58,94 @@ struct NearestWindows::Tree {
   using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Tree>, Tree,
                                                     -1, std::uint32_t>;
   std::unique_ptr<Index> index;
+  std::vector<std::uint32_t> window_of_point;  // the window each point (row of projected) is
+
+  // The tree's order of the points (its leaves' points side by side).
+  std::vector<std::uint32_t>& Order() {
+#if NANOFLANN_VERSION >= 0x150
+    return index->vAcc_;
+#else
+    return index->vAcc;
+#endif
+  }
+
+  // Stores the points in the tree's order, so that a leaf's points lie side by
+  // side in memory (issue 33: the leaves' scans read scattered rows and missed
+  // the cache); the tree then visits them in the same order as before.
+  void StoreInTreeOrder() {
+    std::vector<std::uint32_t>& order = Order();
+    cv::Mat sorted(projected.rows, projected.cols, CV_32FC1);
+    for (std::size_t n = 0; n < order.size(); ++n)
+      projected.row(static_cast<int>(order[n])).copyTo(sorted.row(static_cast<int>(n)));
+    window_of_point = order;
+    for (std::size_t n = 0; n < order.size(); ++n) order[n] = static_cast<std::uint32_t>(n);
+    projected = sorted;
+    points = projected.ptr<float>();
+  }
 };
 
-NearestWindows::NearestWindows(cv::Mat windows, Options options)
-    : options_(options), windows_(std::move(windows)), tree_(std::make_unique<Tree>()) {
-  if (windows_.type() != CV_32FC1 || windows_.rows < 2 || options_.components < 1 ||
+float NearestWindows::WindowMatrix::SquaredDistance(const float* query, int window,
+                                                    float /*bound*/) const {
+  const float* w = windows_.ptr<float>(window);
+  float d = 0.0f;
+  for (int i = 0; i < windows_.cols; ++i) d += (w[i] - query[i]) * (w[i] - query[i]);
+  return d;
+}
+
+NearestWindows::NearestWindows(const Windows& windows, Options options)
+    : options_(options), windows_(windows), tree_(std::make_unique<Tree>()) {
+  if (windows_.Count() < 2 || windows_.Length() < 1 || options_.components < 1 ||
       options_.candidates < 1 || !(options_.eps >= 0.0f))
     throw std::invalid_argument(
-        "NearestWindows: float windows (at least 2), components and candidates >= 1, eps >= 0");
+        "NearestWindows: windows (at least 2), components and candidates >= 1, eps >= 0");
   PrincipalComponents(windows_, options_.components, mean_, components_);
-  tree_->projected = Project(windows_);
+  tree_->projected = ProjectWindows();
+  tree_->points = tree_->projected.ptr<float>();
   tree_->index = std::make_unique<Tree::Index>(  // builds the tree
       components_.rows, *tree_, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize));
+  tree_->StoreInTreeOrder();
 }
 
 NearestWindows::~NearestWindows() = default;
 
+void NearestWindows::ProjectBlock(cv::Mat& centred, cv::Mat block) const {
+  const float* mean = mean_.ptr<float>();
+  for (int r = 0; r < centred.rows; ++r) {
+    float* c = centred.ptr<float>(r);
+    for (int i = 0; i < centred.cols; ++i) c[i] -= mean[i];
+  }
+  cv::gemm(centred, components_, 1.0, cv::noArray(), 0.0, block, cv::GEMM_2_T);
+}
+
+cv::Mat NearestWindows::ProjectWindows() const {
+  // A block of windows at a time (never every window at once).
+  cv::Mat out(windows_.Count(), components_.rows, CV_32FC1);
+  cv::Mat centred;
+  for (int first = 0; first < windows_.Count(); first += kProjectedBlockRows) {
+    const int count = std::min(kProjectedBlockRows, windows_.Count() - first);
+    centred.create(count, windows_.Length(), CV_32FC1);
+    windows_.Rows(first, centred);
+    ProjectBlock(centred, out.rowRange(first, first + count));
+  }
+  return out;
+}
+
 cv::Mat NearestWindows::Project(const cv::Mat& rows) const {
-  // Each row less the mean, a block of rows at a time (no copy of every window at
-  // once), then its components.
   cv::Mat out(rows.rows, components_.rows, CV_32FC1);
   cv::Mat centred;
-  const float* mean = mean_.ptr<float>();
   for (int first = 0; first < rows.rows; first += kProjectedBlockRows) {
     const int count = std::min(kProjectedBlockRows, rows.rows - first);
-    centred.create(count, rows.cols, CV_32FC1);
-    for (int r = 0; r < count; ++r) {
-      const float* in = rows.ptr<float>(first + r);
-      float* c = centred.ptr<float>(r);
-      for (int i = 0; i < rows.cols; ++i) c[i] = in[i] - mean[i];
-    }
-    cv::Mat block = out.rowRange(first, first + count);
-    cv::gemm(centred, components_, 1.0, cv::noArray(), 0.0, block, cv::GEMM_2_T);
+    rows.rowRange(first, first + count).copyTo(centred);
+    ProjectBlock(centred, out.rowRange(first, first + count));
   }
   return out;
 }
 
 void NearestWindows::Nearest(const cv::Mat& queries, std::vector<int>& index,
                              std::vector<float>& squared_distance) const {
-  CV_Assert(queries.type() == CV_32FC1 && queries.cols == windows_.cols);
+  CV_Assert(queries.type() == CV_32FC1 && queries.cols == windows_.Length());
   const cv::Mat projected = Project(queries);
-  const std::size_t k = static_cast<std::size_t>(std::min(options_.candidates, windows_.rows));
+  const std::size_t k = static_cast<std::size_t>(std::min(options_.candidates, windows_.Count()));
   std::vector<std::uint32_t> found(k);
   std::vector<float> reduced_distance(k);
   index.assign(static_cast<std::size_t>(queries.rows), 0);
@@ -106,10 +158,9 @@ void NearestWindows::Nearest(const cv::Mat& queries, std::vector<int>& index,
     const float* query = queries.ptr<float>(q);
     const std::size_t n = static_cast<std::size_t>(q);
     for (std::size_t c = 0; c < nearest.size(); ++c) {
-      const float* window = windows_.ptr<float>(static_cast<int>(found[c]));
-      float d = 0.0f;
-      for (int i = 0; i < windows_.cols; ++i) d += (window[i] - query[i]) * (window[i] - query[i]);
-      if (d < squared_distance[n]) squared_distance[n] = d, index[n] = static_cast<int>(found[c]);
+      const int w = static_cast<int>(tree_->window_of_point[found[c]]);
+      const float d = windows_.SquaredDistance(query, w, squared_distance[n]);
+      if (d < squared_distance[n]) squared_distance[n] = d, index[n] = w;
     }
   }
 }

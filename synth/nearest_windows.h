@@ -28,24 +28,55 @@ class NearestWindows {
     float eps = 8.0f;    ///< approximation of the tree search (0: exact in the components)
   };
 
-  /// Indexes `windows` (CV_32FC1, a window per row, at least 2 rows).
-  NearestWindows(cv::Mat windows, Options options);
+  /// Where the windows come from, so that they need not be held: their count and
+  /// length, any run of them as rows, and a query's full distance to one.
+  class Windows {
+   public:
+    virtual ~Windows() = default;
+    virtual int Count() const = 0;
+    virtual int Length() const = 0;
+    /// Windows first, first + 1, ... as the rows of `block` (CV_32FC1, Length() wide).
+    virtual void Rows(int first, cv::Mat& block) const = 0;
+    /// The squared L2 distance from `query` (Length() floats) to window `window`,
+    /// or a partial sum of it of at least `bound` (it is only compared with bound).
+    virtual float SquaredDistance(const float* query, int window, float bound) const = 0;
+  };
+  /// Windows held in a matrix (CV_32FC1, a window per row).
+  class WindowMatrix : public Windows {
+   public:
+    explicit WindowMatrix(cv::Mat windows) : windows_(std::move(windows)) {}
+    int Count() const override { return windows_.rows; }
+    int Length() const override { return windows_.cols; }
+    void Rows(int first, cv::Mat& block) const override {
+      windows_.rowRange(first, first + block.rows).copyTo(block);
+    }
+    float SquaredDistance(const float* query, int window, float bound) const override;
+
+   private:
+    cv::Mat windows_;
+  };
+
+  /// Indexes `windows` (float, at least 2), which must outlive this.
+  NearestWindows(const Windows& windows, Options options);
   ~NearestWindows();
   NearestWindows(const NearestWindows&) = delete;
   NearestWindows& operator=(const NearestWindows&) = delete;
 
   /// For each row of `queries` (CV_32FC1, the windows' length): the index of the
-  /// nearest window found and its full squared distance.
+  /// nearest window found and its full squared distance (Windows::SquaredDistance).
   void Nearest(const cv::Mat& queries, std::vector<int>& index,
                std::vector<float>& squared_distance) const;
 
   int Components() const { return components_.rows; }
 
  private:
+  // The windows' or the queries' principal components, a row each.
+  cv::Mat ProjectWindows() const;
   cv::Mat Project(const cv::Mat& rows) const;
+  void ProjectBlock(cv::Mat& centred, cv::Mat block) const;
 
   Options options_;
-  cv::Mat windows_;     // CV_32FC1, full length
+  const Windows& windows_;
   cv::Mat mean_;        // 1 x length
   cv::Mat components_;  // Components() x length, orthonormal rows
   struct Tree;

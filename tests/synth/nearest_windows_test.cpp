@@ -39,7 +39,8 @@ float SquaredDistance(const cv::Mat& a, const cv::Mat& b) {
 
 TEST(NearestWindows, FewComponentsFindTheWindowsThemselves) {
   const cv::Mat windows = SmoothWindows(120, 3);
-  const NearestWindows nearest(windows.clone(), NearestWindows::Options{});
+  const NearestWindows::WindowMatrix source(windows.clone());
+  const NearestWindows nearest(source, NearestWindows::Options{});
   EXPECT_GE(nearest.Components(), 1);
   EXPECT_EQ(nearest.Components(), 8);
   cv::Mat queries;
@@ -56,7 +57,8 @@ TEST(NearestWindows, FewComponentsFindTheWindowsThemselves) {
 void ExpectNearlyTheExactNearest(NearestWindows::Options options, double exact_share,
                                  double mean_ratio) {
   const cv::Mat windows = SmoothWindows(120, 5);
-  const NearestWindows nearest(windows.clone(), options);
+  const NearestWindows::WindowMatrix source(windows.clone());
+  const NearestWindows nearest(source, options);
   std::mt19937 rng(9);
   std::normal_distribution<float> noise(0.0f, 0.05f);
   cv::Mat queries;
@@ -102,8 +104,9 @@ TEST(NearestWindows, TheSameWindowsGiveTheSameMatches) {
   const cv::Mat queries = SmoothWindows(20, 8);
   std::vector<int> a, b;
   std::vector<float> da, db;
-  NearestWindows(windows.clone(), NearestWindows::Options{}).Nearest(queries, a, da);
-  NearestWindows(windows.clone(), NearestWindows::Options{}).Nearest(queries, b, db);
+  const NearestWindows::WindowMatrix source(windows);
+  NearestWindows(source, NearestWindows::Options{}).Nearest(queries, a, da);
+  NearestWindows(source, NearestWindows::Options{}).Nearest(queries, b, db);
   EXPECT_EQ(a, b);
   EXPECT_EQ(da, db);
 }
