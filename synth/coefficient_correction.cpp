@@ -168,10 +168,10 @@ class CoefficientCorrection::PatchPass {
     }
   }
 
-  // Prediction (displayed luminance) and luminance Jacobian of view `view` at cell
-  // (i, j), whose coefficients are `cell` (CellNow); the linear value per channel
-  // into `channel_linear`.
-  double Predict(std::size_t view, int i, int j, const CellCoefficients& cell, Row6d& jac,
+  // Prediction (displayed luminance) of view `view` at cell (i, j), whose
+  // coefficients are `cell` (CellNow); its luminance Jacobian into `jac` and the
+  // linear value per channel into `channel_linear`, each unless null.
+  double Predict(std::size_t view, int i, int j, const CellCoefficients& cell, Row6d* jac,
                  Eigen::Vector3d* channel_linear = nullptr) const {
     const float* a = cell.a;
     const float* colour = cell.colour;
@@ -194,27 +194,29 @@ class CoefficientCorrection::PatchPass {
       for (int c = 0; c < 3; ++c) {
         const double v = lum * colour[c];
         if (v <= 0.0 || v >= 1.0) continue;  // clamped: no derivative
+        linear[c] += intensity * SrgbToLinear(static_cast<float>(v));
+        if (!jac) continue;
         const double h = 1e-3;
         const double dlin = (SrgbToLinear(static_cast<float>(std::min(1.0, v + h))) -
                              SrgbToLinear(static_cast<float>(std::max(0.0, v - h)))) /
                             (std::min(1.0, v + h) - std::max(0.0, v - h));
-        linear[c] += intensity * SrgbToLinear(static_cast<float>(v));
         dlinear.row(c) += intensity * dlin * colour[c] * row;
       }
     }
     const double g = gains_[views_[view].photo];
     double y_pred = 0.0;
-    jac.setZero();
+    if (jac) jac->setZero();
     for (int c = 0; c < 3; ++c) {
       const double lin = g * linear[c];
       if (channel_linear) (*channel_linear)[c] = lin;
       const double d = LinearToSrgb(static_cast<float>(lin));
+      y_pred += d / 3.0;
+      if (!jac) continue;
       const double h = 1e-4;
       const double dsrgb = (LinearToSrgb(static_cast<float>(lin + h)) -
                             LinearToSrgb(static_cast<float>(std::max(0.0, lin - h)))) /
                            (lin + h - std::max(0.0, lin - h));
-      y_pred += d / 3.0;
-      jac += dsrgb * g * dlinear.row(c) / 3.0;
+      *jac += dsrgb * g * dlinear.row(c) / 3.0;
     }
     return y_pred;
   }
@@ -225,12 +227,14 @@ class CoefficientCorrection::PatchPass {
   // it, over the patch's cells and views (how much of the patch's own structure
   // the photos confirm where they see it), clamped to [0, 1]. The departure is
   // linearised at the patch, d = -J (mean - patch), and like the prediction
-  // seen through the photo's blur.
-  double PriorShrink() const {
+  // seen through the photo's blur. Keeps the linear values predicted at the
+  // patch for the first round's channel factors (linear_at_patch_).
+  double PriorShrink() {
     if (options_.correction_prior_shrink >= 0.0) return options_.correction_prior_shrink;
     double photo_dot_patch = 0.0, patch_dot_patch = 0.0;
     Row6d jac;
     const std::vector<CellCoefficients> cells = CellsNow();  // the patch's own
+    linear_at_patch_.assign(views_.size() * cells.size(), Eigen::Vector3d::Zero());
     for (std::size_t v = 0; v < views_.size(); ++v) {
       const RectifiedView& r = views_[v];
       // The prediction at the patch and the patch's departure, per cell, both
@@ -241,7 +245,8 @@ class CoefficientCorrection::PatchPass {
       for (int j = 0; j < gh_; ++j)
         for (int i = 0; i < gw_; ++i) {
           if (!Seen(r, i, j)) continue;
-          at_patch.at<float>(j, i) = static_cast<float>(Predict(v, i, j, cells[Cell(i, j)], jac));
+          at_patch.at<float>(j, i) = static_cast<float>(Predict(
+              v, i, j, cells[Cell(i, j)], &jac, &linear_at_patch_[v * cells.size() + Cell(i, j)]));
           departure.at<float>(j, i) = static_cast<float>(-(jac * ToMean(i, j))(0));
           seen.at<float>(j, i) = 1.0f;
         }
@@ -288,14 +293,17 @@ class CoefficientCorrection::PatchPass {
         const CellCoefficients cell = CellNow(i, j);
         for (std::size_t v = 0; v < views_.size(); ++v) {
           if (!Seen(views_[v], i, j)) continue;
-          Row6d row;
           Eigen::Vector3d lin;
-          Predict(v, i, j, cell, row, &lin);
+          if (linear_at_patch_.empty())
+            Predict(v, i, j, cell, nullptr, &lin);
+          else  // the first round: the cells are still the patch's
+            lin = linear_at_patch_[v * static_cast<std::size_t>(gw_ * gh_) + Cell(i, j)];
           for (std::size_t c = 0; c < 3; ++c)
             model_sum[c].at<float>(j, i) += static_cast<float>(lin[static_cast<Eigen::Index>(c)]);
         }
       }
     }
+    linear_at_patch_.clear();
     const std::vector<cv::Mat>& photo_sum = photo_linear_sum_;
     std::vector<cv::Mat> pb(3), mb(3);
     for (std::size_t c = 0; c < 3; ++c) {
@@ -340,7 +348,7 @@ class CoefficientCorrection::PatchPass {
       for (int i = 0; i < gw_; ++i) {
         if (!Seen(r, i, j)) continue;
         p.seen_by_photo.at<float>(j, i) =
-            static_cast<float>(Predict(v, i, j, cells[Cell(i, j)], p.jacobian[Cell(i, j)]));
+            static_cast<float>(Predict(v, i, j, cells[Cell(i, j)], &p.jacobian[Cell(i, j)]));
         seen.at<float>(j, i) = 1.0f;
       }
     p.seen_by_photo = MaskedGaussian(p.seen_by_photo, seen, r.blur_cells);
@@ -429,6 +437,9 @@ class CoefficientCorrection::PatchPass {
   std::vector<Vector6d> to_mean_of_cell_;
   std::vector<CellCoefficients> cells_at_patch_;  // ComputeCellsAtPatch
   std::vector<cv::Mat> photo_linear_sum_;         // SumPhotosLinear, per channel
+  // PriorShrink's linear values per view and cell (view-major), until the first
+  // channel factors use them.
+  std::vector<Eigen::Vector3d> linear_at_patch_;
   // Per view, the lights as the texel answers them (PtmSample::LightsOf), once.
   std::vector<PtmSample::TexelLights> texel_lights_;
   std::vector<std::vector<Row6d>> light_rows_;  // per view and light: ComputeLightRows
