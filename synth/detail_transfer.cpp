@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <opencv2/imgproc.hpp>
 
 #include "core/check.h"
@@ -41,14 +42,24 @@ struct WindowAxis {
   float f[kDetailWindowSide];
 };
 
+// Four floats in one SSE register (GCC's vector extension); a point is two.
+using Lanes = float __attribute__((vector_size(16)));
+constexpr int kLanesPerPoint = kPointFloats / 4;
+Lanes LoadLanes(const float* p) {
+  Lanes v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
 // The coarse coefficients (kPointFloats per point, CV_32FC(kPointFloats) planes) of
 // the window of 3 x 3 points (dx, dy) texels apart around (x, y), bilinear in
-// floats: visit(k, point) for points k = 0, 1, ... until it returns false.
+// floats: visit(k, point) for points k = 0, 1, ... (kLanesPerPoint lanes each)
+// until it returns false.
 template <typename Visit>
 void VisitCoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy,
                        Visit visit) {
   const WindowAxis along_x(coarse.cols, x, dx), along_y(coarse.rows, y, dy);
-  alignas(32) float point[kPointFloats];
+  Lanes point[kLanesPerPoint];
   int k = 0;
   for (int b = 0; b < kDetailWindowSide; ++b) {
     const float* r0 = coarse.ptr<float>(along_y.lo[b]);
@@ -62,16 +73,17 @@ void VisitCoarseWindow(const cv::Mat& coarse, double x, double y, double dx, dou
       const float* v10 = r0 + along_x.hi[a] * kPointFloats;
       const float* v01 = r1 + along_x.lo[a] * kPointFloats;
       const float* v11 = r1 + along_x.hi[a] * kPointFloats;
-      for (int m = 0; m < kPointFloats; ++m)
-        point[m] = w00 * v00[m] + w10 * v10[m] + w01 * v01[m] + w11 * v11[m];
+      for (int h = 0; h < kLanesPerPoint; ++h)
+        point[h] = w00 * LoadLanes(v00 + 4 * h) + w10 * LoadLanes(v10 + 4 * h) +
+                   w01 * LoadLanes(v01 + 4 * h) + w11 * LoadLanes(v11 + 4 * h);
       if (!visit(k++, point)) return;
     }
   }
 }
 
 void CoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy, float* window) {
-  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const float* point) {
-    std::copy(point, point + kPointFloats, window + k * kPointFloats);
+  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const Lanes* point) {
+    std::memcpy(window + k * kPointFloats, point, kPointFloats * sizeof(float));
     return true;
   });
 }
@@ -82,11 +94,13 @@ void CoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double d
 float CoarseWindowDistance(const cv::Mat& coarse, double x, double y, double dx, double dy,
                            const float* query, float bound) {
   float e = 0.0f;
-  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const float* point) {
-    const float* q = query + k * kPointFloats;
-    float point_e[kPointFloats];
-    for (int m = 0; m < kPointFloats; ++m) point_e[m] = (point[m] - q[m]) * (point[m] - q[m]);
-    for (int m = 0; m < kPointFloats; ++m) e += point_e[m];
+  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const Lanes* point) {
+    Lanes squares = {0.0f, 0.0f, 0.0f, 0.0f};
+    for (int h = 0; h < kLanesPerPoint; ++h) {
+      const Lanes d = point[h] - LoadLanes(query + k * kPointFloats + 4 * h);
+      squares += d * d;
+    }
+    e += (squares[0] + squares[1]) + (squares[2] + squares[3]);
     return e < bound;
   });
   return e;
@@ -124,16 +138,7 @@ DetailDictionary::DetailDictionary(const PtmSample& sample, int level, std::vect
   std::vector<cv::Mat> coarse_raw(sample.Values().size());
   for (std::size_t c = 0; c < coarse_raw.size(); ++c)
     cv::resize(red.planes[c], coarse_raw[c], full, 0, 0, cv::INTER_LINEAR);
-  const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
-  coarse_ = cv::Mat::zeros(full, CV_32FC(kPointFloats));
-  for (int y = 0; y < full.height; ++y)
-    for (int x = 0; x < full.width; ++x)
-      for (int m = 0; m < kCoefficients; ++m) {
-        double v = 0.0;
-        for (int k = 0; k < kCoefficients; ++k)
-          v += to(m, k) * coarse_raw[static_cast<std::size_t>(k)].at<float>(y, x);
-        coarse_.ptr<float>(y)[x * kPointFloats + m] = static_cast<float>(v);
-      }
+  ToOrthonormalPoints(coarse_raw);
   const std::vector<cv::Mat>& values = sample.Values();
   band.resize(values.size());
   cv::Mat coarse_plane;
@@ -143,6 +148,22 @@ DetailDictionary::DetailDictionary(const PtmSample& sample, int level, std::vect
     band[c] = values[c] - (luminance ? coarse_plane : coarse_raw[c]);
   }
   IndexWindows(full);
+}
+
+void DetailDictionary::ToOrthonormalPoints(const std::vector<cv::Mat>& coarse_raw) {
+  const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
+  coarse_ = cv::Mat::zeros(coarse_raw[0].size(), CV_32FC(kPointFloats));
+  std::array<const float*, kCoefficients> raw{};
+  for (int y = 0; y < coarse_.rows; ++y) {
+    for (std::size_t k = 0; k < raw.size(); ++k) raw[k] = coarse_raw[k].ptr<float>(y);
+    float* point = coarse_.ptr<float>(y);
+    for (int x = 0; x < coarse_.cols; ++x, point += kPointFloats)
+      for (int m = 0; m < kCoefficients; ++m) {
+        double v = 0.0;
+        for (int k = 0; k < kCoefficients; ++k) v += to(m, k) * raw[static_cast<std::size_t>(k)][x];
+        point[m] = static_cast<float>(v);
+      }
+  }
 }
 
 void DetailDictionary::IndexWindows(cv::Size full) {
@@ -194,7 +215,8 @@ void DetailDictionary::MatchByIndex(const cv::Mat& windows, const std::vector<in
   if (cells.empty()) return;
   cv::Mat queries(static_cast<int>(cells.size()), kDetailWindowLength, CV_32FC1);
   for (std::size_t n = 0; n < cells.size(); ++n)
-    windows.row(cells[n]).copyTo(queries.row(static_cast<int>(n)));
+    std::memcpy(queries.ptr<float>(static_cast<int>(n)), windows.ptr<float>(cells[n]),
+                sizeof(float) * kDetailWindowLength);
   std::vector<int> indices;
   std::vector<float> distances;
   nearest_->Nearest(queries, indices, distances);

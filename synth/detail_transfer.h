@@ -54,6 +54,8 @@ class DetailDictionary {
     std::vector<cv::Vec2f> source;
     std::vector<float> distance;
   };
+  // coarse_: the raw coarse luminance coefficients (full size) in the orthonormal basis.
+  void ToOrthonormalPoints(const std::vector<cv::Mat>& coarse_raw);
   void IndexWindows(cv::Size full);
   // Per cell, the window of the corrected coarse coefficients (a row each).
   cv::Mat CorrectedWindows(const TrianglePatch& patch) const;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <nanoflann.hpp>
 #include <stdexcept>
@@ -38,7 +39,7 @@ void PrincipalComponents(const NearestWindows::Windows& windows, int count, cv::
                       CV_64F);
   cv::eigen(covariance, variances, all);  // descending, symmetric
   mean64.convertTo(mean, CV_32F);
-  all.rowRange(0, std::clamp(count, 1, all.rows)).convertTo(directions, CV_32F);
+  all.rowRange(0, count).convertTo(directions, CV_32F);
 }
 
 }  // namespace
@@ -49,14 +50,14 @@ struct NearestWindows::Tree {
   const float* points = nullptr;  // projected's rows
   std::size_t kdtree_get_point_count() const { return static_cast<std::size_t>(projected.rows); }
   float kdtree_get_pt(std::size_t i, std::size_t d) const {
-    return points[i * static_cast<std::size_t>(projected.cols) + d];
+    return points[i * NearestWindows::kComponents + d];
   }
   template <class Box>
   bool kdtree_get_bbox(Box& /*box*/) const {
     return false;
   }
   using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Tree>, Tree,
-                                                    -1, std::uint32_t>;
+                                                    NearestWindows::kComponents, std::uint32_t>;
   std::unique_ptr<Index> index;
   std::vector<std::uint32_t> window_of_point;  // the window each point (row of projected) is
 
@@ -76,7 +77,8 @@ struct NearestWindows::Tree {
     std::vector<std::uint32_t>& order = Order();
     cv::Mat sorted(projected.rows, projected.cols, CV_32FC1);
     for (std::size_t n = 0; n < order.size(); ++n)
-      projected.row(static_cast<int>(order[n])).copyTo(sorted.row(static_cast<int>(n)));
+      std::memcpy(sorted.ptr<float>(static_cast<int>(n)),
+                  projected.ptr<float>(static_cast<int>(order[n])), sizeof(float) * kComponents);
     window_of_point = order;
     for (std::size_t n = 0; n < order.size(); ++n) order[n] = static_cast<std::uint32_t>(n);
     projected = sorted;
@@ -94,11 +96,11 @@ float NearestWindows::WindowMatrix::SquaredDistance(const float* query, int wind
 
 NearestWindows::NearestWindows(const Windows& windows, Options options)
     : options_(options), windows_(windows), tree_(std::make_unique<Tree>()) {
-  if (windows_.Count() < 2 || windows_.Length() < 1 || options_.components < 1 ||
-      options_.candidates < 1 || !(options_.eps >= 0.0f))
+  if (windows_.Count() < 2 || windows_.Length() < kComponents || options_.candidates < 1 ||
+      !(options_.eps >= 0.0f))
     throw std::invalid_argument(
-        "NearestWindows: windows (at least 2), components and candidates >= 1, eps >= 0");
-  PrincipalComponents(windows_, options_.components, mean_, components_);
+        "NearestWindows: at least 2 windows of at least 8 values, candidates >= 1, eps >= 0");
+  PrincipalComponents(windows_, kComponents, mean_, components_);
   tree_->projected = ProjectWindows();
   tree_->points = tree_->projected.ptr<float>();
   tree_->index = std::make_unique<Tree::Index>(  // builds the tree

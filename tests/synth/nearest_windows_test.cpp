@@ -90,7 +90,7 @@ void ExpectNearlyTheExactNearest(NearestWindows::Options options, double exact_s
 
 // Four candidates at eps 4: nearly always the exact nearest.
 TEST(NearestWindows, NoisyQueriesFindNearlyTheExactNearestAtTheirFullDistance) {
-  ExpectNearlyTheExactNearest(NearestWindows::Options{8, 4, 4.0f}, 0.9, 1.05);
+  ExpectNearlyTheExactNearest(NearestWindows::Options{4, 4.0f}, 0.9, 1.05);
 }
 
 // The defaults (one candidate at eps 8) seed detail transfer's propagation: mostly
