@@ -154,7 +154,7 @@ std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<View
     const ViewAtStep& v = views[r];
     const std::vector<cv::Mat> model =
         sample_.Relight(*v.reduced, v.view->lighting, photo_gains_[v.view->photo]);
-    ssd[r] = MaskedSsd(model, PlaneEnergy(model), v.photo, v.mask);
+    ssd[r] = ImageSpectra(model, PlaneEnergy(model)).MaskedSsd(v.photo, v.mask);
   });
   for (std::size_t r = 0; r < views.size(); ++r) {
     const ViewAtStep& v = views[r];
