@@ -18,6 +18,7 @@ namespace {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Row6d = Eigen::Matrix<double, 1, 6>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 // A cell's coefficients as a prediction reads them: the patch's luminance
 // coefficients (raw PTM) and LRGB colour there.
@@ -360,7 +361,9 @@ class CoefficientCorrection::PatchPass {
   // way to the sample's mean times `shrink` and s^2 = correction_noise x the
   // mean predicted variance. The residual r is the photo's against the
   // prediction through the photo's blur: detail the photo blurs away is no
-  // error, so the change does not take it out.
+  // error, so the change does not take it out. Solved in the coefficients' 6
+  // dimensions whatever the number of views (Woodbury's identity):
+  // q = m + (s^2 Sigma^-1 + J^T J)^-1 J^T (r + J (q0 - m)).
   void UpdateAdditiveChange(double shrink) {
     const std::vector<CellCoefficients> cells = CellsNow();
     std::vector<ViewPrediction> predicted;
@@ -368,27 +371,27 @@ class CoefficientCorrection::PatchPass {
       predicted.push_back(PredictThroughBlur(v, cells));
     for (int j = 0; j < gh_; ++j) {
       for (int i = 0; i < gw_; ++i) {
-        Eigen::Matrix<double, Eigen::Dynamic, 6> jac(static_cast<int>(views_.size()), 6);
-        Eigen::VectorXd res(static_cast<int>(views_.size()));
+        const Vector6d q0 = CorrectionAt(i, j);
+        const Vector6d q_mean = shrink * ToMean(i, j);
+        Matrix6d jtj = Matrix6d::Zero();
+        Vector6d jtb = Vector6d::Zero();
         int rows = 0;
         for (std::size_t v = 0; v < views_.size(); ++v) {
           if (!Seen(views_[v], i, j)) continue;
-          res[rows] = PhotoLuminance(views_[v], i, j) - predicted[v].seen_by_photo.at<float>(j, i);
-          jac.row(rows) = predicted[v].jacobian[static_cast<std::size_t>(j * gw_ + i)];
+          const Row6d& jv = predicted[v].jacobian[Cell(i, j)];
+          const double r =
+              PhotoLuminance(views_[v], i, j) - predicted[v].seen_by_photo.at<float>(j, i);
+          jtj.noalias() += jv.transpose() * jv;
+          jtb += jv.transpose() * (r + jv.dot(q0 - q_mean));
           ++rows;
         }
         if (rows == 0) continue;
         known_.at<std::uint8_t>(j, i) = 1;
-        const auto jr = jac.topRows(rows);
-        const Vector6d q0 = CorrectionAt(i, j);
-        const Vector6d q_mean = shrink * ToMean(i, j);
-        const Eigen::MatrixXd js = jr * prior_.covariance;
-        Eigen::MatrixXd a = js * jr.transpose();
-        const double scale = a.trace() / rows;
+        // The mean predicted variance: trace(J Sigma J^T) / rows = <J^T J, Sigma> / rows.
+        const double scale = jtj.cwiseProduct(prior_.covariance).sum() / rows;
         if (!(scale > 1e-12)) continue;
-        a.diagonal().array() += options_.correction_noise * scale;
         const Vector6d q_new =
-            q_mean + js.transpose() * a.ldlt().solve(res.head(rows) + jr * (q0 - q_mean));
+            q_mean + (options_.correction_noise * scale * prior_.precision + jtj).ldlt().solve(jtb);
         for (int m = 0; m < 6; ++m)
           patch_.correction[static_cast<std::size_t>(m)].at<float>(j, i) =
               static_cast<float>(q_new[m]);
@@ -473,7 +476,9 @@ const CoefficientCorrection::CoefficientPrior& CoefficientCorrection::PriorAt(in
   mean /= n;
   Eigen::Matrix<double, 6, 6> cov = second / n - mean * mean.transpose();
   cov.diagonal().array() += 1e-6 * cov.trace() / 6.0;  // keeps it positive definite
-  return priors_.emplace(level, CoefficientPrior{mean, cov}).first->second;
+  const Eigen::Matrix<double, 6, 6> precision =
+      cov.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+  return priors_.emplace(level, CoefficientPrior{mean, cov, precision}).first->second;
 }
 
 void CoefficientCorrection::Correct(TriangleEngine& engine, std::size_t face,

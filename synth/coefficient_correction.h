@@ -53,6 +53,7 @@ class CoefficientCorrection : public PhotoCorrection {
   struct CoefficientPrior {
     Eigen::Matrix<double, 6, 1> mean;
     Eigen::Matrix<double, 6, 6> covariance;
+    Eigen::Matrix<double, 6, 6> precision;  ///< covariance^-1
   };
 
  private:

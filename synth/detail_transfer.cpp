@@ -152,17 +152,19 @@ DetailDictionary::DetailDictionary(const PtmSample& sample, int level, std::vect
 
 void DetailDictionary::ToOrthonormalPoints(const std::vector<cv::Mat>& coarse_raw) {
   const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
-  coarse_ = cv::Mat::zeros(coarse_raw[0].size(), CV_32FC(kPointFloats));
+  coarse_.create(coarse_raw[0].size(), CV_32FC(kPointFloats));
   std::array<const float*, kCoefficients> raw{};
   for (int y = 0; y < coarse_.rows; ++y) {
     for (std::size_t k = 0; k < raw.size(); ++k) raw[k] = coarse_raw[k].ptr<float>(y);
     float* point = coarse_.ptr<float>(y);
-    for (int x = 0; x < coarse_.cols; ++x, point += kPointFloats)
+    for (int x = 0; x < coarse_.cols; ++x, point += kPointFloats) {
       for (int m = 0; m < kCoefficients; ++m) {
         double v = 0.0;
         for (int k = 0; k < kCoefficients; ++k) v += to(m, k) * raw[static_cast<std::size_t>(k)][x];
         point[m] = static_cast<float>(v);
       }
+      std::fill(point + kCoefficients, point + kPointFloats, 0.0f);  // the pads
+    }
   }
 }
 

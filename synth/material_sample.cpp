@@ -141,12 +141,18 @@ void TransferredDetail(const TrianglePatch& patch, const std::vector<cv::Mat>& b
                     w};
   }
   const double cell_texels_squared = 0.5 * (1.0 / (rx * rx) + 1.0 / (ry * ry));
+  // rho per pair, once (it is symmetric, and 1 on the diagonal).
+  std::array<std::array<double, 4>, 4> rho;
+  for (std::size_t j = 0; j < n; ++j) {
+    rho[j][j] = 1.0;
+    for (std::size_t k = j + 1; k < n; ++k)
+      rho[j][k] = rho[k][j] = std::exp(-(sources[j].first - sources[k].first).squaredNorm() /
+                                       (2.0 * cell_texels_squared));
+  }
   double variance = 0.0;
   for (std::size_t j = 0; j < n; ++j)
     for (std::size_t k = 0; k < n; ++k)
-      variance += sources[j].second * sources[k].second *
-                  std::exp(-(sources[j].first - sources[k].first).squaredNorm() /
-                           (2.0 * cell_texels_squared));
+      variance += sources[j].second * sources[k].second * rho[j][k];
   if (n == 0 || !(variance > 0.0)) return;
   const double norm = 1.0 / std::sqrt(variance);
   for (std::size_t k = 0; k < n; ++k) {
