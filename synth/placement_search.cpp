@@ -224,29 +224,64 @@ class PlacementSearch::RelitView {
   std::unordered_map<long long, double> scores_;
 };
 
-std::array<double, PlacementSearch::kLanes> PlacementSearch::RowOfCellScores(
-    const ViewAtStep& v, cv::Point at, RelitView& relit) const {
-  relit.Cover(cv::Rect(at, v.mask.size() + cv::Size(kLanes - 1, 0)));
-  // Each lane (placement) sums as one placement alone would: a row's sum in floats
-  // over the channels and the row's cells in order, rows in doubles. The lanes are
-  // independent: one vector of four (SSE2, every x86-64) holds them.
-  using Lanes = float __attribute__((vector_size(kLanes * sizeof(float))));
-  std::array<double, kLanes> ssd{};
-  for (int j = 0; j < v.mask.rows; ++j) {
-    const float* m = v.mask.ptr<float>(j);
+namespace {
+
+// kLanes floats side by side: one AVX2 register, or two SSE2 ones on any x86-64.
+using Lanes = float __attribute__((vector_size(PlacementSearch::kLanes * sizeof(float))));
+
+// RowOfCellScores' sums of squared differences, before eq. 3's root. Each lane
+// (placement) sums as one placement alone would: a row's sum in floats over the
+// channels and the row's cells in order, rows in doubles. Inlined into the two
+// builds below, whose lanes give the same values.
+[[gnu::always_inline]] inline void SumSquaredDifferences(
+    const cv::Mat& mask, const std::vector<cv::Mat>& photo,
+    const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
+    std::array<double, PlacementSearch::kLanes>& ssd) {
+  for (int j = 0; j < mask.rows; ++j) {
+    const float* m = mask.ptr<float>(j);
     Lanes row = {};
-    for (std::size_t c = 0; c < v.photo.size(); ++c) {
-      const float* s = relit.planes()[c].ptr<float>(at.y + j) + at.x;
-      const float* p = v.photo[c].ptr<float>(j);
-      for (int i = 0; i < v.mask.cols; ++i) {
+    for (std::size_t c = 0; c < photo.size(); ++c) {
+      const float* s = relit_planes[c].ptr<float>(at.y + j) + at.x;
+      const float* p = photo[c].ptr<float>(j);
+      for (int i = 0; i < mask.cols; ++i) {
         Lanes relit_i;  // cell i of each lane's placement
         std::memcpy(&relit_i, s + i, sizeof(Lanes));
         const Lanes d = relit_i - p[i];
         row += m[i] * d * d;
       }
     }
-    for (int k = 0; k < kLanes; ++k) ssd[static_cast<std::size_t>(k)] += row[k];
+    for (int k = 0; k < PlacementSearch::kLanes; ++k) ssd[static_cast<std::size_t>(k)] += row[k];
   }
+}
+
+__attribute__((target("avx2"))) void SumSquaredDifferencesAvx2(
+    const cv::Mat& mask, const std::vector<cv::Mat>& photo,
+    const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
+    std::array<double, PlacementSearch::kLanes>& ssd) {
+  SumSquaredDifferences(mask, photo, relit_planes, at, ssd);
+}
+
+void SumSquaredDifferencesSse2(const cv::Mat& mask, const std::vector<cv::Mat>& photo,
+                               const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
+                               std::array<double, PlacementSearch::kLanes>& ssd) {
+  SumSquaredDifferences(mask, photo, relit_planes, at, ssd);
+}
+
+bool ScoresUseAvx2() {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+}
+
+}  // namespace
+
+std::array<double, PlacementSearch::kLanes> PlacementSearch::RowOfCellScores(
+    const ViewAtStep& v, cv::Point at, RelitView& relit) const {
+  relit.Cover(cv::Rect(at, v.mask.size() + cv::Size(kLanes - 1, 0)));
+  std::array<double, kLanes> ssd{};
+  if (ScoresUseAvx2())
+    SumSquaredDifferencesAvx2(v.mask, v.photo, relit.planes(), at, ssd);
+  else
+    SumSquaredDifferencesSse2(v.mask, v.photo, relit.planes(), at, ssd);
   // Eq. 3: the RMS difference at the photo's density (as AddImageScore).
   for (double& e : ssd) e = std::sqrt(std::max(e, 0.0) / (3.0 * v.count));
   return ssd;

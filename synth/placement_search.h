@@ -21,6 +21,10 @@ using ScoredPlacement = std::pair<float, cv::Point>;
 /// The placements of one face's patch scored against its rectified views.
 class PlacementSearch {
  public:
+  /// Placements scored side by side: a view's cells at (at.x + k, at.y), k < kLanes
+  /// (one AVX2 register of floats, or two SSE2 ones).
+  static constexpr int kLanes = RelitScratch::kPastTheSample + 1;
+
   /// `views` rectified at their photo density levels (best view first), `photo_gains`
   /// per photo, `patch_texels` the patch's size in sample texels. All references must
   /// outlive the search. `scratch` (optional; it must outlive the search, and serve one
@@ -76,8 +80,6 @@ class PlacementSearch {
   std::vector<float> ScoreAt(const std::vector<ViewAtStep>& views,
                              const std::vector<cv::Point>& texels,
                              std::vector<RelitView>& relit) const;
-  // Placements scored side by side: a view's cells at (at.x + k, at.y), k < kLanes.
-  static constexpr int kLanes = RelitScratch::kPastTheSample + 1;
   // Eq. 3 of view `v` alone at those cells (placements' top left); a lane past the
   // view's last placement holds nothing of use.
   std::array<double, kLanes> RowOfCellScores(const ViewAtStep& v, cv::Point at,

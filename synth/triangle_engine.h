@@ -136,7 +136,7 @@ class RelitScratch {
   void Release() { buffers_.clear(); }
   /// Columns the search's planes hold past the reduced sample's: the placements it
   /// scores side by side past the last one read there (synth/placement_search.h).
-  static constexpr int kPastTheSample = 3;
+  static constexpr int kPastTheSample = 7;
   /// The most the buffers of a search over `views` views of a sample of `sample`
   /// texels can grow to: three float planes per view at the sample's full density.
   static double BytesAtMost(int views, cv::Size sample) {

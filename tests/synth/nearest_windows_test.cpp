@@ -111,5 +111,45 @@ TEST(NearestWindows, TheSameWindowsGiveTheSameMatches) {
   EXPECT_EQ(da, db);
 }
 
+// Windows made as the index asks for them, whose distance stops once past the
+// bound (as detail transfer's dictionaries read theirs from the sample).
+class WindowsMadeOnRequest : public NearestWindows::Windows {
+ public:
+  explicit WindowsMadeOnRequest(cv::Mat all) : all_(std::move(all)) {}
+  int Count() const override { return all_.rows; }
+  int Length() const override { return all_.cols; }
+  void Rows(int first, cv::Mat& block) const override {
+    ++runs_asked;
+    all_.rowRange(first, first + block.rows).copyTo(block);
+  }
+  float SquaredDistance(const float* query, int window, float bound) const override {
+    const float* w = all_.ptr<float>(window);
+    float d = 0.0f;
+    for (int i = 0; i < all_.cols && d < bound; ++i) d += (w[i] - query[i]) * (w[i] - query[i]);
+    return d;
+  }
+  mutable int runs_asked = 0;
+
+ private:
+  cv::Mat all_;
+};
+
+TEST(NearestWindows, WindowsMadeOnRequestMatchAsTheMatrixOfThem) {
+  const cv::Mat windows = SmoothWindows(100, 11);
+  cv::Mat queries = SmoothWindows(30, 12);
+  const NearestWindows::WindowMatrix matrix(windows.clone());
+  const WindowsMadeOnRequest made(windows.clone());
+  // Four candidates: the later ones are often rejected by a partial distance.
+  const NearestWindows::Options options{4, 4.0f};
+  std::vector<int> from_matrix, from_made;
+  std::vector<float> d_matrix, d_made;
+  NearestWindows(matrix, options).Nearest(queries, from_matrix, d_matrix);
+  NearestWindows(made, options).Nearest(queries, from_made, d_made);
+  EXPECT_EQ(from_made, from_matrix);
+  EXPECT_EQ(d_made, d_matrix);
+  // The index read the windows through the source.
+  EXPECT_GT(made.runs_asked, 1);
+}
+
 }  // namespace
 }  // namespace texlume::synth
