@@ -194,14 +194,9 @@ class CoefficientCorrection::PatchPass {
       const Row6d& row = light_rows_[view][k];
       for (int c = 0; c < 3; ++c) {
         const double v = lum * colour[c];
-        if (v <= 0.0 || v >= 1.0) continue;  // clamped: no derivative
-        linear[c] += intensity * SrgbToLinear(static_cast<float>(v));
-        if (!jac) continue;
-        const double h = 1e-3;
-        const double dlin = (SrgbToLinear(static_cast<float>(std::min(1.0, v + h))) -
-                             SrgbToLinear(static_cast<float>(std::max(0.0, v - h)))) /
-                            (std::min(1.0, v + h) - std::max(0.0, v - h));
-        dlinear.row(c) += intensity * dlin * colour[c] * row;
+        double dlin = 0.0;
+        linear[c] += intensity * RelitLinearShare(v, jac ? &dlin : nullptr);
+        if (dlin != 0.0) dlinear.row(c) += intensity * dlin * colour[c] * row;
       }
     }
     const double g = gains_[views_[view].photo];
@@ -449,6 +444,19 @@ class CoefficientCorrection::PatchPass {
   mutable std::vector<ptm::EffectiveLight> shadowed_lights_;  // Predict's, at one cell
   cv::Mat known_;                                             // CV_8UC1: cells with a change
 };
+
+double RelitLinearShare(double display, double* slope) {
+  if (slope) *slope = 0.0;
+  if (display <= 0.0) return 0.0;  // black
+  if (display >= 1.0) return 1.0;  // white: SrgbToLinear(1) = 1
+  if (slope) {
+    const double h = 1e-3;
+    *slope = (SrgbToLinear(static_cast<float>(std::min(1.0, display + h))) -
+              SrgbToLinear(static_cast<float>(std::max(0.0, display - h)))) /
+             (std::min(1.0, display + h) - std::max(0.0, display - h));
+  }
+  return SrgbToLinear(static_cast<float>(display));
+}
 
 CoefficientCorrection::CoefficientCorrection(const PtmSample& sample,
                                              const MeshSynthesisOptions& options)
