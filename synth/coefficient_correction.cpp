@@ -360,6 +360,7 @@ class CoefficientCorrection::PatchPass {
   // dimensions whatever the number of views (Woodbury's identity):
   // q = m + (s^2 Sigma^-1 + J^T J)^-1 J^T (r + J (q0 - m)).
   void UpdateAdditiveChange(double shrink) {
+    linear_at_patch_.clear();  // the first channel factors' alone
     const std::vector<CellCoefficients> cells = CellsNow();
     std::vector<ViewPrediction> predicted;
     for (std::size_t v = 0; v < views_.size(); ++v)

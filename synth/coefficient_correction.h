@@ -31,12 +31,6 @@ namespace texlume::synth {
 /// Finish (detail transfer, synth/detail_transfer.h): per density level a face
 /// was corrected at, the sample's DetailDictionary; each corrected patch's cells
 /// matched to the sample points whose coarse windows are nearest.
-/// One light's share of a texel's linear value in a channel, as PtmSample::Relight
-/// relights it: the display value (luminance polynomial times colour) clamped to
-/// [0, 1] and decoded from sRGB; when `slope` is given, d share / d display into it
-/// (0 where clamped: black or white). The pass predicts the photos with it.
-double RelitLinearShare(double display, double* slope = nullptr);
-
 class CoefficientCorrection : public PhotoCorrection {
  public:
   CoefficientCorrection(const PtmSample& sample, const MeshSynthesisOptions& options);
@@ -73,5 +67,11 @@ class CoefficientCorrection : public PhotoCorrection {
   std::map<int, std::unique_ptr<DetailDictionary>> dictionaries_;
   std::map<int, std::vector<cv::Mat>> detail_bands_;
 };
+
+/// One light's share of a texel's linear value in a channel, as PtmSample::Relight
+/// relights it: the display value (luminance polynomial times colour) clamped to
+/// [0, 1] and decoded from sRGB; when `slope` is given, d share / d display into it
+/// (0 where clamped: black or white). The pass predicts the photos with it.
+double RelitLinearShare(double display, double* slope = nullptr);
 
 }  // namespace texlume::synth

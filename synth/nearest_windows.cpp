@@ -33,6 +33,7 @@ void PrincipalComponents(const NearestWindows::Windows& windows, int count, cv::
   for (int r = 0; r < windows.Count(); r += step) {
     cv::Mat row = rows.row(r / step);
     windows.Rows(r, row);
+    CV_DbgAssert(row.data == rows.ptr(r / step));  // written in place
   }
   cv::Mat covariance, mean64, variances, all;
   cv::calcCovarMatrix(rows, covariance, mean64, cv::COVAR_NORMAL | cv::COVAR_ROWS | cv::COVAR_SCALE,
@@ -85,6 +86,11 @@ struct NearestWindows::Tree {
     points = projected.ptr<float>();
   }
 };
+
+NearestWindows::WindowMatrix::WindowMatrix(cv::Mat windows) : windows_(std::move(windows)) {
+  if (windows_.type() != CV_32FC1)
+    throw std::invalid_argument("NearestWindows::WindowMatrix: float windows, one per row");
+}
 
 float NearestWindows::WindowMatrix::SquaredDistance(const float* query, int window,
                                                     float /*bound*/) const {

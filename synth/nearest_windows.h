@@ -38,7 +38,9 @@ class NearestWindows {
     virtual ~Windows() = default;
     virtual int Count() const = 0;
     virtual int Length() const = 0;
-    /// Windows first, first + 1, ... as the rows of `block` (CV_32FC1, Length() wide).
+    /// Windows first, first + 1, ... written into the rows of `block` (CV_32FC1,
+    /// Length() wide; possibly a view into a larger matrix: write into its storage,
+    /// never reallocate it).
     virtual void Rows(int first, cv::Mat& block) const = 0;
     /// The squared L2 distance from `query` (Length() floats) to window `window`,
     /// or a partial sum of it of at least `bound` (it is only compared with bound).
@@ -47,7 +49,8 @@ class NearestWindows {
   /// Windows held in a matrix (CV_32FC1, a window per row).
   class WindowMatrix : public Windows {
    public:
-    explicit WindowMatrix(cv::Mat windows) : windows_(std::move(windows)) {}
+    /// `windows`: CV_32FC1, a window per row (std::invalid_argument otherwise).
+    explicit WindowMatrix(cv::Mat windows);
     int Count() const override { return windows_.rows; }
     int Length() const override { return windows_.cols; }
     void Rows(int first, cv::Mat& block) const override {
@@ -61,6 +64,7 @@ class NearestWindows {
 
   /// Indexes `windows` (at least 2, at least kComponents long), which must outlive this.
   NearestWindows(const Windows& windows, Options options);
+  NearestWindows(const Windows&& windows, Options options) = delete;  // would dangle
   ~NearestWindows();
   NearestWindows(const NearestWindows&) = delete;
   NearestWindows& operator=(const NearestWindows&) = delete;

@@ -227,11 +227,12 @@ class PlacementSearch::RelitView {
 namespace {
 
 // kLanes floats side by side: one AVX2 register, or two SSE2 ones on any x86-64.
+static_assert(PlacementSearch::kLanes == 8, "a vector of 8 floats (a power of two)");
 using Lanes = float __attribute__((vector_size(PlacementSearch::kLanes * sizeof(float))));
 
 // RowOfCellScores' sums of squared differences, before eq. 3's root. Each lane
 // (placement) sums as one placement alone would: a row's sum in floats over the
-// channels and the row's cells in order, rows in doubles. Inlined into the two
+// channels and the row's cells in order, rows in doubles. Inlined into the
 // builds below, whose lanes give the same values.
 [[gnu::always_inline]] inline void SumSquaredDifferences(
     const cv::Mat& mask, const std::vector<cv::Mat>& photo,
@@ -254,6 +255,13 @@ using Lanes = float __attribute__((vector_size(PlacementSearch::kLanes * sizeof(
   }
 }
 
+void SumSquaredDifferencesGeneric(const cv::Mat& mask, const std::vector<cv::Mat>& photo,
+                                  const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
+                                  std::array<double, PlacementSearch::kLanes>& ssd) {
+  SumSquaredDifferences(mask, photo, relit_planes, at, ssd);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
 __attribute__((target("avx2"))) void SumSquaredDifferencesAvx2(
     const cv::Mat& mask, const std::vector<cv::Mat>& photo,
     const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
@@ -261,15 +269,20 @@ __attribute__((target("avx2"))) void SumSquaredDifferencesAvx2(
   SumSquaredDifferences(mask, photo, relit_planes, at, ssd);
 }
 
-void SumSquaredDifferencesSse2(const cv::Mat& mask, const std::vector<cv::Mat>& photo,
-                               const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
-                               std::array<double, PlacementSearch::kLanes>& ssd) {
-  SumSquaredDifferences(mask, photo, relit_planes, at, ssd);
-}
-
 bool ScoresUseAvx2() {
   static const bool avx2 = __builtin_cpu_supports("avx2");
   return avx2;
+}
+#endif
+
+// SumSquaredDifferences in AVX2 where the CPU has it, else generic (SSE2 on x86-64).
+void SumSquaredDifferencesHere(const cv::Mat& mask, const std::vector<cv::Mat>& photo,
+                               const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
+                               std::array<double, PlacementSearch::kLanes>& ssd) {
+#if defined(__x86_64__) && defined(__GNUC__)
+  if (ScoresUseAvx2()) return SumSquaredDifferencesAvx2(mask, photo, relit_planes, at, ssd);
+#endif
+  SumSquaredDifferencesGeneric(mask, photo, relit_planes, at, ssd);
 }
 
 }  // namespace
@@ -278,10 +291,7 @@ std::array<double, PlacementSearch::kLanes> PlacementSearch::RowOfCellScores(
     const ViewAtStep& v, cv::Point at, RelitView& relit) const {
   relit.Cover(cv::Rect(at, v.mask.size() + cv::Size(kLanes - 1, 0)));
   std::array<double, kLanes> ssd{};
-  if (ScoresUseAvx2())
-    SumSquaredDifferencesAvx2(v.mask, v.photo, relit.planes(), at, ssd);
-  else
-    SumSquaredDifferencesSse2(v.mask, v.photo, relit.planes(), at, ssd);
+  SumSquaredDifferencesHere(v.mask, v.photo, relit.planes(), at, ssd);
   // Eq. 3: the RMS difference at the photo's density (as AddImageScore).
   for (double& e : ssd) e = std::sqrt(std::max(e, 0.0) / (3.0 * v.count));
   return ssd;

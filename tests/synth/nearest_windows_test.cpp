@@ -8,8 +8,9 @@
 namespace texlume::synth {
 namespace {
 
-// Windows as detail transfer makes them: 3 x 3 points 2 texels apart on 6
-// smooth planes (blurred noise), one window per texel inside.
+// Windows like detail transfer's: 3 x 3 points 2 texels apart on 6 smooth planes
+// (blurred noise), one window per texel inside (detail transfer pads each point
+// to 8 floats with zeros, which change no distance).
 cv::Mat SmoothWindows(int size, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<float> n(0.0f, 1.0f);
@@ -125,10 +126,12 @@ class WindowsMadeOnRequest : public NearestWindows::Windows {
   float SquaredDistance(const float* query, int window, float bound) const override {
     const float* w = all_.ptr<float>(window);
     float d = 0.0f;
-    for (int i = 0; i < all_.cols && d < bound; ++i) d += (w[i] - query[i]) * (w[i] - query[i]);
+    int i = 0;
+    for (; i < all_.cols && d < bound; ++i) d += (w[i] - query[i]) * (w[i] - query[i]);
+    stopped_early += i < all_.cols;
     return d;
   }
-  mutable int runs_asked = 0;
+  mutable int runs_asked = 0, stopped_early = 0;
 
  private:
   cv::Mat all_;
@@ -147,8 +150,10 @@ TEST(NearestWindows, WindowsMadeOnRequestMatchAsTheMatrixOfThem) {
   NearestWindows(made, options).Nearest(queries, from_made, d_made);
   EXPECT_EQ(from_made, from_matrix);
   EXPECT_EQ(d_made, d_matrix);
-  // The index read the windows through the source.
+  // The index read the windows through the source, and candidates were rejected
+  // on partial distances.
   EXPECT_GT(made.runs_asked, 1);
+  EXPECT_GT(made.stopped_early, 0);
 }
 
 }  // namespace
