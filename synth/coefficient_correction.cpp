@@ -20,18 +20,18 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Row6d = Eigen::Matrix<double, 1, 6>;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
-// A cell's coefficients as a prediction reads them: the patch's luminance
-// coefficients (raw PTM) and LRGB colour there.
-struct CellCoefficients {
-  float a[6];
-  float colour[3];
-};
-
 }  // namespace
 
 // One patch's photo-consistency pass: the state the Gauss-Newton rounds share.
 class CoefficientCorrection::PatchPass {
  public:
+  // A cell's coefficients as a prediction reads them: the patch's luminance
+  // coefficients (raw PTM) and LRGB colour there.
+  struct CellCoefficients {
+    float a[6];
+    float colour[3];
+  };
+
   PatchPass(const PtmSample& sample, TrianglePatch& patch, const std::vector<RectifiedView>& views,
             const ReducedPlanes& reduced, const CoefficientPrior& prior,
             const std::vector<double>& photo_gains, const MeshSynthesisOptions& options)

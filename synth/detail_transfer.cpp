@@ -43,10 +43,10 @@ struct WindowAxis {
 };
 
 // Four floats in one SSE register (GCC's vector extension); a point is two.
-using Lanes = float __attribute__((vector_size(16)));
+using WindowLanes = float __attribute__((vector_size(16)));
 constexpr int kLanesPerPoint = kPointFloats / 4;
-Lanes LoadLanes(const float* p) {
-  Lanes v;
+WindowLanes LoadWindowLanes(const float* p) {
+  WindowLanes v;
   std::memcpy(&v, p, sizeof v);
   return v;
 }
@@ -59,7 +59,7 @@ template <typename Visit>
 void VisitCoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy,
                        Visit visit) {
   const WindowAxis along_x(coarse.cols, x, dx), along_y(coarse.rows, y, dy);
-  Lanes point[kLanesPerPoint];
+  WindowLanes point[kLanesPerPoint];
   int k = 0;
   for (int b = 0; b < kDetailWindowSide; ++b) {
     const float* r0 = coarse.ptr<float>(along_y.lo[b]);
@@ -74,15 +74,15 @@ void VisitCoarseWindow(const cv::Mat& coarse, double x, double y, double dx, dou
       const float* v01 = r1 + along_x.lo[a] * kPointFloats;
       const float* v11 = r1 + along_x.hi[a] * kPointFloats;
       for (int h = 0; h < kLanesPerPoint; ++h)
-        point[h] = w00 * LoadLanes(v00 + 4 * h) + w10 * LoadLanes(v10 + 4 * h) +
-                   w01 * LoadLanes(v01 + 4 * h) + w11 * LoadLanes(v11 + 4 * h);
+        point[h] = w00 * LoadWindowLanes(v00 + 4 * h) + w10 * LoadWindowLanes(v10 + 4 * h) +
+                   w01 * LoadWindowLanes(v01 + 4 * h) + w11 * LoadWindowLanes(v11 + 4 * h);
       if (!visit(k++, point)) return;
     }
   }
 }
 
 void CoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy, float* window) {
-  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const Lanes* point) {
+  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const WindowLanes* point) {
     std::memcpy(window + k * kPointFloats, point, kPointFloats * sizeof(float));
     return true;
   });
@@ -94,10 +94,10 @@ void CoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double d
 float CoarseWindowDistance(const cv::Mat& coarse, double x, double y, double dx, double dy,
                            const float* query, float bound) {
   float e = 0.0f;
-  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const Lanes* point) {
-    Lanes squares = {0.0f, 0.0f, 0.0f, 0.0f};
+  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const WindowLanes* point) {
+    WindowLanes squares = {0.0f, 0.0f, 0.0f, 0.0f};
     for (int h = 0; h < kLanesPerPoint; ++h) {
-      const Lanes d = point[h] - LoadLanes(query + k * kPointFloats + 4 * h);
+      const WindowLanes d = point[h] - LoadWindowLanes(query + k * kPointFloats + 4 * h);
       squares += d * d;
     }
     e += (squares[0] + squares[1]) + (squares[2] + squares[3]);

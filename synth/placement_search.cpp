@@ -228,7 +228,7 @@ namespace {
 
 // kLanes floats side by side: one AVX2 register, or two SSE2 ones on any x86-64.
 static_assert(PlacementSearch::kLanes == 8, "a vector of 8 floats (a power of two)");
-using Lanes = float __attribute__((vector_size(PlacementSearch::kLanes * sizeof(float))));
+using PlacementLanes = float __attribute__((vector_size(PlacementSearch::kLanes * sizeof(float))));
 
 // RowOfCellScores' sums of squared differences, before eq. 3's root. Each lane
 // (placement) sums as one placement alone would: a row's sum in floats over the
@@ -240,14 +240,14 @@ using Lanes = float __attribute__((vector_size(PlacementSearch::kLanes * sizeof(
     std::array<double, PlacementSearch::kLanes>& ssd) {
   for (int j = 0; j < mask.rows; ++j) {
     const float* m = mask.ptr<float>(j);
-    Lanes row = {};
+    PlacementLanes row = {};
     for (std::size_t c = 0; c < photo.size(); ++c) {
       const float* s = relit_planes[c].ptr<float>(at.y + j) + at.x;
       const float* p = photo[c].ptr<float>(j);
       for (int i = 0; i < mask.cols; ++i) {
-        Lanes relit_i;  // cell i of each lane's placement
-        std::memcpy(&relit_i, s + i, sizeof(Lanes));
-        const Lanes d = relit_i - p[i];
+        PlacementLanes relit_i;  // cell i of each lane's placement
+        std::memcpy(&relit_i, s + i, sizeof(PlacementLanes));
+        const PlacementLanes d = relit_i - p[i];
         row += m[i] * d * d;
       }
     }
