@@ -144,12 +144,10 @@ class CoefficientCorrection::PatchPass {
     to_mean_of_cell_.resize(static_cast<std::size_t>(gw_ * gh_));
     for (int j = 0; j < gh_; ++j)
       for (int i = 0; i < gw_; ++i) {
+        const cv::Point2d s = SamplePoint(i, j);
+        const BilinearTaps at(red0_.planes[0].size(), s.x, s.y);
         Vector6d a_patch;
-        for (int m = 0; m < 6; ++m)
-          a_patch[m] = BilinearClamped(
-              red0_.planes[static_cast<std::size_t>(m)],
-              std::clamp(patch_.sample_x * red0_.rx + i, 0.0, red0_.planes[0].cols - 1.0),
-              std::clamp(patch_.sample_y * red0_.ry + j, 0.0, red0_.planes[0].rows - 1.0));
+        for (int m = 0; m < 6; ++m) a_patch[m] = at.Of(red0_.planes[static_cast<std::size_t>(m)]);
         to_mean_of_cell_[static_cast<std::size_t>(j * gw_ + i)] =
             prior_.mean - to_orthonormal * a_patch;
       }
@@ -283,17 +281,19 @@ class CoefficientCorrection::PatchPass {
     if (photo_linear_sum_.empty()) SumPhotosLinear();
     std::vector<cv::Mat> model_sum(3);
     for (cv::Mat& m : model_sum) m = cv::Mat::zeros(gh_, gw_, CV_32FC1);
+    // The first round's cells are still the patch's: PriorShrink predicted them.
+    const bool predicted = !linear_at_patch_.empty();
     for (int j = 0; j < gh_; ++j) {
       for (int i = 0; i < gw_; ++i) {
         if (!known_.at<std::uint8_t>(j, i)) continue;  // seen by no view
-        const CellCoefficients cell = CellNow(i, j);
+        const CellCoefficients cell = predicted ? CellCoefficients{} : CellNow(i, j);
         for (std::size_t v = 0; v < views_.size(); ++v) {
           if (!Seen(views_[v], i, j)) continue;
           Eigen::Vector3d lin;
-          if (linear_at_patch_.empty())
-            Predict(v, i, j, cell, nullptr, &lin);
-          else  // the first round: the cells are still the patch's
+          if (predicted)
             lin = linear_at_patch_[v * static_cast<std::size_t>(gw_ * gh_) + Cell(i, j)];
+          else
+            Predict(v, i, j, cell, nullptr, &lin);
           for (std::size_t c = 0; c < 3; ++c)
             model_sum[c].at<float>(j, i) += static_cast<float>(lin[static_cast<Eigen::Index>(c)]);
         }

@@ -107,7 +107,7 @@ NearestWindows::NearestWindows(const Windows& windows, Options options)
     throw std::invalid_argument(
         "NearestWindows: at least 2 windows of at least 8 values, candidates >= 1, eps >= 0");
   PrincipalComponents(windows_, kComponents, mean_, components_);
-  tree_->projected = ProjectWindows();
+  tree_->projected = Project(windows_);
   tree_->points = tree_->projected.ptr<float>();
   tree_->index = std::make_unique<Tree::Index>(  // builds the tree
       components_.rows, *tree_, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize));
@@ -116,35 +116,22 @@ NearestWindows::NearestWindows(const Windows& windows, Options options)
 
 NearestWindows::~NearestWindows() = default;
 
-void NearestWindows::ProjectBlock(cv::Mat& centred, cv::Mat block) const {
+cv::Mat NearestWindows::Project(const Windows& rows) const {
+  // A block of rows at a time (never every window at once), each less the mean,
+  // then its components.
+  cv::Mat out(rows.Count(), components_.rows, CV_32FC1);
+  cv::Mat centred;
   const float* mean = mean_.ptr<float>();
-  for (int r = 0; r < centred.rows; ++r) {
-    float* c = centred.ptr<float>(r);
-    for (int i = 0; i < centred.cols; ++i) c[i] -= mean[i];
-  }
-  cv::gemm(centred, components_, 1.0, cv::noArray(), 0.0, block, cv::GEMM_2_T);
-}
-
-cv::Mat NearestWindows::ProjectWindows() const {
-  // A block of windows at a time (never every window at once).
-  cv::Mat out(windows_.Count(), components_.rows, CV_32FC1);
-  cv::Mat centred;
-  for (int first = 0; first < windows_.Count(); first += kProjectedBlockRows) {
-    const int count = std::min(kProjectedBlockRows, windows_.Count() - first);
-    centred.create(count, windows_.Length(), CV_32FC1);
-    windows_.Rows(first, centred);
-    ProjectBlock(centred, out.rowRange(first, first + count));
-  }
-  return out;
-}
-
-cv::Mat NearestWindows::Project(const cv::Mat& rows) const {
-  cv::Mat out(rows.rows, components_.rows, CV_32FC1);
-  cv::Mat centred;
-  for (int first = 0; first < rows.rows; first += kProjectedBlockRows) {
-    const int count = std::min(kProjectedBlockRows, rows.rows - first);
-    rows.rowRange(first, first + count).copyTo(centred);
-    ProjectBlock(centred, out.rowRange(first, first + count));
+  for (int first = 0; first < rows.Count(); first += kProjectedBlockRows) {
+    const int count = std::min(kProjectedBlockRows, rows.Count() - first);
+    centred.create(count, rows.Length(), CV_32FC1);
+    rows.Rows(first, centred);
+    for (int r = 0; r < count; ++r) {
+      float* c = centred.ptr<float>(r);
+      for (int i = 0; i < centred.cols; ++i) c[i] -= mean[i];
+    }
+    cv::Mat block = out.rowRange(first, first + count);
+    cv::gemm(centred, components_, 1.0, cv::noArray(), 0.0, block, cv::GEMM_2_T);
   }
   return out;
 }
@@ -152,7 +139,7 @@ cv::Mat NearestWindows::Project(const cv::Mat& rows) const {
 void NearestWindows::Nearest(const cv::Mat& queries, std::vector<int>& index,
                              std::vector<float>& squared_distance) const {
   CV_Assert(queries.type() == CV_32FC1 && queries.cols == windows_.Length());
-  const cv::Mat projected = Project(queries);
+  const cv::Mat projected = Project(WindowMatrix(queries));
   const std::size_t k = static_cast<std::size_t>(std::min(options_.candidates, windows_.Count()));
   std::vector<std::uint32_t> found(k);
   std::vector<float> reduced_distance(k);

@@ -78,9 +78,7 @@ class NearestWindows {
 
  private:
   // The windows' or the queries' principal components, a row each.
-  cv::Mat ProjectWindows() const;
-  cv::Mat Project(const cv::Mat& rows) const;
-  void ProjectBlock(cv::Mat& centred, cv::Mat block) const;
+  cv::Mat Project(const Windows& rows) const;
 
   Options options_;
   const Windows& windows_;
