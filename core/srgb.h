@@ -70,4 +70,20 @@ inline float FromLinear(float v, const Tables& tables) {
 }
 inline float FromLinear(float v) { return FromLinear(v, TheTables()); }
 
+/// d linear / d display at display value v, given its linear value (ToLinear(v)):
+/// the power segment's derivative 2.4 / 1.055 ((v + 0.055) / 1.055)^1.4 written as
+/// 2.4 linear / (v + 0.055), so no power is taken; 0 outside (0, 1).
+inline float ToLinearSlope(float v, float linear) {
+  if (!(v > 0.0f) || v >= 1.0f) return 0.0f;
+  return v <= kDisplayLinearUpTo ? 1.0f / kLinearSlope : 2.4f * linear / (v + 0.055f);
+}
+
+/// d display / d linear at linear value v, given its display value (FromLinear(v)):
+/// the power segment's derivative (1.055 / 2.4) v^(1 / 2.4 - 1) written as
+/// (display + 0.055) / (2.4 v); 0 outside (0, 1).
+inline float FromLinearSlope(float v, float display) {
+  if (!(v > 0.0f) || v >= 1.0f) return 0.0f;
+  return v <= kLinearUpTo ? kLinearSlope : (display + 0.055f) / (2.4f * v);
+}
+
 }  // namespace texlume::srgb

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/image_io.h"
+#include "core/srgb.h"
 #include "ptm/coefficient_space.h"
 #include "synth/detail_transfer.h"
 #include "synth/photo_blur.h"
@@ -203,13 +204,10 @@ class CoefficientCorrection::PatchPass {
     for (int c = 0; c < 3; ++c) {
       const double lin = g * linear[c];
       if (channel_linear) (*channel_linear)[c] = lin;
-      const double d = LinearToSrgb(static_cast<float>(lin));
+      const float d = LinearToSrgb(static_cast<float>(lin));
       y_pred += d / 3.0;
       if (!jac) continue;
-      const double h = 1e-4;
-      const double dsrgb = (LinearToSrgb(static_cast<float>(lin + h)) -
-                            LinearToSrgb(static_cast<float>(std::max(0.0, lin - h)))) /
-                           (lin + h - std::max(0.0, lin - h));
+      const double dsrgb = srgb::FromLinearSlope(static_cast<float>(lin), d);
       *jac += dsrgb * g * dlinear.row(c) / 3.0;
     }
     return y_pred;
@@ -450,13 +448,10 @@ double RelitLinearShare(double display, double* slope) {
   if (slope) *slope = 0.0;
   if (display <= 0.0) return 0.0;  // black
   if (display >= 1.0) return 1.0;  // white: SrgbToLinear(1) = 1
-  if (slope) {
-    const double h = 1e-3;
-    *slope = (SrgbToLinear(static_cast<float>(std::min(1.0, display + h))) -
-              SrgbToLinear(static_cast<float>(std::max(0.0, display - h)))) /
-             (std::min(1.0, display + h) - std::max(0.0, display - h));
-  }
-  return SrgbToLinear(static_cast<float>(display));
+  const auto v = static_cast<float>(display);
+  const float linear = SrgbToLinear(v);
+  if (slope) *slope = srgb::ToLinearSlope(v, linear);
+  return linear;
 }
 
 CoefficientCorrection::CoefficientCorrection(const PtmSample& sample,

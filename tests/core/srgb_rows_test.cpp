@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -101,6 +102,30 @@ TEST(SrgbRows, KnownValues) {
   std::vector<float> back(display.size());
   ScaledFromLinear(linear.data(), 1.0f, 8, back.data());
   for (std::size_t i = 0; i < display.size(); ++i) EXPECT_NEAR(back[i], display[i], 1e-5f);
+}
+
+// The curves' slopes against central differences of the exact powers, on both
+// segments and at the ends of [0, 1] (0 outside, where the conversions clamp).
+TEST(SrgbSlopes, MatchTheCurvesDerivatives) {
+  const auto decode = [](double v) {
+    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+  };
+  const auto encode = [](double v) {
+    return v <= 0.0031308 ? v * 12.92 : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+  };
+  const double h = 1e-6;
+  for (const float v : {0.01f, 0.04f, 0.05f, 0.2f, 0.5f, 0.9f, 0.999f}) {
+    const double to = (decode(v + h) - decode(v - h)) / (2 * h);
+    EXPECT_NEAR(ToLinearSlope(v, ToLinear(v)), to, 1e-5 * to) << v;
+  }
+  for (const float v : {0.001f, 0.003f, 0.004f, 0.05f, 0.2f, 0.5f, 0.999f}) {
+    const double from = (encode(v + h) - encode(v - h)) / (2 * h);
+    EXPECT_NEAR(FromLinearSlope(v, FromLinear(v)), from, 1e-5 * from) << v;
+  }
+  for (const float v : {-0.1f, 0.0f, 1.0f, 1.5f, std::numeric_limits<float>::quiet_NaN()}) {
+    EXPECT_EQ(ToLinearSlope(v, ToLinear(v)), 0.0f) << v;
+    EXPECT_EQ(FromLinearSlope(v, FromLinear(v)), 0.0f) << v;
+  }
 }
 
 }  // namespace

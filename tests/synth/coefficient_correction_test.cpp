@@ -27,7 +27,7 @@ TEST(RelitLinearShare, DecodesSrgbWithItsSlopeInside) {
     // d/dv of ((v + 0.055) / 1.055)^2.4 above the linear segment, 1 / 12.92 below.
     const double expected =
         v <= 0.04045 ? 1.0 / 12.92 : 2.4 / 1.055 * std::pow((v + 0.055) / 1.055, 1.4);
-    EXPECT_NEAR(slope, expected, 2e-3 * expected) << v;
+    EXPECT_NEAR(slope, expected, 1e-4 * expected) << v;
   }
 }
 
