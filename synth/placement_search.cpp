@@ -22,6 +22,10 @@ constexpr int kLevelsPerHalving = 4;
 // Coarse to fine only when every placement is at least this many times those refined.
 constexpr double kRefineFraction = 4.0;
 
+// Half a cell of `stride` texels, rounded up: how far from a coarse candidate the
+// next density's placements are scored.
+int HalfCell(int stride) { return (stride + 1) / 2; }
+
 // The best `k` of `scored`, best first.
 std::vector<ScoredPlacement> KeepBest(std::vector<ScoredPlacement> scored, int k) {
   const std::size_t kept = std::min<std::size_t>(static_cast<std::size_t>(k), scored.size());
@@ -338,10 +342,11 @@ std::vector<ScoredPlacement> PlacementSearch::CoarseToFine(int top_k, int candid
   if (steps == 0) return Exhaustive(top_k);
   std::vector<ViewAtStep> views = ViewsAtStep(steps);
   int coarse_stride = Stride(views);
-  // Refining scores about (2 coarse / fine + 1)^2 placements per candidate and step;
-  // when that is not well below every placement, the exhaustive search is cheaper.
+  // Refining scores about (2 half a coarse cell / fine + 1)^2 placements per candidate
+  // and step; when that is not well below every placement, the exhaustive search is
+  // cheaper.
   const int fine_stride = Stride(ViewsAtStep(0));
-  const double per_candidate = std::pow(2.0 * coarse_stride / fine_stride + 1.0, 2.0);
+  const double per_candidate = std::pow(2.0 * HalfCell(coarse_stride) / fine_stride + 1.0, 2.0);
   const double everywhere = (last_x_ / fine_stride + 1.0) * (last_y_ / fine_stride + 1.0);
   if (everywhere < kRefineFraction * std::max(candidates, top_k) * per_candidate * steps)
     return Exhaustive(top_k);
@@ -358,16 +363,17 @@ std::vector<ScoredPlacement> PlacementSearch::CoarseToFine(int top_k, int candid
       relit.emplace_back(
           *this, views[r],
           scratch.Planes(r, views[r].reduced->planes[0].size() + cv::Size(kLanes - 1, 0)));
-    // Every placement of this density's grid within a coarse cell of a candidate.
+    // Every placement of this density's grid within half a coarse cell of a candidate
+    // (the coarse grid's placements are a coarse cell apart: half a cell reaches
+    // every placement nearer to this candidate than to its grid neighbours).
     std::unordered_set<long long> seen;
     std::vector<ScoredPlacement> scored;
     for (const auto& [score, c] : kept) {
       std::vector<cv::Point> near;
-      const auto first = [&](int v) {
-        return std::max(0, (v - coarse_stride + stride - 1) / stride);
-      };
-      for (int y = first(c.y) * stride; y <= std::min(last_y_, c.y + coarse_stride); y += stride)
-        for (int x = first(c.x) * stride; x <= std::min(last_x_, c.x + coarse_stride); x += stride)
+      const int reach = HalfCell(coarse_stride);
+      const auto first = [&](int v) { return std::max(0, (v - reach + stride - 1) / stride); };
+      for (int y = first(c.y) * stride; y <= std::min(last_y_, c.y + reach); y += stride)
+        for (int x = first(c.x) * stride; x <= std::min(last_x_, c.x + reach); x += stride)
           if (seen.insert(static_cast<long long>(y) * (last_x_ + 1) + x).second)
             near.emplace_back(x, y);
       if (near.empty()) continue;
