@@ -25,7 +25,6 @@ std::vector<cv::Mat> GeometryPlanes(const btf::BtfFactorisation& s) {
 BtfSample::BtfSample(const btf::BtfFactorisation& btf)
     : btf_(btf),
       geometry_(GeometryPlanes(btf)),
-      energy_(PlaneEnergy(geometry_)),
       mean_g_(btf.geometry.colwise().mean().transpose()) {}
 
 void BtfSample::FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const {

@@ -22,7 +22,6 @@ class BtfSample : public MaterialSample {
   int Width() const override { return btf_.width; }
   int Height() const override { return btf_.height; }
   const std::vector<cv::Mat>& FeaturePlanes() const override { return geometry_; }
-  const cv::Mat& FeatureEnergy() const override { return energy_; }
   void FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const override;
   void TurnFeatures(const Unfolding&, float*) const override {}
   bool Blendable() const override { return false; }
@@ -46,7 +45,6 @@ class BtfSample : public MaterialSample {
  private:
   const btf::BtfFactorisation& btf_;
   std::vector<cv::Mat> geometry_;
-  cv::Mat energy_;
   Eigen::VectorXf mean_g_;
 };
 

@@ -46,7 +46,7 @@ class CoefficientCorrection : public PhotoCorrection {
 
   /// Per density level, the detail bands the transferred patches read
   /// (MeshSynthesis::detail_bands).
-  std::map<int, std::vector<cv::Mat>> TakeDetailBands() { return std::move(detail_bands_); }
+  std::map<int, cv::Mat> TakeDetailBands() { return std::move(detail_bands_); }
 
   /// The prior of the pass at a density level: the mean and covariance of the
   /// reduced sample's orthonormal luminance coefficients.
@@ -65,7 +65,7 @@ class CoefficientCorrection : public PhotoCorrection {
   std::map<int, CoefficientPrior> priors_;
   std::vector<int> correction_level_;  ///< per face: the grid's density level, -1 uncorrected
   std::map<int, std::unique_ptr<DetailDictionary>> dictionaries_;
-  std::map<int, std::vector<cv::Mat>> detail_bands_;
+  std::map<int, cv::Mat> detail_bands_;
 };
 
 /// One light's share of a texel's linear value in a channel, as PtmSample::Relight

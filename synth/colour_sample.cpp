@@ -52,7 +52,6 @@ ColourSample::ColourSample(const cv::Mat& display_rgb) {
   TEXLUME_CHECK(display_rgb.type() == CV_32FC3 && !display_rgb.empty(),
                 "a colour sample is CV_32FC3 display RGB");
   cv::split(display_rgb, display_);
-  energy_ = PlaneEnergy(display_);
   linear_.resize(3);
   double sum = 0.0;
   for (std::size_t c = 0; c < 3; ++c) {

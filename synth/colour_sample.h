@@ -27,7 +27,6 @@ class ColourSample : public MaterialSample {
   int Width() const override { return display_[0].cols; }
   int Height() const override { return display_[0].rows; }
   const std::vector<cv::Mat>& FeaturePlanes() const override { return display_; }
-  const cv::Mat& FeatureEnergy() const override { return energy_; }
   void FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const override;
   void TurnFeatures(const Unfolding&, float*) const override {}
   bool Blendable() const override { return true; }
@@ -47,7 +46,6 @@ class ColourSample : public MaterialSample {
 
  private:
   std::vector<cv::Mat> display_, linear_;
-  cv::Mat energy_;
   double mean_linear_sum_ = 0.0;  ///< mean over texels of lin(R) + lin(G) + lin(B)
 };
 

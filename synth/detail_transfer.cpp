@@ -130,7 +130,7 @@ class DetailDictionary::PointWindows : public NearestWindows::Windows {
 
 DetailDictionary::~DetailDictionary() = default;
 
-DetailDictionary::DetailDictionary(const PtmSample& sample, int level, std::vector<cv::Mat>& band) {
+DetailDictionary::DetailDictionary(const PtmSample& sample, int level, cv::Mat& band) {
   const ReducedPlanes& red = sample.Reduced(level);
   dx_ = 1.0 / red.rx, dy_ = 1.0 / red.ry;
   const cv::Size full(sample.Width(), sample.Height());
@@ -139,15 +139,27 @@ DetailDictionary::DetailDictionary(const PtmSample& sample, int level, std::vect
   for (std::size_t c = 0; c < coarse_raw.size(); ++c)
     cv::resize(red.planes[c], coarse_raw[c], full, 0, 0, cv::INTER_LINEAR);
   ToOrthonormalPoints(coarse_raw);
-  const std::vector<cv::Mat>& values = sample.Values();
-  band.resize(values.size());
-  cv::Mat coarse_plane;
-  for (std::size_t c = 0; c < band.size(); ++c) {
-    const bool luminance = c < static_cast<std::size_t>(kCoefficients);
-    if (luminance) cv::extractChannel(coarse_, coarse_plane, static_cast<int>(c));
-    band[c] = values[c] - (luminance ? coarse_plane : coarse_raw[c]);
-  }
+  DetailBand(sample.Values(), coarse_raw, band);
   IndexWindows(full);
+}
+
+void DetailDictionary::DetailBand(const std::vector<cv::Mat>& values,
+                                  const std::vector<cv::Mat>& coarse_raw, cv::Mat& band) const {
+  // Each plane minus its coarse version: the orthonormal luminance coefficients'
+  // from coarse_, the colour planes' from coarse_raw; interleaved.
+  const int n = static_cast<int>(values.size());
+  band.create(coarse_.size(), CV_32FC(n));
+  for (int y = 0; y < band.rows; ++y) {
+    float* texel = band.ptr<float>(y);
+    const float* point = coarse_.ptr<float>(y);
+    for (int c = 0; c < n; ++c) {
+      const float* value = values[static_cast<std::size_t>(c)].ptr<float>(y);
+      const float* raw = coarse_raw[static_cast<std::size_t>(c)].ptr<float>(y);
+      const bool luminance = c < kCoefficients;
+      for (int x = 0; x < band.cols; ++x)
+        texel[x * n + c] = value[x] - (luminance ? point[x * kPointFloats + c] : raw[x]);
+    }
+  }
 }
 
 void DetailDictionary::ToOrthonormalPoints(const std::vector<cv::Mat>& coarse_raw) {

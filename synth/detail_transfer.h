@@ -23,9 +23,9 @@ namespace texlume::synth {
 class DetailDictionary {
  public:
   /// The dictionary of `sample` reduced to density `level`; `band` receives the
-  /// detail band (per plane of sample.Values()). Touches no shared state, so
-  /// levels can be built in parallel.
-  DetailDictionary(const PtmSample& sample, int level, std::vector<cv::Mat>& band);
+  /// detail band (sample.Values()' planes interleaved: CV_32FC(planes)). Touches
+  /// no shared state, so levels can be built in parallel.
+  DetailDictionary(const PtmSample& sample, int level, cv::Mat& band);
   ~DetailDictionary();
   DetailDictionary(const DetailDictionary&) = delete;
   DetailDictionary& operator=(const DetailDictionary&) = delete;
@@ -56,6 +56,9 @@ class DetailDictionary {
   };
   // coarse_: the raw coarse luminance coefficients (full size) in the orthonormal basis.
   void ToOrthonormalPoints(const std::vector<cv::Mat>& coarse_raw);
+  // The detail band: `values` minus their coarse version (coarse_, coarse_raw).
+  void DetailBand(const std::vector<cv::Mat>& values, const std::vector<cv::Mat>& coarse_raw,
+                  cv::Mat& band) const;
   void IndexWindows(cv::Size full);
   // Per cell, the window of the corrected coarse coefficients (a row each).
   cv::Mat CorrectedWindows(const TrianglePatch& patch) const;

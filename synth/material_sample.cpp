@@ -114,16 +114,16 @@ GridPoint OnCorrectionGrid(const TrianglePatch& patch, double u, double v) {
 // the band around each of the 4 nearest cells' matched sample points in,
 // weighted bilinearly and blended so that the detail keeps its contrast.
 // (uc, vc): the patch texel position, clamped.
-void TransferredDetail(const TrianglePatch& patch, const std::vector<cv::Mat>& band,
-                       const GridPoint& g, double uc, double vc, float* out) {
+void TransferredDetail(const TrianglePatch& patch, const cv::Mat& band, const GridPoint& g,
+                       double uc, double vc, float* out) {
   const double rx = patch.correction_density.x(), ry = patch.correction_density.y();
   const std::array<std::pair<cv::Point, float>, 4> cells = {
       std::pair{cv::Point(g.gx0, g.gy0), (1 - g.gfx) * (1 - g.gfy)},
       std::pair{cv::Point(g.gx1, g.gy0), g.gfx * (1 - g.gfy)},
       std::pair{cv::Point(g.gx0, g.gy1), (1 - g.gfx) * g.gfy},
       std::pair{cv::Point(g.gx1, g.gy1), g.gfx * g.gfy}};
-  const BilinearTaps own(band[0].size(), patch.sample_x + uc, patch.sample_y + vc);
-  for (std::size_t c = 0; c < band.size(); ++c) out[c] -= static_cast<float>(own.Of(band[c]));
+  BilinearTaps(band.size(), patch.sample_x + uc, patch.sample_y + vc)
+      .AddScaledChannels(band, -1.0, out);
   // The band read at each cell's match, blended so that it keeps its contrast
   // (after Heitz and Neyret 2018's variance-preserving blend; the bands are
   // zero-mean): sum_k w_k b_k / sqrt(sum_jk w_j w_k rho_jk), the standard
@@ -155,11 +155,9 @@ void TransferredDetail(const TrianglePatch& patch, const std::vector<cv::Mat>& b
       variance += sources[j].second * sources[k].second * rho[j][k];
   if (n == 0 || !(variance > 0.0)) return;
   const double norm = 1.0 / std::sqrt(variance);
-  for (std::size_t k = 0; k < n; ++k) {
-    const BilinearTaps at(band[0].size(), sources[k].first.x(), sources[k].first.y());
-    for (std::size_t c = 0; c < band.size(); ++c)
-      out[c] += static_cast<float>(sources[k].second * norm * at.Of(band[c]));
-  }
+  for (std::size_t k = 0; k < n; ++k)
+    BilinearTaps(band.size(), sources[k].first.x(), sources[k].first.y())
+        .AddScaledChannels(band, sources[k].second * norm, out);
 }
 
 // Catmull-Rom weights of the 4 taps around t in [0, 1).
@@ -281,9 +279,8 @@ double BilinearClamped(const cv::Mat& m, double x, double y) {
 }
 
 bool SamplePtmPatch(const std::vector<cv::Mat>& values, ptm::PtmFormat format,
-                    const std::map<int, std::vector<cv::Mat>>& detail_bands,
-                    const TrianglePatch& patch, double texel_size, const Eigen::Vector2d& p,
-                    float* out) {
+                    const std::map<int, cv::Mat>& detail_bands, const TrianglePatch& patch,
+                    double texel_size, const Eigen::Vector2d& p, float* out) {
   const double u = (p.x() - patch.x_min) / texel_size - 0.5;
   const double v = (patch.y_max - p.y()) / texel_size - 0.5;
   if (u < -0.5 || v < -0.5 || u > patch.width - 0.5 || v > patch.height - 0.5) return false;
@@ -329,7 +326,6 @@ PtmSample::PtmSample(const ptm::Ptm& ptm, const ptm::SelfShadowing* shadowing)
   }
   const int coefficient_planes = ptm.format == ptm::PtmFormat::kLrgb ? 6 : 18;
   coefficients_.assign(values_.begin(), values_.begin() + coefficient_planes);
-  energy_ = PlaneEnergy(coefficients_);
   coarse_level_ = std::max(
       0, static_cast<int>(std::ceil(4.0 * std::log2(std::max(ptm.width, ptm.height) / 16.0))));
   if (shadowing_) shadowed_sum_texels_ = TexelsOnAGrid(raw_, kShadowedSumGrid);
@@ -337,7 +333,7 @@ PtmSample::PtmSample(const ptm::Ptm& ptm, const ptm::SelfShadowing* shadowing)
 
 bool PtmSample::PatchFeatures(const TrianglePatch& patch, double texel_size,
                               const Eigen::Vector2d& p_in_frame, float* out) const {
-  static const std::map<int, std::vector<cv::Mat>> kNoDetail;
+  static const std::map<int, cv::Mat> kNoDetail;
   std::array<float, 18> all{};  // coefficients (+ LRGB colour): at most 18 values
   if (!SamplePtmPatch(values_, ptm_.format, kNoDetail, patch, texel_size, p_in_frame, all.data()))
     return false;

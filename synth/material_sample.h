@@ -77,9 +77,8 @@ class MaterialSample {
 
   /// Feature planes (CV_32FC1, full size) in which Euclidean distance is the
   /// right distance between texels (PTM: the orthonormal coefficients, paper
-  /// 003 §2.3; BTF: the geometry maps, paper 004 §III), and their summed squares.
+  /// 003 §2.3; BTF: the geometry maps, paper 004 §III).
   virtual const std::vector<cv::Mat>& FeaturePlanes() const = 0;
-  virtual const cv::Mat& FeatureEnergy() const = 0;
   int NumFeatures() const { return static_cast<int>(FeaturePlanes().size()); }
 
   /// The features a placed patch shows at a point of its face's frame (world
@@ -158,7 +157,6 @@ class PtmSample : public MaterialSample {
   int Width() const override { return ptm_.width; }
   int Height() const override { return ptm_.height; }
   const std::vector<cv::Mat>& FeaturePlanes() const override { return coefficients_; }
-  const cv::Mat& FeatureEnergy() const override { return energy_; }
   bool PatchFeatures(const TrianglePatch& patch, double texel_size,
                      const Eigen::Vector2d& p_in_frame, float* out) const override;
   void FeaturesAt(const Eigen::Vector2d& sample_px, float* out) const override;
@@ -214,7 +212,6 @@ class PtmSample : public MaterialSample {
   const ptm::Ptm& ptm_;
   const ptm::SelfShadowing* shadowing_ = nullptr;
   std::vector<cv::Mat> values_, coefficients_, raw_;
-  cv::Mat energy_;
   int coarse_level_ = 0;  ///< the level RelitLinearSum averages at (about 16 texels a side)
   /// With self-shadowing, what RelitLinearSum relights instead: the texels of a
   /// grid over the sample (kShadowedSumGrid a side), each with its own horizon, since
@@ -242,15 +239,24 @@ class BilinearTaps {
   template <std::size_t N>
   void OfChannels(const cv::Mat& interleaved, std::array<double, N>& out) const {
     CV_DbgAssert(interleaved.type() == CV_32FC(static_cast<int>(N)));
-    constexpr int n = static_cast<int>(N);
-    const float* r0 = interleaved.ptr<float>(y0_);
-    const float* r1 = interleaved.ptr<float>(y1_);
-    for (int m = 0; m < n; ++m)
-      out[static_cast<std::size_t>(m)] =
-          Blend(r0[x0_ * n + m], r0[x1_ * n + m], r1[x0_ * n + m], r1[x1_ * n + m]);
+    VisitChannels(interleaved, [&](int m, double v) { out[static_cast<std::size_t>(m)] = v; });
+  }
+  /// out[m] += scale x Of() of channel m, for every channel m of a CV_32FC(n) plane
+  /// of the size given, each rounded to float as it is added.
+  void AddScaledChannels(const cv::Mat& interleaved, double scale, float* out) const {
+    VisitChannels(interleaved, [&](int m, double v) { out[m] += static_cast<float>(scale * v); });
   }
 
  private:
+  template <typename Visit>
+  void VisitChannels(const cv::Mat& interleaved, Visit visit) const {
+    CV_DbgAssert(interleaved.depth() == CV_32F);
+    const int n = interleaved.channels();
+    const float* r0 = interleaved.ptr<float>(y0_);
+    const float* r1 = interleaved.ptr<float>(y1_);
+    for (int m = 0; m < n; ++m)
+      visit(m, Blend(r0[x0_ * n + m], r0[x1_ * n + m], r1[x0_ * n + m], r1[x1_ * n + m]));
+  }
   double Blend(float v00, float v10, float v01, float v11) const {
     return (1 - fy_) * ((1 - fx_) * v00 + fx_ * v10) + fy_ * ((1 - fx_) * v01 + fx_ * v11);
   }
@@ -265,8 +271,7 @@ class BilinearTaps {
 /// (TrianglePatch); `detail_bands` by level as MeshSynthesis holds them. False
 /// outside the rectangle. Writes values.size() planes.
 bool SamplePtmPatch(const std::vector<cv::Mat>& values, ptm::PtmFormat format,
-                    const std::map<int, std::vector<cv::Mat>>& detail_bands,
-                    const TrianglePatch& patch, double texel_size,
-                    const Eigen::Vector2d& p_in_frame, float* out);
+                    const std::map<int, cv::Mat>& detail_bands, const TrianglePatch& patch,
+                    double texel_size, const Eigen::Vector2d& p_in_frame, float* out);
 
 }  // namespace texlume::synth

@@ -63,8 +63,9 @@ struct MeshSynthesis : TriangleSynthesis {
   ptm::PtmFormat format = ptm::PtmFormat::kLrgb;
   std::vector<cv::Mat> sample_planes;  ///< orthonormal coefficients (+ LRGB colour)
   /// Per photo-density level: the sample's detail band, its planes minus their
-  /// reduction to that density brought back to full size (all planes, texels).
-  std::map<int, std::vector<cv::Mat>> detail_bands;
+  /// reduction to that density brought back to full size (all planes, texels;
+  /// interleaved, CV_32FC(planes): a texel's values side by side for the bake).
+  std::map<int, cv::Mat> detail_bands;
   /// Faces whose values another engine supplies in place of their patch (the
   /// main job's graph-cut fill of the faces no photo sees, quilt/unseen_fill.h):
   /// per face whether it does (empty: none), and its values at a point of the

@@ -578,27 +578,12 @@ TriangleEngine::ShadingTurnSet TriangleEngine::ShadingTurns(std::size_t face) co
   return turns;
 }
 
-double TriangleEngine::OverlapTargets::Error(const MaterialSample& sample, int width, int sx,
-                                             int sy) const {
-  if (texels.empty()) return 0.0;
-  const std::vector<cv::Mat>& planes = sample.FeaturePlanes();
-  const std::size_t n = planes.size();
-  double e = 0.0;
-  for (std::size_t m = 0; m < texels.size(); ++m) {
-    const int i = texels[m] % width, j = texels[m] / width;
-    for (std::size_t c = 0; c < n; ++c) {
-      const double d = planes[c].at<float>(sy + j, sx + i) - targets[m * n + c];
-      e += d * d;
-    }
-  }
-  return e / static_cast<double>(texels.size());
-}
-
-TriangleEngine::OverlapTargets TriangleEngine::CollectOverlapTargets(std::size_t f) const {
+OverlapTexels TriangleEngine::CollectOverlapTargets(std::size_t f) const {
   const TrianglePatch& patch = result_.patches[f];
   const double t = options_.sample_texel_size;
   const int w = patch.width, h = patch.height;
-  OverlapTargets overlap;
+  OverlapTexels overlap;
+  overlap.patch = cv::Size(w, h);
   std::vector<float> value(static_cast<std::size_t>(sample_.NumFeatures()));
   for (int j = 0; j < h; ++j) {
     for (int i = 0; i < w; ++i) {
@@ -638,12 +623,16 @@ TriangleEngine::FaceSearch TriangleEngine::SearchFace(std::size_t f, RelitScratc
 }
 
 void TriangleEngine::PlaceAmongCandidates(TrianglePatch& patch, const FaceSearch& found,
-                                          const OverlapTargets& overlap,
+                                          const OverlapTexels& overlap,
                                           std::vector<RelitWindow>& relit) {
-  // Of the top_k, the one closest to the synthesised neighbours (Algorithm 2).
-  KeepClosestToNeighbours(
-      found.candidates, [&](int sx, int sy) { return overlap.Error(sample_, patch.width, sx, sy); },
-      patch);
+  // Of the top_k, the one closest to the synthesised neighbours (Algorithm 2): the
+  // mean squared difference over the overlap.
+  const auto overlap_error = [&](int sx, int sy) {
+    if (overlap.texels.empty()) return 0.0;
+    return overlap.SumOfSquares(sample_.FeaturePlanes(), cv::Point(sx, sy)) /
+           static_cast<double>(overlap.texels.size());
+  };
+  KeepClosestToNeighbours(found.candidates, overlap_error, patch);
   const std::vector<RectifiedView>& views = found.views;
   if (!correction_ || correction_->RelitMarginCells(views.front()) < 0) return;
   std::vector<int> margins;
@@ -653,30 +642,18 @@ void TriangleEngine::PlaceAmongCandidates(TrianglePatch& patch, const FaceSearch
   relit = search.RelitAround(cv::Point(patch.sample_x, patch.sample_y), margins);
 }
 
-void TriangleEngine::PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap,
+void TriangleEngine::PlaceByNeighbours(TrianglePatch& patch, const OverlapTexels& overlap,
                                        std::mt19937_64& rng) {
-  const int w = patch.width, h = patch.height;
-  const std::size_t n = static_cast<std::size_t>(sample_.NumFeatures());
-  std::vector<cv::Mat> target_planes(n);
-  for (cv::Mat& m : target_planes) m = cv::Mat::zeros(h, w, CV_32FC1);
-  cv::Mat mask = cv::Mat::zeros(h, w, CV_32FC1);
-  for (std::size_t m = 0; m < overlap.texels.size(); ++m) {
-    const int i = overlap.texels[m] % w, j = overlap.texels[m] / w;
-    mask.at<float>(j, i) = 1.0f;
-    for (std::size_t c = 0; c < n; ++c)
-      target_planes[c].at<float>(j, i) = overlap.targets[m * n + c];
-  }
-  if (!feature_spectra_) feature_spectra_.emplace(sample_.FeaturePlanes(), sample_.FeatureEnergy());
-  const cv::Mat errors = feature_spectra_->MaskedSsd(target_planes, mask);
-  const cv::Point p = PickWithinTolerance(errors, options_.tolerance, rng);
-  patch.sample_x = p.x;
-  patch.sample_y = p.y;
-  patch.overlap_error = errors.at<float>(p.y, p.x) / static_cast<double>(overlap.texels.size());
+  if (!overlap_placement_) overlap_placement_.emplace(sample_.FeaturePlanes());
+  const OverlapPlacement::Placement p = overlap_placement_->Pick(overlap, options_.tolerance, rng);
+  patch.sample_x = p.texel.x;
+  patch.sample_y = p.texel.y;
+  patch.overlap_error = p.error / static_cast<double>(overlap.texels.size());
 }
 
 void TriangleEngine::SynthesizeFace(std::size_t f, FaceSearch found, std::mt19937_64& rng) {
   TrianglePatch& patch = result_.patches[f];
-  const OverlapTargets overlap = CollectOverlapTargets(f);
+  const OverlapTexels overlap = CollectOverlapTargets(f);
   if (!found.views.empty()) {
     std::vector<RelitWindow> relit;  // per view: the sample relit around the placed patch
     PlaceAmongCandidates(patch, found, overlap, relit);

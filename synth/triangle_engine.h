@@ -19,6 +19,7 @@
 #include "sfm/visibility.h"
 #include "synth/face_regions.h"
 #include "synth/material_sample.h"
+#include "synth/overlap_placement.h"
 #include "synth/photometry.h"
 #include "synth/template_match.h"
 #include "synth/triangle_parts.h"
@@ -399,18 +400,13 @@ class TriangleEngine {
 
   // The synthesised neighbours' features unfolded into a face's frame, on the
   // patch texels within W_e of a shared edge.
-  struct OverlapTargets {
-    std::vector<int> texels;     // j * width + i
-    std::vector<float> targets;  // NumFeatures() per texel
-    double Error(const MaterialSample& sample, int width, int sx, int sy) const;
-  };
-  OverlapTargets CollectOverlapTargets(std::size_t face) const;
+  OverlapTexels CollectOverlapTargets(std::size_t face) const;
   // Of the candidates (eq. 3 summed over the views, top_k), the one closest to the
   // neighbours. `relit`: around the placed patch, when the correction reads it.
   void PlaceAmongCandidates(TrianglePatch& patch, const FaceSearch& found,
-                            const OverlapTargets& overlap, std::vector<RelitWindow>& relit);
-  // Unseen faces: the overlap constraint over every placement (FFT).
-  void PlaceByNeighbours(TrianglePatch& patch, const OverlapTargets& overlap, std::mt19937_64& rng);
+                            const OverlapTexels& overlap, std::vector<RelitWindow>& relit);
+  // Unseen faces: the overlap constraint over every placement (OverlapPlacement).
+  void PlaceByNeighbours(TrianglePatch& patch, const OverlapTexels& overlap, std::mt19937_64& rng);
 
   const mesh::TriangleMesh& mesh_;
   const sfm::Reconstruction& reconstruction_;
@@ -432,8 +428,8 @@ class TriangleEngine {
   std::vector<std::size_t> photo_visit_order_;
   std::optional<FaceRegions> regions_;  // a distributed run (DistributeOver)
   std::vector<char> placed_first_;      // its BordersPlacedFirst
-  // The sample's feature planes transformed once, for the faces no photo sees.
-  std::optional<ImageSpectra> feature_spectra_;
+  // The placement of the faces no photo sees (their sample's spectra made once).
+  std::optional<OverlapPlacement> overlap_placement_;
   // The placement search's relit buffers, one per thread searching
   // (RunAheadWorkers), lent to each face's search in turn.
   std::vector<RelitScratch> relit_scratch_;

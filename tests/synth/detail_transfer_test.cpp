@@ -73,10 +73,10 @@ void ExpectSourcesFrom(const TrianglePatch& patch, cv::Point to) {
 TEST(DetailTransfer, AnUncorrectedPatchKeepsItsOwnDetail) {
   const ptm::Ptm p = SmoothPtm(48, 3);
   const PtmSample sample(p);
-  std::vector<cv::Mat> band;
+  cv::Mat band;
   const DetailDictionary dictionary(sample, 0, band);
   ASSERT_TRUE(dictionary.Usable());
-  ASSERT_EQ(band.size(), sample.Values().size());
+  ASSERT_EQ(band.channels(), static_cast<int>(sample.Values().size()));
   TrianglePatch patch = PatchCorrectedToward(p, cv::Size(13, 11), {9, 17}, {9, 17});
   dictionary.Transfer(patch, 0);
   EXPECT_EQ(patch.detail_level, 0);
@@ -88,7 +88,7 @@ TEST(DetailTransfer, AnUncorrectedPatchKeepsItsOwnDetail) {
 TEST(DetailTransfer, ACorrectedPatchTakesTheDetailOfThePlaceItWasCorrectedToward) {
   const ptm::Ptm p = SmoothPtm(48, 5);
   const PtmSample sample(p);
-  std::vector<cv::Mat> band;
+  cv::Mat band;
   const DetailDictionary dictionary(sample, 0, band);
   for (const cv::Point to : {cv::Point(25, 4), cv::Point(3, 30), cv::Point(30, 31)}) {
     TrianglePatch patch = PatchCorrectedToward(p, cv::Size(12, 12), {6, 8}, to);
@@ -117,7 +117,7 @@ void ExpectSourcesAreWindowCentres(const TrianglePatch& patch) {
 TEST(DetailTransfer, CellsBeyondTheWindowsReachStillFindAMatch) {
   const ptm::Ptm p = SmoothPtm(48, 9);
   const PtmSample sample(p);
-  std::vector<cv::Mat> band;
+  cv::Mat band;
   const DetailDictionary dictionary(sample, 0, band);
   TrianglePatch square = PatchCorrectedToward(p, cv::Size(12, 12), {36, 36}, {36, 36});
   dictionary.Transfer(square, 0);
@@ -134,7 +134,7 @@ TEST(DetailTransfer, CellsBeyondTheWindowsReachStillFindAMatch) {
 TEST(DetailTransfer, ASampleNarrowerThanAWindowIsNotUsable) {
   const ptm::Ptm p = SmoothPtm(4, 7);
   const PtmSample sample(p);
-  std::vector<cv::Mat> band;
+  cv::Mat band;
   EXPECT_FALSE(DetailDictionary(sample, 0, band).Usable());
 }
 

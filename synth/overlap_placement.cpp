@@ -1,0 +1,160 @@
+#include "synth/overlap_placement.h"
+
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+#include <tuple>
+#include <unordered_set>
+
+#include "core/check.h"
+
+namespace texlume::synth {
+namespace {
+
+// Planes averaged over blocks of `block` x `block` texels (their first whole blocks).
+std::vector<cv::Mat> BlockAverages(const std::vector<cv::Mat>& planes, int block) {
+  const cv::Size blocks(planes[0].cols / block, planes[0].rows / block);
+  std::vector<cv::Mat> out(planes.size());
+  for (std::size_t c = 0; c < planes.size(); ++c)
+    cv::resize(planes[c](cv::Rect(0, 0, blocks.width * block, blocks.height * block)), out[c],
+               blocks, 0, 0, cv::INTER_AREA);
+  return out;
+}
+
+// A plane of the patch's size padded with zeros to whole blocks.
+cv::Mat PaddedToBlocks(const cv::Mat& plane, int block) {
+  cv::Mat padded;
+  cv::copyMakeBorder(plane, padded, 0, (block - plane.rows % block) % block, 0,
+                     (block - plane.cols % block) % block, cv::BORDER_CONSTANT, cv::Scalar(0));
+  return padded;
+}
+
+// PickWithinTolerance's rule over a list: uniform among the errors within
+// (1 + tolerance) of the smallest.
+std::size_t PickWithinToleranceOf(const std::vector<double>& errors, double tolerance,
+                                  std::mt19937_64& rng) {
+  const double least = *std::min_element(errors.begin(), errors.end());
+  std::vector<std::size_t> near;
+  for (std::size_t n = 0; n < errors.size(); ++n)
+    if (errors[n] <= least * (1.0 + tolerance) + 1e-12) near.push_back(n);
+  return near[std::uniform_int_distribution<std::size_t>(0, near.size() - 1)(rng)];
+}
+
+}  // namespace
+
+double OverlapTexels::SumOfSquares(const std::vector<cv::Mat>& features, cv::Point at) const {
+  const std::size_t n = features.size();
+  double e = 0.0;
+  for (std::size_t m = 0; m < texels.size(); ++m) {
+    const int i = texels[m] % patch.width, j = texels[m] / patch.width;
+    for (std::size_t c = 0; c < n; ++c) {
+      const double d = features[c].at<float>(at.y + j, at.x + i) - targets[m * n + c];
+      e += d * d;
+    }
+  }
+  return e;
+}
+
+OverlapPlacement::OverlapPlacement(const std::vector<cv::Mat>& features) : features_(features) {
+  TEXLUME_CHECK(!features.empty(), "the overlap placement needs the sample's feature planes");
+}
+
+int OverlapPlacement::Halvings(cv::Size patch) const {
+  const cv::Size sample = features_[0].size();
+  int halvings = 0;
+  for (int h = 1; h <= kMaxHalvings; ++h) {
+    const int block = 1 << h;
+    // The patch keeps kMinCells blocks a side and fits the reduced sample, and the
+    // refined placements are well below every placement (as the photos' search).
+    const bool fits = std::min(patch.width, patch.height) / block >= kMinCells &&
+                      (patch.width + block - 1) / block <= sample.width / block &&
+                      (patch.height + block - 1) / block <= sample.height / block;
+    const double everywhere =
+        (sample.width - patch.width + 1.0) * (sample.height - patch.height + 1.0);
+    const double refined = kCandidates * (block + 1.0) * (block + 1.0);
+    if (!fits || everywhere < 4.0 * refined) break;
+    halvings = h;
+  }
+  return halvings;
+}
+
+std::vector<cv::Mat> OverlapPlacement::TargetPlanes(const OverlapTexels& overlap,
+                                                    cv::Mat& mask) const {
+  const std::size_t n = features_.size();
+  std::vector<cv::Mat> planes(n);
+  for (cv::Mat& m : planes) m = cv::Mat::zeros(overlap.patch, CV_32FC1);
+  mask = cv::Mat::zeros(overlap.patch, CV_32FC1);
+  for (std::size_t m = 0; m < overlap.texels.size(); ++m) {
+    const int i = overlap.texels[m] % overlap.patch.width,
+              j = overlap.texels[m] / overlap.patch.width;
+    mask.at<float>(j, i) = 1.0f;
+    for (std::size_t c = 0; c < n; ++c) planes[c].at<float>(j, i) = overlap.targets[m * n + c];
+  }
+  return planes;
+}
+
+const ImageSpectra& OverlapPlacement::SpectraAt(int halvings) {
+  if (const auto it = spectra_.find(halvings); it != spectra_.end()) return it->second;
+  const std::vector<cv::Mat> planes =
+      halvings == 0 ? features_ : BlockAverages(features_, 1 << halvings);
+  return spectra_.emplace(halvings, ImageSpectra(planes, PlaneEnergy(planes))).first->second;
+}
+
+std::vector<cv::Point> OverlapPlacement::Refined(const cv::Mat& coarse_errors, int halvings,
+                                                 cv::Size patch) const {
+  // The best coarse placements (ties in row order), each standing for the block of
+  // full-density placements it starts.
+  std::vector<std::tuple<float, int, int>> coarse;
+  for (int y = 0; y < coarse_errors.rows; ++y)
+    for (int x = 0; x < coarse_errors.cols; ++x)
+      coarse.emplace_back(coarse_errors.at<float>(y, x), y, x);
+  const std::size_t kept = std::min<std::size_t>(kCandidates, coarse.size());
+  std::partial_sort(coarse.begin(), coarse.begin() + static_cast<std::ptrdiff_t>(kept),
+                    coarse.end());
+  const int block = 1 << halvings, half = block / 2;
+  const int last_x = features_[0].cols - patch.width, last_y = features_[0].rows - patch.height;
+  std::unordered_set<long long> seen;
+  std::vector<cv::Point> near;
+  for (std::size_t k = 0; k < kept; ++k) {
+    const int cx = std::get<2>(coarse[k]) * block, cy = std::get<1>(coarse[k]) * block;
+    for (int y = std::max(0, cy - half); y <= std::min(last_y, cy + half); ++y)
+      for (int x = std::max(0, cx - half); x <= std::min(last_x, cx + half); ++x)
+        if (seen.insert(static_cast<long long>(y) * (last_x + 1) + x).second)
+          near.emplace_back(x, y);
+  }
+  return near;
+}
+
+OverlapPlacement::Placement OverlapPlacement::Pick(const OverlapTexels& overlap, double tolerance,
+                                                   std::mt19937_64& rng) {
+  TEXLUME_CHECK(!overlap.texels.empty(), "a placement by the neighbours needs an overlap");
+  cv::Mat mask;
+  const std::vector<cv::Mat> targets = TargetPlanes(overlap, mask);
+  const int halvings = Halvings(overlap.patch);
+  if (halvings == 0) {  // every placement at full density
+    const cv::Mat errors = SpectraAt(0).MaskedSsd(targets, mask);
+    const cv::Point p = PickWithinTolerance(errors, tolerance, rng);
+    return {p, errors.at<float>(p.y, p.x)};
+  }
+  // The overlap averaged over blocks, weighted by how much of each block it covers.
+  const int block = 1 << halvings;
+  const cv::Mat padded_mask = PaddedToBlocks(mask, block);
+  const cv::Size blocks(padded_mask.cols / block, padded_mask.rows / block);
+  cv::Mat coarse_mask;
+  cv::resize(padded_mask, coarse_mask, blocks, 0, 0, cv::INTER_AREA);
+  std::vector<cv::Mat> coarse_targets(targets.size());
+  for (std::size_t c = 0; c < targets.size(); ++c) {
+    cv::Mat weighted;
+    cv::resize(PaddedToBlocks(targets[c].mul(mask), block), weighted, blocks, 0, 0, cv::INTER_AREA);
+    cv::divide(weighted, coarse_mask, coarse_targets[c]);
+    coarse_targets[c].setTo(0.0f, coarse_mask <= 0.0f);  // 0 / 0: nothing there
+  }
+  const cv::Mat coarse_errors = SpectraAt(halvings).MaskedSsd(coarse_targets, coarse_mask);
+  const std::vector<cv::Point> near = Refined(coarse_errors, halvings, overlap.patch);
+  std::vector<double> errors(near.size());
+  for (std::size_t n = 0; n < near.size(); ++n)
+    errors[n] = overlap.SumOfSquares(features_, near[n]);
+  const std::size_t chosen = PickWithinToleranceOf(errors, tolerance, rng);
+  return {near[chosen], errors[chosen]};
+}
+
+}  // namespace texlume::synth
