@@ -21,6 +21,12 @@ namespace {
 constexpr int kLevelsPerHalving = 4;
 // Coarse to fine only when every placement is at least this many times those refined.
 constexpr double kRefineFraction = 4.0;
+// Every placement's sum directly when its vector multiply-adds are fewer than this
+// many times the FFT's operations (DirectIsCheaper): on s512's coarse grids
+// (about 99 x 99 placements of a 10 x 10 mask, 128 x 128 transforms) a vector
+// multiply-add took about 2.6 times an FFT operation (perf samples: 3.3 % of the
+// job direct against 7.1 % by FFT, for 0.18 times the operations).
+constexpr double kDirectPerFftOperation = 0.4;
 
 // Half a cell of `stride` texels, rounded up: how far from a coarse candidate the
 // next density's placements are scored.
@@ -51,6 +57,97 @@ void ForEachView(std::size_t count, const PerView& view) {
   }
   for (const std::exception_ptr& error : errors)
     if (error) std::rethrow_exception(error);
+}
+
+// kLanes floats side by side: one AVX2 register, or two SSE2 ones on any x86-64.
+static_assert(PlacementSearch::kLanes == 8, "a vector of 8 floats (a power of two)");
+using PlacementLanes = float __attribute__((vector_size(PlacementSearch::kLanes * sizeof(float))));
+
+// RowOfCellScores' sums of squared differences, before eq. 3's root. Each lane
+// (placement) sums as one placement alone would: a row's sum in floats over the
+// channels and the row's cells in order, rows in doubles. Inlined into the
+// builds below, whose lanes give the same values.
+[[gnu::always_inline]] inline void SumSquaredDifferences(
+    const cv::Mat& mask, const std::vector<cv::Mat>& photo,
+    const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
+    std::array<double, PlacementSearch::kLanes>& ssd) {
+  for (int j = 0; j < mask.rows; ++j) {
+    const float* m = mask.ptr<float>(j);
+    PlacementLanes row = {};
+    for (std::size_t c = 0; c < photo.size(); ++c) {
+      const float* s = relit_planes[c].ptr<float>(at.y + j) + at.x;
+      const float* p = photo[c].ptr<float>(j);
+      for (int i = 0; i < mask.cols; ++i) {
+        PlacementLanes relit_i;  // cell i of each lane's placement
+        std::memcpy(&relit_i, s + i, sizeof(PlacementLanes));
+        const PlacementLanes d = relit_i - p[i];
+        row += m[i] * d * d;
+      }
+    }
+    for (int k = 0; k < PlacementSearch::kLanes; ++k) ssd[static_cast<std::size_t>(k)] += row[k];
+  }
+}
+
+void SumSquaredDifferencesGeneric(const cv::Mat& mask, const std::vector<cv::Mat>& photo,
+                                  const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
+                                  std::array<double, PlacementSearch::kLanes>& ssd) {
+  SumSquaredDifferences(mask, photo, relit_planes, at, ssd);
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+__attribute__((target("avx2"))) void SumSquaredDifferencesAvx2(
+    const cv::Mat& mask, const std::vector<cv::Mat>& photo,
+    const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
+    std::array<double, PlacementSearch::kLanes>& ssd) {
+  SumSquaredDifferences(mask, photo, relit_planes, at, ssd);
+}
+
+bool ScoresUseAvx2() {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+}
+#endif
+
+// SumSquaredDifferences in AVX2 where the CPU has it, else generic (SSE2 on x86-64).
+void SumSquaredDifferencesHere(const cv::Mat& mask, const std::vector<cv::Mat>& photo,
+                               const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
+                               std::array<double, PlacementSearch::kLanes>& ssd) {
+#if defined(__x86_64__) && defined(__GNUC__)
+  if (ScoresUseAvx2()) return SumSquaredDifferencesAvx2(mask, photo, relit_planes, at, ssd);
+#endif
+  SumSquaredDifferencesGeneric(mask, photo, relit_planes, at, ssd);
+}
+
+// Eq. 3's sums of squares of a view at every placement of its density, directly:
+// kLanes placements side by side (SumSquaredDifferences) over its relit sample.
+cv::Mat DirectSsd(const cv::Mat& mask, const std::vector<cv::Mat>& photo,
+                  const std::vector<cv::Mat>& relit, cv::Size placements) {
+  // kLanes - 1 zero columns past the sample: lanes past the last placement read them.
+  std::array<cv::Mat, 3> padded;
+  for (std::size_t c = 0; c < padded.size(); ++c)
+    cv::copyMakeBorder(relit[c], padded[c], 0, 0, 0, PlacementSearch::kLanes - 1,
+                       cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::Mat ssd(placements, CV_32FC1);
+  for (int y = 0; y < placements.height; ++y)
+    for (int x = 0; x < placements.width; x += PlacementSearch::kLanes) {
+      std::array<double, PlacementSearch::kLanes> row{};
+      SumSquaredDifferencesHere(mask, photo, padded, cv::Point(x, y), row);
+      for (int k = 0; k < PlacementSearch::kLanes && x + k < placements.width; ++k)
+        ssd.at<float>(y, x + k) = static_cast<float>(row[static_cast<std::size_t>(k)]);
+    }
+  return ssd;
+}
+
+// Whether DirectSsd is the cheaper way to every placement's sum: its multiply-adds
+// (each placement's masked cells, per channel, kLanes at once) against the FFT's
+// (ImageSpectra: the sample's 3 planes and energy, the photo's 3 and mask, and
+// one back, n log2 n each, on the padded size).
+bool DirectIsCheaper(cv::Size sample, cv::Size mask, cv::Size placements, std::size_t channels) {
+  const double direct =
+      static_cast<double>(channels) * placements.area() * mask.area() / PlacementSearch::kLanes;
+  const double padded = static_cast<double>(FastDftSize(sample.width)) * FastDftSize(sample.height);
+  const double fft = 9.0 * padded * std::log2(padded);
+  return direct < kDirectPerFftOperation * fft;
 }
 
 }  // namespace
@@ -158,7 +255,10 @@ std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<View
     const ViewAtStep& v = views[r];
     const std::vector<cv::Mat> model =
         sample_.Relight(*v.reduced, v.view->lighting, photo_gains_[v.view->photo]);
-    ssd[r] = ImageSpectra(model, PlaneEnergy(model)).MaskedSsd(v.photo, v.mask);
+    const cv::Size placements(v.placements_x, v.placements_y);
+    ssd[r] = DirectIsCheaper(model[0].size(), v.mask.size(), placements, v.photo.size())
+                 ? DirectSsd(v.mask, v.photo, model, placements)
+                 : ImageSpectra(model, PlaneEnergy(model)).MaskedSsd(v.photo, v.mask);
   });
   for (std::size_t r = 0; r < views.size(); ++r) {
     const ViewAtStep& v = views[r];
@@ -227,69 +327,6 @@ class PlacementSearch::RelitView {
   cv::Mat covered_;  // CV_8UC1: 1 where relit
   std::unordered_map<long long, double> scores_;
 };
-
-namespace {
-
-// kLanes floats side by side: one AVX2 register, or two SSE2 ones on any x86-64.
-static_assert(PlacementSearch::kLanes == 8, "a vector of 8 floats (a power of two)");
-using PlacementLanes = float __attribute__((vector_size(PlacementSearch::kLanes * sizeof(float))));
-
-// RowOfCellScores' sums of squared differences, before eq. 3's root. Each lane
-// (placement) sums as one placement alone would: a row's sum in floats over the
-// channels and the row's cells in order, rows in doubles. Inlined into the
-// builds below, whose lanes give the same values.
-[[gnu::always_inline]] inline void SumSquaredDifferences(
-    const cv::Mat& mask, const std::vector<cv::Mat>& photo,
-    const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
-    std::array<double, PlacementSearch::kLanes>& ssd) {
-  for (int j = 0; j < mask.rows; ++j) {
-    const float* m = mask.ptr<float>(j);
-    PlacementLanes row = {};
-    for (std::size_t c = 0; c < photo.size(); ++c) {
-      const float* s = relit_planes[c].ptr<float>(at.y + j) + at.x;
-      const float* p = photo[c].ptr<float>(j);
-      for (int i = 0; i < mask.cols; ++i) {
-        PlacementLanes relit_i;  // cell i of each lane's placement
-        std::memcpy(&relit_i, s + i, sizeof(PlacementLanes));
-        const PlacementLanes d = relit_i - p[i];
-        row += m[i] * d * d;
-      }
-    }
-    for (int k = 0; k < PlacementSearch::kLanes; ++k) ssd[static_cast<std::size_t>(k)] += row[k];
-  }
-}
-
-void SumSquaredDifferencesGeneric(const cv::Mat& mask, const std::vector<cv::Mat>& photo,
-                                  const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
-                                  std::array<double, PlacementSearch::kLanes>& ssd) {
-  SumSquaredDifferences(mask, photo, relit_planes, at, ssd);
-}
-
-#if defined(__x86_64__) && defined(__GNUC__)
-__attribute__((target("avx2"))) void SumSquaredDifferencesAvx2(
-    const cv::Mat& mask, const std::vector<cv::Mat>& photo,
-    const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
-    std::array<double, PlacementSearch::kLanes>& ssd) {
-  SumSquaredDifferences(mask, photo, relit_planes, at, ssd);
-}
-
-bool ScoresUseAvx2() {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
-}
-#endif
-
-// SumSquaredDifferences in AVX2 where the CPU has it, else generic (SSE2 on x86-64).
-void SumSquaredDifferencesHere(const cv::Mat& mask, const std::vector<cv::Mat>& photo,
-                               const std::array<cv::Mat, 3>& relit_planes, cv::Point at,
-                               std::array<double, PlacementSearch::kLanes>& ssd) {
-#if defined(__x86_64__) && defined(__GNUC__)
-  if (ScoresUseAvx2()) return SumSquaredDifferencesAvx2(mask, photo, relit_planes, at, ssd);
-#endif
-  SumSquaredDifferencesGeneric(mask, photo, relit_planes, at, ssd);
-}
-
-}  // namespace
 
 std::array<double, PlacementSearch::kLanes> PlacementSearch::RowOfCellScores(
     const ViewAtStep& v, cv::Point at, RelitView& relit) const {
