@@ -9,35 +9,61 @@
 
 namespace texlume::synth {
 
-cv::Mat MaskedGaussian(const cv::Mat& grid, const cv::Mat& mask, double sigma) {
-  if (sigma <= 0.0) return grid.clone();
-  const cv::Mat inside = mask > 0;
+namespace {
+
+// The weight of MaskedGaussian's mask: 1 where mask > 0, else 0.
+cv::Mat MaskWeight(const cv::Mat& mask) {
   cv::Mat weight;
-  inside.convertTo(weight, CV_32FC1, 1.0 / 255.0);
-  cv::Mat blurred, blurred_weight;
+  cv::Mat(mask > 0).convertTo(weight, CV_32FC1, 1.0 / 255.0);
+  return weight;
+}
+
+cv::Mat BlurredWeight(const cv::Mat& weight, double sigma) {
+  cv::Mat blurred;
+  cv::GaussianBlur(weight, blurred, cv::Size(), sigma, sigma, cv::BORDER_CONSTANT);
+  return blurred;
+}
+
+// The grid blurred over the weight, divided by the weight's blur where that is
+// above 1e-6; the grid itself elsewhere.
+cv::Mat NormalisedBlur(const cv::Mat& grid, const cv::Mat& weight, double sigma,
+                       const cv::Mat& blurred_weight) {
+  cv::Mat blurred;
   cv::GaussianBlur(grid.mul(weight), blurred, cv::Size(), sigma, sigma, cv::BORDER_CONSTANT);
-  cv::GaussianBlur(weight, blurred_weight, cv::Size(), sigma, sigma, cv::BORDER_CONSTANT);
-  cv::Mat out = grid.clone();
-  for (int j = 0; j < grid.rows; ++j)
-    for (int i = 0; i < grid.cols; ++i)
-      if (blurred_weight.at<float>(j, i) > 1e-6f)
-        out.at<float>(j, i) = blurred.at<float>(j, i) / blurred_weight.at<float>(j, i);
+  cv::Mat out = grid.clone(), quotient;
+  cv::divide(blurred, blurred_weight, quotient);
+  quotient.copyTo(out, blurred_weight > 1e-6f);
   return out;
 }
 
-BandEnergies MeasureBands(const cv::Mat& grid, const cv::Mat& mask) {
-  TEXLUME_CHECK(grid.type() == CV_32FC1 && mask.type() == CV_32FC1 && grid.size() == mask.size(),
+}  // namespace
+
+cv::Mat MaskedGaussian(const cv::Mat& grid, const cv::Mat& mask, double sigma) {
+  if (sigma <= 0.0) return grid.clone();
+  const cv::Mat weight = MaskWeight(mask);
+  return NormalisedBlur(grid, weight, sigma, BlurredWeight(weight, sigma));
+}
+
+BandMeter::BandMeter(const cv::Mat& mask)
+    : weight_(MaskWeight(mask)),
+      fine_weight_(BlurredWeight(weight_, BandEnergies::kFineSigma)),
+      middle_weight_(BlurredWeight(weight_, BandEnergies::kMiddleSigma)) {
+  TEXLUME_CHECK(mask.type() == CV_32FC1, "BandMeter: a one-channel float mask");
+  const int k = 2 * BandEnergies::kBandSupport + 1;
+  cv::erode(mask > 0, inner_, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)),
+            cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+}
+
+BandEnergies BandMeter::Measure(const cv::Mat& grid) const {
+  TEXLUME_CHECK(grid.type() == CV_32FC1 && grid.size() == weight_.size(),
                 "MeasureBands: grid and mask must be one-channel float of one size");
   BandEnergies e;
-  cv::Mat inner;
-  const int k = 2 * BandEnergies::kBandSupport + 1;
-  cv::erode(mask > 0, inner, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)),
-            cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
-  const cv::Mat fine_low = MaskedGaussian(grid, mask, BandEnergies::kFineSigma);
-  const cv::Mat middle_low = MaskedGaussian(grid, mask, BandEnergies::kMiddleSigma);
+  const cv::Mat fine_low = NormalisedBlur(grid, weight_, BandEnergies::kFineSigma, fine_weight_);
+  const cv::Mat middle_low =
+      NormalisedBlur(grid, weight_, BandEnergies::kMiddleSigma, middle_weight_);
   for (int j = 0; j < grid.rows; ++j)
     for (int i = 0; i < grid.cols; ++i) {
-      if (!inner.at<std::uint8_t>(j, i)) continue;
+      if (!inner_.at<std::uint8_t>(j, i)) continue;
       const double fine = grid.at<float>(j, i) - fine_low.at<float>(j, i);
       const double middle = fine_low.at<float>(j, i) - middle_low.at<float>(j, i);
       e.fine += fine * fine;
@@ -45,6 +71,12 @@ BandEnergies MeasureBands(const cv::Mat& grid, const cv::Mat& mask) {
       ++e.cells;
     }
   return e;
+}
+
+BandEnergies MeasureBands(const cv::Mat& grid, const cv::Mat& mask) {
+  TEXLUME_CHECK(grid.type() == CV_32FC1 && mask.type() == CV_32FC1 && grid.size() == mask.size(),
+                "MeasureBands: grid and mask must be one-channel float of one size");
+  return BandMeter(mask).Measure(grid);
 }
 
 double BlurOnGrid(double sigma_cells, int own_level, int level) {
@@ -63,7 +95,8 @@ bool PhotoBlurEstimator::Wants(std::size_t photo) const {
 void PhotoBlurEstimator::Add(std::size_t photo, const cv::Mat& photo_luminance,
                              const cv::Mat& sample_luminance, const cv::Mat& mask) {
   TEXLUME_CHECK(photo < photos_.size(), "PhotoBlurEstimator: photo index out of range");
-  const BandEnergies seen = MeasureBands(photo_luminance, mask);
+  const BandMeter meter(mask);
+  const BandEnergies seen = meter.Measure(photo_luminance);
   if (seen.cells == 0) return;
   PerPhoto& p = photos_[photo];
   ++p.faces;
@@ -74,7 +107,7 @@ void PhotoBlurEstimator::Add(std::size_t photo, const cv::Mat& photo_luminance,
   const cv::Mat everywhere = cv::Mat::ones(mask.size(), CV_32FC1);
   for (int k = 0; k < kCandidates; ++k) {
     const cv::Mat blurred = MaskedGaussian(sample_luminance, everywhere, k * kCandidateStep);
-    const BandEnergies e = MeasureBands(blurred, mask);
+    const BandEnergies e = meter.Measure(blurred);
     p.sample_fine[static_cast<std::size_t>(k)] += e.fine;
     p.sample_middle[static_cast<std::size_t>(k)] += e.middle;
   }

@@ -40,6 +40,21 @@ struct BandEnergies {
 /// `grid` and `mask` CV_32FC1 of one size; mask > 0 marks the cells.
 BandEnergies MeasureBands(const cv::Mat& grid, const cv::Mat& mask);
 
+/// MeasureBands of many grids over one mask: what depends on the mask alone
+/// (the inner cells, the Gaussians' normalisations) made once; the same values.
+class BandMeter {
+ public:
+  explicit BandMeter(const cv::Mat& mask);
+  BandEnergies Measure(const cv::Mat& grid) const;
+
+ private:
+  // MaskedGaussian(grid, mask, sigma) with the mask's blurred weight given.
+  cv::Mat Blurred(const cv::Mat& grid, double sigma, const cv::Mat& blurred_weight) const;
+  cv::Mat inner_;   // CV_8UC1: cells whose kBandSupport neighbourhood is in the mask
+  cv::Mat weight_;  // CV_32FC1: 1 in the mask, else 0
+  cv::Mat fine_weight_, middle_weight_;  // weight_ blurred by each band's sigma
+};
+
 /// Gaussian blur of sigma cells (none at 0), normalised over `mask` (> 0).
 cv::Mat MaskedGaussian(const cv::Mat& grid, const cv::Mat& mask, double sigma);
 
