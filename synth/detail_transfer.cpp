@@ -149,21 +149,25 @@ void DetailDictionary::DetailBand(const std::vector<cv::Mat>& values,
   // from coarse_, the colour planes' from coarse_raw; interleaved.
   const int n = static_cast<int>(values.size());
   band.create(coarse_.size(), CV_32FC(n));
+  std::vector<const float*> value(values.size()), raw(values.size());
   for (int y = 0; y < band.rows; ++y) {
+    for (std::size_t c = 0; c < values.size(); ++c)
+      value[c] = values[c].ptr<float>(y), raw[c] = coarse_raw[c].ptr<float>(y);
     float* texel = band.ptr<float>(y);
     const float* point = coarse_.ptr<float>(y);
-    for (int c = 0; c < n; ++c) {
-      const float* value = values[static_cast<std::size_t>(c)].ptr<float>(y);
-      const float* raw = coarse_raw[static_cast<std::size_t>(c)].ptr<float>(y);
-      const bool luminance = c < kCoefficients;
-      for (int x = 0; x < band.cols; ++x)
-        texel[x * n + c] = value[x] - (luminance ? point[x * kPointFloats + c] : raw[x]);
+    for (int x = 0; x < band.cols; ++x, texel += n, point += kPointFloats) {
+      for (int c = 0; c < kCoefficients; ++c)
+        texel[c] = value[static_cast<std::size_t>(c)][x] - point[c];
+      for (int c = kCoefficients; c < n; ++c)
+        texel[c] = value[static_cast<std::size_t>(c)][x] - raw[static_cast<std::size_t>(c)][x];
     }
   }
 }
 
 void DetailDictionary::ToOrthonormalPoints(const std::vector<cv::Mat>& coarse_raw) {
-  const Eigen::Matrix<double, 6, 6>& to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
+  // The transform as a row-major array (the loop below reads it row by row).
+  const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> to =
+      ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
   coarse_.create(coarse_raw[0].size(), CV_32FC(kPointFloats));
   std::array<const float*, kCoefficients> raw{};
   for (int y = 0; y < coarse_.rows; ++y) {
