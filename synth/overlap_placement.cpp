@@ -43,11 +43,18 @@ std::size_t PickWithinToleranceOf(const std::vector<double>& errors, double tole
 
 double OverlapTexels::SumOfSquares(const std::vector<cv::Mat>& features, cv::Point at) const {
   const std::size_t n = features.size();
+  // Each plane's texel at the patch's top left; a texel's offset from it is the
+  // same in every plane of one size (in floats, along the plane's rows).
+  std::vector<const float*> at_corner(n);
+  for (std::size_t c = 0; c < n; ++c) at_corner[c] = features[c].ptr<float>(at.y) + at.x;
+  const std::size_t row = features[0].step1();
   double e = 0.0;
   for (std::size_t m = 0; m < texels.size(); ++m) {
-    const int i = texels[m] % patch.width, j = texels[m] / patch.width;
+    const auto texel = static_cast<std::size_t>(texels[m]);
+    const std::size_t offset = texel / static_cast<std::size_t>(patch.width) * row +
+                               texel % static_cast<std::size_t>(patch.width);
     for (std::size_t c = 0; c < n; ++c) {
-      const double d = features[c].at<float>(at.y + j, at.x + i) - targets[m * n + c];
+      const double d = at_corner[c][offset] - targets[m * n + c];
       e += d * d;
     }
   }

@@ -280,7 +280,8 @@ class PlacementSearch::RelitView {
     // The planes are kLanes - 1 columns wider than the reduced sample: lanes past its
     // last placement read zeros there (their scores are not kept).
     for (cv::Mat& plane : planes_)
-      plane.colRange(plane.cols - (kLanes - 1), plane.cols).setTo(0.0f);
+      for (int y = 0; y < plane.rows; ++y)
+        std::fill_n(plane.ptr<float>(y) + plane.cols - (kLanes - 1), kLanes - 1, 0.0f);
     covered_ = cv::Mat::zeros(view.reduced->planes[0].size(), CV_8UC1);
   }
   // Relights the cells of `cells` that are not relit yet: rows whose uncovered cells
