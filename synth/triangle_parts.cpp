@@ -62,6 +62,18 @@ int PhotoDensityLevel(const TrianglePatch& patch, const sfm::TriangleView& view,
   return std::clamp(static_cast<int>(std::lround(-4.0 * std::log2(density))), 0, 40);
 }
 
+namespace {
+
+// SignedDistanceToTriangle(c, p) <= margin, with no distance taken inside the
+// triangle when the margin is not negative.
+bool WithinMargin(const std::array<Eigen::Vector2d, 3>& c, const Eigen::Vector2d& p,
+                  double margin) {
+  return margin >= 0.0 ? mesh::WithinReachOfTriangle(c, p, margin)
+                       : mesh::SignedDistanceToTriangle(c, p) <= margin;
+}
+
+}  // namespace
+
 int RectificationMaps(const TrianglePatch& patch, double t, double rx, double ry, cv::Size grid,
                       const sfm::Camera& camera, const sfm::Rigid3d& cam_from_world,
                       cv::Size image_size, double mask_margin, cv::Mat& map_x, cv::Mat& map_y,
@@ -79,9 +91,9 @@ int RectificationMaps(const TrianglePatch& patch, double t, double rx, double ry
       const std::optional<Eigen::Vector2d> px = camera.ImageFromCam(cam);
       map_x.at<float>(j, i) = px ? static_cast<float>(px->x() - 0.5) : -1e6f;  // OpenCV centres
       map_y.at<float>(j, i) = px ? static_cast<float>(px->y() - 0.5) : -1e6f;
-      if (px && mesh::SignedDistanceToTriangle(patch.corners_in_frame, p) <= mask_margin &&
-          px->x() >= 0.5 && px->y() >= 0.5 && px->x() <= image_size.width - 0.5 &&
-          px->y() <= image_size.height - 0.5) {
+      if (px && px->x() >= 0.5 && px->y() >= 0.5 && px->x() <= image_size.width - 0.5 &&
+          px->y() <= image_size.height - 0.5 &&
+          WithinMargin(patch.corners_in_frame, p, mask_margin)) {
         mask.at<float>(j, i) = 1.0f;
         ++count;
       }
