@@ -444,16 +444,6 @@ class CoefficientCorrection::PatchPass {
   cv::Mat known_;                                             // CV_8UC1: cells with a change
 };
 
-double RelitLinearShare(double display, double* slope) {
-  if (slope) *slope = 0.0;
-  if (display <= 0.0) return 0.0;  // black
-  if (display >= 1.0) return 1.0;  // white: SrgbToLinear(1) = 1
-  const auto v = static_cast<float>(display);
-  const float linear = SrgbToLinear(v);
-  if (slope) *slope = srgb::ToLinearSlope(v, linear);
-  return linear;
-}
-
 CoefficientCorrection::CoefficientCorrection(const PtmSample& sample,
                                              const MeshSynthesisOptions& options)
     : sample_(sample), options_(options) {}

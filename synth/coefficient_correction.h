@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "core/srgb.h"
 #include "synth/detail_transfer.h"
 #include "synth/material_sample.h"
 #include "synth/mesh_synthesis.h"
@@ -71,7 +72,16 @@ class CoefficientCorrection : public PhotoCorrection {
 /// One light's share of a texel's linear value in a channel, as PtmSample::Relight
 /// relights it: the display value (luminance polynomial times colour) clamped to
 /// [0, 1] and decoded from sRGB; when `slope` is given, d share / d display into it
-/// (0 where clamped: black or white). The pass predicts the photos with it.
-double RelitLinearShare(double display, double* slope = nullptr);
+/// (0 where clamped: black or white). The pass predicts the photos with it, a
+/// call per light, channel and cell: inline.
+inline double RelitLinearShare(double display, double* slope = nullptr) {
+  if (slope) *slope = 0.0;
+  if (display <= 0.0) return 0.0;  // black
+  if (display >= 1.0) return 1.0;  // white: srgb::ToLinear(1) = 1
+  const auto v = static_cast<float>(display);
+  const float linear = srgb::ToLinear(v);
+  if (slope) *slope = srgb::ToLinearSlope(v, linear);
+  return linear;
+}
 
 }  // namespace texlume::synth
