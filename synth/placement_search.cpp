@@ -4,11 +4,11 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <exception>
 #include <opencv2/imgproc.hpp>
-#include <unordered_map>
 #include <unordered_set>
 
 #include "synth/template_match.h"
@@ -244,8 +244,8 @@ std::vector<cv::Mat> PlacementSearch::RelitCells(const ViewAtStep& v, cv::Rect c
 
 std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<ViewAtStep>& views,
                                                           int stride) const {
-  // Eq. 3 of every view at every placement of its density (FFT), read at the
-  // placements `stride` texels apart, in rows.
+  // Eq. 3 of every view at every placement of its density (FFT or DirectSsd), read
+  // at the placements `stride` texels apart, in rows.
   std::vector<ScoredPlacement> scored;
   for (int sy = 0; sy <= last_y_; sy += stride)
     for (int sx = 0; sx <= last_x_; sx += stride) scored.emplace_back(0.0f, cv::Point(sx, sy));
@@ -273,6 +273,52 @@ std::vector<ScoredPlacement> PlacementSearch::ScoreOnGrid(const std::vector<View
 
 class PlacementSearch::RelitView {
  public:
+  // A view's eq. 3 by placement cell (row-major keys >= 0), as scored so far: open
+  // addressing with linear probing, at most half full (a std::unordered_map cost an
+  // allocation per score).
+  class CellScores {
+   public:
+    // The score kept for `key`, or null.
+    const double* Find(long long key) const {
+      if (keys_.empty()) return nullptr;
+      for (std::size_t i = Slot(key);; i = (i + 1) & mask_) {
+        if (keys_[i] == key) return &values_[i];
+        if (keys_[i] < 0) return nullptr;
+      }
+    }
+    // Keeps `score` for `key` unless it has one already.
+    void Insert(long long key, double score) {
+      if (2 * (size_ + 1) > keys_.size()) Grow();
+      std::size_t i = Slot(key);
+      for (; keys_[i] >= 0; i = (i + 1) & mask_)
+        if (keys_[i] == key) return;
+      keys_[i] = key, values_[i] = score, ++size_;
+    }
+
+   private:
+    // Fibonacci hashing: the product's top bits index the table.
+    std::size_t Slot(long long key) const {
+      return static_cast<std::size_t>(
+          (static_cast<unsigned long long>(key) * 0x9E3779B97F4A7C15ull) >> shift_);
+    }
+    void Grow() {
+      const std::vector<long long> keys = std::move(keys_);
+      const std::vector<double> values = std::move(values_);
+      const std::size_t capacity = keys.empty() ? 1024 : 2 * keys.size();
+      keys_.assign(capacity, -1);
+      values_.assign(capacity, 0.0);
+      mask_ = capacity - 1;
+      shift_ = 64 - std::countr_zero(capacity);
+      size_ = 0;
+      for (std::size_t i = 0; i < keys.size(); ++i)
+        if (keys[i] >= 0) Insert(keys[i], values[i]);
+    }
+    std::vector<long long> keys_;  // -1: empty
+    std::vector<double> values_;
+    std::size_t size_ = 0, mask_ = 0;
+    int shift_ = 64;
+  };
+
   RelitView(const PlacementSearch& search, const ViewAtStep& view, std::array<cv::Mat, 3> planes)
       : relighter_(search.sample_.RelighterOf(*view.reduced, view.view->lighting,
                                               search.photo_gains_[view.view->photo])),
@@ -297,8 +343,8 @@ class PlacementSearch::RelitView {
       j = end;
     }
   }
-  // The view's eq. 3 by placement cell (row-major), as scored so far.
-  std::unordered_map<long long, double>& scores() { return scores_; }
+  // The view's eq. 3 by placement cell, as scored so far.
+  CellScores& scores() { return scores_; }
   const std::array<cv::Mat, 3>& planes() const { return planes_; }
 
  private:
@@ -326,7 +372,7 @@ class PlacementSearch::RelitView {
   std::unique_ptr<WindowRelighter> relighter_;
   std::array<cv::Mat, 3> planes_;
   cv::Mat covered_;  // CV_8UC1: 1 where relit
-  std::unordered_map<long long, double> scores_;
+  CellScores scores_;
 };
 
 std::array<double, PlacementSearch::kLanes> PlacementSearch::RowOfCellScores(
@@ -349,15 +395,15 @@ std::vector<float> PlacementSearch::ScoreAt(const std::vector<ViewAtStep>& views
     for (std::size_t n = 0; n < texels.size(); ++n) {
       // Placements in one cell of this view score alike: each cell scored once.
       const cv::Point at = v.Cell(texels[n]);
-      std::unordered_map<long long, double>& scores = relit[r].scores();
+      RelitView::CellScores& scores = relit[r].scores();
       const long long key = static_cast<long long>(at.y) * v.placements_x + at.x;
-      if (const auto it = scores.find(key); it != scores.end()) {
-        per_view[r][n] = it->second;
+      if (const double* known = scores.Find(key)) {
+        per_view[r][n] = *known;
         continue;
       }
       // This cell and the next kLanes - 1 in its row.
       const std::array<double, kLanes> row = RowOfCellScores(v, at, relit[r]);
-      for (int k = 0; k < kLanes && at.x + k < v.placements_x; ++k) scores.emplace(key + k, row[k]);
+      for (int k = 0; k < kLanes && at.x + k < v.placements_x; ++k) scores.Insert(key + k, row[k]);
       per_view[r][n] = row[0];
     }
   });

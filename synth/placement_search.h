@@ -10,9 +10,10 @@
 // Where a face's patch goes in the sample under the image constraint of paper
 // 003 (eq. 3, the RMS difference between the sample relit under a photo's
 // lighting and the photo rectified into the face frame, summed over the face's
-// photos): the paper's exhaustive search, every placement by FFT at the photos'
-// density, or the search coarse to fine (issue 33), exhaustive only at the
-// coarsest density and then refined around the best candidates.
+// photos): the paper's exhaustive search, every placement at the photos' density
+// (by FFT, or directly where that takes fewer operations), or the search coarse to
+// fine (issue 33), exhaustive only at the coarsest density and then refined around
+// the best candidates.
 namespace texlume::synth {
 
 /// A placement's score (eq. 3 summed over the views) and its top-left texel in the sample.
@@ -43,7 +44,8 @@ class PlacementSearch {
   /// The same search coarse to fine: every view reduced by halves of its density
   /// (up to `max_steps` times, while the best view's grid keeps `min_cells` cells a
   /// side); every placement scored at the coarsest; then at each finer density only
-  /// the placements within a coarse cell of the `candidates` best are scored, directly.
+  /// the placements within half a coarse cell of the `candidates` best are scored,
+  /// directly.
   /// Returns the top_k at the photos' density, best first. With no coarser density
   /// possible it is Exhaustive.
   std::vector<ScoredPlacement> CoarseToFine(int top_k, int candidates, int max_steps = 3,
@@ -70,7 +72,9 @@ class PlacementSearch {
   std::vector<ViewAtStep> ViewsAtStep(int step) const;
   // The primary view's photo cell at a step, in sample texels (>= 1).
   static int Stride(const std::vector<ViewAtStep>& views);
-  // Eq. 3 at every placement (FFT), at the placements `stride` texels apart.
+  // Eq. 3 at every placement (FFT, or directly where that takes fewer operations:
+  // the sums then differ from the FFT's in rounding), at the placements `stride`
+  // texels apart.
   std::vector<ScoredPlacement> ScoreOnGrid(const std::vector<ViewAtStep>& views, int stride) const;
   // The sample relit under a view at a step, as placements ask, so that no cell is
   // relit twice however the placements overlap; and the view's scores by cell.

@@ -15,6 +15,7 @@
 #include "core/image_io.h"
 #include "core/memory_budget.h"
 #include "core/ordered_pipeline.h"
+#include "core/srgb_rows.h"
 #include "core/timing.h"
 #include "synth/face_order.h"
 #include "synth/photo_blur.h"
@@ -67,11 +68,16 @@ void TakeOutWhiteBalance(const std::array<double, 3>& white_balance, PhotoDomain
       plane /= w;
       continue;
     }
-    for (int j = 0; j < plane.rows; ++j)
-      for (int i = 0; i < plane.cols; ++i) {
-        float& v = plane.at<float>(j, i);
-        v = LinearToSrgb(static_cast<float>(SrgbToLinear(v) / w));
-      }
+    // Display to linear, divided by w (in doubles), back to display: the row
+    // kernels give ToLinear's and FromLinear's values to the bit.
+    std::vector<float> linear(static_cast<std::size_t>(plane.cols));
+    for (int j = 0; j < plane.rows; ++j) {
+      float* row = plane.ptr<float>(j);
+      std::fill(linear.begin(), linear.end(), 0.0f);
+      srgb::AddWeightedLinear(row, 1.0f, plane.cols, linear.data());
+      for (float& v : linear) v = static_cast<float>(v / w);
+      srgb::ScaledFromLinear(linear.data(), 1.0f, plane.cols, row);
+    }
   }
 }
 

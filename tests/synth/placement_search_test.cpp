@@ -173,6 +173,19 @@ void ExpectScoresAsAlone(const Fixture& f, const std::vector<ScoredPlacement>& r
   }
 }
 
+// Every placement of the exhaustive search against PlacementAlone: the grid is summed
+// by FFT for the photos' density (a 160 x 160 sample) and directly for the coarser
+// view (80 x 80, where that takes fewer operations), whose 69 placements a row end
+// in lanes past the last one.
+TEST(PlacementSearch, EveryExhaustiveScoreIsThePlacementsOwn) {
+  const Fixture f(0.05);
+  const PlacementSearch search(f.sample, f.views, f.gains, cv::Size(kPatch, kPatch));
+  const std::vector<ScoredPlacement> everywhere = search.Exhaustive(1 << 20);
+  ASSERT_EQ(everywhere.size(), static_cast<std::size_t>(137 * 137));
+  for (const auto& [score, at] : everywhere)
+    ASSERT_NEAR(score, PlacementAlone(f, at), 1e-4 + 1e-4 * score) << at;
+}
+
 // The direct scores are computed for several neighbouring placements side by side;
 // each is still its own placement's sum, to the bit.
 TEST(PlacementSearch, PlacementsScoredSideBySideScoreAsAlone) {
