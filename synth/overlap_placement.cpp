@@ -10,13 +10,20 @@
 namespace texlume::synth {
 namespace {
 
-// Planes averaged over blocks of `block` x `block` texels (their first whole blocks).
+// Planes averaged over blocks of `block` x `block` texels, mirrored past their right
+// and bottom edges to one block beyond the last partial one: a patch of any size
+// then has a coarse placement within half a block of its last placement at full
+// density (the coarse grid's last ones read the mirrored texels).
 std::vector<cv::Mat> BlockAverages(const std::vector<cv::Mat>& planes, int block) {
-  const cv::Size blocks(planes[0].cols / block, planes[0].rows / block);
+  const cv::Size blocks((planes[0].cols + block - 1) / block + 1,
+                        (planes[0].rows + block - 1) / block + 1);
   std::vector<cv::Mat> out(planes.size());
-  for (std::size_t c = 0; c < planes.size(); ++c)
-    cv::resize(planes[c](cv::Rect(0, 0, blocks.width * block, blocks.height * block)), out[c],
-               blocks, 0, 0, cv::INTER_AREA);
+  for (std::size_t c = 0; c < planes.size(); ++c) {
+    cv::Mat mirrored;
+    cv::copyMakeBorder(planes[c], mirrored, 0, blocks.height * block - planes[c].rows, 0,
+                       blocks.width * block - planes[c].cols, cv::BORDER_REFLECT_101);
+    cv::resize(mirrored, out[c], blocks, 0, 0, cv::INTER_AREA);
+  }
   return out;
 }
 
@@ -43,18 +50,18 @@ std::size_t PickWithinToleranceOf(const std::vector<double>& errors, double tole
 
 double OverlapTexels::SumOfSquares(const std::vector<cv::Mat>& features, cv::Point at) const {
   const std::size_t n = features.size();
-  // Each plane's texel at the patch's top left; a texel's offset from it is the
-  // same in every plane of one size (in floats, along the plane's rows).
+  // Each plane's texel at the patch's top left and its row step (floats).
   std::vector<const float*> at_corner(n);
-  for (std::size_t c = 0; c < n; ++c) at_corner[c] = features[c].ptr<float>(at.y) + at.x;
-  const std::size_t row = features[0].step1();
+  std::vector<std::size_t> row(n);
+  for (std::size_t c = 0; c < n; ++c)
+    at_corner[c] = features[c].ptr<float>(at.y) + at.x, row[c] = features[c].step1();
   double e = 0.0;
   for (std::size_t m = 0; m < texels.size(); ++m) {
     const auto texel = static_cast<std::size_t>(texels[m]);
-    const std::size_t offset = texel / static_cast<std::size_t>(patch.width) * row +
-                               texel % static_cast<std::size_t>(patch.width);
+    const std::size_t j = texel / static_cast<std::size_t>(patch.width),
+                      i = texel % static_cast<std::size_t>(patch.width);
     for (std::size_t c = 0; c < n; ++c) {
-      const double d = at_corner[c][offset] - targets[m * n + c];
+      const double d = at_corner[c][j * row[c] + i] - targets[m * n + c];
       e += d * d;
     }
   }
@@ -122,7 +129,10 @@ std::vector<cv::Point> OverlapPlacement::Refined(const cv::Mat& coarse_errors, i
   std::unordered_set<long long> seen;
   std::vector<cv::Point> near;
   for (std::size_t k = 0; k < kept; ++k) {
-    const int cx = std::get<2>(coarse[k]) * block, cy = std::get<1>(coarse[k]) * block;
+    // Coarse placements past the last one at full density (on the mirrored blocks)
+    // stand for the last ones.
+    const int cx = std::min(std::get<2>(coarse[k]) * block, last_x + half);
+    const int cy = std::min(std::get<1>(coarse[k]) * block, last_y + half);
     for (int y = std::max(0, cy - half); y <= std::min(last_y, cy + half); ++y)
       for (int x = std::max(0, cx - half); x <= std::min(last_x, cx + half); ++x)
         if (seen.insert(static_cast<long long>(y) * (last_x + 1) + x).second)

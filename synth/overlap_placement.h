@@ -31,8 +31,9 @@ struct OverlapTexels {
 /// is scored at a reduced density (the features and the overlap averaged over
 /// blocks of 2^h x 2^h texels; FFT), and around the best `kCandidates` of them
 /// every placement within half a block is scored again at full density, directly
-/// over the overlap texels. h is the most halvings (at most kMaxHalvings) that
-/// leave the patch kMinCells blocks a side; with none, every placement is scored
+/// over the overlap texels (the sample mirrored past its right and bottom edges
+/// for the coarse grid, so that it reaches the last placements). h is the most halvings (at most
+/// kMaxHalvings) that leave the patch kMinCells blocks a side; with none, every placement is scored
 /// at full density (FFT).
 class OverlapPlacement {
  public:
@@ -48,7 +49,8 @@ class OverlapPlacement {
     cv::Point texel;     // top left in the sample
     double error = 0.0;  // the sum of squared differences over the overlap
   };
-  /// The placement of a patch with a non-empty overlap.
+  /// The placement of a patch with a non-empty overlap. Not for several threads at
+  /// once: the reduced sample's spectra are made on first use.
   Placement Pick(const OverlapTexels& overlap, double tolerance, std::mt19937_64& rng);
 
   /// The halvings Pick uses for a patch of this size.

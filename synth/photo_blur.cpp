@@ -56,7 +56,7 @@ BandMeter::BandMeter(const cv::Mat& mask)
 
 BandEnergies BandMeter::Measure(const cv::Mat& grid) const {
   TEXLUME_CHECK(grid.type() == CV_32FC1 && grid.size() == weight_.size(),
-                "MeasureBands: grid and mask must be one-channel float of one size");
+                "BandMeter: a one-channel float grid of the mask's size");
   BandEnergies e;
   const cv::Mat fine_low = NormalisedBlur(grid, weight_, BandEnergies::kFineSigma, fine_weight_);
   const cv::Mat middle_low =

@@ -48,8 +48,6 @@ class BandMeter {
   BandEnergies Measure(const cv::Mat& grid) const;
 
  private:
-  // MaskedGaussian(grid, mask, sigma) with the mask's blurred weight given.
-  cv::Mat Blurred(const cv::Mat& grid, double sigma, const cv::Mat& blurred_weight) const;
   cv::Mat inner_;   // CV_8UC1: cells whose kBandSupport neighbourhood is in the mask
   cv::Mat weight_;  // CV_32FC1: 1 in the mask, else 0
   cv::Mat fine_weight_, middle_weight_;  // weight_ blurred by each band's sigma

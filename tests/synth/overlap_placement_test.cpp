@@ -64,14 +64,34 @@ TEST(OverlapPlacement, CoarseToFineFindsWhereTheOverlapWasCut) {
   }
 }
 
+// The last placements at full density lie past the coarse grid's last one when
+// neither the sample nor the patch is a whole number of blocks (162 = 40 x 4 + 2,
+// 33 x 29 texels): the last coarse column and row reach them.
+TEST(OverlapPlacement, CoarseToFineReachesTheSamplesLastPlacements) {
+  const std::vector<cv::Mat> features = SmoothFeatures(162, 6, 13);
+  OverlapPlacement placement(features);
+  const cv::Size patch(33, 29);
+  ASSERT_EQ(placement.Halvings(patch), 2);
+  std::mt19937_64 rng(9);
+  for (const cv::Point from : {cv::Point(129, 133), cv::Point(127, 131), cv::Point(0, 133)}) {
+    const OverlapPlacement::Placement p =
+        placement.Pick(StripFrom(features, patch, from, 6), 0.0, rng);
+    EXPECT_EQ(p.texel, from);
+  }
+}
+
 // With no halving the pick is the exhaustive one: the same placement from the
-// same random stream as PickWithinTolerance over every placement's error.
+// same random stream as PickWithinTolerance over every placement's error, with
+// targets off the sample (noise) so that several are within the tolerance.
 TEST(OverlapPlacement, WithoutHalvingsEveryPlacementIsScored) {
   const std::vector<cv::Mat> features = SmoothFeatures(48, 3, 11);
   OverlapPlacement placement(features);
   const cv::Size patch(10, 9);
   ASSERT_EQ(placement.Halvings(patch), 0);
-  const OverlapTexels overlap = StripFrom(features, patch, cv::Point(20, 30), 3);
+  OverlapTexels overlap = StripFrom(features, patch, cv::Point(20, 30), 3);
+  std::mt19937 noise_rng(17);
+  std::normal_distribution<float> noise(0.0f, 0.3f);
+  for (float& t : overlap.targets) t += noise(noise_rng);
   std::mt19937_64 a(5), b(5);
   const OverlapPlacement::Placement p = placement.Pick(overlap, 0.5, a);
   std::vector<cv::Mat> targets(features.size());
@@ -84,6 +104,9 @@ TEST(OverlapPlacement, WithoutHalvingsEveryPlacementIsScored) {
       targets[c].at<float>(j, i) = overlap.targets[m * features.size() + c];
   }
   const cv::Mat errors = MaskedSsdBruteForce(features, targets, mask);
+  double least = 0.0;
+  cv::minMaxLoc(errors, &least);
+  ASSERT_GT(cv::countNonZero(errors <= least * 1.5), 1);  // a choice to make
   EXPECT_EQ(p.texel, PickWithinTolerance(errors, 0.5, b));
   EXPECT_NEAR(p.error, overlap.SumOfSquares(features, p.texel), 1e-3);
 }
