@@ -35,17 +35,6 @@ cv::Mat PaddedToBlocks(const cv::Mat& plane, int block) {
   return padded;
 }
 
-// PickWithinTolerance's rule over a list: uniform among the errors within
-// (1 + tolerance) of the smallest.
-std::size_t PickWithinToleranceOf(const std::vector<double>& errors, double tolerance,
-                                  std::mt19937_64& rng) {
-  const double least = *std::min_element(errors.begin(), errors.end());
-  std::vector<std::size_t> near;
-  for (std::size_t n = 0; n < errors.size(); ++n)
-    if (errors[n] <= least * (1.0 + tolerance) + 1e-12) near.push_back(n);
-  return near[std::uniform_int_distribution<std::size_t>(0, near.size() - 1)(rng)];
-}
-
 }  // namespace
 
 double OverlapTexels::SumOfSquares(const std::vector<cv::Mat>& features, cv::Point at) const {
@@ -170,7 +159,7 @@ OverlapPlacement::Placement OverlapPlacement::Pick(const OverlapTexels& overlap,
   std::vector<double> errors(near.size());
   for (std::size_t n = 0; n < near.size(); ++n)
     errors[n] = overlap.SumOfSquares(features_, near[n]);
-  const std::size_t chosen = PickWithinToleranceOf(errors, tolerance, rng);
+  const std::size_t chosen = PickWithinTolerance(errors, tolerance, rng);
   return {near[chosen], errors[chosen]};
 }
 

@@ -74,9 +74,7 @@ BandEnergies BandMeter::Measure(const cv::Mat& grid) const {
 }
 
 BandEnergies MeasureBands(const cv::Mat& grid, const cv::Mat& mask) {
-  TEXLUME_CHECK(grid.type() == CV_32FC1 && mask.type() == CV_32FC1 && grid.size() == mask.size(),
-                "MeasureBands: grid and mask must be one-channel float of one size");
-  return BandMeter(mask).Measure(grid);
+  return BandMeter(mask).Measure(grid);  // which checks both
 }
 
 double BlurOnGrid(double sigma_cells, int own_level, int level) {

@@ -113,14 +113,37 @@ cv::Mat MaskedSsdBruteForce(const std::vector<cv::Mat>& image_planes,
   return out;
 }
 
-cv::Point PickWithinTolerance(const cv::Mat& errors, double tolerance, std::mt19937_64& rng) {
-  double min_error;
-  cv::minMaxLoc(errors, &min_error);
-  std::vector<cv::Point> near;
-  for (int y = 0; y < errors.rows; ++y)
-    for (int x = 0; x < errors.cols; ++x)
-      if (errors.at<float>(y, x) <= min_error * (1.0 + tolerance) + 1e-12) near.emplace_back(x, y);
+namespace {
+
+// Classic quilting's rule over `count` errors error(i): the index, uniform from
+// `rng`, of one of those within (1 + tolerance) of the smallest.
+template <typename ErrorAt>
+std::size_t PickIndexWithinTolerance(std::size_t count, ErrorAt error, double tolerance,
+                                     std::mt19937_64& rng) {
+  double least = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < count; ++i) least = std::min(least, error(i));
+  std::vector<std::size_t> near;
+  for (std::size_t i = 0; i < count; ++i)
+    if (error(i) <= least * (1.0 + tolerance) + 1e-12) near.push_back(i);
   return near[std::uniform_int_distribution<std::size_t>(0, near.size() - 1)(rng)];
+}
+
+}  // namespace
+
+cv::Point PickWithinTolerance(const cv::Mat& errors, double tolerance, std::mt19937_64& rng) {
+  const auto cols = static_cast<std::size_t>(errors.cols);
+  const auto error = [&](std::size_t i) {
+    return static_cast<double>(
+        errors.at<float>(static_cast<int>(i / cols), static_cast<int>(i % cols)));
+  };
+  const std::size_t i = PickIndexWithinTolerance(errors.total(), error, tolerance, rng);
+  return {static_cast<int>(i % cols), static_cast<int>(i / cols)};
+}
+
+std::size_t PickWithinTolerance(const std::vector<double>& errors, double tolerance,
+                                std::mt19937_64& rng) {
+  return PickIndexWithinTolerance(
+      errors.size(), [&](std::size_t i) { return errors[i]; }, tolerance, rng);
 }
 
 }  // namespace texlume::synth

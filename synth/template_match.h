@@ -51,5 +51,8 @@ cv::Mat MaskedSsdBruteForce(const std::vector<cv::Mat>& image_planes,
 /// Classic quilting's choice: a position at random (uniform, from `rng`) among
 /// those whose error is within (1 + tolerance) of the smallest in `errors`.
 cv::Point PickWithinTolerance(const cv::Mat& errors, double tolerance, std::mt19937_64& rng);
+/// The same choice among a list of errors: the index chosen.
+std::size_t PickWithinTolerance(const std::vector<double>& errors, double tolerance,
+                                std::mt19937_64& rng);
 
 }  // namespace texlume::synth
