@@ -27,12 +27,13 @@ constexpr int kDetailWindowLength = kDetailWindowSide * kDetailWindowSide * kPoi
 // 62 000; the index holds their 8 principal components, 2 MiB).
 constexpr std::size_t kDetailMaxPoints = std::size_t{1} << 16;
 
-// Bilinear taps along one axis of the coarse planes at the window's points
-// centre + k step, k = -radius..radius (clamped as BilinearTaps clamps).
+// Bilinear taps along one axis of the coarse planes (the sample reduced to the
+// photo's density: a pixel is a photo cell) at the window's points centre + k,
+// k = -radius..radius, in their pixels (clamped as BilinearTaps clamps).
 struct WindowAxis {
-  WindowAxis(int size, double centre, double step) {
+  WindowAxis(int size, double centre) {
     for (int k = 0; k < kDetailWindowSide; ++k) {
-      const double t = std::clamp(centre + (k - kDetailWindowRadius) * step, 0.0, size - 1.0);
+      const double t = std::clamp(centre + (k - kDetailWindowRadius), 0.0, size - 1.0);
       lo[k] = std::min(static_cast<int>(t), std::max(size - 2, 0));
       hi[k] = std::min(lo[k] + 1, size - 1);
       f[k] = static_cast<float>(t - lo[k]);
@@ -41,6 +42,20 @@ struct WindowAxis {
   int lo[kDetailWindowSide], hi[kDetailWindowSide];
   float f[kDetailWindowSide];
 };
+
+// The orthonormal basis's transform as a row-major array (ToOrthonormal reads it
+// row by row).
+using OrthonormalTransform = Eigen::Matrix<double, 6, 6, Eigen::RowMajor>;
+
+// The raw luminance coefficients at x of the rows `raw` (the first kCoefficients)
+// in the orthonormal basis, into `out`.
+void ToOrthonormal(const OrthonormalTransform& to, const float* const* raw, int x, float* out) {
+  for (int m = 0; m < kCoefficients; ++m) {
+    double v = 0.0;
+    for (int k = 0; k < kCoefficients; ++k) v += to(m, k) * raw[k][x];
+    out[m] = static_cast<float>(v);
+  }
+}
 
 // Four floats in one SSE register (GCC's vector extension); a point is two.
 using WindowLanes = float __attribute__((vector_size(16)));
@@ -51,14 +66,13 @@ WindowLanes LoadWindowLanes(const float* p) {
   return v;
 }
 
-// The coarse coefficients (kPointFloats per point, CV_32FC(kPointFloats) planes) of
-// the window of 3 x 3 points (dx, dy) texels apart around (x, y), bilinear in
-// floats: visit(k, point) for points k = 0, 1, ... (kLanesPerPoint lanes each)
-// until it returns false.
+// The coarse coefficients (kPointFloats per point, CV_32FC(kPointFloats) planes at
+// the photo's density) of the window of 3 x 3 points one photo cell apart around
+// (u, v) (the planes' pixels), bilinear in floats: visit(k, point) for points
+// k = 0, 1, ... (kLanesPerPoint lanes each) until it returns false.
 template <typename Visit>
-void VisitCoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy,
-                       Visit visit) {
-  const WindowAxis along_x(coarse.cols, x, dx), along_y(coarse.rows, y, dy);
+void VisitCoarseWindow(const cv::Mat& coarse, cv::Point2d at, Visit visit) {
+  const WindowAxis along_x(coarse.cols, at.x), along_y(coarse.rows, at.y);
   WindowLanes point[kLanesPerPoint];
   int k = 0;
   for (int b = 0; b < kDetailWindowSide; ++b) {
@@ -81,20 +95,19 @@ void VisitCoarseWindow(const cv::Mat& coarse, double x, double y, double dx, dou
   }
 }
 
-void CoarseWindow(const cv::Mat& coarse, double x, double y, double dx, double dy, float* window) {
-  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const WindowLanes* point) {
+void CoarseWindow(const cv::Mat& coarse, cv::Point2d at, float* window) {
+  VisitCoarseWindow(coarse, at, [&](int k, const WindowLanes* point) {
     std::memcpy(window + k * kPointFloats, point, kPointFloats * sizeof(float));
     return true;
   });
 }
 
-// The squared distance from `query` to the coarse window at (x, y), or a partial
-// sum of it (whole points) of at least `bound` (the sum only grows: the
-// comparison with the bound is the same).
-float CoarseWindowDistance(const cv::Mat& coarse, double x, double y, double dx, double dy,
-                           const float* query, float bound) {
+// The squared distance from `query` to the coarse window at `at` (the planes'
+// pixels), or a partial sum of it (whole points) of at least `bound` (the sum only
+// grows: the comparison with the bound is the same).
+float CoarseWindowDistance(const cv::Mat& coarse, cv::Point2d at, const float* query, float bound) {
   float e = 0.0f;
-  VisitCoarseWindow(coarse, x, y, dx, dy, [&](int k, const WindowLanes* point) {
+  VisitCoarseWindow(coarse, at, [&](int k, const WindowLanes* point) {
     WindowLanes squares = {0.0f, 0.0f, 0.0f, 0.0f};
     for (int h = 0; h < kLanesPerPoint; ++h) {
       const WindowLanes d = point[h] - LoadWindowLanes(query + k * kPointFloats + 4 * h);
@@ -116,12 +129,12 @@ class DetailDictionary::PointWindows : public NearestWindows::Windows {
   void Rows(int first, cv::Mat& block) const override {
     for (int r = 0; r < block.rows; ++r) {
       const cv::Point p = d_.points_[static_cast<std::size_t>(first + r)];
-      CoarseWindow(d_.coarse_, p.x, p.y, d_.dx_, d_.dy_, block.ptr<float>(r));
+      CoarseWindow(d_.coarse_, d_.OnCoarse(p.x, p.y), block.ptr<float>(r));
     }
   }
   float SquaredDistance(const float* query, int window, float bound) const override {
     const cv::Point p = d_.points_[static_cast<std::size_t>(window)];
-    return CoarseWindowDistance(d_.coarse_, p.x, p.y, d_.dx_, d_.dy_, query, bound);
+    return CoarseWindowDistance(d_.coarse_, d_.OnCoarse(p.x, p.y), query, bound);
   }
 
  private:
@@ -132,59 +145,59 @@ DetailDictionary::~DetailDictionary() = default;
 
 DetailDictionary::DetailDictionary(const PtmSample& sample, int level, cv::Mat& band) {
   const ReducedPlanes& red = sample.Reduced(level);
+  rx_ = red.rx, ry_ = red.ry;
   dx_ = 1.0 / red.rx, dy_ = 1.0 / red.ry;
-  const cv::Size full(sample.Width(), sample.Height());
-  // The raw coefficients and LRGB colour (Values()' planes), not a horizon's.
+  full_ = cv::Size(sample.Width(), sample.Height());
+  coarse_ = ToOrthonormalPoints(red.planes);
+  // The raw coefficients and LRGB colour (Values()' planes), not a horizon's, brought
+  // back to full size for the band.
   std::vector<cv::Mat> coarse_raw(sample.Values().size());
   for (std::size_t c = 0; c < coarse_raw.size(); ++c)
-    cv::resize(red.planes[c], coarse_raw[c], full, 0, 0, cv::INTER_LINEAR);
-  ToOrthonormalPoints(coarse_raw);
+    cv::resize(red.planes[c], coarse_raw[c], full_, 0, 0, cv::INTER_LINEAR);
   DetailBand(sample.Values(), coarse_raw, band);
-  IndexWindows(full);
+  IndexWindows();
 }
 
 void DetailDictionary::DetailBand(const std::vector<cv::Mat>& values,
-                                  const std::vector<cv::Mat>& coarse_raw, cv::Mat& band) const {
-  // Each plane minus its coarse version: the orthonormal luminance coefficients'
-  // from coarse_, the colour planes' from coarse_raw; interleaved.
+                                  const std::vector<cv::Mat>& coarse_raw, cv::Mat& band) {
+  // Each plane minus its coarse version: the luminance coefficients' in the
+  // orthonormal basis, the colour planes' as they are; interleaved.
+  const OrthonormalTransform to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
   const int n = static_cast<int>(values.size());
-  band.create(coarse_.size(), CV_32FC(n));
+  band.create(coarse_raw[0].size(), CV_32FC(n));
   std::vector<const float*> value(values.size()), raw(values.size());
+  float coarse[kCoefficients];
   for (int y = 0; y < band.rows; ++y) {
     for (std::size_t c = 0; c < values.size(); ++c)
       value[c] = values[c].ptr<float>(y), raw[c] = coarse_raw[c].ptr<float>(y);
     float* texel = band.ptr<float>(y);
-    const float* point = coarse_.ptr<float>(y);
-    for (int x = 0; x < band.cols; ++x, texel += n, point += kPointFloats) {
+    for (int x = 0; x < band.cols; ++x, texel += n) {
+      ToOrthonormal(to, raw.data(), x, coarse);
       for (int c = 0; c < kCoefficients; ++c)
-        texel[c] = value[static_cast<std::size_t>(c)][x] - point[c];
+        texel[c] = value[static_cast<std::size_t>(c)][x] - coarse[c];
       for (int c = kCoefficients; c < n; ++c)
         texel[c] = value[static_cast<std::size_t>(c)][x] - raw[static_cast<std::size_t>(c)][x];
     }
   }
 }
 
-void DetailDictionary::ToOrthonormalPoints(const std::vector<cv::Mat>& coarse_raw) {
-  // The transform as a row-major array (the loop below reads it row by row).
-  const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> to =
-      ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
-  coarse_.create(coarse_raw[0].size(), CV_32FC(kPointFloats));
+cv::Mat DetailDictionary::ToOrthonormalPoints(const std::vector<cv::Mat>& raw_planes) {
+  const OrthonormalTransform to = ptm::OrthonormalBasis::Hemisphere().ToOrthonormal();
+  cv::Mat points(raw_planes[0].size(), CV_32FC(kPointFloats));
   std::array<const float*, kCoefficients> raw{};
-  for (int y = 0; y < coarse_.rows; ++y) {
-    for (std::size_t k = 0; k < raw.size(); ++k) raw[k] = coarse_raw[k].ptr<float>(y);
-    float* point = coarse_.ptr<float>(y);
-    for (int x = 0; x < coarse_.cols; ++x, point += kPointFloats) {
-      for (int m = 0; m < kCoefficients; ++m) {
-        double v = 0.0;
-        for (int k = 0; k < kCoefficients; ++k) v += to(m, k) * raw[static_cast<std::size_t>(k)][x];
-        point[m] = static_cast<float>(v);
-      }
+  for (int y = 0; y < points.rows; ++y) {
+    for (std::size_t k = 0; k < raw.size(); ++k) raw[k] = raw_planes[k].ptr<float>(y);
+    float* point = points.ptr<float>(y);
+    for (int x = 0; x < points.cols; ++x, point += kPointFloats) {
+      ToOrthonormal(to, raw.data(), x, point);
       std::fill(point + kCoefficients, point + kPointFloats, 0.0f);  // the pads
     }
   }
+  return points;
 }
 
-void DetailDictionary::IndexWindows(cv::Size full) {
+void DetailDictionary::IndexWindows() {
+  const cv::Size full = full_;
   const int bx = static_cast<int>(std::ceil(kDetailWindowRadius * dx_)),
             by = static_cast<int>(std::ceil(kDetailWindowRadius * dy_));
   const int nx = full.width - 2 * bx, ny = full.height - 2 * by;
@@ -206,9 +219,9 @@ cv::Mat DetailDictionary::CorrectedWindows(const TrianglePatch& patch) const {
   for (int j = 0; j < gh; ++j)
     for (int i = 0; i < gw; ++i) {
       std::array<double, kPointFloats> coarse;
-      BilinearTaps(coarse_.size(), patch.sample_x + (i + 0.5) * dx_ - 0.5,
-                   patch.sample_y + (j + 0.5) * dy_ - 0.5)
-          .OfChannels(coarse_, coarse);
+      const cv::Point2d at =
+          OnCoarse(patch.sample_x + (i + 0.5) * dx_ - 0.5, patch.sample_y + (j + 0.5) * dy_ - 0.5);
+      BilinearTaps(coarse_.size(), at.x, at.y).OfChannels(coarse_, coarse);
       float* point = corrected.ptr<float>(j) + i * kPointFloats;
       for (std::size_t m = 0; m < kCoefficients; ++m)
         point[m] = static_cast<float>(coarse[m] + patch.correction[m].at<float>(j, i));
@@ -249,8 +262,8 @@ void DetailDictionary::MatchByIndex(const cv::Mat& windows, const std::vector<in
 void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, Matches& matches) const {
   // A neighbour cell's match moved by one cell, wherever it is nearer.
   const int gw = matches.width, gh = static_cast<int>(matches.source.size()) / gw;
-  const double x_lo = kDetailWindowRadius * dx_, x_hi = coarse_.cols - 1 - x_lo;
-  const double y_lo = kDetailWindowRadius * dy_, y_hi = coarse_.rows - 1 - y_lo;
+  const double x_lo = kDetailWindowRadius * dx_, x_hi = full_.width - 1 - x_lo;
+  const double y_lo = kDetailWindowRadius * dy_, y_hi = full_.height - 1 - y_lo;
   const auto try_shift = [&](int i, int j, int ni, int nj) {
     if (ni < 0 || nj < 0 || ni >= gw || nj >= gh) return;
     const auto c = static_cast<std::size_t>(j * gw + i), n = static_cast<std::size_t>(nj * gw + ni);
@@ -258,7 +271,7 @@ void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, Matches& 
     const double x = matches.source[n][0] + (i - ni) * dx_;
     const double y = matches.source[n][1] + (j - nj) * dy_;
     if (x < x_lo || x > x_hi || y < y_lo || y > y_hi) return;
-    const float e = CoarseWindowDistance(coarse_, x, y, dx_, dy_, windows.ptr<float>(j * gw + i),
+    const float e = CoarseWindowDistance(coarse_, OnCoarse(x, y), windows.ptr<float>(j * gw + i),
                                          matches.distance[c]);
     if (e < matches.distance[c])
       matches.distance[c] = e,

@@ -16,10 +16,11 @@
 namespace texlume::synth {
 
 /// Detail transfer's dictionary at one density level: the sample's coarse
-/// luminance coefficients brought back to full size (orthonormal), and the
-/// window of them around every sample point, 3 x 3 points one photo cell apart,
-/// indexed for nearest-neighbour search. Its detail band (planes minus coarse)
-/// is what the transferred patches read.
+/// luminance coefficients (orthonormal) at that density, and the window of them
+/// around every sample point, 3 x 3 points one photo cell apart (read bilinearly
+/// there), indexed for nearest-neighbour search. Its detail band (the planes minus
+/// their coarse version brought back to full size) is what the transferred patches
+/// read.
 class DetailDictionary {
  public:
   /// The dictionary of `sample` reduced to density `level`; `band` receives the
@@ -54,12 +55,18 @@ class DetailDictionary {
     std::vector<cv::Vec2f> source;
     std::vector<float> distance;
   };
-  // coarse_: the raw coarse luminance coefficients (full size) in the orthonormal basis.
-  void ToOrthonormalPoints(const std::vector<cv::Mat>& coarse_raw);
-  // The detail band: `values` minus their coarse version (coarse_, coarse_raw).
-  void DetailBand(const std::vector<cv::Mat>& values, const std::vector<cv::Mat>& coarse_raw,
-                  cv::Mat& band) const;
-  void IndexWindows(cv::Size full);
+  // The first 6 of `raw_planes` (raw luminance coefficients) in the orthonormal
+  // basis, interleaved (kPointFloats a point).
+  static cv::Mat ToOrthonormalPoints(const std::vector<cv::Mat>& raw_planes);
+  // The detail band: `values` minus their coarse version `coarse_raw` (the raw
+  // planes brought back to full size; the luminance's in the orthonormal basis).
+  static void DetailBand(const std::vector<cv::Mat>& values, const std::vector<cv::Mat>& coarse_raw,
+                         cv::Mat& band);
+  void IndexWindows();
+  // A sample position (texels, centres at integers) in coarse_'s pixels.
+  cv::Point2d OnCoarse(double x, double y) const {
+    return {(x + 0.5) * rx_ - 0.5, (y + 0.5) * ry_ - 0.5};
+  }
   // Per cell, the window of the corrected coarse coefficients (a row each).
   cv::Mat CorrectedWindows(const TrianglePatch& patch) const;
   // The nearest windows of the index for `cells` (row-major indices).
@@ -72,7 +79,11 @@ class DetailDictionary {
   class PointWindows;
 
   double dx_ = 1.0, dy_ = 1.0;  // texels per photo cell
-  cv::Mat coarse_;  // the 6 orthonormal luminance planes interleaved (8 floats a point), full size
+  double rx_ = 1.0, ry_ = 1.0;  // photo cells per texel
+  cv::Size full_;               // the sample's size, texels
+  // The 6 orthonormal luminance planes interleaved (8 floats a point), at the
+  // photo's density (a pixel a photo cell: the windows' points fall on its grid).
+  cv::Mat coarse_;
   std::vector<cv::Point> points_;  // window centres, texels
   std::unique_ptr<PointWindows> windows_;
   std::unique_ptr<NearestWindows> nearest_;
