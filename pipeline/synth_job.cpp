@@ -317,6 +317,15 @@ const char* FillUnseenName(FillUnseen fill) {
   return fill == FillUnseen::kGraphcut ? "graphcut" : "overlap";
 }
 
+synth::MeshSynthesisOptions SynthesisOptionsOf(const SynthJobOptions& job) {
+  synth::MeshSynthesisOptions options = job.synthesis;
+  // The bake reads a face's patch over its gutter ring (to half a texel past it) and a
+  // neighbour's to W_e / 2 past their shared edge (atlas/atlas.h); the graph-cut fill
+  // reads the faces' own texels.
+  options.detail_reach_texels = std::max(job.atlas.gutter + 0.5, 0.5 * job.atlas.blend_strip);
+  return options;
+}
+
 quilt::UnseenFillOptions UnseenFillOptionsOf(const SynthJobOptions& job, std::uint64_t seed) {
   quilt::UnseenFillOptions fill;
   fill.quilt = job.fill_quilt;
@@ -561,10 +570,11 @@ class SynthJob {
     const std::optional<synth::FaceRegions> regions =
         RegionsOfJob(options_, in, options_.synthesis);
     const synth::FaceRegions* regions_or_null = regions ? &*regions : nullptr;
+    const synth::MeshSynthesisOptions synthesis_options = SynthesisOptionsOf(options_);
     synthesis_ = sample_.colour.empty()
                      ? synth::SynthesizeMeshPtm(
                            in.mesh, in.reconstruction, in.visibility, in.photos, sample_.ptm,
-                           options_.synthesis, progress_, regions_or_null,
+                           synthesis_options, progress_, regions_or_null,
                            sample_shadowing_ ? sample_shadowing_->ForSynthesis() : nullptr)
                      : synth::SynthesizeMeshColour(
                            in.mesh, in.reconstruction, in.visibility, in.photos, sample_.colour,
@@ -651,6 +661,7 @@ class SynthJob {
         {"correction_noise", so.correction_noise},
         {"channel_correction", so.channel_correction},
         {"detail_transfer", so.detail_transfer},
+        {"detail_reach_texels", SynthesisOptionsOf(options_).detail_reach_texels},
         {"correction_prior_shrink", so.correction_prior_shrink < 0.0
                                         ? nlohmann::json("auto")
                                         : nlohmann::json(so.correction_prior_shrink)},

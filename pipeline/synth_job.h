@@ -32,6 +32,9 @@ enum class FillUnseen {
 /// "overlap" or "graphcut" (the CLI's and the manifest's names).
 const char* FillUnseenName(FillUnseen fill);
 struct SynthJobOptions;
+/// The job's synthesis options with what follows from its atlas options: how far
+/// past a triangle the bake reads its patch (MeshSynthesisOptions::detail_reach_texels).
+synth::MeshSynthesisOptions SynthesisOptionsOf(const SynthJobOptions& job);
 /// The graph-cut fill's options for a job (its charts; `seed` the synthesis's).
 quilt::UnseenFillOptions UnseenFillOptionsOf(const SynthJobOptions& job, std::uint64_t seed);
 /// Refuses, with the estimate, a graph-cut fill whose dense surface over the

@@ -538,7 +538,10 @@ void CoefficientCorrection::Finish(TriangleEngine& engine, const std::vector<std
 #pragma omp parallel for schedule(dynamic, 8)
   for (std::size_t n = 0; n < transferred.size(); ++n) {
     const std::size_t f = transferred[n];
-    dictionaries_.at(correction_level_[f])->Transfer(patches[f], correction_level_[f]);
+    dictionaries_.at(correction_level_[f])
+        ->Transfer(
+            patches[f], correction_level_[f],
+            CellsReadWithin(patches[f], options_.sample_texel_size, options_.detail_reach_texels));
     const std::size_t done_now = ++transfers_done;
     if (progress && (done_now % 64 == 0 || done_now == transferred.size())) {
 #pragma omp critical(texlume_detail_progress)

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/check.h"
+#include "mesh/triangle_frame.h"
 #include "ptm/coefficient_space.h"
 
 namespace texlume::synth {
@@ -259,7 +260,8 @@ void DetailDictionary::MatchByIndex(const cv::Mat& windows, const std::vector<in
   }
 }
 
-void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, Matches& matches) const {
+void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, const cv::Mat& wanted,
+                                 Matches& matches) const {
   // A neighbour cell's match moved by one cell, wherever it is nearer.
   const int gw = matches.width, gh = static_cast<int>(matches.source.size()) / gw;
   const double x_lo = kDetailWindowRadius * dx_, x_hi = full_.width - 1 - x_lo;
@@ -267,7 +269,7 @@ void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, Matches& 
   const auto try_shift = [&](int i, int j, int ni, int nj) {
     if (ni < 0 || nj < 0 || ni >= gw || nj >= gh) return;
     const auto c = static_cast<std::size_t>(j * gw + i), n = static_cast<std::size_t>(nj * gw + ni);
-    if (!matches.Found(n)) return;
+    if (!matches.Found(n) || (!wanted.empty() && !wanted.data[c])) return;
     const double x = matches.source[n][0] + (i - ni) * dx_;
     const double y = matches.source[n][1] + (j - nj) * dy_;
     if (x < x_lo || x > x_hi || y < y_lo || y > y_hi) return;
@@ -286,9 +288,12 @@ void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, Matches& 
   }
 }
 
-void DetailDictionary::Transfer(TrianglePatch& patch, int level) const {
+void DetailDictionary::Transfer(TrianglePatch& patch, int level, const cv::Mat& wanted) const {
   const int gw = patch.correction[0].cols, gh = patch.correction[0].rows;
   TEXLUME_CHECK(gw > 0 && gh > 0, "detail transfer needs a correction grid");
+  TEXLUME_CHECK(wanted.empty() || (wanted.cols == gw && wanted.rows == gh),
+                "detail transfer's wanted cells on the correction grid");
+  const auto want = [&](int c) { return wanted.empty() || wanted.data[c] != 0; };
   const cv::Mat windows = CorrectedWindows(patch);
   Matches matches(gw, gh);
   // The index is asked at the cells of one colour of a checkerboard (issue 33:
@@ -296,23 +301,52 @@ void DetailDictionary::Transfer(TrianglePatch& patch, int level) const {
   // cell, and any cell those cannot reach (the sample's edge) asks the index itself.
   std::vector<int> cells;
   for (int j = 0; j < gh; ++j)
-    for (int i = j % 2; i < gw; i += 2) cells.push_back(j * gw + i);
+    for (int i = j % 2; i < gw; i += 2)
+      if (want(j * gw + i)) cells.push_back(j * gw + i);
   MatchByIndex(windows, cells, matches);
-  Propagate(windows, true, matches);
+  Propagate(windows, true, wanted, matches);
   cells.clear();
   for (int c = 0; c < gw * gh; ++c)
-    if (!matches.Found(static_cast<std::size_t>(c))) cells.push_back(c);
+    if (want(c) && !matches.Found(static_cast<std::size_t>(c))) cells.push_back(c);
   // Coherent matches keep the detail whole where their bands are blended (a
   // second forward pass changes nothing unless the index matched more cells).
   if (!cells.empty()) {
     MatchByIndex(windows, cells, matches);
-    Propagate(windows, true, matches);
+    Propagate(windows, true, wanted, matches);
   }
-  Propagate(windows, false, matches);
+  Propagate(windows, false, wanted, matches);
+  // A cell no read takes keeps its own place in the sample.
   patch.detail_source = cv::Mat(gh, gw, CV_32FC2);
-  for (int c = 0; c < gw * gh; ++c)
-    patch.detail_source.at<cv::Vec2f>(c / gw, c % gw) = matches.source[static_cast<std::size_t>(c)];
+  for (int c = 0; c < gw * gh; ++c) {
+    const int i = c % gw, j = c / gw;
+    patch.detail_source.at<cv::Vec2f>(j, i) =
+        matches.Found(static_cast<std::size_t>(c))
+            ? matches.source[static_cast<std::size_t>(c)]
+            : cv::Vec2f(static_cast<float>(patch.sample_x + (i + 0.5) * dx_ - 0.5),
+                        static_cast<float>(patch.sample_y + (j + 0.5) * dy_ - 0.5));
+  }
   patch.detail_level = level;
+}
+
+cv::Mat CellsReadWithin(const TrianglePatch& patch, double texel_size, double reach_texels) {
+  if (reach_texels < 0.0) return {};
+  // The triangle in the patch's texels, centres at integers (as SamplePtmPatch reads).
+  std::array<Eigen::Vector2d, 3> corners;
+  for (std::size_t k = 0; k < corners.size(); ++k)
+    corners[k] = Eigen::Vector2d((patch.corners_in_frame[k].x() - patch.x_min) / texel_size - 0.5,
+                                 (patch.y_max - patch.corners_in_frame[k].y()) / texel_size - 0.5);
+  // A texel reads the cells whose centres lie within a cell of it along each axis;
+  // half a cell more covers the grid's clamped edges.
+  const double rx = patch.correction_density.x(), ry = patch.correction_density.y();
+  const double reach = reach_texels + std::hypot(1.5 / rx, 1.5 / ry);
+  const cv::Size grid = patch.correction[0].size();
+  cv::Mat wanted(grid, CV_8UC1);
+  for (int j = 0; j < grid.height; ++j)
+    for (int i = 0; i < grid.width; ++i) {
+      const Eigen::Vector2d centre((i + 0.5) / rx - 0.5, (j + 0.5) / ry - 0.5);
+      wanted.at<std::uint8_t>(j, i) = mesh::WithinReachOfTriangle(corners, centre, reach) ? 1 : 0;
+    }
+  return wanted;
 }
 
 }  // namespace texlume::synth

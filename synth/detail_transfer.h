@@ -39,8 +39,10 @@ class DetailDictionary {
   /// index is asked at the cells of one colour of a checkerboard (issue 33: half
   /// the queries); passes then take a neighbour cell's match moved by one cell
   /// wherever it is nearer (the other cells' only matches, unless they lie beyond
-  /// the neighbours' reach and ask the index themselves).
-  void Transfer(TrianglePatch& patch, int level) const;
+  /// the neighbours' reach and ask the index themselves). Only the cells `wanted`
+  /// marks (CellsReadWithin; empty: every cell) are matched; the others keep their
+  /// own place in the sample (the patch's own detail).
+  void Transfer(TrianglePatch& patch, int level, const cv::Mat& wanted = cv::Mat()) const;
 
  private:
   // Per cell of a patch's grid (row-major): the sample point its detail comes from
@@ -72,8 +74,10 @@ class DetailDictionary {
   // The nearest windows of the index for `cells` (row-major indices).
   void MatchByIndex(const cv::Mat& windows, const std::vector<int>& cells, Matches& matches) const;
   // One pass over the grid (forward: from the left and above; else from the right
-  // and below) taking a neighbour's match moved by one cell wherever it is nearer.
-  void Propagate(const cv::Mat& windows, bool forward, Matches& matches) const;
+  // and below) taking a neighbour's match moved by one cell wherever it is nearer,
+  // into the cells `wanted` marks (empty: every cell).
+  void Propagate(const cv::Mat& windows, bool forward, const cv::Mat& wanted,
+                 Matches& matches) const;
 
   // The windows around points_, read from coarse_ as the index asks (none held).
   class PointWindows;
@@ -88,5 +92,11 @@ class DetailDictionary {
   std::unique_ptr<PointWindows> windows_;
   std::unique_ptr<NearestWindows> nearest_;
 };
+
+/// The cells of a corrected patch's grid whose detail a read of the patch within
+/// `reach_texels` of its triangle takes (SamplePtmPatch reads the 4 cells around a
+/// texel), 1 each (CV_8UC1, the grid's size, with a margin of half a cell); empty
+/// (every cell) when the reach is negative.
+cv::Mat CellsReadWithin(const TrianglePatch& patch, double texel_size, double reach_texels);
 
 }  // namespace texlume::synth

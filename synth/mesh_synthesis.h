@@ -51,6 +51,11 @@ struct MeshSynthesisOptions : TriangleEngineOptions {
   /// best match the corrected ones (a 3 x 3 window of photo cells), so that it
   /// follows the photo's structure rather than the quilted patch's.
   bool detail_transfer = true;
+  /// How far past its triangle the model reads a patch, in texels: the atlas's
+  /// gutter ring, and half the blend strip (W_e / 2) into a neighbour's patch.
+  /// Detail transfer matches only the cells such reads take (CellsReadWithin);
+  /// the others keep the patch's own detail. < 0: every cell.
+  double detail_reach_texels = -1.0;
 
   /// The engine's checks, then the photo-consistency pass's.
   void Check() const;

@@ -2,9 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "mesh/triangle_frame.h"
 #include "ptm/coefficient_space.h"
 
 namespace texlume::synth {
@@ -128,6 +132,84 @@ TEST(DetailTransfer, CellsBeyondTheWindowsReachStillFindAMatch) {
   TrianglePatch row = PatchCorrectedToward(p, cv::Size(12, 1), {36, 20}, {36, 20});
   dictionary.Transfer(row, 0);
   ExpectSourcesAreWindowCentres(row);
+}
+
+// Only the wanted cells are matched (here the left half of the grid: the
+// correction's place found there, by the index and by propagation within it); the
+// others keep their own place in the sample.
+TEST(DetailTransfer, OnlyTheWantedCellsAreMatched) {
+  const ptm::Ptm p = SmoothPtm(48, 5);
+  const PtmSample sample(p);
+  cv::Mat band;
+  const DetailDictionary dictionary(sample, 0, band);
+  const cv::Point at(6, 8), to(25, 4);
+  TrianglePatch patch = PatchCorrectedToward(p, cv::Size(12, 12), at, to);
+  cv::Mat wanted = cv::Mat::zeros(12, 12, CV_8UC1);
+  wanted.colRange(0, 6).setTo(1);
+  dictionary.Transfer(patch, 0, wanted);
+  for (int j = 1; j + 1 < 12; ++j)
+    for (int i = 0; i < 12; ++i) {
+      const cv::Vec2f s = patch.detail_source.at<cv::Vec2f>(j, i);
+      const cv::Point expected = i < 6 ? to : at;
+      if (i == 0) continue;  // the grid's edge: clamped windows
+      EXPECT_NEAR(s[0], expected.x + i, 1e-3) << "cell " << i << ", " << j;
+      EXPECT_NEAR(s[1], expected.y + j, 1e-3) << "cell " << i << ", " << j;
+    }
+  // Every cell wanted: the same matches as no mask.
+  TrianglePatch all = PatchCorrectedToward(p, cv::Size(12, 12), at, to);
+  TrianglePatch unmasked = all;
+  dictionary.Transfer(all, 0, cv::Mat::ones(12, 12, CV_8UC1));
+  dictionary.Transfer(unmasked, 0);
+  EXPECT_EQ(cv::norm(all.detail_source, unmasked.detail_source, cv::NORM_INF), 0.0);
+}
+
+// A right triangle's patch (strip of 8 texels) with a correction grid at 0.6 cells
+// per texel.
+TrianglePatch TrianglePatchWithGrid(double t) {
+  TrianglePatch patch;
+  patch.corners_in_frame = {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(0.4, 0.0),
+                            Eigen::Vector2d(0.0, 0.3)};
+  patch.x_min = -8 * t, patch.y_max = 0.3 + 8 * t;
+  patch.width = 56, patch.height = 46;
+  patch.correction_density = Eigen::Vector2d(0.6, 0.6);
+  patch.correction.assign(6, cv::Mat::zeros(28, 34, CV_32FC1));
+  return patch;
+}
+
+// Every cell that a texel within the reach of the triangle reads (the 4 cells
+// around it on the grid with a weight above 0, clamped at the grid's edges, as
+// SamplePtmPatch reads them) is wanted, and the cells far from the triangle are not.
+TEST(CellsReadWithin, HoldsEveryCellAReadWithinTheReachTakes) {
+  const double t = 0.01, reach = 4.0;
+  const TrianglePatch patch = TrianglePatchWithGrid(t);
+  EXPECT_TRUE(CellsReadWithin(patch, t, -1.0).empty());
+  const cv::Mat wanted = CellsReadWithin(patch, t, reach);
+  ASSERT_EQ(wanted.size(), patch.correction[0].size());
+  std::array<Eigen::Vector2d, 3> corners;
+  for (std::size_t k = 0; k < 3; ++k)
+    corners[k] = Eigen::Vector2d((patch.corners_in_frame[k].x() - patch.x_min) / t - 0.5,
+                                 (patch.y_max - patch.corners_in_frame[k].y()) / t - 0.5);
+  const cv::Size grid = wanted.size();
+  int reads = 0;
+  for (double v = -0.5; v <= patch.height - 0.5; v += 0.25)
+    for (double u = -0.5; u <= patch.width - 0.5; u += 0.25) {
+      if (mesh::SignedDistanceToTriangle(corners, Eigen::Vector2d(u, v)) > reach) continue;
+      const double gu = std::clamp((u + 0.5) * 0.6 - 0.5, 0.0, grid.width - 1.0);
+      const double gv = std::clamp((v + 0.5) * 0.6 - 0.5, 0.0, grid.height - 1.0);
+      const int x0 = static_cast<int>(gu), y0 = static_cast<int>(gv);
+      for (const int y : {y0, std::min(y0 + 1, grid.height - 1)})
+        for (const int x : {x0, std::min(x0 + 1, grid.width - 1)}) {
+          const double w = (1.0 - std::abs(gu - x)) * (1.0 - std::abs(gv - y));
+          if (w <= 0.0) continue;
+          ++reads;
+          ASSERT_EQ(wanted.at<std::uint8_t>(y, x), 1)
+              << "cell " << x << ", " << y << " read at (" << u << ", " << v << ")";
+        }
+    }
+  EXPECT_GT(reads, 1000);
+  // The corner of the patch opposite the right angle lies far from the hypotenuse.
+  EXPECT_EQ(wanted.at<std::uint8_t>(0, grid.width - 1), 0);
+  EXPECT_LT(cv::countNonZero(wanted), grid.area());
 }
 
 // A sample narrower than a window's reach has no dictionary to transfer from.
