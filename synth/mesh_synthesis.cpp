@@ -20,6 +20,8 @@ void MeshSynthesisOptions::Check() const {
     throw OptionError("correction_noise must be > 0");
   if (correction_iterations < 0 || correction_iterations > 5)
     throw OptionError("correction_iterations must be in [0, 5]");
+  if (std::isnan(detail_reach_texels))
+    throw OptionError("detail_reach_texels must be a number (< 0: every cell)");
 }
 
 bool MeshSynthesis::SamplePatch(int face, const Eigen::Vector2d& p, float* out) const {

@@ -52,7 +52,8 @@ struct MeshSynthesisOptions : TriangleEngineOptions {
   /// follows the photo's structure rather than the quilted patch's.
   bool detail_transfer = true;
   /// How far past its triangle the model reads a patch, in texels: the atlas's
-  /// gutter ring, and half the blend strip (W_e / 2) into a neighbour's patch.
+  /// gutter ring, and half the blend strip (W_e / 2) into a neighbour's patch (the
+  /// main job sets it from its atlas options: pipeline::SynthesisOptionsOf).
   /// Detail transfer matches only the cells such reads take (CellsReadWithin);
   /// the others keep the patch's own detail. < 0: every cell.
   double detail_reach_texels = -1.0;

@@ -105,6 +105,23 @@ TEST(SynthJobOptions, AGraphCutFillTheMemoryCannotHoldIsRefusedWithTheEstimate) 
   EXPECT_NO_THROW(pipeline::RequireFillMemory(job, sphere, 0.01, 6));  // 100 times fewer samples
 }
 
+// Detail transfer's reach is how far past a triangle the bake reads its patch: the
+// gutter ring in atlas pixels (each up to the charts' largest stretch in texels) or
+// half the blend strip into a neighbour, whichever is farther.
+TEST(SynthJobOptions, DetailTransferReachesAsFarAsTheBakeReads) {
+  pipeline::SynthJobOptions job;
+  EXPECT_LT(job.synthesis.detail_reach_texels, 0.0);  // a library caller: every cell
+  job.atlas.gutter = 2, job.atlas.blend_strip = 8, job.atlas.max_chart_stretch = 1.25;
+  EXPECT_DOUBLE_EQ(pipeline::SynthesisOptionsOf(job).detail_reach_texels, 4.0);
+  job.atlas.gutter = 6;
+  EXPECT_DOUBLE_EQ(pipeline::SynthesisOptionsOf(job).detail_reach_texels, 6.5 * 1.25);
+  synth::MeshSynthesisOptions options = pipeline::SynthesisOptionsOf(job);
+  options.sample_texel_size = 0.004;
+  EXPECT_NO_THROW(options.Check());
+  options.detail_reach_texels = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(options.Check(), OptionError);
+}
+
 TEST(RenderJobOptions, MissingPathsAndOutOfRangeSettingsAreRefused) {
   pipeline::RenderJobOptions o;
   EXPECT_THROW(o.Check(), OptionError);
