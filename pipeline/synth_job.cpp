@@ -319,10 +319,8 @@ const char* FillUnseenName(FillUnseen fill) {
 
 synth::MeshSynthesisOptions SynthesisOptionsOf(const SynthJobOptions& job) {
   synth::MeshSynthesisOptions options = job.synthesis;
-  // The bake reads a face's patch over its gutter ring (to half an atlas pixel past it,
-  // a pixel up to max_chart_stretch texels where a chart is stretched) and a
-  // neighbour's to W_e / 2 texels past their shared edge (atlas/atlas.h); the
-  // graph-cut fill reads the faces' own texels.
+  // The bake's reads of a patch: its gutter ring (atlas pixels, up to max_chart_stretch
+  // texels each) and W_e / 2 texels into a neighbour (atlas/atlas.h).
   options.detail_reach_texels =
       std::max((job.atlas.gutter + 0.5) * job.atlas.max_chart_stretch, 0.5 * job.atlas.blend_strip);
   return options;
