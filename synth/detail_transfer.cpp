@@ -58,6 +58,12 @@ void ToOrthonormal(const OrthonormalTransform& to, const float* const* raw, int 
   }
 }
 
+// Whether cell c (row-major) is to be matched: marked in `wanted`, or every cell
+// when it is empty.
+bool IsWanted(const cv::Mat& wanted, std::size_t c) {
+  return wanted.empty() || wanted.data[c] != 0;
+}
+
 // Four floats in one SSE register (GCC's vector extension); a point is two.
 using WindowLanes = float __attribute__((vector_size(16)));
 constexpr int kLanesPerPoint = kPointFloats / 4;
@@ -220,8 +226,7 @@ cv::Mat DetailDictionary::CorrectedWindows(const TrianglePatch& patch) const {
   for (int j = 0; j < gh; ++j)
     for (int i = 0; i < gw; ++i) {
       std::array<double, kPointFloats> coarse;
-      const cv::Point2d at =
-          OnCoarse(patch.sample_x + (i + 0.5) * dx_ - 0.5, patch.sample_y + (j + 0.5) * dy_ - 0.5);
+      const cv::Point2d own = CellInSample(patch, i, j), at = OnCoarse(own.x, own.y);
       BilinearTaps(coarse_.size(), at.x, at.y).OfChannels(coarse_, coarse);
       float* point = corrected.ptr<float>(j) + i * kPointFloats;
       for (std::size_t m = 0; m < kCoefficients; ++m)
@@ -269,7 +274,7 @@ void DetailDictionary::Propagate(const cv::Mat& windows, bool forward, const cv:
   const auto try_shift = [&](int i, int j, int ni, int nj) {
     if (ni < 0 || nj < 0 || ni >= gw || nj >= gh) return;
     const auto c = static_cast<std::size_t>(j * gw + i), n = static_cast<std::size_t>(nj * gw + ni);
-    if (!matches.Found(n) || (!wanted.empty() && !wanted.data[c])) return;
+    if (!matches.Found(n) || !IsWanted(wanted, c)) return;
     const double x = matches.source[n][0] + (i - ni) * dx_;
     const double y = matches.source[n][1] + (j - nj) * dy_;
     if (x < x_lo || x > x_hi || y < y_lo || y > y_hi) return;
@@ -293,7 +298,6 @@ void DetailDictionary::Transfer(TrianglePatch& patch, int level, const cv::Mat& 
   TEXLUME_CHECK(gw > 0 && gh > 0, "detail transfer needs a correction grid");
   TEXLUME_CHECK(wanted.empty() || (wanted.cols == gw && wanted.rows == gh),
                 "detail transfer's wanted cells on the correction grid");
-  const auto want = [&](int c) { return wanted.empty() || wanted.data[c] != 0; };
   const cv::Mat windows = CorrectedWindows(patch);
   Matches matches(gw, gh);
   // The index is asked at the cells of one colour of a checkerboard (issue 33:
@@ -302,12 +306,14 @@ void DetailDictionary::Transfer(TrianglePatch& patch, int level, const cv::Mat& 
   std::vector<int> cells;
   for (int j = 0; j < gh; ++j)
     for (int i = j % 2; i < gw; i += 2)
-      if (want(j * gw + i)) cells.push_back(j * gw + i);
+      if (IsWanted(wanted, static_cast<std::size_t>(j * gw + i))) cells.push_back(j * gw + i);
   MatchByIndex(windows, cells, matches);
   Propagate(windows, true, wanted, matches);
   cells.clear();
   for (int c = 0; c < gw * gh; ++c)
-    if (want(c) && !matches.Found(static_cast<std::size_t>(c))) cells.push_back(c);
+    if (IsWanted(wanted, static_cast<std::size_t>(c)) &&
+        !matches.Found(static_cast<std::size_t>(c)))
+      cells.push_back(c);
   // Coherent matches keep the detail whole where their bands are blended (a
   // second forward pass changes nothing unless the index matched more cells).
   if (!cells.empty()) {
@@ -318,12 +324,11 @@ void DetailDictionary::Transfer(TrianglePatch& patch, int level, const cv::Mat& 
   // A cell no read takes keeps its own place in the sample.
   patch.detail_source = cv::Mat(gh, gw, CV_32FC2);
   for (int c = 0; c < gw * gh; ++c) {
-    const int i = c % gw, j = c / gw;
-    patch.detail_source.at<cv::Vec2f>(j, i) =
+    const cv::Point2d own = CellInSample(patch, c % gw, c / gw);
+    patch.detail_source.at<cv::Vec2f>(c / gw, c % gw) =
         matches.Found(static_cast<std::size_t>(c))
             ? matches.source[static_cast<std::size_t>(c)]
-            : cv::Vec2f(static_cast<float>(patch.sample_x + (i + 0.5) * dx_ - 0.5),
-                        static_cast<float>(patch.sample_y + (j + 0.5) * dy_ - 0.5));
+            : cv::Vec2f(static_cast<float>(own.x), static_cast<float>(own.y));
   }
   patch.detail_level = level;
 }

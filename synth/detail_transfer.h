@@ -65,6 +65,11 @@ class DetailDictionary {
   static void DetailBand(const std::vector<cv::Mat>& values, const std::vector<cv::Mat>& coarse_raw,
                          cv::Mat& band);
   void IndexWindows();
+  // Cell (i, j) of a patch's correction grid at its own place in the sample (texels,
+  // centres at integers).
+  cv::Point2d CellInSample(const TrianglePatch& patch, int i, int j) const {
+    return {patch.sample_x + (i + 0.5) * dx_ - 0.5, patch.sample_y + (j + 0.5) * dy_ - 0.5};
+  }
   // A sample position (texels, centres at integers) in coarse_'s pixels.
   cv::Point2d OnCoarse(double x, double y) const {
     return {(x + 0.5) * rx_ - 0.5, (y + 0.5) * ry_ - 0.5};
