@@ -534,6 +534,10 @@ void AddSceneCommand(CLI::App& app, CommandRunners& run) {
   sub->add_option("--camera-distance", s->camera_distance,
                   "cameras' distance from the object's centre, world units")
       ->capture_default_str();
+  sub->add_option("--photo-light-spread", s->photo_light_azimuth_spread_deg,
+                  "azimuths of the photos' lights: within this many degrees centred on their "
+                  "camera's (72: its side of the object; 360: from anywhere)")
+      ->capture_default_str();
   sub->add_option("--focal", s->focal_px,
                   "focal length in pixels of a 640-pixel-wide photo (scaled with --width)")
       ->capture_default_str();

@@ -81,6 +81,8 @@ void ObjectSceneOptions::Check() const {
   if (max_lights_per_image < 1 || max_lights_per_image > 3) {
     throw OptionError("max_lights_per_image must be in [1, 3]");
   }
+  if (!(light_azimuth_spread_deg >= 0.0 && light_azimuth_spread_deg <= 360.0))
+    throw OptionError("light_azimuth_spread_deg must be in [0, 360]");
   if (camera_model != sfm::CameraModelId::kPinhole && camera_model != sfm::CameraModelId::kOpenCV) {
     throw OptionError("camera_model must be PINHOLE or OPENCV");
   }
@@ -144,8 +146,9 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
 
   // Cameras looking at the origin (the plane is seen from above only, the torus
   // from higher up so its hole shows). Each photo gets 1 to
-  // max_lights_per_image directional lights from the camera's side of the object,
-  // 20 to 70 degrees above the horizon, with intensities summing to about 1.
+  // max_lights_per_image directional lights within light_azimuth_spread_deg of
+  // azimuth around the camera's (by default its side of the object), 25 to 65
+  // degrees above the horizon, with intensities summing to about 1.
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const std::vector<CameraAngles> photo_angles = PhotoAngles(options);
   for (int i = 0; i < options.num_images; ++i) {
@@ -166,7 +169,9 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
     const int num_lights = 1 + static_cast<int>(uniform(rng) * options.max_lights_per_image);
     std::vector<sfm::ObjectLight> lights;
     for (int k = 0; k < num_lights; ++k) {
-      const double light_azimuth = azimuth + (uniform(rng) - 0.5) * std::numbers::pi / 2.5;
+      const double light_azimuth = azimuth + (uniform(rng) - 0.5) *
+                                                 options.light_azimuth_spread_deg *
+                                                 std::numbers::pi / 180.0;
       const double light_elevation = (25.0 + 40.0 * uniform(rng)) * std::numbers::pi / 180.0;
       sfm::ObjectLight light;
       light.direction_in_world = Eigen::Vector3d(

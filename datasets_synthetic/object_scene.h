@@ -44,6 +44,8 @@ struct ObjectSceneOptions {
   double observation_noise_px = 0.3;
   /// Each photo is lit by 1 to this many directional lights (drawn per photo). [1, 3].
   int max_lights_per_image = 1;
+  /// The lights' azimuths lie within this range centred on their camera's, degrees, [0, 360].
+  double light_azimuth_spread_deg = 72.0;
   std::uint32_t seed = 1;
 
   void Check() const;

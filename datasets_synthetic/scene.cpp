@@ -83,6 +83,7 @@ void SceneOptions::Check() const {
   RequireInRange(focal_px, 1, 1e6, "focal_px");
   RequireInRange(camera_distance, 1.6, 1000, "camera_distance");
   RequireInRange(max_lights_per_image, 1, 3, "max_lights_per_image");
+  RequireInRange(photo_light_azimuth_spread_deg, 0.0, 360.0, "photo_light_azimuth_spread_deg");
   RequireInRange(num_held_out_views, 0, 100, "num_held_out_views");
   RequireInRange(held_out_lights_per_view, 1, 20, "held_out_lights_per_view");
   RequireInRange(held_out_scale, 1, 4, "held_out_scale");
@@ -480,6 +481,7 @@ class SceneGenerator {
     object_options.camera_distance = options_.camera_distance;
     object_options.camera_model = options_.camera_model;
     object_options.max_lights_per_image = options_.max_lights_per_image;
+    object_options.light_azimuth_spread_deg = options_.photo_light_azimuth_spread_deg;
     object_options.seed = options_.seed;
     object_ = MakeObjectScene(object_options);
 
@@ -637,6 +639,7 @@ class SceneGenerator {
                          {"shadows", options_.shading.shadows},
                          {"interreflection_rays", options_.shading.interreflection_rays}};
     record["light_error_deg"] = options_.light_error_deg;
+    record["photo_light_azimuth_spread_deg"] = options_.photo_light_azimuth_spread_deg;
     record["sensor"] = options_.sensor.ToJson();
     record["capture"] = {{"size", options_.capture_size},
                          {"lights", options_.num_capture_lights},

@@ -31,6 +31,9 @@ struct SceneOptions {
   double camera_distance = 3.5;  ///< world units from the origin
   sfm::CameraModelId camera_model = sfm::CameraModelId::kPinhole;  ///< PINHOLE or OPENCV
   int max_lights_per_image = 3;  ///< each photo has 1..this many directional lights, [1, 3]
+  /// The photos' lights lie within this range of azimuths centred on their camera's,
+  /// degrees, [0, 360] (72: the camera's side; 360: from anywhere around the object).
+  double photo_light_azimuth_spread_deg = 72.0;
   /// Per-photo exposure drawn in [0.8, 1.2] (recorded in scene.json); off: 1 for all.
   bool vary_exposure = true;
   int num_held_out_views = 4;        ///< [0, 100]

@@ -373,10 +373,14 @@ nlohmann::json LightResponseJson(const ptm::LightResponse& response) {
   return {{"elevations_deg", elevations},
           {"factors", response.elevation_factor},
           {"ambient", response.ambient},
+          {"oren_nayar_b_over_a", response.oren_nayar_b_over_a},
           {"meaning",
            "each light's linear value times the factor at its elevation above the texel's "
-           "tangent plane (linear between knots); plus ambient times the linear value under a "
-           "unit light at the zenith"}};
+           "tangent plane (linear between knots) and times 1 + oren_nayar_b_over_a max(0, "
+           "cos(phi_r - phi_i)) sin(alpha) tan(beta) (Oren and Nayar 1994: alpha, beta the "
+           "larger and the smaller of the light's and the view's angles from the normal, beta "
+           "at most 80 degrees; phi their azimuths); plus ambient times the linear value under "
+           "a unit light at the zenith"}};
 }
 
 ptm::LightResponse LightResponseFromJson(const nlohmann::json& record, const std::string& file) {
@@ -397,6 +401,12 @@ ptm::LightResponse LightResponseFromJson(const nlohmann::json& record, const std
     r.elevation_factor[k] = factors[k].get<double>();
   }
   r.ambient = record["ambient"].get<double>();
+  // Models written before the view term have none.
+  if (record.contains("oren_nayar_b_over_a")) {
+    if (!record["oren_nayar_b_over_a"].is_number())
+      throw InputError(file, "light_response: oren_nayar_b_over_a is not a number");
+    r.oren_nayar_b_over_a = record["oren_nayar_b_over_a"].get<double>();
+  }
   try {
     r.Check();
   } catch (const OptionError& e) {

@@ -208,7 +208,8 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
         local.emplace_back(direction, l.intensity * shadow);
       }
       value = synth::RelightMixture(texel.data(), lrgb ? texel.data() + 6 : nullptr, atlas.format,
-                                    local, 1.0, model_.light_response);
+                                    local, 1.0, model_.light_response,
+                                    s.frame.transpose() * s.to_viewer);
     }
     return value;
   });

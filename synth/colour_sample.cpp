@@ -75,7 +75,8 @@ void ColourSample::FeaturesAt(const Eigen::Vector2d& sample_px, float* out) cons
 double ColourSample::LambertFactor(const FaceLighting& lighting) {
   double factor = lighting.response.ambient;
   for (const auto& [l, intensity] : lighting.lights)
-    factor += intensity * std::max(0.0, l.z()) * lighting.response.FactorAt(l.z());
+    factor += intensity * std::max(0.0, l.z()) * lighting.response.FactorAt(l.z()) *
+              lighting.response.ViewFactorAt(l, lighting.view_in_frame);
   return factor;
 }
 

@@ -359,7 +359,8 @@ void PtmSample::TurnFeatures(const Unfolding& u, float* features) const {
 PtmSample::TexelLights PtmSample::LightsOf(const FaceLighting& lighting) const {
   TexelLights out;
   std::vector<int> source;
-  out.lights = ptm::EffectiveLights(lighting.lights, lighting.response, &source);
+  out.lights =
+      ptm::EffectiveLights(lighting.lights, lighting.response, lighting.view_in_frame, &source);
   for (const int k : source)
     if (shadowing_ && k >= 0)
       out.among_sectors.emplace_back(ptm::LightAmongSectors(

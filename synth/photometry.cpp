@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <utility>
 
 #include "synth/triangle_parts.h"
@@ -11,7 +12,8 @@ namespace texlume::synth {
 namespace {
 
 constexpr int kKnots = ptm::LightResponse::kKnots;
-constexpr int kUnknowns = kKnots + 1;  // the knots, then the ambient
+constexpr int kAmbient = kKnots, kOrenNayar = kKnots + 1;
+constexpr int kUnknowns = kKnots + 2;  // the knots, the ambient, Oren and Nayar's B / A
 using Row = Eigen::Matrix<double, 1, kUnknowns>;
 using Vector = Eigen::Matrix<double, kUnknowns, 1>;
 using Matrix = Eigen::Matrix<double, kUnknowns, kUnknowns>;
@@ -22,22 +24,36 @@ constexpr double kHuberScale = 1.5;   // in robust standard deviations of the re
 // other photo saw.
 constexpr std::pair<double, double> kWhiteBalanceRange{0.5, 2.0};
 
-// The observation's prediction as a row: linear in the knots and the ambient.
-Row DesignRow(const PhotometricObservation& o) {
+// The observation's prediction as a row: linear in the knots and the ambient at
+// the Oren-Nayar ratio b (its own column 0).
+Row DesignRow(const PhotometricObservation& o, double b) {
   Row row = Row::Zero();
-  for (const auto& [elevation_deg, relit] : o.lights) {
-    const ptm::KnotWeights w = ptm::KnotWeightsAt(elevation_deg);
+  for (const PhotometricObservation::Light& l : o.lights) {
+    const ptm::KnotWeights w = ptm::KnotWeightsAt(l.elevation_deg);
+    const double relit = l.relit * (1.0 + b * l.oren_nayar);
     row[w.lower] += (1.0 - w.upper_weight) * relit;
     row[w.lower + 1] += w.upper_weight * relit;
   }
-  row[kKnots] = o.zenith_linear;
+  row[kAmbient] = o.zenith_linear;
+  return row;
+}
+
+// DesignRow at the current response r0 with the Oren-Nayar ratio's column as well,
+// linearised about r0 (Gauss-Newton): d prediction / d b = sum_l r0(theta_l) P_l s_l.
+// The target then gains b0 times that column.
+Row LinearisedRow(const PhotometricObservation& o, const ptm::LightResponse& r0) {
+  Row row = DesignRow(o, r0.oren_nayar_b_over_a);
+  for (const PhotometricObservation::Light& l : o.lights)
+    row[kOrenNayar] +=
+        r0.FactorAt(std::sin(l.elevation_deg * std::numbers::pi / 180.0)) * l.relit * l.oren_nayar;
   return row;
 }
 
 Vector ToVector(const ptm::LightResponse& r) {
   Vector x;
   for (int k = 0; k < kKnots; ++k) x[k] = r.elevation_factor[static_cast<std::size_t>(k)];
-  x[kKnots] = r.ambient;
+  x[kAmbient] = r.ambient;
+  x[kOrenNayar] = r.oren_nayar_b_over_a;
   return x;
 }
 
@@ -95,7 +111,9 @@ class ResponseFit {
     single_den_ += weight * lit * lit;
   }
 
-  ptm::LightResponse Solve() const {
+  // With `view_term`, the Oren-Nayar ratio too, damped towards `b0` (the
+  // linearisation's point); without, it stays 0.
+  ptm::LightResponse Solve(bool view_term, double b0) const {
     Matrix a = normal_;
     Vector b = rhs_;
     const double scale = std::max(1e-12, a.diagonal().head<kKnots>().sum() / kKnots);
@@ -107,62 +125,86 @@ class ResponseFit {
       a += smooth * d.transpose() * d;
     }
     for (int k = 0; k < kKnots; ++k) a(k, k) += ridge, b[k] += ridge * single;
-    a(kKnots, kKnots) += ridge;
+    a(kAmbient, kAmbient) += ridge;
+    a(kOrenNayar, kOrenNayar) += ridge, b[kOrenNayar] += ridge * b0;
+    if (!view_term) FixAtZero(kOrenNayar, a, b);
     Vector x = a.ldlt().solve(b);
-    if (!(x[kKnots] >= 0.0)) {  // no negative ambient: solve without it
-      a.row(kKnots).setZero(), a.col(kKnots).setZero(), a(kKnots, kKnots) = 1, b[kKnots] = 0;
-      x = a.ldlt().solve(b);
-    }
+    for (const int unknown : {kAmbient, kOrenNayar})  // neither may be negative
+      if (!(x[unknown] >= 0.0)) {
+        FixAtZero(unknown, a, b);
+        x = a.ldlt().solve(b);
+      }
     ptm::LightResponse r;
     for (int k = 0; k < kKnots; ++k)
       r.elevation_factor[static_cast<std::size_t>(k)] = std::clamp(x[k], 0.25, 4.0);
-    r.ambient = std::clamp(x[kKnots], 0.0, 0.5);
+    r.ambient = std::clamp(x[kAmbient], 0.0, 0.5);
+    r.oren_nayar_b_over_a = std::clamp(x[kOrenNayar], 0.0, 2.0);
     return r;
   }
 
  private:
+  static void FixAtZero(int unknown, Matrix& a, Vector& b) {
+    a.row(unknown).setZero(), a.col(unknown).setZero(), a(unknown, unknown) = 1, b[unknown] = 0;
+  }
+
   Matrix normal_ = Matrix::Zero();
   Vector rhs_ = Vector::Zero();
   double single_num_ = 0.0, single_den_ = 0.0;
 };
 
-ptm::LightResponse ResponseUnder(const std::vector<PhotometricObservation>& observations,
-                                 const std::vector<double>& gains,
-                                 const std::vector<double>& albedo,
-                                 const std::vector<bool>& photo_observed,
-                                 const ptm::LightResponse& current) {
-  // Faces without a steep view and photos without one have no albedo or gain.
-  const auto known = [&](const PhotometricObservation& o) {
-    return albedo[o.face] > 0.0 && photo_observed[o.photo];
-  };
-  // Relative residuals at the current response, and their robust spread.
+// Each observation's weight in the response's least squares, at the current
+// response: relative errors (a floor for the unlit) and Huber weights; 0 for an
+// observation without a known albedo or gain.
+std::vector<double> ResponseWeights(const std::vector<PhotometricObservation>& observations,
+                                    const std::vector<double>& gains,
+                                    const std::vector<double>& albedo,
+                                    const std::vector<bool>& photo_observed,
+                                    const ptm::LightResponse& current) {
   const Vector x = ToVector(current);
   std::vector<double> relative(observations.size(), 0.0), scale(observations.size(), 0.0);
   std::vector<double> magnitudes;
   for (std::size_t i = 0; i < observations.size(); ++i) {
     const PhotometricObservation& o = observations[i];
-    if (!known(o)) continue;
-    const double cells = std::max(1, o.cells);
+    // Faces without a steep view and photos without one have no albedo or gain.
+    if (!(albedo[o.face] > 0.0 && photo_observed[o.photo])) continue;
     const double target = o.photo_linear / (gains[o.photo] * albedo[o.face]);
-    const double model = DesignRow(o).dot(x.transpose());
-    scale[i] = std::max(model, kUnlitFloor * cells);
+    const double model = DesignRow(o, current.oren_nayar_b_over_a).dot(x.transpose());
+    scale[i] = std::max(model, kUnlitFloor * std::max(1, o.cells));
     relative[i] = (target - model) / scale[i];
     magnitudes.push_back(std::abs(relative[i]));
   }
-  if (magnitudes.empty()) return current;
+  std::vector<double> weight(observations.size(), 0.0);
+  if (magnitudes.empty()) return weight;
   std::nth_element(magnitudes.begin(), magnitudes.begin() + magnitudes.size() / 2,
                    magnitudes.end());
   const double sigma = std::max(1e-3, 1.4826 * magnitudes[magnitudes.size() / 2]);
-  ResponseFit fit;
   for (std::size_t i = 0; i < observations.size(); ++i) {
-    const PhotometricObservation& o = observations[i];
-    if (!known(o)) continue;
+    if (!(scale[i] > 0.0)) continue;
     const double huber =
         std::min(1.0, kHuberScale * sigma / std::max(1e-12, std::abs(relative[i])));
-    const double weight = std::min(o.cells, 64) * huber / (scale[i] * scale[i]);
-    fit.Add(DesignRow(o), o.photo_linear / (gains[o.photo] * albedo[o.face]), weight);
+    weight[i] = std::min(observations[i].cells, 64) * huber / (scale[i] * scale[i]);
   }
-  return fit.Solve();
+  return weight;
+}
+
+ptm::LightResponse ResponseUnder(const std::vector<PhotometricObservation>& observations,
+                                 const std::vector<double>& gains,
+                                 const std::vector<double>& albedo,
+                                 const std::vector<bool>& photo_observed,
+                                 const ptm::LightResponse& current, bool estimate_view_term) {
+  const std::vector<double> weight =
+      ResponseWeights(observations, gains, albedo, photo_observed, current);
+  if (std::none_of(weight.begin(), weight.end(), [](double w) { return w > 0.0; })) return current;
+  ResponseFit fit;
+  const double b0 = current.oren_nayar_b_over_a;
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    if (!(weight[i] > 0.0)) continue;
+    const PhotometricObservation& o = observations[i];
+    const Row row = LinearisedRow(o, current);
+    fit.Add(row, o.photo_linear / (gains[o.photo] * albedo[o.face]) + b0 * row[kOrenNayar],
+            weight[i]);
+  }
+  return fit.Solve(estimate_view_term, b0);
 }
 
 }  // namespace
@@ -208,12 +250,12 @@ std::vector<std::array<double, 3>> SolveWhiteBalance(
 }
 
 double PhotometricObservation::Predicted(const ptm::LightResponse& response) const {
-  return DesignRow(*this).dot(ToVector(response).transpose());
+  return DesignRow(*this, response.oren_nayar_b_over_a).dot(ToVector(response).transpose());
 }
 
 Photometry SolvePhotometry(std::vector<PhotometricObservation> observations, std::size_t num_faces,
                            std::size_t num_photos, bool estimate_response,
-                           bool estimate_white_balance) {
+                           bool estimate_white_balance, bool estimate_view_term) {
   Photometry p;
   p.white_balance.assign(num_photos, {1.0, 1.0, 1.0});
   if (estimate_white_balance) {
@@ -231,7 +273,8 @@ Photometry SolvePhotometry(std::vector<PhotometricObservation> observations, std
   for (int round = 0; round < 6; ++round) {
     p.photo_gains =
         GainsUnder(observations, num_faces, num_photos, p.response, albedo, true, &photo_observed);
-    p.response = ResponseUnder(observations, p.photo_gains, albedo, photo_observed, p.response);
+    p.response = ResponseUnder(observations, p.photo_gains, albedo, photo_observed, p.response,
+                               estimate_view_term);
   }
   p.photo_gains = GainsUnder(observations, num_faces, num_photos, p.response, albedo, true);
   return p;

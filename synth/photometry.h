@@ -23,17 +23,24 @@ struct PhotometricObservation {
   /// once the photo's white balance is taken out.
   std::array<double, 3> photo_channels{};
   double photo_linear = 0.0;
-  /// Per light and shading point of the face (TriangleEngine::ShadingTurns: the
-  /// face frame turned onto the smooth normal there, as the renderer shades), when
-  /// the light is above the tangent plane there: its elevation (degrees) and the
-  /// sample's mean relit linear R + G + B under it alone (intensity and horizon fade
-  /// included) over the point's share (a third) of the cells.
-  std::vector<std::pair<double, double>> lights;
+  /// One light at one shading point of the face (TriangleEngine::ShadingTurns: the
+  /// face frame turned onto the smooth normal there, as the renderer shades).
+  struct Light {
+    double elevation_deg = 0.0;
+    /// The sample's mean relit linear R + G + B under it alone (intensity and
+    /// horizon fade included) over the point's share (a third) of the cells.
+    double relit = 0.0;
+    /// ptm::OrenNayarTerm of the light and the photo's view there.
+    double oren_nayar = 0.0;
+  };
+  /// Per light and shading point, when the light is above the tangent plane there.
+  std::vector<Light> lights;
   double zenith_linear = 0.0;  ///< the same under a unit light at the zenith
   /// Every light and the view steep (RectifiedView::steep): the gains trust it.
   bool steep = false;
 
-  /// sum_l r(elevation_l) P_l + ambient Z: the sample's prediction under a response.
+  /// sum_l r(elevation_l) (1 + b s_l) P_l + ambient Z: the sample's prediction under a
+  /// response (b its Oren-Nayar ratio, s_l the light's term).
   double Predicted(const ptm::LightResponse& response) const;
 };
 
@@ -64,9 +71,11 @@ std::vector<char> PhotometryFaces(const std::vector<std::vector<std::uint32_t>>&
                                   std::size_t num_photos, std::size_t limit,
                                   std::size_t min_per_photo);
 
-/// Solves photo_linear = g_n a_f (sum_l r(theta_l) P_l + alpha Z) for the photo
-/// gains g_n, the faces' albedos a_f relative to the sample, the elevation
-/// factors r (ptm::LightResponse's knots) and the ambient alpha, alternating:
+/// Solves photo_linear = g_n a_f (sum_l r(theta_l) (1 + b s_l) P_l + alpha Z) for
+/// the photo gains g_n, the faces' albedos a_f relative to the sample, the elevation
+/// factors r (ptm::LightResponse's knots), the ambient alpha and, with
+/// `estimate_view_term` (a sample that does not hold the view's effect itself), the
+/// Oren-Nayar ratio b = B / A (s_l = ptm::OrenNayarTerm), alternating:
 ///  - g and a from the steep observations under the current response
 ///    (SolvePhotoGains: log ratios, the mean log a at 0), then the gains scaled
 ///    so that their mean log is 0: on average the photos are exposed as the
@@ -75,12 +84,13 @@ std::vector<char> PhotometryFaces(const std::vector<std::vector<std::uint32_t>>&
 ///  - r and alpha from every observation by weighted least squares on
 ///    photo / (g a): relative errors (a floor for the unlit), Huber weights
 ///    against cast shadows and highlights, second differences of r penalised,
-///    and knots without observations drawn to the best single factor.
+///    and knots without observations drawn to the best single factor;
+///  - b, in [0, 2], by the same weighted least squares given r and alpha.
 /// Without `estimate_response`, the gains alone as SolvePhotoGains gives them.
 /// With `estimate_white_balance`, first each photo's white balance
 /// (SolveWhiteBalance), taken out of the photo sums before the rest.
 Photometry SolvePhotometry(std::vector<PhotometricObservation> observations, std::size_t num_faces,
                            std::size_t num_photos, bool estimate_response,
-                           bool estimate_white_balance);
+                           bool estimate_white_balance, bool estimate_view_term = false);
 
 }  // namespace texlume::synth

@@ -506,8 +506,10 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
     }
   }
   if (progress) progress("photometry", num_faces, num_faces);
-  const Photometry photometry = SolvePhotometry(std::move(observations), num_faces, photos_.size(),
-                                                options_.light_response, options_.white_balance);
+  // A sample that holds the view's effect itself (a BTF) takes no Oren-Nayar term.
+  const Photometry photometry =
+      SolvePhotometry(std::move(observations), num_faces, photos_.size(), options_.light_response,
+                      options_.white_balance, !sample_.ViewDependent());
   result_.photo_gains = photometry.photo_gains;
   if (blur) {
     std::vector<std::uint32_t> camera_of_photo;
@@ -556,8 +558,9 @@ PhotometricObservation TriangleEngine::Observe(std::size_t face, const Rectified
     for (const auto& [light, intensity] : rect.lighting.lights) {
       const Eigen::Vector3d l = turn * light;
       if (l.z() > 0.0)
-        o.lights.emplace_back(std::asin(std::min(1.0, l.z())) * 180.0 / std::numbers::pi,
-                              relit_under(view, l, intensity) / kShadingPoints);
+        o.lights.push_back({std::asin(std::min(1.0, l.z())) * 180.0 / std::numbers::pi,
+                            relit_under(view, l, intensity) / kShadingPoints,
+                            ptm::OrenNayarTerm(l, view)});
     }
   }
   o.zenith_linear = zenith_per_cell >= 0.0

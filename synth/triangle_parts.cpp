@@ -19,9 +19,9 @@ using LightList = std::vector<std::pair<Eigen::Vector3d, double>>;  // (tangent-
 
 Eigen::Vector3f RelightMixture(const float* coefficients, const float* colour,
                                ptm::PtmFormat format, const LightList& lights, double gain,
-                               const ptm::LightResponse& response) {
-  return RelightEffective(coefficients, colour, format, ptm::EffectiveLights(lights, response),
-                          gain);
+                               const ptm::LightResponse& response, const Eigen::Vector3d& view) {
+  return RelightEffective(coefficients, colour, format,
+                          ptm::EffectiveLights(lights, response, view), gain);
 }
 
 ReducedPlanes ReduceToDensityLevel(const std::vector<cv::Mat>& planes, int level) {

@@ -212,12 +212,14 @@ void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& can
 /// The display value of a PTM texel under several lights (tangent frame) with
 /// intensities, times a gain: the sum is taken in the linear domain,
 /// srgb(gain * (sum_i w_i lin(clamp(f(l'_i))) + ambient lin(clamp(f(0, 0))))), l'_i
-/// and w_i the lights as the texel answers them (ptm::Effective: horizon fade and
-/// the response's elevation factor), ambient the response's.
+/// and w_i the lights as the texel answers them seen from `view` (ptm::Effective:
+/// horizon fade, the response's elevation factor and view factor), ambient the
+/// response's.
 Eigen::Vector3f RelightMixture(const float* coefficients_or_l, const float* colour,
                                ptm::PtmFormat format,
                                const std::vector<std::pair<Eigen::Vector3d, double>>& lights,
-                               double gain, const ptm::LightResponse& response = {});
+                               double gain, const ptm::LightResponse& response = {},
+                               const Eigen::Vector3d& view = Eigen::Vector3d::UnitZ());
 /// RelightMixture with the lights already as the texel answers them
 /// (ptm::EffectiveLights): for many texels under one lighting. Inline: the
 /// sample's relighting (MaterialSample::Relight) calls it per cell.

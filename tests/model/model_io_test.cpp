@@ -17,11 +17,16 @@ TEST(LightResponseJson, RoundTripsAndRefusesMalformedRecordsNamingTheFile) {
   for (std::size_t k = 0; k < r.elevation_factor.size(); ++k)
     r.elevation_factor[k] = 0.7 + 0.05 * static_cast<double>(k);
   r.ambient = 0.021;
+  r.oren_nayar_b_over_a = 0.13;
   const nlohmann::json record = LightResponseJson(r);
   EXPECT_EQ(record["elevations_deg"][3].get<double>(), 30.0);
   const ptm::LightResponse back = LightResponseFromJson(record, "m/manifest.json");
   EXPECT_EQ(back.elevation_factor, r.elevation_factor);
   EXPECT_EQ(back.ambient, r.ambient);
+  EXPECT_EQ(back.oren_nayar_b_over_a, r.oren_nayar_b_over_a);
+  nlohmann::json older = record;  // written before the view term: none
+  older.erase("oren_nayar_b_over_a");
+  EXPECT_EQ(LightResponseFromJson(older, "m/manifest.json").oren_nayar_b_over_a, 0.0);
 
   nlohmann::json short_factors = record;
   short_factors["factors"].erase(0);
@@ -31,8 +36,11 @@ TEST(LightResponseJson, RoundTripsAndRefusesMalformedRecordsNamingTheFile) {
   moved_knot["elevations_deg"][1] = 12.0;
   nlohmann::json no_ambient = record;
   no_ambient.erase("ambient");
-  for (const nlohmann::json& bad : {short_factors, negative, moved_knot, no_ambient,
-                                    nlohmann::json(), nlohmann::json::array()}) {
+  nlohmann::json view_term_text = record, view_term_large = record;
+  view_term_text["oren_nayar_b_over_a"] = "0.1";
+  view_term_large["oren_nayar_b_over_a"] = 3.0;
+  for (const nlohmann::json& bad : {short_factors, negative, moved_knot, no_ambient, view_term_text,
+                                    view_term_large, nlohmann::json(), nlohmann::json::array()}) {
     try {
       LightResponseFromJson(bad, "m/manifest.json");
       ADD_FAILURE() << "accepted " << bad.dump();

@@ -22,7 +22,8 @@ struct KnownCapture {
   ptm::LightResponse response;
   std::vector<PhotometricObservation> observations;
 
-  explicit KnownCapture(double shadowed_share = 0.0) {
+  // `oren_nayar`: the response's B / A, each light then seen at a term in [0, 1.5).
+  explicit KnownCapture(double shadowed_share = 0.0, double oren_nayar = 0.0) {
     std::mt19937_64 rng(29);
     std::normal_distribution<double> normal(0.0, 1.0);
     std::uniform_real_distribution<double> uniform(0.0, 1.0);
@@ -45,6 +46,7 @@ struct KnownCapture {
     for (std::size_t k = 0; k < ptm::LightResponse::kKnots; ++k)
       response.elevation_factor[k] = 1.15 - 0.04 * static_cast<double>(k);
     response.ambient = 0.03;
+    response.oren_nayar_b_over_a = oren_nayar;
     chroma.assign(kFaces, {});
     for (auto& k : chroma) {
       for (double& v : k) v = 0.3 + 0.05 * uniform(rng);
@@ -62,10 +64,10 @@ struct KnownCapture {
           const double elevation = i == 0 ? 60.0 : 3.0 + 85.0 * uniform(rng);
           const double relit = o.cells * 1.5 * std::sin(elevation * std::numbers::pi / 180.0) *
                                (0.8 + 0.4 * uniform(rng));
-          o.lights.emplace_back(elevation, relit);
+          o.lights.push_back({elevation, relit, oren_nayar > 0.0 ? 1.5 * uniform(rng) : 0.0});
         }
         o.steep = lights > 0;
-        for (const auto& l : o.lights) o.steep = o.steep && l.first > 30.0;
+        for (const auto& l : o.lights) o.steep = o.steep && l.elevation_deg > 30.0;
         o.zenith_linear = o.cells * 1.5;
         double sum = gain[o.photo] * albedo[f] * o.Predicted(response);
         if (i > 0 && uniform(rng) < shadowed_share) sum *= 0.3;  // a cast shadow
@@ -114,6 +116,28 @@ TEST(SolvePhotometry, CastShadowsHardlyMoveTheResponse) {
     EXPECT_NEAR(p.response.elevation_factor[k], capture.response.elevation_factor[k], 0.04)
         << "knot " << k;
   EXPECT_NEAR(p.response.ambient, capture.response.ambient, 0.01);
+}
+
+TEST(SolvePhotometry, RecoversTheViewsOrenNayarRatioWhenAskedAndOnlyThen) {
+  const KnownCapture capture(0.0, 0.3);
+  const Photometry p = SolvePhotometry(capture.observations, KnownCapture::kFaces,
+                                       KnownCapture::kPhotos, true, true, true);
+  EXPECT_NEAR(p.response.oren_nayar_b_over_a, 0.3, 0.01);
+  for (std::size_t k = 1; k < ptm::LightResponse::kKnots; ++k)
+    EXPECT_NEAR(p.response.elevation_factor[k], capture.response.elevation_factor[k], 0.02)
+        << "knot " << k;
+  for (std::size_t n = 0; n < KnownCapture::kPhotos; ++n)
+    EXPECT_NEAR(p.photo_gains[n] / capture.gain[n], 1.0, 0.01) << "photo " << n;
+  // A sample that holds the view's effect itself: no term.
+  const Photometry without = SolvePhotometry(capture.observations, KnownCapture::kFaces,
+                                             KnownCapture::kPhotos, true, true, false);
+  EXPECT_EQ(without.response.oren_nayar_b_over_a, 0.0);
+  // A view-blind object: the term stays near 0.
+  const KnownCapture blind;
+  EXPECT_LT(SolvePhotometry(blind.observations, KnownCapture::kFaces, KnownCapture::kPhotos, true,
+                            true, true)
+                .response.oren_nayar_b_over_a,
+            0.01);
 }
 
 TEST(SolvePhotometry, WithoutResponseTheGainsCarryTheSamplesBrightness) {

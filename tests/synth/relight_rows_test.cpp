@@ -108,7 +108,7 @@ TEST(PtmRowRelighter, IsWhatAPtmSampleRelightsWith) {
     const ReducedPlanes& reduced = sample.Reduced(2);
     const std::vector<cv::Mat> relit = sample.Relight(reduced, lighting, 0.9);
     const std::vector<ptm::EffectiveLight> lights =
-        ptm::EffectiveLights(lighting.lights, lighting.response);
+        ptm::EffectiveLights(lighting.lights, lighting.response, lighting.view_in_frame);
     ASSERT_EQ(lights.size(), 3u);
     ExpectSameAsPerCell(format, reduced.planes, {relit[0], relit[1], relit[2]}, lights, 0.9);
   }

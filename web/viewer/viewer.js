@@ -54,6 +54,7 @@ uniform vec3 flatAlbedo;     // display domain
 uniform float horizonZ;      // sin of the horizon elevation (PTM evaluation)
 uniform float responseFactor[10];  // light response: factor per 10 degrees of elevation
 uniform float ambient;       // light response: ambient times the zenith value (linear)
+uniform float orenNayarBOverA;  // light response: the view's term (Oren and Nayar's B / A)
 uniform sampler2D horizon0, horizon1, horizon2, horizon3;  // the relief's horizon, 16 sectors
 uniform bool hasHorizon;
 uniform float horizonScale;  // radians per unit of a horizon texture's value
@@ -122,6 +123,19 @@ float responseAt(float lz) {
   return mix(lo, hi, f);
 }
 
+// Oren and Nayar's view term max(0, cos(phi_r - phi_i)) sin(alpha) tan(beta) for the
+// light l and the view v in the texel frame, beta at most 80 degrees
+// (ptm::OrenNayarTerm).
+float orenNayarTerm(vec3 l, vec3 v) {
+  if (l.z <= 0.0 || v.z <= 0.0) return 0.0;
+  float ll = length(l.xy), lv = length(v.xy);
+  if (ll < 1e-12 || lv < 1e-12) return 0.0;
+  float cosAzimuth = dot(l.xy, v.xy) / (ll * lv);
+  if (cosAzimuth <= 0.0) return 0.0;
+  float thetaI = acos(min(1.0, l.z)), thetaR = acos(min(1.0, v.z));
+  return cosAzimuth * sin(max(thetaI, thetaR)) * tan(min(min(thetaI, thetaR), radians(80.0)));
+}
+
 // The relief's self-shadowing of the light l (texel frame), as texlume's renderer
 // (ptm::SelfShadowing::LightFactor): the horizon at l's azimuth, linear between
 // the two nearest of 16 sectors, and v + (1 - v) shadowFloor, v rising linearly
@@ -150,11 +164,12 @@ float shadowFactor(vec3 l) {
 
 // As texlume's renderer: lights below the horizon elevation are evaluated at it
 // (same azimuth), fading linearly with l_z to 0 at the horizon; the light
-// response's factor and ambient term apply (ptm::EffectiveLights).
-vec3 relight(vec3 c[6], vec3 colour, vec3 l) {
+// response's factors (elevation, and the view v's) and ambient term apply
+// (ptm::EffectiveLights).
+vec3 relight(vec3 c[6], vec3 colour, vec3 l, vec3 v) {
   vec3 linear = ambient * srgbToLinear(max(evaluate(c, colour, vec2(0.0)), vec3(0.0)));
   if (l.z <= 0.0) return linearToSrgb(linear);
-  float fall = responseAt(l.z) * shadowFactor(l);
+  float fall = responseAt(l.z) * (1.0 + orenNayarBOverA * orenNayarTerm(l, v)) * shadowFactor(l);
   vec3 at = l;
   if (l.z < horizonZ) {
     fall *= l.z / horizonZ;
@@ -203,14 +218,14 @@ void main() {
   t = normalize(t - n * dot(n, t));
   vec3 b = cross(n, t);  // the atlas frame's y (v up)
   vec3 l = vec3(dot(lightWorld, t), dot(lightWorld, b), dot(lightWorld, n));
+  vec3 toEye = normalize(cameraPosition - vWorldPosition);
+  vec3 v = vec3(dot(toEye, t), dot(toEye, b), dot(toEye, n));
   vec3 colour;
   if (mode == 0) {
     vec3 c[6], tint;
     ptmValues(c, tint);  // sampled once per fragment
-    colour = relight(c, tint, l);
+    colour = relight(c, tint, l, v);
     if (specular > 0.0 && l.z > 0.0) {
-      vec3 toEye = normalize(cameraPosition - vWorldPosition);
-      vec3 v = vec3(dot(toEye, t), dot(toEye, b), dot(toEye, n));
       vec3 h = normalize(l + v);
       colour += specular * pow(max(dot(ptmNormal(c), h), 0.0), 40.0);
     }
@@ -311,6 +326,9 @@ async function main() {
     // A scene.json without one (written before it): the identity.
     responseFactor: { value: scene.light_response ? scene.light_response.factors : Array(10).fill(1) },
     ambient: { value: scene.light_response ? scene.light_response.ambient : 0 },
+    orenNayarBOverA: {
+      value: scene.light_response ? scene.light_response.oren_nayar_b_over_a || 0 : 0,
+    },
   };
   const materials = [];
   for (const range of g.ranges) {
