@@ -20,7 +20,7 @@ struct SynthWords {
       engine = "triangle", orientation = "field", fill_unseen = "overlap";
   std::vector<double> tangent_field;
   bool best_view_only = false, no_additive = false, no_channel = false, no_detail = false,
-       no_report = false, no_light_response = false, no_white_balance = false,
+       no_report = false, no_light_response = false, no_view_term = false, no_white_balance = false,
        no_photo_blur = false;
 };
 
@@ -177,6 +177,10 @@ void BindCorrection(CLI::App* sub, pipeline::SynthCommandOptions& o, SynthWords&
   sub->add_flag("--no-detail-transfer", w.no_detail, "keep the quilted patch's own detail");
   sub->add_flag("--no-light-response", w.no_light_response,
                 "no light response from the photos (elevation factors, ambient)");
+  sub->add_flag(
+      "--no-view-term", w.no_view_term,
+      "a light response without Oren and Nayar's view term (elevation factors and ambient "
+      "alone)");
   sub->add_flag("--no-white-balance", w.no_white_balance,
                 "keep each photo's white balance as taken");
   sub->add_flag("--no-photo-blur", w.no_photo_blur,
@@ -242,6 +246,7 @@ void TakePhotos(const CLI::App* sub, const SynthWords& w, const pipeline::SynthC
   e.all_views = !w.best_view_only;
   e.max_views = j.synthesis.max_views;
   e.light_response = !w.no_light_response;
+  e.view_term = !w.no_view_term;
   e.white_balance = !w.no_white_balance;
   e.photo_blur = !w.no_photo_blur;
   e.seed = j.synthesis.seed;
@@ -318,6 +323,7 @@ void Resolve(const CLI::App* sub, const SynthWords& w, const quilt::QuiltOptions
   s.channel_correction = !w.no_channel;
   s.detail_transfer = !w.no_detail;
   s.light_response = !w.no_light_response;
+  s.view_term = !w.no_view_term;
   s.white_balance = !w.no_white_balance;
   s.photo_blur = !w.no_photo_blur;
   if (!w.prior_shrink.empty() && w.prior_shrink != "auto")

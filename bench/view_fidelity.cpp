@@ -32,6 +32,7 @@ namespace {
 struct Row {
   std::string label;
   render::ViewMetrics mean;
+  std::vector<double> linear_luma_bias;  ///< per view
 };
 
 Row MeasureFolder(const std::string& label, const fs::path& dir, const std::vector<fs::path>& views,
@@ -44,7 +45,9 @@ Row MeasureFolder(const std::string& label, const fs::path& dir, const std::vect
     metrics.push_back(
         pipeline::MeasureAgainstTruth(name, rgb, coverage, truth_dir, masks_dir, reduced_factor));
   }
-  return {label, render::MeanViewMetrics(metrics)};
+  std::vector<double> per_view;
+  for (const render::ViewMetrics& m : metrics) per_view.push_back(m.fidelity.linear_luma_bias);
+  return {label, render::MeanViewMetrics(metrics), per_view};
 }
 
 // The truth views' display and linear luma inside their masks, after `change`
@@ -94,6 +97,21 @@ void PrintLumaBiasApart(const std::vector<Row>& rows, const std::vector<fs::path
     std::printf("- the truth blurred by %.1f px: linear %+.2f %%, display %+.2f %%\n", sigma_px,
                 100 * (blurred.linear / truth.linear - 1),
                 100 * (blurred.display / truth.display - 1));
+  }
+}
+
+// Each view's linear luma bias: a response that is wrong for one kind of lighting
+// (a side light, a low one) shows in the views lit so.
+void PrintLinearBiasPerView(const std::vector<Row>& rows, const std::vector<fs::path>& views) {
+  std::printf("\nLinear luma bias per view (%%):\n| view |");
+  for (const Row& row : rows) std::printf(" %s |", row.label.c_str());
+  std::printf("\n|---|");
+  for (std::size_t r = 0; r < rows.size(); ++r) std::printf("---|");
+  std::printf("\n");
+  for (std::size_t v = 0; v < views.size(); ++v) {
+    std::printf("| %s |", views[v].stem().string().c_str());
+    for (const Row& row : rows) std::printf(" %+.1f |", 100 * row.linear_luma_bias[v]);
+    std::printf("\n");
   }
 }
 
@@ -148,6 +166,7 @@ int main(int argc, char** argv) {
       std::printf("\n");
     }
     PrintLumaBiasApart(rows, views, masks_dir);
+    PrintLinearBiasPerView(rows, views);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "view_fidelity: %s\n", e.what());
     return 1;

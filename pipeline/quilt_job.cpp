@@ -75,6 +75,7 @@ nlohmann::json QuiltJobOptions::PhotosJson() const {
           {"min_photo_pixels", photo_engine.min_photo_pixels},
           {"tangent_frame", synth::TangentFrameName(photo_engine.tangent_frame)},
           {"light_response", photo_engine.light_response},
+          {"view_term", photo_engine.view_term},
           {"white_balance", photo_engine.white_balance},
           {"photo_blur", photo_engine.photo_blur},
           {"max_buffer_size", visibility.max_buffer_dimension}};

@@ -668,6 +668,7 @@ class SynthJob {
         {"correction_sigma", so.correction_sigma},
         {"horizon_elevation_deg", ptm::kHorizonElevationDeg},
         {"light_response", so.light_response},
+        {"view_term", so.view_term},
         {"white_balance", so.white_balance},
         {"photo_blur", so.photo_blur},
         {"seed", so.seed},

@@ -509,7 +509,7 @@ void TriangleEngine::EstimatePhotometry(const ProgressCallback& progress) {
   // A sample that holds the view's effect itself (a BTF) takes no Oren-Nayar term.
   const Photometry photometry =
       SolvePhotometry(std::move(observations), num_faces, photos_.size(), options_.light_response,
-                      options_.white_balance, !sample_.ViewDependent());
+                      options_.white_balance, options_.view_term && !sample_.ViewDependent());
   result_.photo_gains = photometry.photo_gains;
   if (blur) {
     std::vector<std::uint32_t> camera_of_photo;

@@ -73,6 +73,9 @@ struct TriangleEngineOptions {
   /// (samples that apply one; synth/photometry.h). Off: the identity, and the
   /// gains with the object's mean albedo the sample's.
   bool light_response = true;
+  /// With the light response, Oren and Nayar's view term too (ptm::OrenNayarTerm;
+  /// never for a sample that holds the view's effect itself, a BTF).
+  bool view_term = true;
   /// Estimate each photo's white balance against the others' and take it out
   /// of the photos before they are compared with the sample (SolveWhiteBalance).
   bool white_balance = true;
