@@ -234,7 +234,7 @@ void TakePhotos(const CLI::App* sub, const SynthWords& w, const pipeline::SynthC
         throw UsageError("--engine graphcut follows photos with --model, --images and --lights");
     for (const char* name :
          {"--top-k", "--best-view-only", "--max-views", "--tangent-frame", "--max-buffer-size",
-          "--no-light-response", "--no-white-balance", "--no-photo-blur"})
+          "--no-light-response", "--no-view-term", "--no-white-balance", "--no-photo-blur"})
       if (sub->count(name) > 0)
         throw UsageError(std::string(name) +
                          " is for --engine graphcut with photos (--model, --images, --lights)");

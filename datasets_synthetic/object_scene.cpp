@@ -169,9 +169,9 @@ ObjectScene MakeObjectScene(const ObjectSceneOptions& options) {
     const int num_lights = 1 + static_cast<int>(uniform(rng) * options.max_lights_per_image);
     std::vector<sfm::ObjectLight> lights;
     for (int k = 0; k < num_lights; ++k) {
-      const double light_azimuth = azimuth + (uniform(rng) - 0.5) *
-                                                 options.light_azimuth_spread_deg *
-                                                 std::numbers::pi / 180.0;
+      // pi / (180 / 72) is pi / 2.5 exactly: the default gives the same bits as before.
+      const double light_azimuth = azimuth + (uniform(rng) - 0.5) * std::numbers::pi /
+                                                 (180.0 / options.light_azimuth_spread_deg);
       const double light_elevation = (25.0 + 40.0 * uniform(rng)) * std::numbers::pi / 180.0;
       sfm::ObjectLight light;
       light.direction_in_world = Eigen::Vector3d(

@@ -133,7 +133,8 @@ HshFitResult FitHshFromFiles(const std::vector<std::filesystem::path>& files,
 
 std::vector<float> RelightHsh(const Hsh& hsh, const Eigen::Vector3d& light) {
   // As texlume evaluates a PTM: below the horizon elevation, the value there fading to 0.
-  const EffectiveLight effective = Effective(light.normalized(), 1.0, LightResponse{});
+  const EffectiveLight effective =
+      Effective(light.normalized(), 1.0, LightResponse{}, Eigen::Vector3d::UnitZ());
   const std::array<double, 9> b = HshBasis(effective.direction);
   std::vector<float> out(hsh.NumTexels() * 3);
   for (std::size_t t = 0; t < hsh.NumTexels(); ++t) {

@@ -72,14 +72,13 @@ KnotWeights KnotWeightsAt(double elevation_deg);
 /// biquadratic (clamped to kHorizonElevationDeg, same azimuth) and the weight
 /// of its linear value (intensity x horizon fade x elevation factor x the view's
 /// factor, `view_in_frame` the unit direction towards the viewer); weight 0 at
-/// or below the horizon. A view along the normal (the default) has factor 1.
+/// or below the horizon. A view along the normal has factor 1.
 struct EffectiveLight {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();
   double weight = 0.0;
 };
 EffectiveLight Effective(const Eigen::Vector3d& light_in_frame, double intensity,
-                         const LightResponse& response,
-                         const Eigen::Vector3d& view_in_frame = Eigen::Vector3d::UnitZ());
+                         const LightResponse& response, const Eigen::Vector3d& view_in_frame);
 
 /// Every light as the texel answers it seen from `view_in_frame` (Effective; those
 /// of weight 0 left out), then the ambient light as a light at the zenith of weight

@@ -17,6 +17,10 @@ constexpr int kUnknowns = kKnots + 2;  // the knots, the ambient, Oren and Nayar
 using Row = Eigen::Matrix<double, 1, kUnknowns>;
 using Vector = Eigen::Matrix<double, kUnknowns, 1>;
 using Matrix = Eigen::Matrix<double, kUnknowns, kUnknowns>;
+// The knots and the ambient alone: a view-blind response is solved and predicted in
+// these, in the same sums as before the view term (the same bits).
+constexpr int kViewBlind = kKnots + 1;
+using ViewBlindRow = Eigen::Matrix<double, 1, kViewBlind>;
 
 constexpr double kUnlitFloor = 0.03;  // linear R + G + B per cell: errors relative to at least this
 constexpr double kHuberScale = 1.5;   // in robust standard deviations of the relative residual
@@ -47,6 +51,13 @@ Row LinearisedRow(const PhotometricObservation& o, const ptm::LightResponse& r0)
     row[kOrenNayar] +=
         r0.FactorAt(std::sin(l.elevation_deg * std::numbers::pi / 180.0)) * l.relit * l.oren_nayar;
   return row;
+}
+
+// A row's prediction under the unknowns x: the knots' and the ambient's part (the
+// Oren-Nayar ratio is in the knots' columns already; its own column is 0 but in
+// LinearisedRow).
+double PredictionOf(const Row& row, const Vector& x) {
+  return ViewBlindRow(row.head<kViewBlind>()).dot(ViewBlindRow(x.head<kViewBlind>().transpose()));
 }
 
 Vector ToVector(const ptm::LightResponse& r) {
@@ -114,26 +125,13 @@ class ResponseFit {
   // With `view_term`, the Oren-Nayar ratio too, damped towards `b0` (the
   // linearisation's point); without, it stays 0.
   ptm::LightResponse Solve(bool view_term, double b0) const {
-    Matrix a = normal_;
-    Vector b = rhs_;
-    const double scale = std::max(1e-12, a.diagonal().head<kKnots>().sum() / kKnots);
     const double single = single_den_ > 0 ? single_num_ / single_den_ : 1.0;
-    const double smooth = 0.05 * scale, ridge = 1e-3 * scale;
-    for (int k = 1; k + 1 < kKnots; ++k) {  // (r_k-1 - 2 r_k + r_k+1)^2
-      Row d = Row::Zero();
-      d[k - 1] = 1, d[k] = -2, d[k + 1] = 1;
-      a += smooth * d.transpose() * d;
-    }
-    for (int k = 0; k < kKnots; ++k) a(k, k) += ridge, b[k] += ridge * single;
-    a(kAmbient, kAmbient) += ridge;
-    a(kOrenNayar, kOrenNayar) += ridge, b[kOrenNayar] += ridge * b0;
-    if (!view_term) FixAtZero(kOrenNayar, a, b);
-    Vector x = a.ldlt().solve(b);
-    for (const int unknown : {kAmbient, kOrenNayar})  // neither may be negative
-      if (!(x[unknown] >= 0.0)) {
-        FixAtZero(unknown, a, b);
-        x = a.ldlt().solve(b);
-      }
+    Vector x = Vector::Zero();
+    if (view_term)
+      x = Regularised<kUnknowns>(normal_, rhs_, single, b0);
+    else
+      x.head<kViewBlind>() = Regularised<kViewBlind>(
+          normal_.topLeftCorner<kViewBlind, kViewBlind>(), rhs_.head<kViewBlind>(), single, 0.0);
     ptm::LightResponse r;
     for (int k = 0; k < kKnots; ++k)
       r.elevation_factor[static_cast<std::size_t>(k)] = std::clamp(x[k], 0.25, 4.0);
@@ -143,8 +141,30 @@ class ResponseFit {
   }
 
  private:
-  static void FixAtZero(int unknown, Matrix& a, Vector& b) {
-    a.row(unknown).setZero(), a.col(unknown).setZero(), a(unknown, unknown) = 1, b[unknown] = 0;
+  // The normal equations of the first N unknowns with the second differences of
+  // the knots penalised, knots drawn to `single`, the Oren-Nayar ratio (N > its
+  // index) to `b0`; the ambient and the ratio fixed at 0 where they come out negative.
+  template <int N>
+  static Eigen::Matrix<double, N, 1> Regularised(Eigen::Matrix<double, N, N> a,
+                                                 Eigen::Matrix<double, N, 1> b, double single,
+                                                 double b0) {
+    const double scale = std::max(1e-12, a.diagonal().template head<kKnots>().sum() / kKnots);
+    const double smooth = 0.05 * scale, ridge = 1e-3 * scale;
+    for (int k = 1; k + 1 < kKnots; ++k) {  // (r_k-1 - 2 r_k + r_k+1)^2
+      Eigen::Matrix<double, 1, N> d = Eigen::Matrix<double, 1, N>::Zero();
+      d[k - 1] = 1, d[k] = -2, d[k + 1] = 1;
+      a += smooth * d.transpose() * d;
+    }
+    for (int k = 0; k < kKnots; ++k) a(k, k) += ridge, b[k] += ridge * single;
+    a(kAmbient, kAmbient) += ridge;
+    if constexpr (N > kOrenNayar) a(kOrenNayar, kOrenNayar) += ridge, b[kOrenNayar] += ridge * b0;
+    Eigen::Matrix<double, N, 1> x = a.ldlt().solve(b);
+    for (int unknown = kAmbient; unknown < N; ++unknown)  // none may be negative
+      if (!(x[unknown] >= 0.0)) {
+        a.row(unknown).setZero(), a.col(unknown).setZero(), a(unknown, unknown) = 1, b[unknown] = 0;
+        x = a.ldlt().solve(b);
+      }
+    return x;
   }
 
   Matrix normal_ = Matrix::Zero();
@@ -168,7 +188,7 @@ std::vector<double> ResponseWeights(const std::vector<PhotometricObservation>& o
     // Faces without a steep view and photos without one have no albedo or gain.
     if (!(albedo[o.face] > 0.0 && photo_observed[o.photo])) continue;
     const double target = o.photo_linear / (gains[o.photo] * albedo[o.face]);
-    const double model = DesignRow(o, current.oren_nayar_b_over_a).dot(x.transpose());
+    const double model = PredictionOf(DesignRow(o, current.oren_nayar_b_over_a), x);
     scale[i] = std::max(model, kUnlitFloor * std::max(1, o.cells));
     relative[i] = (target - model) / scale[i];
     magnitudes.push_back(std::abs(relative[i]));
@@ -250,7 +270,7 @@ std::vector<std::array<double, 3>> SolveWhiteBalance(
 }
 
 double PhotometricObservation::Predicted(const ptm::LightResponse& response) const {
-  return DesignRow(*this, response.oren_nayar_b_over_a).dot(ToVector(response).transpose());
+  return PredictionOf(DesignRow(*this, response.oren_nayar_b_over_a), ToVector(response));
 }
 
 Photometry SolvePhotometry(std::vector<PhotometricObservation> observations, std::size_t num_faces,

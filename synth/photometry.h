@@ -85,7 +85,8 @@ std::vector<char> PhotometryFaces(const std::vector<std::vector<std::uint32_t>>&
 ///    photo / (g a): relative errors (a floor for the unlit), Huber weights
 ///    against cast shadows and highlights, second differences of r penalised,
 ///    and knots without observations drawn to the best single factor;
-///  - b, in [0, 2], by the same weighted least squares given r and alpha.
+///  - b, in [0, 2], jointly with r and alpha, its rows linearised about the
+///    current response (Gauss-Newton).
 /// Without `estimate_response`, the gains alone as SolvePhotoGains gives them.
 /// With `estimate_white_balance`, first each photo's white balance
 /// (SolveWhiteBalance), taken out of the photo sums before the rest.

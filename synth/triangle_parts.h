@@ -218,8 +218,8 @@ void KeepClosestToNeighbours(const std::vector<std::pair<float, cv::Point>>& can
 Eigen::Vector3f RelightMixture(const float* coefficients_or_l, const float* colour,
                                ptm::PtmFormat format,
                                const std::vector<std::pair<Eigen::Vector3d, double>>& lights,
-                               double gain, const ptm::LightResponse& response = {},
-                               const Eigen::Vector3d& view = Eigen::Vector3d::UnitZ());
+                               double gain, const ptm::LightResponse& response,
+                               const Eigen::Vector3d& view);
 /// RelightMixture with the lights already as the texel answers them
 /// (ptm::EffectiveLights): for many texels under one lighting. Inline: the
 /// sample's relighting (MaterialSample::Relight) calls it per cell.

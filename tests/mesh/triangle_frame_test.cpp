@@ -44,7 +44,8 @@ TEST(RelightMixture, LightsBelowTheHorizonElevationFadeToZero) {
   auto at = [&](double elevation_deg) {
     const double e = elevation_deg * std::numbers::pi / 180.0;
     const Eigen::Vector3d l(std::cos(e), 0.0, std::sin(e));
-    return SrgbToLinear(RelightMixture(a, colour, ptm::PtmFormat::kLrgb, {{l, 1.0}}, 1.0)[0]);
+    return SrgbToLinear(RelightMixture(a, colour, ptm::PtmFormat::kLrgb, {{l, 1.0}}, 1.0, {},
+                                       Eigen::Vector3d::UnitZ())[0]);
   };
   const double h = ptm::kHorizonElevationDeg * std::numbers::pi / 180.0;
   // Above the horizon elevation: the polynomial itself.

@@ -102,8 +102,8 @@ PhotographedPlane Photograph(const ptm::Ptm& ptm, double truth_rad,
       const Eigen::Vector3d on_plane = centre - centre.z() / ray.z() * ray;
       float raw[9];
       RawAt(ptm, TruthAt(on_plane, truth_rad), raw);
-      const Eigen::Vector3f rgb =
-          synth::RelightMixture(raw, raw + 6, ptm.format, {{light_in_sample, 1.0}}, 1.0);
+      const Eigen::Vector3f rgb = synth::RelightMixture(
+          raw, raw + 6, ptm.format, {{light_in_sample, 1.0}}, 1.0, {}, Eigen::Vector3d::UnitZ());
       pixels.at<cv::Vec3f>(v, u) = cv::Vec3f(rgb.x(), rgb.y(), rgb.z());
     }
   photo.pixels = PhotoPixels(pixels);
