@@ -3,7 +3,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <utility>
 
 #include "synth/triangle_parts.h"
@@ -28,16 +27,19 @@ constexpr double kHuberScale = 1.5;   // in robust standard deviations of the re
 // other photo saw.
 constexpr std::pair<double, double> kWhiteBalanceRange{0.5, 2.0};
 
+// Adds `value` at `elevation_deg` to a row's knot columns, linear between knots.
+void AddToKnots(double elevation_deg, double value, Row& row) {
+  const ptm::KnotWeights w = ptm::KnotWeightsAt(elevation_deg);
+  row[w.lower] += (1.0 - w.upper_weight) * value;
+  row[w.lower + 1] += w.upper_weight * value;
+}
+
 // The observation's prediction as a row: linear in the knots and the ambient at
 // the Oren-Nayar ratio b (its own column 0).
 Row DesignRow(const PhotometricObservation& o, double b) {
   Row row = Row::Zero();
-  for (const PhotometricObservation::Light& l : o.lights) {
-    const ptm::KnotWeights w = ptm::KnotWeightsAt(l.elevation_deg);
-    const double relit = l.relit * (1.0 + b * l.oren_nayar);
-    row[w.lower] += (1.0 - w.upper_weight) * relit;
-    row[w.lower + 1] += w.upper_weight * relit;
-  }
+  for (const PhotometricObservation::Light& l : o.lights)
+    AddToKnots(l.elevation_deg, l.relit * (1.0 + b * l.oren_nayar), row);
   row[kAmbient] = o.zenith_linear;
   return row;
 }
@@ -46,10 +48,12 @@ Row DesignRow(const PhotometricObservation& o, double b) {
 // linearised about r0 (Gauss-Newton): d prediction / d b = sum_l r0(theta_l) P_l s_l.
 // The target then gains b0 times that column.
 Row LinearisedRow(const PhotometricObservation& o, const ptm::LightResponse& r0) {
-  Row row = DesignRow(o, r0.oren_nayar_b_over_a);
+  Row slope = Row::Zero();  // sum_l P_l s_l spread over the knots
   for (const PhotometricObservation::Light& l : o.lights)
-    row[kOrenNayar] +=
-        r0.FactorAt(std::sin(l.elevation_deg * std::numbers::pi / 180.0)) * l.relit * l.oren_nayar;
+    AddToKnots(l.elevation_deg, l.relit * l.oren_nayar, slope);
+  Row row = DesignRow(o, r0.oren_nayar_b_over_a);
+  for (int k = 0; k < kKnots; ++k)
+    row[kOrenNayar] += slope[k] * r0.elevation_factor[static_cast<std::size_t>(k)];
   return row;
 }
 
