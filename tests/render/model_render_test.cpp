@@ -1,0 +1,97 @@
+#include "render/model_render.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "core/srgb.h"
+#include "ptm/light_response.h"
+
+namespace texlume::render {
+namespace {
+
+// A square in the plane z = 0, facing +z, textured with one PTM atlas whose
+// luminance is the same under every light: what the render shows then is the
+// light response alone.
+model::TexturedModel FlatSquare() {
+  model::TexturedModel m;
+  m.mesh.vertices = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  m.mesh.faces = {{0, 1, 2}, {0, 2, 3}};
+  m.corner_px = {{Eigen::Vector2f(1, 31), Eigen::Vector2f(31, 31), Eigen::Vector2f(31, 1)},
+                 {Eigen::Vector2f(1, 31), Eigen::Vector2f(31, 1), Eigen::Vector2f(1, 1)}};
+  m.face_atlas = {0, 0};
+  ptm::Ptm atlas;
+  atlas.Resize(ptm::PtmFormat::kLrgb, 32, 32);
+  for (std::size_t t = 0; t < atlas.NumTexels(); ++t) {
+    const float a[6] = {0, 0, 0, 0, 0, 0.6f};  // L = 0.6 under any light
+    std::memcpy(atlas.Coefficients(t), a, sizeof a);
+    for (int c = 0; c < 3; ++c) atlas.colour[t * 3 + static_cast<std::size_t>(c)] = 1.0f;
+  }
+  m.atlases = {atlas};
+  return m;
+}
+
+// A 64 x 64 pinhole camera at (0, -2, 2) looking at the origin, 45 degrees from
+// the square's normal.
+struct ObliqueCamera {
+  sfm::Camera camera;
+  sfm::Rigid3d cam_from_world;
+  Eigen::Vector3d centre{0, -2, 2};
+
+  ObliqueCamera() {
+    camera.model = sfm::CameraModelId::kPinhole;
+    camera.width = camera.height = 64;
+    camera.params = {64, 64, 32, 32};
+    Eigen::Matrix3d world_to_cam;
+    const Eigen::Vector3d z = -centre.normalized(), x = Eigen::Vector3d::UnitX();
+    world_to_cam.row(0) = x.transpose();
+    world_to_cam.row(1) = z.cross(x).transpose();
+    world_to_cam.row(2) = z.transpose();
+    cam_from_world.rotation = Eigen::Quaterniond(world_to_cam);
+    cam_from_world.translation = -(world_to_cam * centre);
+  }
+
+  // The unit direction from the square's point seen at pixel (x, y) to the camera.
+  Eigen::Vector3d ToViewerAt(int x, int y) const {
+    const Eigen::Vector3d ray = cam_from_world.rotation.inverse() *
+                                camera.CamRayFromImage(Eigen::Vector2d(x + 0.5, y + 0.5));
+    const Eigen::Vector3d point = centre + (-centre.z() / ray.z()) * ray;
+    return (centre - point).normalized();
+  }
+};
+
+double LinearGreenAt(const RenderedView& view, int x, int y) {
+  return srgb::ToLinear(view.rgb.at<cv::Vec3f>(y, x)[1]);
+}
+
+TEST(ModelRenderer, ShadesEachPixelWithTheViewTermOfItsOwnView) {
+  const ObliqueCamera cam;
+  model::TexturedModel flat_response = FlatSquare(), with_term = FlatSquare();
+  with_term.light_response.oren_nayar_b_over_a = 0.5;
+  const ModelRenderer plain(flat_response), viewed(with_term);
+  // A light on the camera's side of the normal, then one across it.
+  for (const Eigen::Vector3d& light :
+       {Eigen::Vector3d(0, -0.5, std::sqrt(0.75)), Eigen::Vector3d(0.5, 0, std::sqrt(0.75))}) {
+    sfm::ObjectLight l;
+    l.direction_in_world = light;
+    const RenderedView a = plain.Render(cam.camera, cam.cam_from_world, {l}, RenderMode::kPtm, 1);
+    const RenderedView b = viewed.Render(cam.camera, cam.cam_from_world, {l}, RenderMode::kPtm, 1);
+    for (const auto& [x, y] : {std::pair{32, 32}, std::pair{20, 40}, std::pair{44, 24}}) {
+      // The square's frame has z along its normal, world z: the term is the same in
+      // any frame turned about it.
+      const double expected = 1.0 + 0.5 * ptm::OrenNayarTerm(light, cam.ToViewerAt(x, y));
+      ASSERT_GT(LinearGreenAt(a, x, y), 0.05);
+      EXPECT_NEAR(LinearGreenAt(b, x, y) / LinearGreenAt(a, x, y), expected, 2e-3)
+          << "light " << light.transpose() << " pixel " << x << ", " << y;
+    }
+  }
+  // The light on the camera's side brightens by a known amount at the centre
+  // (alpha 45, beta 30 degrees: 1 + 0.5 sin 45 tan 30 = 1.204); across, not at all.
+  EXPECT_NEAR(1.0 + 0.5 * ptm::OrenNayarTerm(Eigen::Vector3d(0, -0.5, std::sqrt(0.75)),
+                                             cam.ToViewerAt(32, 32)),
+              1.204, 0.01);
+}
+
+}  // namespace
+}  // namespace texlume::render
