@@ -13,13 +13,17 @@
 // an image of every view's name. Per bin it prints the pixels, the truth's mean
 // linear luma and each row's (sum over the bin / the truth's sum - 1) in %.
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/errors.h"
@@ -96,8 +100,14 @@ class GeometryBins {
     if (truth.cols != static_cast<int>(camera.width) ||
         truth.rows != static_cast<int>(camera.height))
       throw InputError((truth_dir / image.name).string(), "its size is not its camera's");
+    if (mask.size() != truth.size())
+      throw InputError((masks_dir / image.name).string(), "its size is not its view's");
     std::vector<cv::Mat> rendered;
-    for (const auto& [label, dir] : rows_) rendered.push_back(ReadPhotoRgb(dir / image.name));
+    for (const auto& [label, dir] : rows_) {
+      rendered.push_back(ReadPhotoRgb(dir / image.name));
+      if (rendered.back().size() != truth.size())
+        throw InputError((dir / image.name).string(), "its size is not the truth's");
+    }
     const Eigen::Vector3d centre = image.ProjectionCenter();
     const Eigen::Matrix3d world_from_cam =
         image.cam_from_world.rotation.inverse().toRotationMatrix();
@@ -132,7 +142,7 @@ class GeometryBins {
     for (std::size_t r = 0; r < rows_.size(); ++r) std::printf("---|");
     std::printf("\n");
     for (const auto& [key, bin] : bins_) {
-      if (bin.pixels < kMinPixels) continue;
+      if (bin.pixels < kMinPixels || !(bin.truth > 0.0)) continue;
       const auto [a, e, v] = key;
       std::printf("| %s | %.0f-%.0f | %.0f-%.0f | %zu | %.4f |", kAzimuthNames[a],
                   kElevationEdgesDeg[e], std::floor(kElevationEdgesDeg[e + 1]), kViewEdgesDeg[v],
@@ -174,6 +184,7 @@ int Run(int argc, char** argv) {
     bins.AddView(model.cameras.at(image.camera_id), image, light->second.front(), argv[4], argv[5]);
     ++views;
   }
+  if (views == 0) throw InputError(argv[3], "no view of the model has exactly one light here");
   std::printf("%d views with one light each\n\n", views);
   bins.Print();
   return 0;

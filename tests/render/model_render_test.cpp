@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstring>
 
@@ -11,12 +12,20 @@
 namespace texlume::render {
 namespace {
 
-// A square in the plane z = 0, facing +z, textured with one PTM atlas whose
-// luminance is the same under every light: what the render shows then is the
-// light response alone.
+// The square's frame in the world: tilted, so that a renderer that shaded with
+// world directions instead of the face frame's would not pass.
+const Eigen::Matrix3d kWorldFromSquare = (Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitX()) *
+                                          Eigen::AngleAxisd(-0.3, Eigen::Vector3d::UnitY()))
+                                             .toRotationMatrix();
+
+// A square in its frame's plane z = 0, facing +z, textured with one PTM atlas
+// whose luminance is the same under every light: what the render shows then is
+// the light response alone.
 model::TexturedModel FlatSquare() {
   model::TexturedModel m;
-  m.mesh.vertices = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  for (const Eigen::Vector3d& corner : {Eigen::Vector3d(-1, -1, 0), Eigen::Vector3d(1, -1, 0),
+                                        Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(-1, 1, 0)})
+    m.mesh.vertices.push_back(kWorldFromSquare * corner);
   m.mesh.faces = {{0, 1, 2}, {0, 2, 3}};
   m.corner_px = {{Eigen::Vector2f(1, 31), Eigen::Vector2f(31, 31), Eigen::Vector2f(31, 1)},
                  {Eigen::Vector2f(1, 31), Eigen::Vector2f(31, 1), Eigen::Vector2f(1, 1)}};
@@ -32,32 +41,36 @@ model::TexturedModel FlatSquare() {
   return m;
 }
 
-// A 64 x 64 pinhole camera at (0, -2, 2) looking at the origin, 45 degrees from
-// the square's normal.
+// A 64 x 64 pinhole camera at (0, -2, 2) in the square's frame, looking at its
+// centre, 45 degrees from its normal.
 struct ObliqueCamera {
   sfm::Camera camera;
   sfm::Rigid3d cam_from_world;
-  Eigen::Vector3d centre{0, -2, 2};
+  Eigen::Vector3d centre_in_square{0, -2, 2};
 
   ObliqueCamera() {
     camera.model = sfm::CameraModelId::kPinhole;
     camera.width = camera.height = 64;
     camera.params = {64, 64, 32, 32};
-    Eigen::Matrix3d world_to_cam;
-    const Eigen::Vector3d z = -centre.normalized(), x = Eigen::Vector3d::UnitX();
-    world_to_cam.row(0) = x.transpose();
-    world_to_cam.row(1) = z.cross(x).transpose();
-    world_to_cam.row(2) = z.transpose();
-    cam_from_world.rotation = Eigen::Quaterniond(world_to_cam);
-    cam_from_world.translation = -(world_to_cam * centre);
+    Eigen::Matrix3d cam_from_square;
+    const Eigen::Vector3d z = -centre_in_square.normalized(), x = Eigen::Vector3d::UnitX();
+    cam_from_square.row(0) = x.transpose();
+    cam_from_square.row(1) = z.cross(x).transpose();
+    cam_from_square.row(2) = z.transpose();
+    const Eigen::Matrix3d rotation = cam_from_square * kWorldFromSquare.transpose();
+    cam_from_world.rotation = Eigen::Quaterniond(rotation);
+    cam_from_world.translation = -(rotation * (kWorldFromSquare * centre_in_square));
   }
 
-  // The unit direction from the square's point seen at pixel (x, y) to the camera.
-  Eigen::Vector3d ToViewerAt(int x, int y) const {
-    const Eigen::Vector3d ray = cam_from_world.rotation.inverse() *
-                                camera.CamRayFromImage(Eigen::Vector2d(x + 0.5, y + 0.5));
-    const Eigen::Vector3d point = centre + (-centre.z() / ray.z()) * ray;
-    return (centre - point).normalized();
+  // The unit direction, in the square's frame, from the square's point seen at
+  // pixel (x, y) to the camera.
+  Eigen::Vector3d ToViewerInSquareAt(int x, int y) const {
+    const Eigen::Vector3d ray_in_square =
+        kWorldFromSquare.transpose() * (cam_from_world.rotation.inverse() *
+                                        camera.CamRayFromImage(Eigen::Vector2d(x + 0.5, y + 0.5)));
+    const Eigen::Vector3d point =
+        centre_in_square + (-centre_in_square.z() / ray_in_square.z()) * ray_in_square;
+    return (centre_in_square - point).normalized();
   }
 };
 
@@ -70,26 +83,27 @@ TEST(ModelRenderer, ShadesEachPixelWithTheViewTermOfItsOwnView) {
   model::TexturedModel flat_response = FlatSquare(), with_term = FlatSquare();
   with_term.light_response.oren_nayar_b_over_a = 0.5;
   const ModelRenderer plain(flat_response), viewed(with_term);
-  // A light on the camera's side of the normal, then one across it.
-  for (const Eigen::Vector3d& light :
+  // A light on the camera's side of the normal, then one across it (square's frame).
+  for (const Eigen::Vector3d& light_in_square :
        {Eigen::Vector3d(0, -0.5, std::sqrt(0.75)), Eigen::Vector3d(0.5, 0, std::sqrt(0.75))}) {
     sfm::ObjectLight l;
-    l.direction_in_world = light;
+    l.direction_in_world = kWorldFromSquare * light_in_square;
     const RenderedView a = plain.Render(cam.camera, cam.cam_from_world, {l}, RenderMode::kPtm, 1);
     const RenderedView b = viewed.Render(cam.camera, cam.cam_from_world, {l}, RenderMode::kPtm, 1);
     for (const auto& [x, y] : {std::pair{32, 32}, std::pair{20, 40}, std::pair{44, 24}}) {
-      // The square's frame has z along its normal, world z: the term is the same in
-      // any frame turned about it.
-      const double expected = 1.0 + 0.5 * ptm::OrenNayarTerm(light, cam.ToViewerAt(x, y));
+      // The face frame has z along the square's normal: the term is the same in any
+      // frame turned about it, the square's too.
+      const double expected =
+          1.0 + 0.5 * ptm::OrenNayarTerm(light_in_square, cam.ToViewerInSquareAt(x, y));
       ASSERT_GT(LinearGreenAt(a, x, y), 0.05);
       EXPECT_NEAR(LinearGreenAt(b, x, y) / LinearGreenAt(a, x, y), expected, 2e-3)
-          << "light " << light.transpose() << " pixel " << x << ", " << y;
+          << "light " << light_in_square.transpose() << " pixel " << x << ", " << y;
     }
   }
   // The light on the camera's side brightens by a known amount at the centre
   // (alpha 45, beta 30 degrees: 1 + 0.5 sin 45 tan 30 = 1.204); across, not at all.
   EXPECT_NEAR(1.0 + 0.5 * ptm::OrenNayarTerm(Eigen::Vector3d(0, -0.5, std::sqrt(0.75)),
-                                             cam.ToViewerAt(32, 32)),
+                                             cam.ToViewerInSquareAt(32, 32)),
               1.204, 0.01);
 }
 
