@@ -81,16 +81,10 @@ struct Bin {
 class GeometryBins {
  public:
   GeometryBins(const fs::path& mesh_file, std::vector<std::pair<std::string, fs::path>> rows)
-      : mesh_(mesh::LoadMesh(mesh_file).mesh), rows_(std::move(rows)) {
-    vertex_normals_ = mesh::VertexNormals(mesh_);
-    std::vector<Eigen::Vector3f> positions;
-    for (const Eigen::Vector3d& v : mesh_.vertices) positions.push_back(v.cast<float>());
-    std::vector<std::array<std::uint32_t, 3>> triangles;
-    for (const auto& f : mesh_.faces)
-      triangles.push_back({static_cast<std::uint32_t>(f[0]), static_cast<std::uint32_t>(f[1]),
-                           static_cast<std::uint32_t>(f[2])});
-    caster_ = std::make_unique<mesh::RayCaster>(positions, triangles);
-  }
+      : mesh_(mesh::LoadMesh(mesh_file).mesh),
+        vertex_normals_(mesh::VertexNormals(mesh_)),
+        caster_(mesh::RayCasterOf(mesh_)),
+        rows_(std::move(rows)) {}
 
   // Adds one view's masked pixels.
   void AddView(const sfm::Camera& camera, const sfm::Image& image, const sfm::ObjectLight& light,

@@ -89,4 +89,16 @@ bool RayCaster::Occluded(const Eigen::Vector3d& origin, const Eigen::Vector3d& d
   return ray.tfar < 0.0f;
 }
 
+std::unique_ptr<RayCaster> RayCasterOf(const TriangleMesh& mesh) {
+  std::vector<Eigen::Vector3f> positions;
+  positions.reserve(mesh.vertices.size());
+  for (const Eigen::Vector3d& v : mesh.vertices) positions.push_back(v.cast<float>());
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  triangles.reserve(mesh.faces.size());
+  for (const auto& f : mesh.faces)
+    triangles.push_back({static_cast<std::uint32_t>(f[0]), static_cast<std::uint32_t>(f[1]),
+                         static_cast<std::uint32_t>(f[2])});
+  return std::make_unique<RayCaster>(positions, triangles);
+}
+
 }  // namespace texlume::mesh

@@ -7,6 +7,8 @@
 #include <optional>
 #include <vector>
 
+#include "mesh/mesh.h"
+
 namespace texlume::mesh {
 
 /// Nearest-hit and shadow rays against a triangle mesh (Embree 3), thread safe
@@ -37,5 +39,9 @@ class RayCaster {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// A RayCaster over a mesh's faces (its vertices as floats): the model renderer's
+/// and the benches' surface.
+std::unique_ptr<RayCaster> RayCasterOf(const TriangleMesh& mesh);
 
 }  // namespace texlume::mesh

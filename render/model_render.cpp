@@ -91,13 +91,7 @@ ModelRenderer::ModelRenderer(const model::TexturedModel& model) : model_(model),
   face_frames_.resize(mesh.faces.size());
   for (std::size_t f = 0; f < mesh.faces.size(); ++f)
     face_frames_[f] = model::AtlasFaceFrame(model, f);
-  std::vector<Eigen::Vector3f> positions;
-  for (const Eigen::Vector3d& v : mesh.vertices) positions.push_back(v.cast<float>());
-  std::vector<std::array<std::uint32_t, 3>> triangles;
-  for (const auto& f : mesh.faces)
-    triangles.push_back({static_cast<std::uint32_t>(f[0]), static_cast<std::uint32_t>(f[1]),
-                         static_cast<std::uint32_t>(f[2])});
-  impl_->caster = std::make_unique<mesh::RayCaster>(positions, triangles);
+  impl_->caster = mesh::RayCasterOf(mesh);
 }
 
 ModelRenderer::~ModelRenderer() = default;
