@@ -11,6 +11,7 @@
 #include <numeric>
 
 #include "core/check.h"
+#include "core/cubic_interpolation.h"
 #include "core/errors.h"
 #include "core/file_util.h"
 #include "core/image_io.h"
@@ -447,17 +448,10 @@ BtfFactorisation ReadBtfFactorisation(const fs::path& dir) {
 }
 
 void SampleGeometry(const BtfFactorisation& s, const Eigen::Vector2d& sample_px, float* out) {
-  const double u = std::clamp(sample_px.x() - 0.5, 0.0, s.width - 1.0);
-  const double v = std::clamp(sample_px.y() - 0.5, 0.0, s.height - 1.0);
-  const int x0 = std::min(static_cast<int>(u), std::max(0, s.width - 2));
-  const int y0 = std::min(static_cast<int>(v), std::max(0, s.height - 2));
-  const int x1 = std::min(x0 + 1, s.width - 1), y1 = std::min(y0 + 1, s.height - 1);
-  const float fx = static_cast<float>(u - x0), fy = static_cast<float>(v - y0);
   const Eigen::Index w = s.width;
-  const auto r00 = s.geometry.row(y0 * w + x0), r01 = s.geometry.row(y0 * w + x1);
-  const auto r10 = s.geometry.row(y1 * w + x0), r11 = s.geometry.row(y1 * w + x1);
-  for (int i = 0; i < s.Components(); ++i)
-    out[i] = (1 - fy) * ((1 - fx) * r00[i] + fx * r01[i]) + fy * ((1 - fx) * r10[i] + fx * r11[i]);
+  CatmullRomTaps(s.width, s.height, sample_px.x() - 0.5, sample_px.y() - 0.5)
+      .Read(
+          s.Components(), [&](int x, int y, int i) { return s.geometry(y * w + x, i); }, out);
 }
 
 }  // namespace texlume::btf

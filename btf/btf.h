@@ -128,7 +128,8 @@ void WriteBtfFactorisation(const BtfFactorisation& factorisation,
 BtfFactorisation ReadBtfFactorisation(const std::filesystem::path& dir);
 
 /// The geometry-map vector (n values) of the sample at a continuous texel
-/// position (x right, y down, centres at +0.5), bilinear, clamped to the sample.
+/// position (x right, y down, centres at +0.5), Catmull-Rom (CatmullRomTaps),
+/// clamped to the sample.
 void SampleGeometry(const BtfFactorisation& sample, const Eigen::Vector2d& sample_px, float* out);
 
 }  // namespace texlume::btf

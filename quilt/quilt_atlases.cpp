@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/cubic_interpolation.h"
 #include "ptm/coefficient_space.h"
 #include "synth/planar_synthesis.h"
 
@@ -45,9 +46,8 @@ int NearestSample(const DenseSurface& surface, const QuiltResult& quilt,
 
 void SampleValuesTurned(const std::vector<cv::Mat>& values, int polynomials,
                         const Eigen::Vector2d& sample_px, double turn_rad, float* out) {
-  for (std::size_t k = 0; k < values.size(); ++k)
-    out[k] = static_cast<float>(
-        synth::BilinearClamped(values[k], sample_px.x() - 0.5, sample_px.y() - 0.5));
+  const CatmullRomTaps taps(values[0].size(), sample_px.x() - 0.5, sample_px.y() - 0.5);
+  for (std::size_t k = 0; k < values.size(); ++k) out[k] = static_cast<float>(taps.Of(values[k]));
   const Eigen::Matrix<double, 6, 6> turn = ptm::OrthonormalFrameRotation(turn_rad);
   for (int poly = 0; poly < polynomials; ++poly) {
     Eigen::Map<Eigen::Matrix<float, 6, 1>> c(out + poly * 6);

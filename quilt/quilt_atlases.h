@@ -35,9 +35,9 @@ class QuiltedSurfaceLookup {
 };
 
 /// A PTM sample's values (orthonormal coefficients, then LRGB colour: `values`,
-/// PtmSample::Values) at a sample position (texels, centres at +0.5), bilinear
-/// and clamped, with the coefficients of each of `polynomials` polynomials
-/// taken into a frame turned by `turn_rad` (ptm::OrthonormalFrameRotation).
+/// PtmSample::Values) at a sample position (texels, centres at +0.5), Catmull-Rom
+/// and clamped (core/cubic_interpolation.h), with the coefficients of each of `polynomials`
+/// polynomials taken into a frame turned by `turn_rad` (ptm::OrthonormalFrameRotation).
 void SampleValuesTurned(const std::vector<cv::Mat>& values, int polynomials,
                         const Eigen::Vector2d& sample_px, double turn_rad, float* out);
 

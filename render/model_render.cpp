@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "core/check.h"
+#include "core/cubic_interpolation.h"
 #include "core/errors.h"
 #include "mesh/ray_caster.h"
 #include "synth/face_order.h"
@@ -181,16 +182,18 @@ RenderedView ModelRenderer::Render(const sfm::Camera& camera, const sfm::Rigid3d
       const ptm::Ptm& atlas = model_.atlases[static_cast<std::size_t>(s.atlas)];
       const int coefficient_count = atlas.NumPolynomials() * 6;
       const bool lrgb = atlas.format == ptm::PtmFormat::kLrgb;
-      Bilinear(
-          atlas.width, atlas.height, s.atlas_px.x(), s.atlas_px.y(),
-          coefficient_count + (lrgb ? 3 : 0),
-          [&](int xx, int yy, int ch) {
-            const std::size_t t = static_cast<std::size_t>(yy) * atlas.width + xx;
-            return ch < coefficient_count
-                       ? atlas.Coefficients(t)[ch]
-                       : atlas.colour[t * 3 + static_cast<std::size_t>(ch - coefficient_count)];
-          },
-          texel.data());
+      // Catmull-Rom, as the viewer reads the planes: bilinear reads flatten the
+      // finest detail the atlas holds (issue 29).
+      CatmullRomTaps(atlas.width, atlas.height, s.atlas_px.x() - 0.5, s.atlas_px.y() - 0.5)
+          .Read(
+              coefficient_count + (lrgb ? 3 : 0),
+              [&](int xx, int yy, int ch) {
+                const std::size_t t = static_cast<std::size_t>(yy) * atlas.width + xx;
+                return ch < coefficient_count
+                           ? atlas.Coefficients(t)[ch]
+                           : atlas.colour[t * 3 + static_cast<std::size_t>(ch - coefficient_count)];
+              },
+              texel.data());
       std::vector<std::pair<Eigen::Vector3d, double>> local;  // lights in the face frame
       for (const sfm::ObjectLight& l : lights) {
         const Eigen::Vector3d direction = s.frame.transpose() * l.DirectionFrom(s.point);

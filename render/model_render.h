@@ -34,8 +34,9 @@ const char* RenderModeName(RenderMode mode);
 
 /// Ray-casts a textured model (Embree) through COLMAP cameras, distortion
 /// included: perspective-correct by construction (barycentrics of the hit),
-/// nearest surface only, bilinear texture lookups, `samples_per_axis`^2 rays
-/// per pixel.
+/// nearest surface only, `samples_per_axis`^2 rays per pixel. PTM atlases are read
+/// Catmull-Rom (core/cubic_interpolation.h, as the viewer reads them); horizon maps
+/// and baked textures bilinearly.
 class ModelRenderer {
  public:
   explicit ModelRenderer(const model::TexturedModel& model);

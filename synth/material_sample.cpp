@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/check.h"
+#include "core/cubic_interpolation.h"
 #include "core/image_io.h"
 #include "core/srgb.h"
 #include "ptm/coefficient_space.h"
@@ -122,7 +123,7 @@ void TransferredDetail(const TrianglePatch& patch, const cv::Mat& band, const Gr
       std::pair{cv::Point(g.gx1, g.gy0), g.gfx * (1 - g.gfy)},
       std::pair{cv::Point(g.gx0, g.gy1), (1 - g.gfx) * g.gfy},
       std::pair{cv::Point(g.gx1, g.gy1), g.gfx * g.gfy}};
-  BilinearTaps(band.size(), patch.sample_x + uc, patch.sample_y + vc)
+  CatmullRomTaps(band.size(), patch.sample_x + uc, patch.sample_y + vc)
       .AddScaledChannels(band, -1.0, out);
   // The band read at each cell's match, blended so that it keeps its contrast
   // (after Heitz and Neyret 2018's variance-preserving blend; the bands are
@@ -156,38 +157,16 @@ void TransferredDetail(const TrianglePatch& patch, const cv::Mat& band, const Gr
   if (n == 0 || !(variance > 0.0)) return;
   const double norm = 1.0 / std::sqrt(variance);
   for (std::size_t k = 0; k < n; ++k)
-    BilinearTaps(band.size(), sources[k].first.x(), sources[k].first.y())
+    CatmullRomTaps(band.size(), sources[k].first.x(), sources[k].first.y())
         .AddScaledChannels(band, sources[k].second * norm, out);
-}
-
-// Catmull-Rom weights of the 4 taps around t in [0, 1).
-void CatmullRomWeights(double t, double w[4]) {
-  const double t2 = t * t, t3 = t2 * t;
-  w[0] = -0.5 * t3 + t2 - 0.5 * t;
-  w[1] = 1.5 * t3 - 2.5 * t2 + 1.0;
-  w[2] = -1.5 * t3 + 2.0 * t2 + 0.5 * t;
-  w[3] = 0.5 * t3 - 0.5 * t2;
 }
 
 // The additive change of the 6 luminance coefficients: Catmull-Rom (bicubic)
 // over the 4 x 4 nearest cells, which keeps the photo's detail sharper than
 // bilinear.
 void AddCorrection(const TrianglePatch& patch, const GridPoint& g, float* out) {
-  const int bx = static_cast<int>(std::floor(g.gu)), by = static_cast<int>(std::floor(g.gv));
-  double wx[4], wy[4];
-  CatmullRomWeights(g.gu - bx, wx);
-  CatmullRomWeights(g.gv - by, wy);
-  for (int i = 0; i < 6; ++i) {
-    const cv::Mat& m = patch.correction[static_cast<std::size_t>(i)];
-    double acc = 0.0;
-    for (int a = 0; a < 4; ++a) {
-      const float* row = m.ptr<float>(std::clamp(by - 1 + a, 0, m.rows - 1));
-      double r = 0.0;
-      for (int b = 0; b < 4; ++b) r += wx[b] * row[std::clamp(bx - 1 + b, 0, m.cols - 1)];
-      acc += wy[a] * r;
-    }
-    out[i] += static_cast<float>(acc);
-  }
+  const CatmullRomTaps taps(patch.correction[0].size(), g.gu, g.gv);
+  for (std::size_t i = 0; i < 6; ++i) out[i] += static_cast<float>(taps.Of(patch.correction[i]));
 }
 
 // Any sample's windows relit by its Relight, then copied into place.
@@ -286,18 +265,10 @@ bool SamplePtmPatch(const std::vector<cv::Mat>& values, ptm::PtmFormat format,
   if (u < -0.5 || v < -0.5 || u > patch.width - 0.5 || v > patch.height - 0.5) return false;
   const double uc = std::clamp(u, 0.0, patch.width - 1.0),
                vc = std::clamp(v, 0.0, patch.height - 1.0);
-  const int x0 = std::min(static_cast<int>(uc), patch.width - 2 < 0 ? 0 : patch.width - 2);
-  const int y0 = std::min(static_cast<int>(vc), patch.height - 2 < 0 ? 0 : patch.height - 2);
-  const int x1 = std::min(x0 + 1, patch.width - 1), y1 = std::min(y0 + 1, patch.height - 1);
-  const float fx = static_cast<float>(uc - x0), fy = static_cast<float>(vc - y0);
-  for (std::size_t c = 0; c < values.size(); ++c) {
-    const cv::Mat& m = values[c];
-    const float a = m.at<float>(patch.sample_y + y0, patch.sample_x + x0);
-    const float b = m.at<float>(patch.sample_y + y0, patch.sample_x + x1);
-    const float d = m.at<float>(patch.sample_y + y1, patch.sample_x + x0);
-    const float e = m.at<float>(patch.sample_y + y1, patch.sample_x + x1);
-    out[c] = (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * d + fx * e);
-  }
+  // Catmull-Rom, so the bake keeps the sample's finest detail (issue 29); the taps
+  // past the patch's rectangle read the sample around it.
+  const CatmullRomTaps taps(values[0].size(), patch.sample_x + uc, patch.sample_y + vc);
+  for (std::size_t c = 0; c < values.size(); ++c) out[c] = static_cast<float>(taps.Of(values[c]));
   if (patch.correction.empty()) return true;
   const GridPoint g = OnCorrectionGrid(patch, u, v);
   if (!patch.detail_source.empty())

@@ -266,10 +266,10 @@ class BilinearTaps {
 };
 
 /// The values of a PTM patch at a point of its face's frame (world units),
-/// bilinear within the patch rectangle, with its photo-consistency correction
-/// (additive change, per-channel factors) and detail transfer when it has them
-/// (TrianglePatch); `detail_bands` by level as MeshSynthesis holds them. False
-/// outside the rectangle. Writes values.size() planes.
+/// Catmull-Rom within the patch rectangle (its taps read the sample around it), with its
+/// photo-consistency correction (additive change, per-channel factors) and detail transfer when it
+/// has them (TrianglePatch); `detail_bands` by level as MeshSynthesis holds them. False outside the
+/// rectangle. Writes values.size() planes.
 bool SamplePtmPatch(const std::vector<cv::Mat>& values, ptm::PtmFormat format,
                     const std::map<int, cv::Mat>& detail_bands, const TrianglePatch& patch,
                     double texel_size, const Eigen::Vector2d& p_in_frame, float* out);

@@ -62,15 +62,16 @@ struct ObliqueCamera {
     cam_from_world.translation = -(rotation * (kWorldFromSquare * centre_in_square));
   }
 
-  // The unit direction, in the square's frame, from the square's point seen at
-  // pixel (x, y) to the camera.
-  Eigen::Vector3d ToViewerInSquareAt(int x, int y) const {
+  // The square's point (its frame) seen at the centre of pixel (x, y).
+  Eigen::Vector3d PointInSquareAt(int x, int y) const {
     const Eigen::Vector3d ray_in_square =
         kWorldFromSquare.transpose() * (cam_from_world.rotation.inverse() *
                                         camera.CamRayFromImage(Eigen::Vector2d(x + 0.5, y + 0.5)));
-    const Eigen::Vector3d point =
-        centre_in_square + (-centre_in_square.z() / ray_in_square.z()) * ray_in_square;
-    return (centre_in_square - point).normalized();
+    return centre_in_square + (-centre_in_square.z() / ray_in_square.z()) * ray_in_square;
+  }
+  // The unit direction, in the square's frame, from that point to the camera.
+  Eigen::Vector3d ToViewerInSquareAt(int x, int y) const {
+    return (centre_in_square - PointInSquareAt(x, y)).normalized();
   }
 };
 
@@ -105,6 +106,45 @@ TEST(ModelRenderer, ShadesEachPixelWithTheViewTermOfItsOwnView) {
   EXPECT_NEAR(1.0 + 0.5 * ptm::OrenNayarTerm(Eigen::Vector3d(0, -0.5, std::sqrt(0.75)),
                                              cam.ToViewerInSquareAt(32, 32)),
               1.204, 0.01);
+}
+
+// FlatSquare's atlas position (pixels, centres at +0.5) of a point of the square.
+Eigen::Vector2d AtlasPxOfSquarePoint(const Eigen::Vector3d& p) {
+  return {16.0 + 15.0 * p.x(), 16.0 - 15.0 * p.y()};
+}
+
+// The luminance an atlas texel (x, y) holds: a quadratic, which a Catmull-Rom read
+// reproduces between texel centres and a bilinear read does not.
+double QuadraticLuminance(double x, double y) {
+  return 0.3 + 0.0015 * ((x - 15.5) * (x - 15.5) + (y - 15.5) * (y - 15.5));
+}
+
+TEST(ModelRenderer, ReadsTheAtlasCatmullRomBetweenTexelCentres) {
+  const ObliqueCamera cam;
+  model::TexturedModel constant = FlatSquare(), quadratic = FlatSquare();
+  ptm::Ptm& atlas = quadratic.atlases[0];
+  for (int y = 0; y < atlas.height; ++y)
+    for (int x = 0; x < atlas.width; ++x)
+      atlas.Coefficients(static_cast<std::size_t>(y) * atlas.width + x)[5] =
+          static_cast<float>(QuadraticLuminance(x, y));
+  const ModelRenderer reference(constant), rendered(quadratic);
+  sfm::ObjectLight zenith;  // along the square's normal: the luminance is a5
+  zenith.direction_in_world = kWorldFromSquare * Eigen::Vector3d::UnitZ();
+  const RenderedView a =
+      reference.Render(cam.camera, cam.cam_from_world, {zenith}, RenderMode::kPtm, 1);
+  const RenderedView b =
+      rendered.Render(cam.camera, cam.cam_from_world, {zenith}, RenderMode::kPtm, 1);
+  for (const auto& [x, y] :
+       {std::pair{32, 32}, std::pair{20, 40}, std::pair{44, 24}, std::pair{27, 35}}) {
+    const Eigen::Vector2d texel = AtlasPxOfSquarePoint(cam.PointInSquareAt(x, y)).array() - 0.5;
+    ASSERT_TRUE(texel.minCoeff() > 1.0 && texel.maxCoeff() < 29.0) << texel.transpose();
+    // The same light on both: their linear ratio is that of the luminances'.
+    const double expected =
+        srgb::ToLinear(static_cast<float>(QuadraticLuminance(texel.x(), texel.y()))) /
+        srgb::ToLinear(0.6f);
+    EXPECT_NEAR(LinearGreenAt(b, x, y) / LinearGreenAt(a, x, y), expected, 2e-5)
+        << "pixel " << x << ", " << y << ", texel " << texel.transpose();
+  }
 }
 
 }  // namespace

@@ -311,6 +311,78 @@ test('the viewer draws what texlume render draws for the same camera and side li
   assert.deepEqual(consoleErrors, []);
 });
 
+// Texture `bytes` (RGBA8, width x height) read at texel position (x, y) (centres at
+// integers), channel k, by 4 x 4 taps with `weights`, the point clamped to the
+// texel centres and the taps to the edges (CatmullRomTaps of core/cubic_interpolation.h).
+function filtered(bytes, width, height, x, y, k, weights) {
+  x = Math.min(Math.max(x, 0), width - 1);
+  y = Math.min(Math.max(y, 0), height - 1);
+  const bx = Math.floor(x), by = Math.floor(y);
+  const wx = weights(x - bx), wy = weights(y - by);
+  let sum = 0;
+  for (let a = 0; a < 4; ++a)
+    for (let b = 0; b < 4; ++b) {
+      const tx = Math.min(Math.max(bx - 1 + b, 0), width - 1);
+      const ty = Math.min(Math.max(by - 1 + a, 0), height - 1);
+      sum += wy[a] * wx[b] * bytes[(ty * width + tx) * 4 + k];
+    }
+  return sum / 255;
+}
+const catmullRomWeights = (t) => [-0.5 * t ** 3 + t * t - 0.5 * t, 1.5 * t ** 3 - 2.5 * t * t + 1,
+                                   -1.5 * t ** 3 + 2 * t * t + 0.5 * t, 0.5 * t ** 3 - 0.5 * t * t];
+const bilinearWeights = (t) => [0, 1 - t, t, 0];
+
+test('the viewer\'s atlas read is Catmull-Rom, as texlume render\'s, to within a level', async () => {
+  const work = mkdtempSync(join(tmpdir(), 'texlume-catmull-rom-'));
+  const server = createServer((request, response) => {
+    const file = { '/': 'index.html', '/page.js': 'page.js' }[request.url];
+    if (!file) { response.writeHead(404).end(); return; }
+    response.writeHead(200, { 'Content-Type': file.endsWith('.js') ? 'text/javascript' : 'text/html' })
+        .end(readFileSync(join(work, file)));
+  });
+  try {
+    await esbuild.build({ entryPoints: [join(import.meta.dirname, '..', 'test_pages', 'catmull_rom_page.js')],
+                          bundle: true, format: 'esm', outfile: join(work, 'page.js'), logLevel: 'silent' });
+    writeFileSync(join(work, 'index.html'), '<!doctype html><body style="margin:0">' +
+        '<canvas id="view"></canvas><script type="module" src="/page.js"></script></body>');
+    await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+    const crPage = await browser.newPage({ viewport: { width: 200, height: 200 } });
+    await crPage.goto(`http://127.0.0.1:${server.address().port}/`);
+    await crPage.waitForFunction(() => window.catmullRomPageReady, null, { timeout: 60000 });
+    // Random texels (a fixed seed): detail at the finest scale, where the reads differ most.
+    const width = 7, height = 5, scale = 8;
+    let seed = 12345;
+    const bytes = Array.from({ length: width * height * 4 }, () => {
+      seed = (1103515245 * seed + 12345) % 2147483648;
+      return seed >> 23;
+    });
+    const drawn = await crPage.evaluate(([b, w, h, s]) => window.drawCatmullRom(b, w, h, s),
+                                        [bytes, width, height, scale]);
+    await crPage.close();
+    let worst = 0, worstBilinear = 0, sum = 0, n = 0;
+    for (let j = 0; j < height * scale; ++j)
+      for (let i = 0; i < width * scale; ++i)
+        for (let k = 0; k < 3; ++k) {
+          const x = (i + 0.5) / scale - 0.5, y = (j + 0.5) / scale - 0.5;
+          const shown = (v) => Math.min(255, Math.max(0, 255 * (0.25 + 0.5 * v)));
+          const expected = shown(filtered(bytes, width, height, x, y, k, catmullRomWeights));
+          const bilinear = shown(filtered(bytes, width, height, x, y, k, bilinearWeights));
+          const d = Math.abs(drawn[(j * width * scale + i) * 4 + k] - expected);
+          worst = Math.max(worst, d);
+          worstBilinear = Math.max(worstBilinear, Math.abs(bilinear - expected));
+          sum += d; ++n;
+        }
+    console.log(`viewer's Catmull-Rom read against the reference: mean ${(sum / n).toFixed(2)} levels, ` +
+                `worst ${worst.toFixed(2)} (a bilinear read would differ by up to ${worstBilinear.toFixed(1)})`);
+    assert.ok(worstBilinear > 10, 'the texture tells Catmull-Rom from bilinear');
+    assert.ok(worst <= 1.5, `worst difference ${worst.toFixed(2)} levels`);
+  } finally {
+    server.close();
+    rmSync(work, { recursive: true, force: true });
+  }
+  assert.deepEqual(consoleErrors, []);
+});
+
 // Luminance minus its 7 x 7 box mean: the relief's detail, at pixels whose 7 x 7
 // neighbourhood lies inside `inside`.
 function detail(image, inside) {

@@ -3,6 +3,7 @@
 // /model/geometry.bin and the PTM of every atlas as 8-bit RGBA PNGs.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { catmullRomGlsl } from './catmull_rom.js';
 import { colmapProjection, worldFromColmapCamera } from './colmap_camera.js';
 
 const statusEl = document.getElementById('status');
@@ -45,6 +46,7 @@ precision highp float;
 uniform sampler2D ptm0, ptm1, ptm2, ptm3, ptm4, bakedTexture;
 uniform vec4 ptmScale[5];
 uniform vec4 ptmBias[5];
+uniform vec2 ptmSize;        // the PTM textures' width and height, texels
 uniform bool lrgb;
 uniform int mode;            // 0 PTM, 1 baked 2D texture, 2 flat
 uniform bool showSeams, showCharts;
@@ -69,8 +71,9 @@ float linearToSrgb(float v) {
 }
 vec3 linearToSrgb(vec3 v) { return vec3(linearToSrgb(v.r), linearToSrgb(v.g), linearToSrgb(v.b)); }
 
+${catmullRomGlsl}
 // Texture k of the atlas: four 8-bit values times scale plus bias (docs/viewer.md).
-vec4 ptmTexel(sampler2D t, int k) { return texture2D(t, vUv) * ptmScale[k] + ptmBias[k]; }
+vec4 ptmTexel(sampler2D t, int k) { return catmullRom(t, vUv, ptmSize) * ptmScale[k] + ptmBias[k]; }
 
 // The PTM's values at this fragment: LRGB, the luminance coefficients a0..a5 in
 // c[0].x, c[1].x, ..., and the colour in colour; RGB, coefficient k of the R, G,
@@ -255,7 +258,7 @@ function textureOf(bitmap) {
   const texture = new THREE.Texture(bitmap);
   texture.flipY = false;                    // flipped while decoding
   texture.colorSpace = THREE.NoColorSpace;  // raw values: coefficients, display-domain colour
-  texture.minFilter = THREE.LinearFilter;   // no mipmaps: gutters cover bilinear reads only
+  texture.minFilter = THREE.LinearFilter;   // no mipmaps: gutters cover the 4 x 4 taps only
   texture.magFilter = THREE.LinearFilter;
   texture.generateMipmaps = false;
   texture.needsUpdate = true;
@@ -342,6 +345,7 @@ async function main() {
     }
     const uniforms = { ...uniformsShared, lrgb: { value: atlas.format === 'LRGB' },
       ptmScale: { value: scale }, ptmBias: { value: bias }, bakedTexture: { value: placeholder },
+      ptmSize: { value: new THREE.Vector2(1, 1) },  // the placeholder's; the atlas's once in
       hasHorizon: { value: false },  // until its textures are in
       horizonScale: { value: atlas.horizon ? atlas.horizon.elevation_scale : 0 },
       shadowFloor: { value: atlas.horizon ? atlas.horizon.shadow_floor : 1 },
@@ -482,6 +486,7 @@ async function main() {
     const u = materials[i].uniforms;
     ptmTextures[range.atlas] = ptmTextures[range.atlas] || bitmaps.map(textureOf);
     for (let k = 0; k < bitmaps.length; ++k) u['ptm' + k].value = ptmTextures[range.atlas][k];
+    u.ptmSize.value.set(bitmaps[0].width, bitmaps[0].height);
     const horizon = await horizonsOfAtlas[range.atlas];
     if (horizon.length === 4) {
       horizonTextures[range.atlas] = horizonTextures[range.atlas] || horizon.map(textureOf);
