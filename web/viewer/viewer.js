@@ -73,7 +73,7 @@ vec3 linearToSrgb(vec3 v) { return vec3(linearToSrgb(v.r), linearToSrgb(v.g), li
 
 ${catmullRomGlsl}
 // Texture k of the atlas: four 8-bit values times scale plus bias (docs/viewer.md).
-vec4 ptmTexel(sampler2D t, int k) { return texture2D(t, vUv) * ptmScale[k] + ptmBias[k]; }
+vec4 ptmTexel(sampler2D t, int k) { return catmullRom(t, vUv, ptmSize) * ptmScale[k] + ptmBias[k]; }
 
 // The PTM's values at this fragment: LRGB, the luminance coefficients a0..a5 in
 // c[0].x, c[1].x, ..., and the colour in colour; RGB, coefficient k of the R, G,
