@@ -74,7 +74,8 @@ AtlasStretch MeasureStretch(const std::vector<synth::TrianglePatch>& patches,
 
 void AtlasOptions::Check() const {
   if (atlas_size < 64 || atlas_size > 16384) throw OptionError("atlas size must be in [64, 16384]");
-  if (gutter < 1 || gutter > 16) throw OptionError("gutter must be in [1, 16] texels");
+  // Catmull-Rom reads (render, viewer) reach 2 texels past a chart's last centre.
+  if (gutter < 2 || gutter > 16) throw OptionError("gutter must be in [2, 16] texels");
   if (blend_strip < 2 || blend_strip > 32) throw OptionError("blend strip must be in [2, 32]");
   if (max_chart_size < 0 || max_chart_size > atlas_size)
     throw OptionError("max chart size must be in [0, atlas size]");

@@ -35,8 +35,9 @@ struct AtlasOptions {
   /// Width of every atlas and the most height (texels); the last atlas is cropped
   /// to the rows it uses. [64, 16384].
   int atlas_size = 2048;
-  /// Texels of dilated values around every chart, so bilinear filtering (and
-  /// one mipmap level) never reads texels of another chart. [1, 16].
+  /// Texels of dilated values around every chart, so the renderer's and the
+  /// viewer's Catmull-Rom reads (2 texels past a chart's last centre) never read
+  /// texels of another chart. [2, 16].
   int gutter = 2;
   /// Blend width across mesh edges (W_e, texels; the synthesis strip). [2, 32].
   int blend_strip = 8;

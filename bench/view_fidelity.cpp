@@ -121,23 +121,28 @@ void PrintLinearBiasPerView(const std::vector<Row>& rows, const std::vector<fs::
   }
 }
 
-// `rgb` resampled at M (x, y, 1) for every pixel (x, y), centres at integers.
+// `rgb` resampled at M (x, y, 1) for every pixel (x, y), centres at integers:
+// bilinear or Catmull-Rom, both with exact weights and the taps clamped to the image.
 cv::Mat Resampled(const cv::Mat& rgb, const cv::Matx23d& m, bool catmull_rom) {
-  cv::Mat out;
-  if (!catmull_rom) {
-    cv::warpAffine(rgb, out, m, rgb.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
-                   cv::BORDER_REPLICATE);
-    return out;
-  }
-  out.create(rgb.size(), rgb.type());
+  cv::Mat out(rgb.size(), rgb.type());
+  const auto texel = [&](int tx, int ty, int c) { return rgb.at<cv::Vec3f>(ty, tx)[c]; };
   for (int y = 0; y < rgb.rows; ++y)
     for (int x = 0; x < rgb.cols; ++x) {
       const double sx = m(0, 0) * x + m(0, 1) * y + m(0, 2),
                    sy = m(1, 0) * x + m(1, 1) * y + m(1, 2);
-      CatmullRomTaps(rgb.size(), sx, sy)
-          .Read(
-              3, [&](int tx, int ty, int c) { return rgb.at<cv::Vec3f>(ty, tx)[c]; },
-              &out.at<cv::Vec3f>(y, x)[0]);
+      float* value = &out.at<cv::Vec3f>(y, x)[0];
+      if (catmull_rom) {
+        CatmullRomTaps(rgb.size(), sx, sy).Read(3, texel, value);
+        continue;
+      }
+      const double u = std::clamp(sx, 0.0, rgb.cols - 1.0), v = std::clamp(sy, 0.0, rgb.rows - 1.0);
+      const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
+      const int x1 = std::min(x0 + 1, rgb.cols - 1), y1 = std::min(y0 + 1, rgb.rows - 1);
+      const double fx = u - x0, fy = v - y0;
+      for (int c = 0; c < 3; ++c)
+        value[c] =
+            static_cast<float>((1 - fy) * ((1 - fx) * texel(x0, y0, c) + fx * texel(x1, y0, c)) +
+                               fy * ((1 - fx) * texel(x0, y1, c) + fx * texel(x1, y1, c)));
     }
   return out;
 }

@@ -14,7 +14,7 @@ Eigen::Vector3f ShadeBtf(const model::BtfModel& model, const ModelRenderer::Surf
   const int n = model.sample.Components();
   // Paper 004's lookup: the nearest texel's sample position, moved by the hit's
   // offset from that texel's centre turned into the sample frame (atlas and
-  // sample texels have the same size); g bilinear in the sample. Across a seam
+  // sample texels have the same size); g Catmull-Rom in the sample. Across a seam
   // the nearest texel decides, so the cut stays sharp.
   const int nx = std::clamp(static_cast<int>(std::floor(s.atlas_px.x())), 0, coords.cols - 1);
   const int ny = std::clamp(static_cast<int>(std::floor(s.atlas_px.y())), 0, coords.rows - 1);

@@ -144,6 +144,15 @@ TEST(ModelRenderer, ReadsTheAtlasCatmullRomBetweenTexelCentres) {
         srgb::ToLinear(0.6f);
     EXPECT_NEAR(LinearGreenAt(b, x, y) / LinearGreenAt(a, x, y), expected, 2e-5)
         << "pixel " << x << ", " << y << ", texel " << texel.transpose();
+    // A bilinear read would miss by far more than that at these points.
+    const double fx = texel.x() - std::floor(texel.x()), fy = texel.y() - std::floor(texel.y());
+    const double x0 = std::floor(texel.x()), y0 = std::floor(texel.y());
+    const double bilinear =
+        (1 - fy) * ((1 - fx) * QuadraticLuminance(x0, y0) + fx * QuadraticLuminance(x0 + 1, y0)) +
+        fy * ((1 - fx) * QuadraticLuminance(x0, y0 + 1) + fx * QuadraticLuminance(x0 + 1, y0 + 1));
+    EXPECT_GT(
+        std::abs(srgb::ToLinear(static_cast<float>(bilinear)) / srgb::ToLinear(0.6f) - expected),
+        1e-4);
   }
 }
 

@@ -332,8 +332,8 @@ const catmullRomWeights = (t) => [-0.5 * t ** 3 + t * t - 0.5 * t, 1.5 * t ** 3 
                                    -1.5 * t ** 3 + 2 * t * t + 0.5 * t, 0.5 * t ** 3 - 0.5 * t * t];
 const bilinearWeights = (t) => [0, 1 - t, t, 0];
 
-test('the viewer\'s atlas read is Catmull-Rom, as texlume render\'s, to within a level', async () => {
-  const work = mkdtempSync(join(tmpdir(), 'texlume-catmull-rom-'));
+test('the viewer\'s PTM reads are Catmull-Rom, as texlume render\'s, to within a level', async () => {
+  const work = mkdtempSync(join(tmpdir(), 'texlume-ptm-reads-'));
   const server = createServer((request, response) => {
     const file = { '/': 'index.html', '/page.js': 'page.js' }[request.url];
     if (!file) { response.writeHead(404).end(); return; }
@@ -341,22 +341,22 @@ test('the viewer\'s atlas read is Catmull-Rom, as texlume render\'s, to within a
         .end(readFileSync(join(work, file)));
   });
   try {
-    await esbuild.build({ entryPoints: [join(import.meta.dirname, '..', 'test_pages', 'catmull_rom_page.js')],
+    await esbuild.build({ entryPoints: [join(import.meta.dirname, '..', 'test_pages', 'ptm_reads_page.js')],
                           bundle: true, format: 'esm', outfile: join(work, 'page.js'), logLevel: 'silent' });
     writeFileSync(join(work, 'index.html'), '<!doctype html><body style="margin:0">' +
         '<canvas id="view"></canvas><script type="module" src="/page.js"></script></body>');
     await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
     const crPage = await browser.newPage({ viewport: { width: 200, height: 200 } });
     await crPage.goto(`http://127.0.0.1:${server.address().port}/`);
-    await crPage.waitForFunction(() => window.catmullRomPageReady, null, { timeout: 60000 });
+    await crPage.waitForFunction(() => window.ptmReadsPageReady, null, { timeout: 60000 });
     // Random texels (a fixed seed): detail at the finest scale, where the reads differ most.
     const width = 7, height = 5, scale = 8;
     let seed = 12345;
     const bytes = Array.from({ length: width * height * 4 }, () => {
-      seed = (1103515245 * seed + 12345) % 2147483648;
-      return seed >> 23;
+      seed = (Math.imul(1103515245, seed) + 12345) >>> 0;  // mod 2^32
+      return seed >>> 24;
     });
-    const drawn = await crPage.evaluate(([b, w, h, s]) => window.drawCatmullRom(b, w, h, s),
+    const drawn = await crPage.evaluate(([b, w, h, s]) => window.drawPtmReads(b, w, h, s),
                                         [bytes, width, height, scale]);
     await crPage.close();
     let worst = 0, worstBilinear = 0, sum = 0, n = 0;
@@ -372,7 +372,7 @@ test('the viewer\'s atlas read is Catmull-Rom, as texlume render\'s, to within a
           worstBilinear = Math.max(worstBilinear, Math.abs(bilinear - expected));
           sum += d; ++n;
         }
-    console.log(`viewer's Catmull-Rom read against the reference: mean ${(sum / n).toFixed(2)} levels, ` +
+    console.log(`viewer's PTM reads (ptmValues) against Catmull-Rom's: mean ${(sum / n).toFixed(2)} levels, ` +
                 `worst ${worst.toFixed(2)} (a bilinear read would differ by up to ${worstBilinear.toFixed(1)})`);
     assert.ok(worstBilinear > 10, 'the texture tells Catmull-Rom from bilinear');
     assert.ok(worst <= 1.5, `worst difference ${worst.toFixed(2)} levels`);

@@ -3,7 +3,7 @@
 // /model/geometry.bin and the PTM of every atlas as 8-bit RGBA PNGs.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { catmullRomGlsl } from './catmull_rom.js';
+import { ptmReadsGlsl } from './ptm_reads.js';
 import { colmapProjection, worldFromColmapCamera } from './colmap_camera.js';
 
 const statusEl = document.getElementById('status');
@@ -43,11 +43,7 @@ void main() {
 
 const fragmentShader = /* glsl */ `
 precision highp float;
-uniform sampler2D ptm0, ptm1, ptm2, ptm3, ptm4, bakedTexture;
-uniform vec4 ptmScale[5];
-uniform vec4 ptmBias[5];
-uniform vec2 ptmSize;        // the PTM textures' width and height, texels
-uniform bool lrgb;
+uniform sampler2D bakedTexture;
 uniform int mode;            // 0 PTM, 1 baked 2D texture, 2 flat
 uniform bool showSeams, showCharts;
 uniform float specular;      // ks of the specular enhancement, 0 = off
@@ -71,27 +67,7 @@ float linearToSrgb(float v) {
 }
 vec3 linearToSrgb(vec3 v) { return vec3(linearToSrgb(v.r), linearToSrgb(v.g), linearToSrgb(v.b)); }
 
-${catmullRomGlsl}
-// Texture k of the atlas: four 8-bit values times scale plus bias (docs/viewer.md).
-vec4 ptmTexel(sampler2D t, int k) { return catmullRom(t, vUv, ptmSize) * ptmScale[k] + ptmBias[k]; }
-
-// The PTM's values at this fragment: LRGB, the luminance coefficients a0..a5 in
-// c[0].x, c[1].x, ..., and the colour in colour; RGB, coefficient k of the R, G,
-// B polynomials in c[k].
-void ptmValues(out vec3 c[6], out vec3 colour) {
-  vec4 t0 = ptmTexel(ptm0, 0), t1 = ptmTexel(ptm1, 1);
-  if (lrgb) {
-    c[0] = vec3(t0.x); c[1] = vec3(t0.y); c[2] = vec3(t0.z);
-    c[3] = vec3(t0.w); c[4] = vec3(t1.x); c[5] = vec3(t1.y);
-    colour = vec3(t1.z, t1.w, 3.0 - t1.z - t1.w);  // the colour sums to 3
-    return;
-  }
-  vec4 t2 = ptmTexel(ptm2, 2), t3 = ptmTexel(ptm3, 3), t4 = ptmTexel(ptm4, 4);
-  c[0] = t0.xyz; c[1] = vec3(t0.w, t1.xy); c[2] = vec3(t1.zw, t2.x);
-  c[3] = t2.yzw; c[4] = t3.xyz; c[5] = vec3(t3.w, t4.xy);
-  colour = vec3(1.0);
-}
-
+${ptmReadsGlsl}
 // Paper 003 eq. 1: L = a0 lu^2 + a1 lv^2 + a2 lu lv + a3 lu + a4 lv + a5.
 float biquadratic(vec3 a012, vec3 a345, vec2 l) {
   return a012.x * l.x * l.x + a012.y * l.y * l.y + a012.z * l.x * l.y + a345.x * l.x +
