@@ -17,6 +17,7 @@
 // (as an atlas is baked from a sample and then read by the renderer), and its
 // gradient figures against the untouched view's.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -29,6 +30,7 @@
 #include "core/image_io.h"
 #include "pipeline/render_job.h"
 #include "render/fidelity.h"
+#include "synth/material_sample.h"
 
 namespace fs = std::filesystem;
 using namespace texlume;
@@ -135,14 +137,10 @@ cv::Mat Resampled(const cv::Mat& rgb, const cv::Matx23d& m, bool catmull_rom) {
         CatmullRomTaps(rgb.size(), sx, sy).Read(3, texel, value);
         continue;
       }
-      const double u = std::clamp(sx, 0.0, rgb.cols - 1.0), v = std::clamp(sy, 0.0, rgb.rows - 1.0);
-      const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
-      const int x1 = std::min(x0 + 1, rgb.cols - 1), y1 = std::min(y0 + 1, rgb.rows - 1);
-      const double fx = u - x0, fy = v - y0;
+      std::array<double, 3> rgb_at{};
+      synth::BilinearTaps(rgb.size(), sx, sy).OfChannels(rgb, rgb_at);
       for (int c = 0; c < 3; ++c)
-        value[c] =
-            static_cast<float>((1 - fy) * ((1 - fx) * texel(x0, y0, c) + fx * texel(x1, y0, c)) +
-                               fy * ((1 - fx) * texel(x0, y1, c) + fx * texel(x1, y1, c)));
+        value[c] = static_cast<float>(rgb_at[static_cast<std::size_t>(c)]);
     }
   return out;
 }
