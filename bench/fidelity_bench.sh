@@ -23,7 +23,9 @@
 # builds from it: a model that keeps the capture's own images, shadows included.
 # With HORIZON=1 the sample is also fitted with its horizon map (texlume fit
 # --horizon) and a row "texlume_horizon" renders the model that casts the relief's
-# own shadows (texlume synth --sample-horizon).
+# own shadows (texlume synth --sample-horizon: the atlases' relief matched to the
+# sample's shadows), and a row "texlume_horizon_gain1" the same model with the
+# sample's own height scale (--atlas-relief-gain 1).
 # Usage: bench/fidelity_bench.sh [BUILD_DIR (build)] [WORK_DIR (temporary)] [SHAPES (sphere cylinder)]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -118,7 +120,8 @@ for shape in $shapes; do
     "$texlume" fit --images "$capture" --lights "$capture/lights.lp" \
       --out "$dir/sample_lit.ptm" --horizon "$dir/horizon.exr" > /dev/null
     synth horizon "$object/sparse" --horizon
-    rows+=(texlume_horizon="$dir/render_horizon")
+    synth horizon_gain1 "$object/sparse" --horizon --atlas-relief-gain 1
+    rows+=(texlume_horizon="$dir/render_horizon" texlume_horizon_gain1="$dir/render_horizon_gain1")
   fi
   if [ "${BTF:-0}" = 1 ]; then
     synth btf "$object/sparse" --btf "$dir/scene/material/btf"
